@@ -1,0 +1,17 @@
+"""cnem: the constrained natural element method (C-NEM) on 2-D node clouds.
+
+>>> import cnem
+>>> dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.5, 0.5]]])
+>>> model = cnem.discretize(cnem.nodes.regular(dom, 0.1))
+>>> round(model.cells.area.sum(), 12)
+1.0
+"""
+
+from . import geometry, nodes
+from .errors import CNEMError, GeometryError, SolveError
+from .geometry import Domain, Model, NodeCloud, discretize
+
+__version__ = "0.1.0"
+
+__all__ = ["Domain", "NodeCloud", "Model", "discretize", "nodes", "geometry",
+           "CNEMError", "GeometryError", "SolveError", "__version__"]

@@ -1,0 +1,15 @@
+"""Tolerances used across cnem, kept in one place.
+
+All tolerances are *relative*: multiply by the domain diameter (lengths) or
+its square (areas) before comparing.
+"""
+
+#: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
+#: are snapped onto it; vertices closer than this are the same vertex.
+SNAP_TOL = 1e-9
+
+#: Relative area below which an overlap of two regions is considered round-off.
+OVERLAP_TOL = 1e-12
+
+#: Relative length below which two Voronoi vertices are merged into one.
+MERGE_TOL = 1e-13

@@ -1,0 +1,18 @@
+"""Geometry layer: domains, node clouds, constrained Delaunay and Voronoi cells.
+
+>>> import cnem
+>>> from cnem.geometry import rectangle
+>>> dom = rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.5, 0.5]]])
+>>> model = cnem.discretize(cnem.nodes.regular(dom, 0.1))
+>>> abs(model.cells.area.sum() - dom.area) < 1e-12
+True
+"""
+
+from .cloud import NodeCloud
+from .domain import Domain
+from .model import Cells, Model, discretize
+from .pslg import PSLG
+from .shapes import annulus, arc, l_shape, plate_with_hole, rectangle
+
+__all__ = ["Domain", "NodeCloud", "Model", "Cells", "PSLG", "discretize",
+           "rectangle", "plate_with_hole", "annulus", "l_shape", "arc"]

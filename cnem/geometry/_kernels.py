@@ -1,0 +1,185 @@
+"""Numba kernels of the geometry layer (arrays and scalars only).
+
+The fast path of the constrained Voronoi cells: for a node with no incident
+constraint, whose circumcentres are all visible from it and whose dual polygon
+is star-shaped around it, the cell is exactly the polygon of the circumcentres
+of its triangles in counter-clockwise order (the dual of the constrained
+Delaunay triangulation). Every other node is left to the exact clipping path.
+"""
+
+import numba
+import numpy as np
+
+#: Status codes of the fast path.
+FAST, SLOW = 0, 1
+
+
+@numba.njit(cache=True, inline="always")
+def _orient(ax, ay, bx, by, cx, cy):
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+
+
+@numba.njit(cache=True)
+def _local(tri, t, v):
+    for k in range(3):
+        if tri[t, k] == v:
+            return k
+    return -1
+
+
+@numba.njit(cache=True)
+def _ordered_fan(i, tri, nb, offsets, star, out):
+    """Triangles around interior node ``i`` in CCW order; count, or -1 if open."""
+    deg = offsets[i + 1] - offsets[i]
+    t0 = star[offsets[i]]
+    t = t0
+    count = 0
+    while True:
+        if count >= deg:
+            return -1
+        out[count] = t
+        count += 1
+        p = _local(tri, t, i)
+        nxt = nb[t, (p + 1) % 3]
+        if nxt < 0:
+            return -1
+        t = nxt
+        if t == t0:
+            break
+    return count if count == deg else -1
+
+
+@numba.njit(cache=True)
+def _visible(i, cx, cy, pts, tri, nb, fan, nfan, max_steps):
+    """Whether the segment from node ``i`` to ``(cx, cy)`` crosses no constraint."""
+    xi, yi = pts[i, 0], pts[i, 1]
+    t = -1
+    a = -1
+    b = -1
+    for m in range(nfan):
+        s = fan[m]
+        p = _local(tri, s, i)
+        j, k = tri[s, (p + 1) % 3], tri[s, (p + 2) % 3]
+        oj = _orient(xi, yi, pts[j, 0], pts[j, 1], cx, cy)
+        ok = _orient(xi, yi, pts[k, 0], pts[k, 1], cx, cy)
+        if oj >= 0.0 and ok <= 0.0:
+            if _orient(pts[j, 0], pts[j, 1], pts[k, 0], pts[k, 1], cx, cy) >= 0.0:
+                return True
+            if oj == 0.0 or ok == 0.0:
+                return False
+            t = nb[s, p]
+            a, b = j, k
+            break
+    if t < 0:
+        return False
+    for _ in range(max_steps):
+        # entered t through edge (a, b): a right of the ray, b left of it
+        w = tri[t, 0] + tri[t, 1] + tri[t, 2] - a - b
+        pa = _local(tri, t, a)
+        pb = _local(tri, t, b)
+        inside = True
+        for k in range(3):
+            u, v = tri[t, k], tri[t, (k + 1) % 3]
+            if _orient(pts[u, 0], pts[u, 1], pts[v, 0], pts[v, 1], cx, cy) < 0.0:
+                inside = False
+        if inside:
+            return True
+        ow = _orient(xi, yi, cx, cy, pts[w, 0], pts[w, 1])
+        if ow > 0.0:      # w left: leave through (a, w), opposite b
+            nxt = nb[t, pb]
+            b = w
+        elif ow < 0.0:    # w right: leave through (w, b), opposite a
+            nxt = nb[t, pa]
+            a = w
+        else:
+            return False
+        if nxt < 0:
+            return False
+        t = nxt
+    return False
+
+
+@numba.njit(cache=True, parallel=True)
+def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg):
+    """Cells of the nodes that need no clipping.
+
+    Parameters
+    ----------
+    pts : (n, 2) float64
+    tri : (t, 3) int64
+    nb : (t, 3) int64
+        Neighbours with region changes cut (-1).
+    offsets, star : CSR of the triangles around each node.
+    cc : (t, 2) float64
+        Circumcentres.
+    merge_tol : float
+        Relative distance under which consecutive vertices are merged.
+    max_deg : int
+        Largest vertex degree.
+
+    Returns
+    -------
+    status : (n,) int8
+        ``FAST`` or ``SLOW``.
+    poly_offsets : (n + 1,) int64
+    poly : (k, 2) float64
+        Vertices of the fast cells, CCW; empty rows for slow nodes.
+    region_tri : (n,) int64
+        One triangle of each fast node (for its region).
+    """
+    n = pts.shape[0]
+    status = np.full(n, SLOW, dtype=np.int8)
+    counts = np.zeros(n, dtype=np.int64)
+    region_tri = np.full(n, -1, dtype=np.int64)
+    for i in numba.prange(n):
+        fan = np.empty(max_deg, dtype=np.int64)
+        nfan = _ordered_fan(i, tri, nb, offsets, star, fan)
+        if nfan < 3:
+            continue
+        xi, yi = pts[i, 0], pts[i, 1]
+        scale = 0.0
+        for m in range(nfan):
+            d = np.hypot(cc[fan[m], 0] - xi, cc[fan[m], 1] - yi)
+            scale = max(scale, d)
+        tol = merge_tol * scale
+        ok = True
+        kept = 0
+        for m in range(nfan):
+            c0 = fan[m]
+            c1 = fan[(m + 1) % nfan]
+            o = _orient(xi, yi, cc[c0, 0], cc[c0, 1], cc[c1, 0], cc[c1, 1])
+            if o < -tol * scale:
+                ok = False
+                break
+            if not _visible(i, cc[c0, 0], cc[c0, 1], pts, tri, nb, fan, nfan, 64):
+                ok = False
+                break
+            if np.hypot(cc[c1, 0] - cc[c0, 0], cc[c1, 1] - cc[c0, 1]) > tol:
+                kept += 1
+        if ok and kept >= 3:
+            status[i] = FAST
+            counts[i] = kept
+            region_tri[i] = fan[0]
+    poly_offsets = np.zeros(n + 1, dtype=np.int64)
+    for i in range(n):
+        poly_offsets[i + 1] = poly_offsets[i] + counts[i]
+    poly = np.empty((poly_offsets[n], 2), dtype=np.float64)
+    for i in numba.prange(n):
+        if status[i] != FAST:
+            continue
+        fan = np.empty(max_deg, dtype=np.int64)
+        nfan = _ordered_fan(i, tri, nb, offsets, star, fan)
+        xi, yi = pts[i, 0], pts[i, 1]
+        scale = 0.0
+        for m in range(nfan):
+            scale = max(scale, np.hypot(cc[fan[m], 0] - xi, cc[fan[m], 1] - yi))
+        tol = merge_tol * scale
+        w = poly_offsets[i]
+        for m in range(nfan):
+            c0 = fan[m]
+            c1 = fan[(m + 1) % nfan]
+            if np.hypot(cc[c1, 0] - cc[c0, 0], cc[c1, 1] - cc[c0, 1]) > tol:
+                poly[w, 0] = cc[c1, 0]
+                poly[w, 1] = cc[c1, 1]
+                w += 1
+    return status, poly_offsets, poly, region_tri

@@ -1,0 +1,212 @@
+"""Constrained Voronoi integration cells (C-NEM paper eq. 13, SCNI cells of §4.2).
+
+A point ``x`` of region ``r`` belongs to the cell of node ``i`` when ``i`` is
+visible from ``x`` (the segment between them crosses no boundary, interface or
+crack; touching at the node is allowed) and no node visible from ``x`` is
+nearer. A node on an interface owns one cell per region.
+
+Two paths compute the cells:
+
+* the *fast path* (numba, `._kernels.fast_cells`): a node with no incident
+  constraint whose circumcentres are all visible from it and whose dual polygon
+  is star-shaped owns exactly the polygon of its circumcentres;
+* the *exact path* (shapely), for every other node and region: the cell is the
+  part of a bounding box that node ``i`` sees (its wedge between its constraint
+  edges minus the shadows of every constraint segment), minus, for each nearby
+  node ``j`` of the region, the points nearer to ``j`` that ``j`` sees.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from scipy.spatial import cKDTree
+from tqdm.auto import tqdm
+
+from .. import config
+from ..errors import GeometryError
+from ._kernels import FAST, fast_cells
+from .topology import circumcenters, constraint_edges, triangle_neighbors, vertex_triangles
+
+__all__ = ["voronoi_cells"]
+
+
+def _halfplane_box(box, p, q):
+    """The part of box ``(xmin, ymin, xmax, ymax)`` nearer to ``q`` than to ``p``."""
+    x0, y0, x1, y1 = box
+    poly = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+    nrm, off = q - p, 0.5 * ((q @ q) - (p @ p))
+    val = poly @ nrm - off          # > 0 nearer to q
+    out = []
+    for k in range(4):
+        a, b, va, vb = poly[k], poly[(k + 1) % 4], val[k], val[(k + 1) % 4]
+        if va > 0:
+            out.append(a)
+        if (va > 0) != (vb > 0):
+            out.append(a + va / (va - vb) * (b - a))
+    return shapely.Polygon(out) if len(out) >= 3 else None
+
+
+def _shadows(origin, edges_xy, reach):
+    """Union of the shadows cast by segments seen from ``origin``, up to ``reach``."""
+    if len(edges_xy) == 0:
+        return None
+    a, b = edges_xy[:, 0], edges_xy[:, 1]
+    da, db = a - origin, b - origin
+    la, lb = np.linalg.norm(da, axis=1), np.linalg.norm(db, axis=1)
+    cross = da[:, 0] * db[:, 1] - da[:, 1] * db[:, 0]
+    keep = (np.minimum(la, lb) > 0) & (np.abs(cross) > 1e-14 * la * lb)
+    if not keep.any():
+        return None
+    a, b, da, db = a[keep], b[keep], da[keep], db[keep]
+    k = (reach / np.minimum(la[keep], lb[keep]))[:, None]
+    ring = np.stack([a, b, b + k * db, a + k * da, a], axis=1)
+    return shapely.union_all(shapely.polygons(ring))
+
+
+class _ExactCells:
+    """State shared by the exact (clipping) path."""
+
+    def __init__(self, nodes, triangles, region, nb, offsets, star, cc):
+        self.nodes, self.tri, self.region = nodes, triangles, region
+        self.offsets, self.star, self.cc = offsets, star, cc
+        edges, owner = constraint_edges(triangles, nb)
+        self.edges, self.edge_region = edges, region[owner]
+        mid = 0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]])
+        self.edge_tree = cKDTree(mid)
+        self.edge_half = 0.5 * np.linalg.norm(nodes[edges[:, 0]] - nodes[edges[:, 1]], axis=1).max()
+        self.node_tree = cKDTree(nodes)
+        pairs = np.unique(np.column_stack([triangles.ravel(), np.repeat(region, 3)]), axis=0)
+        self.member = set(map(tuple, pairs.tolist()))
+        on_edge = np.column_stack([edges.ravel(), np.repeat(self.edge_region, 2)])
+        self.constrained = set(map(tuple, on_edge.tolist()))
+        self.circ_r = np.linalg.norm(cc - nodes[triangles[:, 0]], axis=1)
+
+    def fan(self, i, r):
+        ts = self.star[self.offsets[i]:self.offsets[i + 1]]
+        return ts[self.region[ts] == r]
+
+    def wedge(self, i, r, reach):
+        """Directions from node ``i`` into region ``r`` (None: all directions)."""
+        if (i, r) not in self.constrained:
+            return None
+        x = self.nodes[i]
+        quads = []
+        for t in self.fan(i, r):
+            k = int(np.flatnonzero(self.tri[t] == i)[0])
+            u = self.nodes[self.tri[t, (k + 1) % 3]] - x
+            v = self.nodes[self.tri[t, (k + 2) % 3]] - x
+            u, v = u / np.linalg.norm(u), v / np.linalg.norm(v)
+            w = u + v
+            w /= np.linalg.norm(w)
+            quads.append([x, x + 2 * reach * u, x + 2 * reach * w, x + 2 * reach * v, x])
+        return shapely.union_all(shapely.polygons(np.asarray(quads)))
+
+    def visible_part(self, i, r, geom, reach):
+        """The part of ``geom`` that node ``i`` sees within region ``r``."""
+        w = self.wedge(i, r, reach)
+        if w is not None:
+            geom = geom.intersection(w)
+        if geom.is_empty:
+            return geom
+        hull = shapely.convex_hull(shapely.union_all([geom, shapely.Point(self.nodes[i])]))
+        cand = self.edge_tree.query_ball_point(self.nodes[i], 2 * reach + self.edge_half)
+        cand = np.asarray(cand, dtype=np.int64)
+        cand = cand[self.edge_region[cand] == r]
+        if cand.size == 0:
+            return geom
+        xy = self.nodes[self.edges[cand]]
+        hit = shapely.intersects(shapely.linestrings(xy), hull)
+        shadow = _shadows(self.nodes[i], xy[hit], 4 * reach)
+        return geom if shadow is None else geom.difference(shadow)
+
+    def cell(self, i, r):
+        x = self.nodes[i]
+        fan = self.fan(i, r)
+        lo = (self.cc[fan] - self.circ_r[fan, None]).min(axis=0)
+        hi = (self.cc[fan] + self.circ_r[fan, None]).max(axis=0)
+        lo, hi = np.minimum(lo, x), np.maximum(hi, x)
+        box = (lo[0], lo[1], hi[0], hi[1])
+        reach = float(np.max(np.linalg.norm(np.array([[lo[0], lo[1]], [hi[0], lo[1]],
+                                                       [hi[0], hi[1]], [lo[0], hi[1]]]) - x, axis=1)))
+        cell = self.visible_part(i, r, shapely.box(*box), reach)
+        near = np.asarray(self.node_tree.query_ball_point(x, 2 * reach), dtype=np.int64)
+        dist = np.linalg.norm(self.nodes[near] - x, axis=1)
+        tiny = config.MERGE_TOL * reach
+        for j in near[np.argsort(dist)]:
+            if j == i or (int(j), r) not in self.member:
+                continue
+            if np.linalg.norm(self.nodes[j] - x) <= tiny:
+                continue
+            half = _halfplane_box(box, x, self.nodes[j])
+            if half is None or not cell.intersects(half):
+                continue
+            region = cell.intersection(half)
+            if region.area <= 0:
+                continue
+            stolen = self.visible_part(j, r, region, reach)
+            if not stolen.is_empty:
+                cell = cell.difference(stolen)
+        return self._polygon(cell, i, r)
+
+    def _polygon(self, cell, i, r):
+        parts = [g for g in getattr(cell, "geoms", [cell]) if g.geom_type == "Polygon"]
+        parts.sort(key=lambda g: g.area, reverse=True)
+        if not parts or parts[0].area <= 0:
+            raise GeometryError(f"node {i} at {self.nodes[i].tolist()} has an empty cell in "
+                                f"region {r}; is it a duplicate of another node?")
+        total = sum(g.area for g in parts)
+        if total - parts[0].area > 1e-9 * total:
+            raise GeometryError(f"the cell of node {i} at {self.nodes[i].tolist()} in region {r} "
+                                "is not connected; the node cloud is too coarse near this node")
+        poly = shapely.geometry.polygon.orient(parts[0], 1.0)
+        return np.asarray(poly.exterior.coords)[:-1]
+
+
+def voronoi_cells(nodes, triangles, region, *, progress=None):
+    """Constrained Voronoi cells of a (crack-split) constrained Delaunay triangulation.
+
+    Parameters
+    ----------
+    nodes : (n, 2) ndarray
+    triangles : (t, 3) int64 ndarray
+        Counter-clockwise, crack faces already split.
+    region : (t,) int64 ndarray
+    progress : bool, optional
+        Progress bar over the clipped cells (default: when on a terminal).
+
+    Returns
+    -------
+    node, region : (m,) int64 ndarray
+    offsets : (m + 1,) int64 ndarray
+    vertices : (k, 2) ndarray
+        Cell ``c`` is ``vertices[offsets[c]:offsets[c + 1]]``, counter-clockwise.
+    """
+    n = len(nodes)
+    nb = triangle_neighbors(triangles, region)
+    offsets, star = vertex_triangles(triangles, n)
+    cc = circumcenters(nodes, triangles)
+    max_deg = int(np.diff(offsets).max())
+    status, poff, poly, rtri = fast_cells(nodes, triangles, nb, offsets, star, cc,
+                                          config.MERGE_TOL, max_deg)
+    fast = np.flatnonzero(status == FAST)
+    exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc)
+    slow = np.flatnonzero(status != FAST)
+    pairs = sorted({(int(i), int(r)) for i in slow
+                    for r in region[star[offsets[i]:offsets[i + 1]]]})
+    slow_polys = [exact.cell(i, r) for i, r in tqdm(
+        pairs, desc="clipping cells", disable=None if progress is None else not progress,
+        leave=False)]
+    cell_node = np.concatenate([fast, np.array([p[0] for p in pairs], dtype=np.int64)])
+    cell_region = np.concatenate([region[rtri[fast]], np.array([p[1] for p in pairs], dtype=np.int64)])
+    counts = np.concatenate([poff[fast + 1] - poff[fast], [len(p) for p in slow_polys]])
+    verts = np.concatenate([poly] + slow_polys) if slow_polys else poly
+    order = np.lexsort((cell_region, cell_node))
+    cell_offsets = np.zeros(len(counts) + 1, dtype=np.int64)
+    np.cumsum(counts, out=cell_offsets[1:])
+    starts = cell_offsets[:-1][order]
+    new_counts = counts[order]
+    new_offsets = np.zeros(len(counts) + 1, dtype=np.int64)
+    np.cumsum(new_counts, out=new_offsets[1:])
+    gather = np.repeat(starts - new_offsets[:-1], new_counts) + np.arange(new_offsets[-1])
+    return cell_node[order], cell_region[order], new_offsets, verts[gather]

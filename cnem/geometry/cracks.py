@@ -1,0 +1,104 @@
+"""Opening cracks by node duplication.
+
+Each crack node except a tip becomes one node per crack face; the triangles on
+each side of the crack attach to that side's copy, so no triangle edge crosses
+the crack and the crack faces become boundaries of the triangulation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .pslg import BOUNDARY, CRACK
+from .topology import vertex_triangles
+
+__all__ = ["split_cracks"]
+
+
+def _fan_groups(v, fan, triangles, crack_neighbors):
+    """Group the triangles around node ``v`` into sides separated by crack segments."""
+    parent = {t: t for t in fan}
+
+    def find(t):
+        while parent[t] != t:
+            parent[t] = parent[parent[t]]
+            t = parent[t]
+        return t
+
+    by_other = {}
+    for t in fan:
+        for w in triangles[t]:
+            if w != v:
+                by_other.setdefault(int(w), []).append(t)
+    for w, ts in by_other.items():
+        if len(ts) == 2 and w not in crack_neighbors:
+            parent[find(ts[0])] = find(ts[1])
+    groups = {}
+    for t in fan:
+        groups.setdefault(find(t), []).append(t)
+    return sorted(groups.values(), key=min)
+
+
+def split_cracks(points, triangles, segments, kind):
+    """Duplicate crack nodes so that each crack face has its own nodes.
+
+    Parameters
+    ----------
+    points : (n0, 2) ndarray
+    triangles : (t, 3) int64 ndarray
+    segments : (s, 2) int64 ndarray
+    kind : (s,) int8 ndarray
+
+    Returns
+    -------
+    nodes : (n, 2) ndarray
+    node_of_point : (n,) int64 ndarray
+        Index into ``points`` of each node.
+    triangles : (t, 3) int64 ndarray
+        The same triangles, attached to the copies on their side.
+    segments, kind : ndarray
+        Constraint segments renumbered; each crack segment appears once per face.
+    """
+    crack = segments[kind == CRACK]
+    n0 = len(points)
+    if len(crack) == 0:
+        return points.copy(), np.arange(n0), triangles.copy(), segments.copy(), kind.copy()
+    degree = np.bincount(crack.ravel(), minlength=n0)
+    on_boundary = np.zeros(n0, dtype=bool)
+    on_boundary[segments[kind == BOUNDARY].ravel()] = True
+    split = np.flatnonzero((degree >= 2) | ((degree == 1) & on_boundary))
+    crack_nb = {}
+    for a, b in crack:
+        crack_nb.setdefault(int(a), set()).add(int(b))
+        crack_nb.setdefault(int(b), set()).add(int(a))
+    offsets, star = vertex_triangles(triangles, n0)
+    new_tri = triangles.copy()
+    node_of_point = list(range(n0))
+    for v in split:
+        fan = star[offsets[v]:offsets[v + 1]].tolist()
+        for group in _fan_groups(v, fan, triangles, crack_nb[int(v)])[1:]:
+            copy = len(node_of_point)
+            node_of_point.append(int(v))
+            g = np.asarray(group)
+            new_tri[g] = np.where(triangles[g] == v, copy, new_tri[g])
+    node_of_point = np.asarray(node_of_point, dtype=np.int64)
+    # renumber segments through the triangles that carry them
+    a = triangles[:, [1, 2, 0]].ravel()
+    b = triangles[:, [2, 0, 1]].ravel()
+    na = new_tri[:, [1, 2, 0]].ravel()
+    nb_ = new_tri[:, [2, 0, 1]].ravel()
+    key = np.minimum(a, b) * n0 + np.maximum(a, b)
+    order = np.argsort(key, kind="stable")
+    skey = np.minimum(segments[:, 0], segments[:, 1]) * n0 + np.maximum(segments[:, 0], segments[:, 1])
+    lo = np.searchsorted(key[order], skey, side="left")
+    hi = np.searchsorted(key[order], skey, side="right")
+    seg_new, kind_new = [], []
+    for s in range(len(segments)):
+        for slot in order[lo[s]:hi[s]]:
+            seg_new.append(sorted((int(na[slot]), int(nb_[slot]))))
+            kind_new.append(kind[s])
+    seg_new = np.asarray(seg_new, dtype=np.int64)
+    kind_new = np.asarray(kind_new, dtype=np.int8)
+    _, first = np.unique(seg_new, axis=0, return_index=True)
+    first = np.sort(first)
+    return points[node_of_point], node_of_point, new_tri, seg_new[first], kind_new[first]

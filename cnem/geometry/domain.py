@@ -1,0 +1,274 @@
+"""`Domain`: material regions, holes and cracks, validated.
+
+>>> import cnem
+>>> dom = cnem.Domain([[0, 0], [1, 0], [1, 1], [0, 1]], cracks=[[[0, 0.5], [0.5, 0.5]]])
+>>> dom.area, dom.tips.tolist()
+(1.0, [[0.5, 0.5]])
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from shapely.geometry import LineString, Polygon
+from shapely.geometry.polygon import orient
+from shapely.validation import explain_validity
+
+from .. import config
+from ..errors import GeometryError
+from .pslg import CRACK, build_pslg, ring_coordinates
+
+__all__ = ["Domain"]
+
+
+def _fmt(p):
+    return f"({p[0]:.6g}, {p[1]:.6g})"
+
+
+def _check_ring(coords, what):
+    arr = np.asarray(coords, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 3:
+        raise GeometryError(f"{what}: expected a (k, 2) array of at least 3 vertices, "
+                            f"received shape {arr.shape}")
+    if not np.isfinite(arr).all():
+        raise GeometryError(f"{what}: vertices must be finite, received NaN or inf")
+    if np.allclose(arr[0], arr[-1]):
+        arr = arr[:-1]
+    return arr
+
+
+def _check_zero_length(arr, closed, what, tol):
+    nxt = np.roll(arr, -1, axis=0) if closed else arr[1:]
+    cur = arr if closed else arr[:-1]
+    short = np.flatnonzero(np.linalg.norm(nxt - cur, axis=1) <= tol)
+    if short.size:
+        k = short[0]
+        raise GeometryError(
+            f"{what}: zero-length segment between vertex {k} and vertex {(k + 1) % len(arr)} "
+            f"at {_fmt(cur[k])}; remove the repeated vertex")
+
+
+def _as_polygon(obj, index):
+    """Coerce one region description into a valid, CCW-oriented shapely Polygon."""
+    what = f"region {index}"
+    if isinstance(obj, Polygon):
+        poly = obj
+    elif isinstance(obj, tuple) and len(obj) == 2:
+        shell = _check_ring(obj[0], f"{what} shell")
+        holes = [_check_ring(h, f"{what} hole {k}") for k, h in enumerate(obj[1])]
+        poly = Polygon(shell, holes)
+    else:
+        poly = Polygon(_check_ring(obj, what))
+    if poly.is_empty or poly.area <= 0:
+        raise GeometryError(f"{what}: polygon has zero area; expected a non-degenerate polygon")
+    if not poly.is_valid:
+        raise GeometryError(f"{what} is not a valid polygon: {explain_validity(poly)}; "
+                            "a ring must not cross or touch itself (bow-tie) and holes must lie "
+                            "strictly inside the shell")
+    return orient(poly, 1.0)
+
+
+class Domain:
+    """A 2-D body: material regions (with holes) and cracks.
+
+    Parameters
+    ----------
+    regions : polygon or list of polygons
+        A polygon is a ``(k, 2)`` array-like shell, a tuple ``(shell, [hole, ...])``
+        or a ``shapely.Polygon``. Region ``i`` is ``regions[i]``. Boundaries that
+        two regions share are material interfaces.
+    cracks : list of (k, 2) array-like
+        Traction-free crack polylines inside the closure of the domain. An end on
+        the outer boundary or a hole makes an edge crack; an end inside is a tip.
+
+    Raises
+    ------
+    GeometryError
+        Invalid or self-intersecting polygons, overlapping regions, cracks leaving
+        the domain or crossing each other, zero-length segments.
+    """
+
+    def __init__(self, regions, cracks=()):
+        if isinstance(regions, (Polygon, tuple)) or (
+                not isinstance(regions, list) and np.asarray(regions, dtype=object).ndim == 2
+                and np.asarray(regions, dtype=object).shape[-1] == 2):
+            regions = [regions]
+        if len(regions) == 0:
+            raise GeometryError("expected at least one region, received an empty list")
+        self._regions = tuple(_as_polygon(r, i) for i, r in enumerate(regions))
+        self._union = shapely.union_all(self._regions)
+        minx, miny, maxx, maxy = self._union.bounds
+        self._diameter = float(np.hypot(maxx - minx, maxy - miny))
+        self._tol = config.SNAP_TOL * self._diameter
+        for i, poly in enumerate(self._regions):
+            for k, ring in enumerate(ring_coordinates(poly)):
+                _check_zero_length(ring, True, f"region {i} ring {k}", self._tol)
+        self._check_overlaps()
+        self._cracks = tuple(self._check_crack(c, i) for i, c in enumerate(cracks))
+        self._check_crack_crossings()
+        polylines = [(r, True) for p in self._regions for r in ring_coordinates(p)]
+        hints = [-1] * len(polylines)
+        polylines += [(c, False) for c in self._cracks]
+        hints += [CRACK] * len(self._cracks)
+        self._pslg = build_pslg(polylines, hints, self._tol,
+                                extra_vertices=self._crack_interface_points())
+        self._tips = self._find_tips()
+
+    # ------------------------------------------------------------------ checks
+    def _check_overlaps(self):
+        tree = shapely.STRtree(self._regions)
+        left, right = tree.query(self._regions, predicate="intersects")
+        scale = max(p.area for p in self._regions)
+        for i, j in zip(left, right):
+            if i >= j:
+                continue
+            inter = self._regions[i].intersection(self._regions[j])
+            if inter.area > config.OVERLAP_TOL * scale:
+                raise GeometryError(
+                    f"regions {i} and {j} overlap (area {inter.area:.3g} around "
+                    f"{_fmt(inter.representative_point().coords[0])}); regions must only "
+                    "share boundaries: subtract one from the other")
+
+    def _check_crack(self, crack, index):
+        what = f"crack {index}"
+        arr = np.asarray(crack, dtype=float)
+        if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 2:
+            raise GeometryError(f"{what}: expected a (k, 2) polyline with k >= 2, "
+                                f"received shape {arr.shape}")
+        if not np.isfinite(arr).all():
+            raise GeometryError(f"{what}: vertices must be finite, received NaN or inf")
+        _check_zero_length(arr, False, what, self._tol)
+        line = LineString(arr)
+        if not line.is_simple:
+            raise GeometryError(f"{what} crosses itself; expected a simple polyline")
+        outside = line.difference(self._union.buffer(self._tol))
+        if not outside.is_empty:
+            raise GeometryError(
+                f"{what} leaves the domain near {_fmt(outside.representative_point().coords[0])}; "
+                "cracks must lie inside the closure of the domain")
+        touch = line.intersection(self._union.boundary.buffer(self._tol))
+        ends = shapely.points(arr[[0, -1]])
+        bad = touch.difference(shapely.union_all(ends).buffer(2 * self._tol))
+        if not bad.is_empty and bad.length > 2 * self._tol:
+            raise GeometryError(
+                f"{what} touches the outer boundary or a hole away from its ends near "
+                f"{_fmt(bad.representative_point().coords[0])}; only crack ends may lie on it")
+        return arr
+
+    def _check_crack_crossings(self):
+        lines = [LineString(c) for c in self._cracks]
+        for i in range(len(lines)):
+            for j in range(i + 1, len(lines)):
+                if lines[i].distance(lines[j]) <= self._tol:
+                    p = lines[i].intersection(lines[j].buffer(self._tol)).representative_point()
+                    raise GeometryError(
+                        f"cracks {i} and {j} cross or touch near {_fmt(p.coords[0])}; "
+                        "expected disjoint cracks (join them into one polyline for a kinked crack)")
+
+    def _crack_interface_points(self):
+        """Points where cracks cross interfaces (to become vertices of both)."""
+        if not self._cracks or len(self._regions) < 2:
+            return np.empty((0, 2))
+        inner = shapely.union_all([p.boundary for p in self._regions]).difference(
+            self._union.boundary.buffer(self._tol))
+        pts = []
+        for c in self._cracks:
+            inter = LineString(c).intersection(inner)
+            for g in getattr(inter, "geoms", [inter]):
+                if not g.is_empty:
+                    pts.extend(np.asarray(g.coords)[:, :2])
+        return np.asarray(pts, dtype=float).reshape(-1, 2)
+
+    def _find_tips(self):
+        if not self._cracks:
+            return np.empty((0, 2))
+        ends = np.concatenate([c[[0, -1]] for c in self._cracks])
+        dist = shapely.distance(shapely.points(ends), self._union.boundary)
+        return ends[dist > self._tol]
+
+    # -------------------------------------------------------------- properties
+    @property
+    def regions(self):
+        """tuple of shapely.Polygon: the material regions, counter-clockwise."""
+        return self._regions
+
+    @property
+    def cracks(self):
+        """tuple of (k, 2) ndarray: the crack polylines."""
+        return self._cracks
+
+    @property
+    def polygon(self):
+        """shapely geometry: union of all regions (cracks not cut)."""
+        return self._union
+
+    @property
+    def pslg(self):
+        """PSLG: vertices and constraint edges (boundaries, interfaces, cracks)."""
+        return self._pslg
+
+    @property
+    def area(self):
+        """float: total area of the regions."""
+        return float(sum(p.area for p in self._regions))
+
+    @property
+    def bounds(self):
+        """(4,) tuple ``(xmin, ymin, xmax, ymax)``."""
+        return tuple(float(b) for b in self._union.bounds)
+
+    @property
+    def diameter(self):
+        """float: length of the bounding-box diagonal."""
+        return self._diameter
+
+    @property
+    def tolerance(self):
+        """float: absolute snapping tolerance ``SNAP_TOL * diameter``."""
+        return self._tol
+
+    @property
+    def tips(self):
+        """(t, 2) ndarray: crack ends that lie inside the domain."""
+        return self._tips
+
+    def contains(self, points):
+        """Whether points lie in the closed domain.
+
+        Parameters
+        ----------
+        points : (p, 2) array_like
+
+        Returns
+        -------
+        (p,) bool ndarray
+        """
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        return self.region_of(pts) >= 0
+
+    def region_of(self, points):
+        """Index of the region (closure) containing each point, -1 outside.
+
+        Parameters
+        ----------
+        points : (p, 2) array_like
+
+        Returns
+        -------
+        (p,) int64 ndarray
+            The lowest region index for points on an interface.
+        """
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        out = np.full(len(pts), -1, dtype=np.int64)
+        for i in reversed(range(len(self._regions))):
+            shapely.prepare(self._regions[i])
+            inside = shapely.intersects_xy(self._regions[i], pts[:, 0], pts[:, 1])
+            out[inside] = i
+        return out
+
+    def __repr__(self):
+        holes = sum(len(p.interiors) for p in self._regions)
+        return (f"<Domain {len(self._regions)} region{'s' * (len(self._regions) != 1)}, "
+                f"{holes} hole{'s' * (holes != 1)}, {len(self._cracks)} "
+                f"crack{'s' * (len(self._cracks) != 1)} ({len(self._tips)} tips), "
+                f"area {self.area:.6g}>")

@@ -1,0 +1,159 @@
+"""`discretize`: node cloud -> constrained Delaunay triangulation, opened cracks, cells."""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import GeometryError
+from .cells import voronoi_cells
+from .cloud import NodeCloud
+from .cracks import split_cracks
+
+from .triangulation import constrained_delaunay
+
+__all__ = ["Cells", "Model", "discretize"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, repr=False)
+class Cells:
+    """SCNI integration cells: constrained Voronoi cells cut by the domain and regions.
+
+    Attributes
+    ----------
+    node : (m,) int64 ndarray
+        Owner node of each cell.
+    region : (m,) int64 ndarray
+    offsets : (m + 1,) int64 ndarray
+    vertices : (k, 2) ndarray
+        Cell ``c`` is ``vertices[offsets[c]:offsets[c + 1]]`` (counter-clockwise).
+    area : (m,) ndarray
+    """
+
+    node: np.ndarray
+    region: np.ndarray
+    offsets: np.ndarray
+    vertices: np.ndarray
+    area: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        x, y = self.vertices[:, 0], self.vertices[:, 1]
+        nxt = np.arange(len(x)) + 1
+        nxt[self.offsets[1:] - 1] = self.offsets[:-1]
+        cross = x * y[nxt] - x[nxt] * y
+        area = 0.5 * np.add.reduceat(cross, self.offsets[:-1]) if len(x) else np.zeros(0)
+        object.__setattr__(self, "area", area)
+
+    def __len__(self):
+        return len(self.node)
+
+    def polygon(self, i):
+        """Vertices of cell ``i``, ``(k, 2)``, counter-clockwise."""
+        return self.vertices[self.offsets[i]:self.offsets[i + 1]]
+
+    def centroid(self):
+        """Centroids of all cells, ``(m, 2)``."""
+        x, y = self.vertices[:, 0], self.vertices[:, 1]
+        nxt = np.arange(len(x)) + 1
+        nxt[self.offsets[1:] - 1] = self.offsets[:-1]
+        cross = x * y[nxt] - x[nxt] * y
+        cx = np.add.reduceat((x + x[nxt]) * cross, self.offsets[:-1])
+        cy = np.add.reduceat((y + y[nxt]) * cross, self.offsets[:-1])
+        return np.column_stack([cx, cy]) / (6.0 * self.area[:, None])
+
+    def __repr__(self):
+        return f"<Cells {len(self.node)} cells, {len(self.vertices)} vertices>"
+
+
+@dataclass(frozen=True, repr=False)
+class Model:
+    """A discretised domain: nodes (cracks opened), triangulation and integration cells.
+
+    Attributes
+    ----------
+    cloud : NodeCloud
+    nodes : (n, 2) ndarray
+        Nodes after splitting cracks (one node per crack face except at tips).
+    node_of_point : (n,) int64 ndarray
+        Index into ``cloud.points`` of each node.
+    triangles : (t, 3) int64 ndarray
+        Constrained Delaunay triangles, counter-clockwise.
+    triangle_region : (t,) int64 ndarray
+    segments : (s, 2) int64 ndarray
+        Constraint segments after splitting (each crack segment once per face).
+    segment_kind : (s,) int8 ndarray
+        0 boundary, 1 interface, 2 crack face.
+    cells : Cells
+    timings : dict
+        Seconds spent in each stage.
+    """
+
+    cloud: NodeCloud
+    nodes: np.ndarray
+    node_of_point: np.ndarray
+    triangles: np.ndarray
+    triangle_region: np.ndarray
+    segments: np.ndarray
+    segment_kind: np.ndarray
+    cells: Cells
+    timings: dict
+
+    @property
+    def domain(self):
+        """Domain: the body this model discretises."""
+        return self.cloud.domain
+
+    def __repr__(self):
+        dom = self.domain
+        nreg, ncr = len(dom.regions), len(dom.cracks)
+        return (f"<Model {len(self.nodes)} nodes, {len(self.cells)} cells, {nreg} "
+                f"region{'s' * (nreg != 1)}, {ncr} crack{'s' * (ncr != 1)} "
+                f"({len(dom.tips)} tip{'s' * (len(dom.tips) != 1)})>")
+
+
+def discretize(cloud, *, progress=None):
+    """Constrained Delaunay triangulation, crack opening and constrained Voronoi cells.
+
+    Parameters
+    ----------
+    cloud : NodeCloud
+        From `cnem.nodes`.
+    progress : bool, optional
+        Show a progress bar while clipping cells near constraints
+        (default: only on a terminal).
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    GeometryError
+        Crossing constraints (`triangle` would need Steiner points), nodes that
+        are not vertices of the triangulation.
+    """
+    if not isinstance(cloud, NodeCloud):
+        raise GeometryError(f"discretize expects a NodeCloud from cnem.nodes, received "
+                            f"{type(cloud).__name__}; build one with cnem.nodes.from_points")
+    timings = {}
+    t0 = time.perf_counter()
+    tri, region = constrained_delaunay(cloud)
+    t1 = time.perf_counter()
+    nodes, node_of_point, tri, segments, kind = split_cracks(
+        cloud.points, tri, cloud.segments, cloud.segment_kind)
+    t2 = time.perf_counter()
+    node, cell_region, offsets, vertices = voronoi_cells(nodes, tri, region, progress=progress)
+    t3 = time.perf_counter()
+    timings.update(triangulation=t1 - t0, splitting=t2 - t1, cells=t3 - t2)
+    log.info("discretize: %d nodes, %s", len(nodes),
+             ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
+    cells = Cells(node, cell_region, offsets, vertices)
+    return Model(cloud, nodes, node_of_point, tri, region, segments, kind, cells, timings)
+
+
+

@@ -1,0 +1,120 @@
+"""Builders for the domains users need most.
+
+>>> from cnem.geometry import rectangle, annulus
+>>> rectangle(2.0, 1.0).area
+2.0
+>>> round(annulus([1.0, 1.5, 2.0], spacing=0.05).area, 3)
+9.42
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import GeometryError
+from .domain import Domain
+
+__all__ = ["rectangle", "plate_with_hole", "annulus", "l_shape", "arc"]
+
+
+def _positive(name, value):
+    if not np.isfinite(value) or value <= 0:
+        raise GeometryError(f"{name} must be a positive number, received {value!r}")
+    return float(value)
+
+
+def arc(center, radius, start, stop, spacing):
+    """Points on a circular arc, ends included, about ``spacing`` apart.
+
+    Parameters
+    ----------
+    center : (2,) array_like
+    radius, start, stop, spacing : float
+        Angles in radians; the count of pieces depends only on the radius,
+        the angle span and the spacing, so arcs of equal radius match.
+
+    Returns
+    -------
+    (k, 2) ndarray
+    """
+    _positive("spacing", spacing)
+    span = stop - start
+    pieces = max(2, int(np.ceil(abs(span) * radius / spacing)))
+    t = np.linspace(start, stop, pieces + 1)
+    return np.asarray(center, float) + radius * np.column_stack([np.cos(t), np.sin(t)])
+
+
+def rectangle(width=1.0, height=1.0, *, origin=(0.0, 0.0), cracks=()):
+    """Axis-aligned rectangle ``[x0, x0 + width] x [y0, y0 + height]``.
+
+    Returns
+    -------
+    Domain
+    """
+    w, h = _positive("width", width), _positive("height", height)
+    x0, y0 = map(float, origin)
+    shell = [[x0, y0], [x0 + w, y0], [x0 + w, y0 + h], [x0, y0 + h]]
+    return Domain([shell], cracks=cracks)
+
+
+def plate_with_hole(width=1.0, height=1.0, radius=0.2, *, center=None, spacing=None,
+                    cracks=()):
+    """Rectangle ``[0, width] x [0, height]`` with a circular hole.
+
+    Parameters
+    ----------
+    center : (2,) array_like, optional
+        Hole centre, default the plate centre.
+    spacing : float, optional
+        Length of the chords of the hole, default ``radius / 8``.
+    """
+    w, h, r = _positive("width", width), _positive("height", height), _positive("radius", radius)
+    c = np.array([w / 2, h / 2] if center is None else center, dtype=float)
+    if (c - r < 0).any() or c[0] + r > w or c[1] + r > h:
+        raise GeometryError(f"the hole (centre {c.tolist()}, radius {r}) does not fit inside "
+                            f"the plate [0, {w}] x [0, {h}]; make it smaller or move it")
+    ring = arc(c, r, 0.0, 2 * np.pi, spacing or r / 8)[:-1]
+    shell = [[0, 0], [w, 0], [w, h], [0, h]]
+    return Domain([(shell, [ring[::-1]])], cracks=cracks)
+
+
+def annulus(radii, *, angles=None, center=(0.0, 0.0), spacing=None, cracks=()):
+    """Concentric annular regions (a multi-material cylinder section).
+
+    Parameters
+    ----------
+    radii : sequence of float
+        Increasing radii ``r_0 < r_1 < ... < r_k``; region ``i`` lies between
+        ``r_i`` and ``r_{i+1}``, so the inner radii are material interfaces.
+    angles : (2,) sequence of float, optional
+        ``(start, stop)`` in radians for a sector; default a full annulus.
+    spacing : float, optional
+        Chord length of the arcs, default ``(r_k - r_0) / 10``.
+    """
+    radii = np.asarray(radii, dtype=float)
+    if radii.ndim != 1 or len(radii) < 2 or radii[0] <= 0 or (np.diff(radii) <= 0).any():
+        raise GeometryError(f"radii must be >= 2 positive increasing numbers, received {radii}")
+    spacing = spacing or (radii[-1] - radii[0]) / 10
+    regions = []
+    for r_in, r_out in zip(radii[:-1], radii[1:]):
+        if angles is None:
+            outer = arc(center, r_out, 0, 2 * np.pi, spacing)[:-1]
+            inner = arc(center, r_in, 0, 2 * np.pi, spacing)[:-1]
+            regions.append((outer, [inner[::-1]]))
+        else:
+            a0, a1 = map(float, angles)
+            if not 0 < a1 - a0 < 2 * np.pi:
+                raise GeometryError(f"angles must satisfy 0 < stop - start < 2 pi, received {angles}")
+            outer = arc(center, r_out, a0, a1, spacing)
+            inner = arc(center, r_in, a0, a1, spacing)[::-1]
+            regions.append(np.concatenate([outer, inner]))
+    return Domain(regions, cracks=cracks)
+
+
+def l_shape(size=1.0, cut=0.5, *, cracks=()):
+    """Square ``[0, size]^2`` without its top-right ``cut x cut`` corner."""
+    s, c = _positive("size", size), _positive("cut", cut)
+    if c >= s:
+        raise GeometryError(f"cut ({c}) must be smaller than size ({s})")
+    shell = [[0, 0], [s, 0], [s, s - c], [s - c, s - c], [s - c, s], [0, s]]
+    return Domain([shell], cracks=cracks)

@@ -1,0 +1,77 @@
+"""Constrained Delaunay triangulation of a node cloud with `triangle`, no Steiner points."""
+
+from __future__ import annotations
+
+import numpy as np
+import triangle
+
+from ..errors import GeometryError
+
+__all__ = ["constrained_delaunay"]
+
+
+def _orient(points, tri):
+    a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
+    return (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+
+
+def _steiner_error(points, segments, extra, tol):
+    """Name the constraint segments that meet at inserted (Steiner) points."""
+    a, b = points[segments[:, 0]], points[segments[:, 1]]
+    d = b - a
+    msgs = []
+    for p in extra[:3]:
+        rel = p - a
+        t = np.einsum("ij,ij->i", rel, d) / np.einsum("ij,ij->i", d, d)
+        dist = np.abs(rel[:, 0] * d[:, 1] - rel[:, 1] * d[:, 0]) / np.linalg.norm(d, axis=1)
+        hit = np.flatnonzero((dist <= max(tol, 1e-12)) & (t > -1e-12) & (t < 1 + 1e-12))
+        msgs.append(f"at ({p[0]:.6g}, {p[1]:.6g}) segments "
+                    + ", ".join(f"{s} {points[segments[s]].tolist()}" for s in hit[:4]))
+    return GeometryError(
+        f"the constraint segments intersect away from nodes ({len(extra)} crossing points): "
+        + "; ".join(msgs) + "; boundaries, interfaces and cracks may only meet at shared vertices")
+
+
+def constrained_delaunay(cloud):
+    """Triangulate a `NodeCloud` respecting all its segments.
+
+    Parameters
+    ----------
+    cloud : NodeCloud
+
+    Returns
+    -------
+    triangles : (t, 3) int64 ndarray
+        Counter-clockwise triangles inside the domain.
+    region : (t,) int64 ndarray
+        Region index of each triangle.
+
+    Raises
+    ------
+    GeometryError
+        If `triangle` had to insert a Steiner point (segments cross) or a node
+        is not a vertex of any triangle (duplicated or outside the domain).
+    """
+    points = np.ascontiguousarray(cloud.points, dtype=float)
+    segments = np.ascontiguousarray(cloud.segments, dtype=np.int32)
+    out = triangle.triangulate({"vertices": points, "segments": segments}, "pQ")
+    verts = out["vertices"]
+    if len(verts) != len(points) or not np.array_equal(verts, points):
+        extra = verts[len(points):]
+        raise _steiner_error(points, cloud.segments, extra, cloud.domain.tolerance)
+    tri = out["triangles"].astype(np.int64)
+    flip = _orient(points, tri) < 0
+    tri[flip] = tri[flip][:, [0, 2, 1]]
+    centroid = points[tri].mean(axis=1)
+    region = cloud.domain.region_of(centroid)
+    tri, region = tri[region >= 0], region[region >= 0]
+    used = np.zeros(len(points), dtype=bool)
+    used[tri.ravel()] = True
+    if not used.all():
+        lost = np.flatnonzero(~used)
+        raise GeometryError(
+            f"{lost.size} nodes are not vertices of the triangulation (duplicated or outside "
+            f"the domain), first (index: point) "
+            + ", ".join(f"{i}: {points[i].tolist()}" for i in lost[:5])
+            + "; remove duplicated nodes and nodes outside the domain")
+    return tri, region

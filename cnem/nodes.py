@@ -1,0 +1,257 @@
+"""Node clouds on a `Domain`: regular, irregular, graded, or the user's own points.
+
+Every polygon corner, interface vertex and crack vertex is a node, and every
+boundary, interface and crack edge carries nodes about one local spacing apart.
+
+>>> import cnem
+>>> from cnem.geometry import rectangle
+>>> cloud = cnem.nodes.regular(rectangle(), 0.25)
+>>> len(cloud.points)
+25
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from scipy.spatial import cKDTree
+
+from .errors import GeometryError
+from .geometry.cloud import NodeCloud
+
+__all__ = ["regular", "irregular", "graded", "from_points", "NodeCloud"]
+
+#: Interior nodes closer than this fraction of the local spacing to a
+#: boundary, interface or crack are dropped (the boundary nodes stand there).
+CLEARANCE = 0.5
+
+
+def _check_spacing(dom, h, name="h"):
+    h = float(h)
+    if not np.isfinite(h) or h <= 0:
+        raise GeometryError(f"{name} must be a positive spacing, received {h!r}")
+    if h >= dom.diameter:
+        raise GeometryError(f"{name} = {h:g} is not smaller than the domain diameter "
+                            f"{dom.diameter:g}; choose a spacing that fits several nodes")
+    return h
+
+
+def _edge_lines(dom):
+    v, e = dom.pslg.vertices, dom.pslg.edges
+    return shapely.linestrings(np.stack([v[e[:, 0]], v[e[:, 1]]], axis=1))
+
+
+def _boundary_nodes(dom, spacing_of, jitter=None):
+    """Nodes along every PSLG edge, about ``spacing_of(x)`` apart.
+
+    Returns ``points (n0, 2), segments (s, 2), kind (s,)``.
+    """
+    v, edges, kinds = dom.pslg.vertices, dom.pslg.edges, dom.pslg.kind
+    points, segments, seg_kind = [v], [], []
+    count = len(v)
+    samples = np.linspace(0.0, 1.0, 65)
+    for (a, b), k in zip(edges, kinds):
+        pa, pb = v[a], v[b]
+        length = np.linalg.norm(pb - pa)
+        dens = length / spacing_of(pa + samples[:, None] * (pb - pa))
+        cum = np.concatenate([[0.0], np.cumsum(0.5 * (dens[1:] + dens[:-1]) * np.diff(samples))])
+        pieces = max(1, int(round(cum[-1])))
+        t = np.interp(np.linspace(0, cum[-1], pieces + 1)[1:-1], cum, samples)
+        if jitter is not None and len(t):
+            t = np.sort(t + jitter.uniform(-0.2, 0.2, len(t)) / pieces)
+        chain = np.concatenate([[a], count + np.arange(len(t)), [b]])
+        points.append(pa + t[:, None] * (pb - pa))
+        segments.append(np.column_stack([chain[:-1], chain[1:]]))
+        seg_kind.append(np.full(len(chain) - 1, k, dtype=np.int8))
+        count += len(t)
+    return np.concatenate(points), np.concatenate(segments), np.concatenate(seg_kind)
+
+
+def _keep_interior(dom, pts, clearance):
+    """Points inside the domain and farther than ``clearance`` from every constraint.
+
+    ``clearance`` is a number or a ``(p,)`` array aligned with ``pts``.
+    """
+    inside = dom.region_of(pts) >= 0
+    pts = pts[inside]
+    clearance = np.broadcast_to(clearance, inside.shape)[inside]
+    tree = shapely.STRtree(_edge_lines(dom))
+    near, _ = tree.query(shapely.points(pts), predicate="dwithin", distance=clearance)
+    keep = np.ones(len(pts), dtype=bool)
+    keep[near] = False
+    return pts[keep]
+
+
+def _lattice(dom, h, offset=0.0):
+    xmin, ymin, xmax, ymax = dom.bounds
+    xs = xmin + offset + h * np.arange(int(np.ceil((xmax - xmin) / h)) + 1)
+    ys = ymin + offset + h * np.arange(int(np.ceil((ymax - ymin) / h)) + 1)
+    gx, gy = np.meshgrid(xs, ys)
+    return np.column_stack([gx.ravel(), gy.ravel()])
+
+
+def _assemble(dom, boundary, interior, spacing_of):
+    pts_b, segs, kinds = boundary
+    points = np.concatenate([pts_b, interior])
+    return NodeCloud(dom, points, segs.astype(np.int64), kinds, spacing_of(points))
+
+
+def regular(domain, h):
+    """Square lattice of spacing ``h`` plus boundary nodes every ~h.
+
+    Parameters
+    ----------
+    domain : Domain
+    h : float
+        Node spacing, ``0 < h < domain.diameter``.
+
+    Returns
+    -------
+    NodeCloud
+    """
+    h = _check_spacing(domain, h)
+    spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
+    lattice = _lattice(domain, h)
+    interior = _keep_interior(domain, lattice, CLEARANCE * h * (1 - 1e-9))
+    return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
+
+
+def irregular(domain, h, *, seed=0):
+    """Randomly perturbed lattice of mean spacing ``h`` (reproducible with ``seed``).
+
+    Interior nodes are moved by up to 0.35 h in each direction and boundary
+    nodes by up to 0.2 of their spacing along their edge; corners stay put.
+
+    Returns
+    -------
+    NodeCloud
+    """
+    h = _check_spacing(domain, h)
+    rng = np.random.default_rng(seed)
+    spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
+    lattice = _lattice(domain, h, offset=0.5 * h)
+    lattice = lattice + rng.uniform(-0.35 * h, 0.35 * h, lattice.shape)
+    interior = _keep_interior(domain, lattice, CLEARANCE * h)
+    boundary = _boundary_nodes(domain, spacing_of, jitter=rng)
+    return _assemble(domain, boundary, interior, spacing_of)
+
+
+def graded(domain, h, *, near, h_min, growth=0.3, seed=None):
+    """Nodes whose spacing shrinks from ``h`` to ``h_min`` towards given points.
+
+    The local spacing is ``s(x) = min(h, h_min + growth * d(x))`` with ``d`` the
+    distance to the nearest point of ``near`` (crack tips, say).
+
+    Parameters
+    ----------
+    near : (q, 2) array_like
+        Refinement centres.
+    h_min : float
+        Spacing at the centres, ``0 < h_min <= h``.
+    growth : float
+        Spacing increase per unit distance (a grading rate, 0 < growth <= 1).
+    seed : int, optional
+        When given, interior nodes are perturbed by up to 0.25 s(x).
+
+    Returns
+    -------
+    NodeCloud
+    """
+    h = _check_spacing(domain, h)
+    h_min = _check_spacing(domain, h_min, "h_min")
+    if h_min > h:
+        raise GeometryError(f"h_min ({h_min:g}) must not exceed h ({h:g})")
+    if not 0 < growth <= 1:
+        raise GeometryError(f"growth must lie in (0, 1], received {growth!r}")
+    centres = np.asarray(near, dtype=float).reshape(-1, 2)
+    if len(centres) == 0:
+        raise GeometryError("graded: `near` is empty; give at least one refinement point")
+    tree = cKDTree(centres)
+
+    def spacing_of(x):
+        return np.minimum(h, h_min + growth * tree.query(x)[0])
+
+    levels = int(np.ceil(np.log2(h / h_min))) if h > h_min else 0
+    interior = []
+    for k in range(levels + 1):
+        hk = h / 2 ** k
+        pts = _lattice(domain, hk, offset=0.5 * hk)
+        s = spacing_of(pts)
+        level = np.clip(np.floor(np.log2(h / s)), 0, levels)
+        interior.append(pts[level == k])
+    interior = np.concatenate(interior)
+    if seed is not None:
+        rng = np.random.default_rng(seed)
+        interior = interior + rng.uniform(-0.25, 0.25, interior.shape) * spacing_of(interior)[:, None]
+    interior = _keep_interior(domain, interior, CLEARANCE * spacing_of(interior))
+    return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
+
+
+def from_points(domain, points):
+    """The user's own nodes, with missing corners and crack vertices added.
+
+    Points within ``domain.tolerance`` of a boundary, interface or crack are
+    snapped onto it (onto the vertex if they are that close to one).
+
+    Parameters
+    ----------
+    domain : Domain
+    points : (p, 2) array_like
+
+    Returns
+    -------
+    NodeCloud
+
+    Raises
+    ------
+    GeometryError
+        Points outside the domain or duplicated (closer than the tolerance).
+    """
+    pts = np.array(points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise GeometryError(f"points: expected a (p, 2) array, received shape {pts.shape}")
+    if not np.isfinite(pts).all():
+        bad = np.flatnonzero(~np.isfinite(pts).all(axis=1))
+        raise GeometryError(f"points: {len(bad)} rows are not finite, first {bad[:5].tolist()}")
+    tol = domain.tolerance
+    v, edges = domain.pslg.vertices, domain.pslg.edges
+    # snap onto vertices, then onto edges
+    dv, iv = cKDTree(v).query(pts)
+    on_vertex = dv <= tol
+    pts[on_vertex] = v[iv[on_vertex]]
+    tree = shapely.STRtree(_edge_lines(domain))
+    pi, ei = tree.query(shapely.points(pts), predicate="dwithin", distance=tol)
+    seg_of = np.full(len(pts), -1)
+    keep = ~on_vertex[pi]
+    pi, ei = pi[keep], ei[keep]
+    seg_of[pi] = ei
+    a, b = v[edges[ei, 0]], v[edges[ei, 1]]
+    d = b - a
+    t = np.einsum("ij,ij->i", pts[pi] - a, d) / np.einsum("ij,ij->i", d, d)
+    pts[pi] = a + np.clip(t, 0, 1)[:, None] * d
+    outside = np.flatnonzero((domain.region_of(pts) < 0) & (seg_of < 0) & ~on_vertex)
+    if outside.size:
+        raise GeometryError(
+            f"{outside.size} of {len(pts)} points lie outside the domain, first (index: point) "
+            + ", ".join(f"{i}: {pts[i].tolist()}" for i in outside[:5])
+            + "; remove them or enlarge the domain")
+    pairs = cKDTree(pts).query_pairs(tol, output_type="ndarray")
+    if len(pairs):
+        raise GeometryError(
+            f"{len(pairs)} pairs of duplicated points (closer than {tol:.3g}), first "
+            + ", ".join(f"{i} and {j}" for i, j in pairs[:5]) + "; remove the duplicates")
+    # the user's points keep their order; missing vertices are appended
+    vertex_node = np.full(len(v), -1)
+    vertex_node[iv[on_vertex]] = np.flatnonzero(on_vertex)
+    missing = np.flatnonzero(vertex_node < 0)
+    vertex_node[missing] = len(pts) + np.arange(len(missing))
+    all_pts = np.concatenate([pts, v[missing]])
+    segments, kinds = [], []
+    for k, (ea, eb) in enumerate(edges):
+        inside = np.flatnonzero(seg_of == k)
+        t = (pts[inside] - v[ea]) @ (v[eb] - v[ea])
+        chain = np.concatenate([[vertex_node[ea]], inside[np.argsort(t)], [vertex_node[eb]]])
+        segments.append(np.column_stack([chain[:-1], chain[1:]]))
+        kinds.append(np.full(len(chain) - 1, domain.pslg.kind[k], dtype=np.int8))
+    nn = cKDTree(all_pts).query(all_pts, k=2)[0][:, 1]
+    return NodeCloud(domain, all_pts, np.concatenate(segments), np.concatenate(kinds), nn)
