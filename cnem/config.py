@@ -13,3 +13,7 @@ OVERLAP_TOL = 1e-12
 
 #: Relative length below which two Voronoi vertices are merged into one.
 MERGE_TOL = 1e-13
+
+#: Relative grid (times the extent of the nodes) on which the exact cell
+#: clipping is snap-rounded, so that neighbouring cells share their vertices.
+GRID_TOL = 1e-13

@@ -64,11 +64,36 @@ def _shadows(origin, edges_xy, reach):
     return shapely.union_all(shapely.polygons(ring))
 
 
+def _polygonal(geom):
+    """The polygonal part of an overlay result (drops stray points and lines)."""
+    if geom.geom_type in ("Polygon", "MultiPolygon"):
+        return geom
+    parts = [g for g in shapely.get_parts(geom) if g.geom_type == "Polygon"]
+    return shapely.MultiPolygon(parts) if parts else shapely.Polygon()
+
+
+def _splice_hole(ring, hole, i, x):
+    """Join a hole that touches the outer ring at a vertex into the ring.
+
+    Snap-rounded overlays return a notch that touches the boundary at one
+    point as a hole touching the shell; the cell is the simple ring that walks
+    around the notch.
+    """
+    d = np.linalg.norm(ring[:, None, :] - hole[None, :, :], axis=2)
+    a, b = np.unravel_index(np.argmin(d), d.shape)
+    if d[a, b] > 0:
+        raise GeometryError(f"the cell of node {i} at {x.tolist()} has a hole; the node cloud "
+                            "is too coarse or degenerate near this node")
+    return np.concatenate([ring[:a + 1], np.roll(hole, -b, axis=0)[1:], hole[b:b + 1], ring[a + 1:]])
+
+
 class _ExactCells:
     """State shared by the exact (clipping) path."""
 
     def __init__(self, nodes, triangles, region, nb, offsets, star, cc):
         self.nodes, self.tri, self.region = nodes, triangles, region
+        extent = nodes.max(axis=0) - nodes.min(axis=0)
+        self.grid = config.GRID_TOL * float(np.hypot(*extent))
         self.offsets, self.star, self.cc = offsets, star, cc
         edges, owner = constraint_edges(triangles, nb)
         self.edges, self.edge_region = edges, region[owner]
@@ -106,7 +131,7 @@ class _ExactCells:
         """The part of ``geom`` that node ``i`` sees within region ``r``."""
         w = self.wedge(i, r, reach)
         if w is not None:
-            geom = geom.intersection(w)
+            geom = _polygonal(geom.intersection(w, grid_size=self.grid))
         if geom.is_empty:
             return geom
         hull = shapely.convex_hull(shapely.union_all([geom, shapely.Point(self.nodes[i])]))
@@ -118,7 +143,7 @@ class _ExactCells:
         xy = self.nodes[self.edges[cand]]
         hit = shapely.intersects(shapely.linestrings(xy), hull)
         shadow = _shadows(self.nodes[i], xy[hit], 4 * reach)
-        return geom if shadow is None else geom.difference(shadow)
+        return geom if shadow is None else _polygonal(geom.difference(shadow, grid_size=self.grid))
 
     def cell(self, i, r):
         x = self.nodes[i]
@@ -129,7 +154,7 @@ class _ExactCells:
         box = (lo[0], lo[1], hi[0], hi[1])
         reach = float(np.max(np.linalg.norm(np.array([[lo[0], lo[1]], [hi[0], lo[1]],
                                                        [hi[0], hi[1]], [lo[0], hi[1]]]) - x, axis=1)))
-        cell = self.visible_part(i, r, shapely.box(*box), reach)
+        cell = self.visible_part(i, r, shapely.set_precision(shapely.box(*box), self.grid), reach)
         near = np.asarray(self.node_tree.query_ball_point(x, 2 * reach), dtype=np.int64)
         dist = np.linalg.norm(self.nodes[near] - x, axis=1)
         tiny = config.MERGE_TOL * reach
@@ -141,12 +166,12 @@ class _ExactCells:
             half = _halfplane_box(box, x, self.nodes[j])
             if half is None or not cell.intersects(half):
                 continue
-            region = cell.intersection(half)
+            region = _polygonal(cell.intersection(half, grid_size=self.grid))
             if region.area <= 0:
                 continue
             stolen = self.visible_part(j, r, region, reach)
             if not stolen.is_empty:
-                cell = cell.difference(stolen)
+                cell = _polygonal(cell.difference(stolen, grid_size=self.grid))
         return self._polygon(cell, i, r)
 
     def _polygon(self, cell, i, r):
@@ -160,7 +185,10 @@ class _ExactCells:
             raise GeometryError(f"the cell of node {i} at {self.nodes[i].tolist()} in region {r} "
                                 "is not connected; the node cloud is too coarse near this node")
         poly = shapely.geometry.polygon.orient(parts[0], 1.0)
-        return np.asarray(poly.exterior.coords)[:-1]
+        ring = np.asarray(poly.exterior.coords)[:-1]
+        for hole in poly.interiors:
+            ring = _splice_hole(ring, np.asarray(hole.coords)[:-1], i, self.nodes[i])
+        return ring
 
 
 def voronoi_cells(nodes, triangles, region, *, progress=None):
