@@ -1,10 +1,14 @@
 """Numba kernels of the geometry layer (arrays and scalars only).
 
-The fast path of the constrained Voronoi cells: for a node with no incident
-constraint, whose circumcentres are all visible from it and whose dual polygon
-is star-shaped around it, the cell is exactly the polygon of the circumcentres
-of its triangles in counter-clockwise order (the dual of the constrained
-Delaunay triangulation). Every other node is left to the exact clipping path.
+The fast path of the constrained Voronoi cells: for a node whose
+circumcentres are all visible from it and whose dual polygon is star-shaped
+around it, the cell is exactly the polygon of the circumcentres of its
+triangles in counter-clockwise order (the dual of the constrained Delaunay
+triangulation); for a node on a straight boundary or a convex corner the
+polygon starts at the node and at the midpoint of its first constraint edge
+and ends at the midpoint of its last. Every other node (reflex corners, crack
+tips, interfaces, circumcentres behind a constraint) is left to the exact
+clipping path.
 """
 
 import numba
@@ -99,6 +103,97 @@ def _visible(i, cx, cy, pts, tri, nb, fan, nfan, max_steps):
     return False
 
 
+@numba.njit(cache=True)
+def _open_fan(i, tri, nb, offsets, star, out):
+    """Triangles around boundary node ``i`` in CCW order, one fan only; count or -1."""
+    deg = offsets[i + 1] - offsets[i]
+    t0 = -1
+    for m in range(offsets[i], offsets[i + 1]):
+        s = star[m]
+        p = _local(tri, s, i)
+        if nb[s, (p + 2) % 3] < 0:      # edge (i, next vertex) is a constraint
+            if t0 >= 0:
+                return -1               # several fans
+            t0 = s
+    if t0 < 0:
+        return -1
+    t = t0
+    count = 0
+    while t >= 0:
+        if count >= deg:
+            return -1
+        out[count] = t
+        count += 1
+        p = _local(tri, t, i)
+        t = nb[t, (p + 1) % 3]
+    return count if count == deg else -1
+
+
+@numba.njit(cache=True)
+def _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly):
+    """Write the fast-path cell of node ``i`` into ``poly``; count, or -1 if not fast.
+
+    ``fan``, ``path`` and ``poly`` are scratch arrays of length ``max_deg + 2``.
+    """
+    xi, yi = pts[i, 0], pts[i, 1]
+    nfan = _ordered_fan(i, tri, nb, offsets, star, fan)
+    closed = nfan >= 3
+    if not closed:
+        nfan = _open_fan(i, tri, nb, offsets, star, fan)
+        if nfan < 1:
+            return -1
+    npath = 0
+    angle = 0.0
+    if not closed:
+        p = _local(tri, fan[0], i)
+        a = tri[fan[0], (p + 1) % 3]
+        path[0, 0] = 0.5 * (xi + pts[a, 0])
+        path[0, 1] = 0.5 * (yi + pts[a, 1])
+        npath = 1
+    for m in range(nfan):
+        t = fan[m]
+        p = _local(tri, t, i)
+        j, k = tri[t, (p + 1) % 3], tri[t, (p + 2) % 3]
+        ux, uy = pts[j, 0] - xi, pts[j, 1] - yi
+        vx, vy = pts[k, 0] - xi, pts[k, 1] - yi
+        angle += np.arctan2(ux * vy - uy * vx, ux * vx + uy * vy)
+        if not _visible(i, cc[t, 0], cc[t, 1], pts, tri, nb, fan, nfan, 64):
+            return -1
+        path[npath, 0] = cc[t, 0]
+        path[npath, 1] = cc[t, 1]
+        npath += 1
+    if not closed:
+        if angle > np.pi * (1.0 + 1e-12):
+            return -1                   # reflex corner or crack tip
+        p = _local(tri, fan[nfan - 1], i)
+        b = tri[fan[nfan - 1], (p + 2) % 3]
+        path[npath, 0] = 0.5 * (xi + pts[b, 0])
+        path[npath, 1] = 0.5 * (yi + pts[b, 1])
+        npath += 1
+    scale = 0.0
+    for m in range(npath):
+        scale = max(scale, np.hypot(path[m, 0] - xi, path[m, 1] - yi))
+    tol = merge_tol * scale
+    last = npath if closed else npath - 1
+    count = 0
+    if not closed:
+        poly[0, 0] = xi
+        poly[0, 1] = yi
+        poly[1, 0] = path[0, 0]
+        poly[1, 1] = path[0, 1]
+        count = 2
+    for m in range(last):
+        q = (m + 1) % npath
+        o = _orient(xi, yi, path[m, 0], path[m, 1], path[q, 0], path[q, 1])
+        if o < -tol * scale:
+            return -1
+        if np.hypot(path[q, 0] - path[m, 0], path[q, 1] - path[m, 1]) > tol:
+            poly[count, 0] = path[q, 0]
+            poly[count, 1] = path[q, 1]
+            count += 1
+    return count if count >= 3 else -1
+
+
 @numba.njit(cache=True, parallel=True)
 def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg):
     """Cells of the nodes that need no clipping.
@@ -133,53 +228,23 @@ def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg):
     region_tri = np.full(n, -1, dtype=np.int64)
     for i in numba.prange(n):
         fan = np.empty(max_deg, dtype=np.int64)
-        nfan = _ordered_fan(i, tri, nb, offsets, star, fan)
-        if nfan < 3:
-            continue
-        xi, yi = pts[i, 0], pts[i, 1]
-        scale = 0.0
-        for m in range(nfan):
-            d = np.hypot(cc[fan[m], 0] - xi, cc[fan[m], 1] - yi)
-            scale = max(scale, d)
-        tol = merge_tol * scale
-        ok = True
-        kept = 0
-        for m in range(nfan):
-            c0 = fan[m]
-            c1 = fan[(m + 1) % nfan]
-            o = _orient(xi, yi, cc[c0, 0], cc[c0, 1], cc[c1, 0], cc[c1, 1])
-            if o < -tol * scale:
-                ok = False
-                break
-            if not _visible(i, cc[c0, 0], cc[c0, 1], pts, tri, nb, fan, nfan, 64):
-                ok = False
-                break
-            if np.hypot(cc[c1, 0] - cc[c0, 0], cc[c1, 1] - cc[c0, 1]) > tol:
-                kept += 1
-        if ok and kept >= 3:
+        path = np.empty((max_deg + 2, 2))
+        poly = np.empty((max_deg + 3, 2))
+        c = _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly)
+        if c > 0:
             status[i] = FAST
-            counts[i] = kept
-            region_tri[i] = fan[0]
+            counts[i] = c
+            region_tri[i] = star[offsets[i]]
     poly_offsets = np.zeros(n + 1, dtype=np.int64)
     for i in range(n):
         poly_offsets[i + 1] = poly_offsets[i] + counts[i]
-    poly = np.empty((poly_offsets[n], 2), dtype=np.float64)
+    out = np.empty((poly_offsets[n], 2), dtype=np.float64)
     for i in numba.prange(n):
         if status[i] != FAST:
             continue
         fan = np.empty(max_deg, dtype=np.int64)
-        nfan = _ordered_fan(i, tri, nb, offsets, star, fan)
-        xi, yi = pts[i, 0], pts[i, 1]
-        scale = 0.0
-        for m in range(nfan):
-            scale = max(scale, np.hypot(cc[fan[m], 0] - xi, cc[fan[m], 1] - yi))
-        tol = merge_tol * scale
-        w = poly_offsets[i]
-        for m in range(nfan):
-            c0 = fan[m]
-            c1 = fan[(m + 1) % nfan]
-            if np.hypot(cc[c1, 0] - cc[c0, 0], cc[c1, 1] - cc[c0, 1]) > tol:
-                poly[w, 0] = cc[c1, 0]
-                poly[w, 1] = cc[c1, 1]
-                w += 1
-    return status, poly_offsets, poly, region_tri
+        path = np.empty((max_deg + 2, 2))
+        poly = np.empty((max_deg + 3, 2))
+        c = _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly)
+        out[poly_offsets[i]:poly_offsets[i] + c] = poly[:c]
+    return status, poly_offsets, out, region_tri

@@ -157,14 +157,21 @@ class _ExactCells:
         cell = self.visible_part(i, r, shapely.set_precision(shapely.box(*box), self.grid), reach)
         near = np.asarray(self.node_tree.query_ball_point(x, 2 * reach), dtype=np.int64)
         dist = np.linalg.norm(self.nodes[near] - x, axis=1)
+        order = np.argsort(dist)
+        near, dist = near[order], dist[order]
         tiny = config.MERGE_TOL * reach
-        for j in near[np.argsort(dist)]:
-            if j == i or (int(j), r) not in self.member:
+        corners = shapely.get_coordinates(cell)
+        radius = np.linalg.norm(corners - x, axis=1).max(initial=0.0)
+        for j, dj in zip(near, dist):
+            if dj > 2 * radius:
+                break            # j is farther from every point of the cell than i
+            if dj <= tiny or (int(j), r) not in self.member:
                 continue
-            if np.linalg.norm(self.nodes[j] - x) <= tiny:
-                continue
-            half = _halfplane_box(box, x, self.nodes[j])
-            if half is None or not cell.intersects(half):
+            q = self.nodes[j]
+            if (corners @ (q - x)).max() <= 0.5 * (q @ q - x @ x):
+                continue         # the cell lies on i's side of the bisector
+            half = _halfplane_box(box, x, q)
+            if half is None:
                 continue
             region = _polygonal(cell.intersection(half, grid_size=self.grid))
             if region.area <= 0:
@@ -172,6 +179,8 @@ class _ExactCells:
             stolen = self.visible_part(j, r, region, reach)
             if not stolen.is_empty:
                 cell = _polygonal(cell.difference(stolen, grid_size=self.grid))
+                corners = shapely.get_coordinates(cell)
+                radius = np.linalg.norm(corners - x, axis=1).max(initial=0.0)
         return self._polygon(cell, i, r)
 
     def _polygon(self, cell, i, r):
