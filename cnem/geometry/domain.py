@@ -68,6 +68,17 @@ def _as_polygon(obj, index):
     return orient(poly, 1.0)
 
 
+def _is_single_polygon(obj):
+    """Whether ``obj`` is one polygon rather than a list of polygons."""
+    if isinstance(obj, (Polygon, tuple)):
+        return True
+    try:
+        arr = np.asarray(obj, dtype=float)
+    except (ValueError, TypeError):
+        return False
+    return arr.ndim == 2 and arr.shape[1] == 2
+
+
 class Domain:
     """A 2-D body: material regions (with holes) and cracks.
 
@@ -89,10 +100,9 @@ class Domain:
     """
 
     def __init__(self, regions, cracks=()):
-        if isinstance(regions, (Polygon, tuple)) or (
-                not isinstance(regions, list) and np.asarray(regions, dtype=object).ndim == 2
-                and np.asarray(regions, dtype=object).shape[-1] == 2):
+        if _is_single_polygon(regions):
             regions = [regions]
+        regions = list(regions)
         if len(regions) == 0:
             raise GeometryError("expected at least one region, received an empty list")
         self._regions = tuple(_as_polygon(r, i) for i, r in enumerate(regions))
@@ -268,7 +278,7 @@ class Domain:
 
     def __repr__(self):
         holes = sum(len(p.interiors) for p in self._regions)
-        return (f"<Domain {len(self._regions)} region{'s' * (len(self._regions) != 1)}, "
-                f"{holes} hole{'s' * (holes != 1)}, {len(self._cracks)} "
-                f"crack{'s' * (len(self._cracks) != 1)} ({len(self._tips)} tips), "
-                f"area {self.area:.6g}>")
+        counts = [(len(self._regions), "region"), (holes, "hole"), (len(self._cracks), "crack")]
+        text = ", ".join(f"{k} {word}{'s' * (k != 1)}" for k, word in counts)
+        tips = len(self._tips)
+        return f"<Domain {text} ({tips} tip{'s' * (tips != 1)}), area {self.area:.6g}>"

@@ -1,0 +1,111 @@
+"""Shared catalogue of geometry cases for the test suite.
+
+Each case is a function returning ``(domain, cloud)``; `CASES` maps names to
+them and `model(name)` discretises a case once per session (cached).
+Cases are small (100-900 nodes) so the suite stays fast, but they cover the
+degenerate situations the geometry layer must handle: cocircular lattices,
+collinear boundary nodes, reflex corners, holes, interfaces, edge and
+internal (kinked) cracks, graded clouds and the user's own random points.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+import cnem
+from cnem import geometry, nodes
+
+#: Edge crack of the square (ends on the boundary at x = 0, tip at (0.5, 0.5)).
+EDGE_CRACK = [[0.0, 0.5], [0.5, 0.5]]
+#: Kinked internal crack (two tips).
+KINKED_CRACK = [[0.2, 0.3], [0.5, 0.5], [0.8, 0.45]]
+#: Inclined internal crack (two tips) for the graded cloud.
+INCLINED_CRACK = [[0.3, 0.35], [0.7, 0.62]]
+
+
+def square_regular():
+    dom = geometry.rectangle(1.0, 1.0)
+    return dom, nodes.regular(dom, 0.08)
+
+
+def square_irregular():
+    dom = geometry.rectangle(1.0, 1.0)
+    return dom, nodes.irregular(dom, 0.07, seed=3)
+
+
+def lshape_regular():
+    dom = geometry.l_shape(1.0, 0.5)
+    return dom, nodes.regular(dom, 0.0625)
+
+
+def lshape_irregular():
+    dom = geometry.l_shape(1.0, 0.4)
+    return dom, nodes.irregular(dom, 0.06, seed=7)
+
+
+def plate_hole_irregular():
+    dom = geometry.plate_with_hole(1.0, 1.0, 0.2, spacing=0.05)
+    return dom, nodes.irregular(dom, 0.06, seed=11)
+
+
+def annulus_full_irregular():
+    dom = geometry.annulus([1.0, 1.5, 2.0], spacing=0.15)
+    return dom, nodes.irregular(dom, 0.15, seed=5)
+
+
+def annulus_sector_regular():
+    dom = geometry.annulus([1.0, 1.5, 2.0], angles=(0.0, np.pi / 2), spacing=0.1)
+    return dom, nodes.regular(dom, 0.1)
+
+
+def edge_crack_regular():
+    # crack on lattice lines: many cocircular quadruples along the crack
+    dom = geometry.rectangle(1.0, 1.0, cracks=[EDGE_CRACK])
+    return dom, nodes.regular(dom, 0.05)
+
+
+def kinked_crack_irregular():
+    dom = geometry.rectangle(1.0, 1.0, cracks=[KINKED_CRACK])
+    return dom, nodes.irregular(dom, 0.06, seed=2)
+
+
+def graded_inclined_crack():
+    dom = geometry.rectangle(1.0, 1.0, cracks=[INCLINED_CRACK])
+    return dom, nodes.graded(dom, 0.1, near=dom.tips, h_min=0.02, growth=0.3, seed=1)
+
+
+#: Points put exactly on the boundary of the unit square by `random_points`.
+RANDOM_ON_BOUNDARY = np.array([[0.3, 0.0], [0.71, 0.0], [1.0, 0.45], [0.5, 1.0],
+                               [0.0, 0.62], [0.0, 0.2]])
+
+
+def random_points():
+    dom = geometry.rectangle(1.0, 1.0)
+    rng = np.random.default_rng(1234)
+    pts = rng.uniform(0.02, 0.98, (250, 2))
+    pts = np.concatenate([pts, RANDOM_ON_BOUNDARY])
+    return dom, nodes.from_points(dom, pts)
+
+
+CASES = {f.__name__: f for f in [
+    square_regular, square_irregular, lshape_regular, lshape_irregular,
+    plate_hole_irregular, annulus_full_irregular, annulus_sector_regular,
+    edge_crack_regular, kinked_crack_irregular, graded_inclined_crack, random_points,
+]}
+
+NAMES = list(CASES)
+
+
+@functools.lru_cache(maxsize=None)
+def case(name):
+    """``(domain, cloud)`` of a case, built once."""
+    return CASES[name]()
+
+
+@functools.lru_cache(maxsize=None)
+def model(name):
+    """``(domain, cloud, model)`` of a case, discretised once."""
+    dom, cloud = case(name)
+    return dom, cloud, cnem.discretize(cloud, progress=False)
