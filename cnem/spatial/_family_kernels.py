@@ -1,0 +1,251 @@
+"""Numba kernels of family search: cell list, brute force, bond-crossing filter.
+
+Every method decides membership with the same arithmetic: the squared
+(minimum-image) distance ``s = sum(d_k ** 2)`` must satisfy ``0 < s < h_i ** 2``,
+so that all methods return identical sets even at ties.
+"""
+
+import numba
+import numpy as np
+
+from ._rtree_kernels import _wrap
+
+
+@numba.njit(cache=True, inline="always")
+def _dist2(a, i, b, j, period):
+    """Squared minimum-image distance between ``a[i]`` and ``b[j]`` (no row views:
+    views inside parallel loops cost atomic reference counting)."""
+    s = 0.0
+    for k in range(a.shape[1]):
+        d = _wrap(b[j, k] - a[i, k], period[k])
+        s += d * d
+    return s
+
+
+@numba.njit(cache=True)
+def _cell_axis(x, origin, size, nc):
+    """Cell of a coordinate (clamped: periodic coordinates already lie in [0, L))."""
+    c = int(np.floor((x - origin) / size))
+    return min(max(c, 0), nc - 1)
+
+
+@numba.njit(cache=True)
+def bin_points(pts, origin, size, nc, period):
+    """Counting sort of points into a 3-D grid of cells.
+
+    Returns
+    -------
+    perm : (n,) int64, points sorted by cell
+    start : (ncells + 1,) int64, CSR of the cells over ``perm``
+    """
+    n = pts.shape[0]
+    ncell = nc[0] * nc[1] * nc[2]
+    cell = np.empty(n, dtype=np.int64)
+    count = np.zeros(ncell + 1, dtype=np.int64)
+    for i in range(n):
+        c0 = _cell_axis(pts[i, 0], origin[0], size[0], nc[0])
+        c1 = _cell_axis(pts[i, 1], origin[1], size[1], nc[1])
+        c2 = _cell_axis(pts[i, 2], origin[2], size[2], nc[2])
+        cell[i] = (c0 * nc[1] + c1) * nc[2] + c2
+        count[cell[i] + 1] += 1
+    for c in range(ncell):
+        count[c + 1] += count[c]
+    fill = count[:-1].copy()
+    perm = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        perm[fill[cell[i]]] = i
+        fill[cell[i]] += 1
+    return perm, count
+
+
+@numba.njit(cache=True, inline="always")
+def _axis_cells(x, origin, size, nc, reach, period, out, row):
+    """Cells along one axis that may hold points within ``reach`` of ``x`` (into ``out[row]``)."""
+    periodic = np.isfinite(period)
+    c = _cell_axis(x, origin, size, nc)
+    r = int(np.ceil(reach / size))
+    m = 0
+    if periodic and 2 * r + 1 >= nc:
+        for k in range(nc):
+            out[row, m] = k
+            m += 1
+        return m
+    for o in range(-r, r + 1):
+        k = c + o
+        if periodic:
+            k = k % nc
+        elif k < 0 or k >= nc:
+            continue
+        out[row, m] = k
+        m += 1
+    return m
+
+
+@numba.njit(cache=True, inline="always")
+def _gap(x, k, origin, size, period):
+    """Distance from coordinate ``x`` to the slab of cell ``k`` along one axis."""
+    if np.isfinite(period):
+        centre = origin + (k + 0.5) * size
+        g = abs(_wrap(x - centre, period)) - 0.5 * size
+    else:
+        lo = origin + k * size
+        g = max(lo - x, x - lo - size)
+    return max(g, 0.0)
+
+
+@numba.njit(cache=True)
+def _scan(i, spts, pts, start, perm, origin, size, nc, period, h, write_at, out, buf):
+    """Count (and write if ``write_at >= 0``) the family of point ``i``."""
+    h2 = h * h
+    x0, x1, x2 = pts[i, 0], pts[i, 1], pts[i, 2]
+    n0 = _axis_cells(x0, origin[0], size[0], nc[0], h, period[0], buf, 0)
+    n1 = _axis_cells(x1, origin[1], size[1], nc[1], h, period[1], buf, 1)
+    n2 = _axis_cells(x2, origin[2], size[2], nc[2], h, period[2], buf, 2)
+    hits = 0
+    for a in range(n0):
+        g0 = _gap(x0, buf[0, a], origin[0], size[0], period[0])
+        g0 *= g0
+        if g0 >= h2:
+            continue
+        for b in range(n1):
+            g1 = _gap(x1, buf[1, b], origin[1], size[1], period[1])
+            g1 = g0 + g1 * g1
+            if g1 >= h2:
+                continue
+            base = (buf[0, a] * nc[1] + buf[1, b]) * nc[2]
+            for c in range(n2):
+                g2 = _gap(x2, buf[2, c], origin[2], size[2], period[2])
+                if g1 + g2 * g2 >= h2:
+                    continue
+                cell = base + buf[2, c]
+                for s in range(start[cell], start[cell + 1]):
+                    d2 = _dist2(pts, i, spts, s, period)
+                    if d2 < h2 and d2 > 0.0:
+                        if write_at >= 0:
+                            out[write_at + hits] = perm[s]
+                        hits += 1
+    return hits
+
+
+@numba.njit(cache=True, parallel=True)
+def cell_family(pts, horizon, origin, size, nc, period, index_dtype_sample, nch):
+    """Family of every point with a cell list (both passes in parallel).
+
+    Parameters
+    ----------
+    pts : (n, 3) float64
+        Points (2-D points padded with a zero third coordinate).
+    horizon : (n,) float64
+    origin, size : (3,) float64
+        Grid origin and cell sizes.
+    nc : (3,) int64
+        Cells per axis.
+    period : (3,) float64
+        ``inf`` on open axes.
+    index_dtype_sample : (0,) array
+        Its dtype (int32 or int64) is the dtype of the returned indices.
+    nch : int
+        Work chunks shared between threads.
+    """
+    n = pts.shape[0]
+    perm, start = bin_points(pts, origin, size, nc, period)
+    spts = np.empty_like(pts)
+    for s in numba.prange(n):
+        for k in range(3):
+            spts[s, k] = pts[perm[s], k]
+    width = 1
+    for k in range(3):
+        width = max(width, nc[k])
+    counts = np.zeros(n, dtype=np.int64)
+    dummy = np.empty(0, dtype=index_dtype_sample.dtype)
+    nch = max(1, min(n, nch))
+    for ch in numba.prange(nch):
+        buf = np.empty((3, width + 1), dtype=np.int64)
+        for s in range(ch * n // nch, (ch + 1) * n // nch):
+            i = perm[s]
+            counts[i] = _scan(i, spts, pts, start, perm, origin, size, nc, period, horizon[i],
+                              -1, dummy, buf)
+    offsets = np.zeros(n + 1, dtype=np.int64)
+    for i in range(n):
+        offsets[i + 1] = offsets[i] + counts[i]
+    out = np.empty(offsets[n], dtype=index_dtype_sample.dtype)
+    for ch in numba.prange(nch):
+        buf = np.empty((3, width + 1), dtype=np.int64)
+        for s in range(ch * n // nch, (ch + 1) * n // nch):
+            i = perm[s]
+            _scan(i, spts, pts, start, perm, origin, size, nc, period, horizon[i], offsets[i],
+                  out, buf)
+    return offsets, out
+
+
+@numba.njit(cache=True, parallel=True)
+def brute_family(pts, horizon, period):
+    """Reference: every pair tested, O(n^2)."""
+    n = pts.shape[0]
+    counts = np.zeros(n, dtype=np.int64)
+    for i in numba.prange(n):
+        h2 = horizon[i] * horizon[i]
+        c = 0
+        for j in range(n):
+            d2 = _dist2(pts, i, pts, j, period)
+            if d2 < h2 and d2 > 0.0:
+                c += 1
+        counts[i] = c
+    offsets = np.zeros(n + 1, dtype=np.int64)
+    for i in range(n):
+        offsets[i + 1] = offsets[i] + counts[i]
+    out = np.empty(offsets[n], dtype=np.int64)
+    for i in numba.prange(n):
+        h2 = horizon[i] * horizon[i]
+        w = offsets[i]
+        for j in range(n):
+            d2 = _dist2(pts, i, pts, j, period)
+            if d2 < h2 and d2 > 0.0:
+                out[w] = j
+                w += 1
+    return offsets, out
+
+
+@numba.njit(cache=True, parallel=True)
+def exact_filter(pts, rows, cols, horizon, period):
+    """Mask of candidate pairs ``(rows, cols)`` that satisfy ``0 < d^2 < h_row^2``."""
+    keep = np.empty(rows.shape[0], dtype=np.bool_)
+    for k in numba.prange(rows.shape[0]):
+        i = rows[k]
+        d2 = _dist2(pts, i, pts, cols[k], period)
+        keep[k] = d2 < horizon[i] * horizon[i] and d2 > 0.0
+    return keep
+
+
+@numba.njit(cache=True, inline="always")
+def _orient(ax, ay, bx, by, cx, cy):
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+
+
+@numba.njit(cache=True, parallel=True)
+def crossing_mask(pts, offsets, indices, seg, cand_off, cand_idx):
+    """Mask of bonds that properly cross none of their point's candidate segments.
+
+    ``seg`` is ``(s, 4)``: ``ax, ay, bx, by``; candidates of point ``i`` are
+    ``cand_idx[cand_off[i]:cand_off[i + 1]]``.
+    """
+    n = offsets.shape[0] - 1
+    keep = np.ones(indices.shape[0], dtype=np.bool_)
+    for i in numba.prange(n):
+        xi, yi = pts[i, 0], pts[i, 1]
+        for k in range(offsets[i], offsets[i + 1]):
+            j = indices[k]
+            xj, yj = pts[j, 0], pts[j, 1]
+            for c in range(cand_off[i], cand_off[i + 1]):
+                s = cand_idx[c]
+                ax, ay, bx, by = seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]
+                o1 = _orient(ax, ay, bx, by, xi, yi)
+                o2 = _orient(ax, ay, bx, by, xj, yj)
+                if o1 * o2 >= 0.0:
+                    continue
+                o3 = _orient(xi, yi, xj, yj, ax, ay)
+                o4 = _orient(xi, yi, xj, yj, bx, by)
+                if o3 * o4 < 0.0:
+                    keep[k] = False
+                    break
+    return keep

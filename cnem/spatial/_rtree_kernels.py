@@ -1,0 +1,226 @@
+"""Numba kernels of the packed R-tree (arrays and scalars only).
+
+Boxes and tree nodes are stored in centre / half-width form (Niina). Under
+periodic boundaries every centre lies in ``[0, L)`` and every difference of
+centres is reduced to its minimum image, so boxes that straddle the cell
+boundary are handled without images or copied queries (Periortree,
+Algorithms 1-5). ``period[k] = inf`` means "not periodic along k".
+"""
+
+import numba
+import numpy as np
+
+#: Query kinds.
+INTERSECT, BALL_CLOSED, BALL_OPEN = 0, 1, 2
+
+
+@numba.njit(cache=True, inline="always")
+def _wrap(d, period):
+    """Minimum image of a coordinate difference (RestrictVector)."""
+    if np.isfinite(period):
+        return d - period * np.floor(d / period + 0.5)
+    return d
+
+
+@numba.njit(cache=True, parallel=True)
+def sort_within(keys, perm, size):
+    """Sort ``perm`` by ``keys[perm]`` inside consecutive runs of ``size`` items."""
+    n = perm.shape[0]
+    runs = (n + size - 1) // size
+    for s in numba.prange(runs):
+        a = s * size
+        b = min(n, a + size)
+        idx = perm[a:b].copy()
+        order = np.argsort(keys[idx], kind="mergesort")
+        for k in range(b - a):
+            perm[a + k] = idx[order[k]]
+
+
+@numba.njit(cache=True, parallel=True)
+def build_level(cen, half, first, cnt, start, count, fanout, out_start, period):
+    """Parent boxes of ``count`` consecutive entries starting at ``start``.
+
+    Writes ``ceil(count / fanout)`` parents at ``out_start`` with their child
+    ranges (Algorithm 1 under periodic boundaries: expand by the minimum image
+    of each child centre).
+    """
+    d = cen.shape[1]
+    parents = (count + fanout - 1) // fanout
+    for p in numba.prange(parents):
+        a = start + p * fanout
+        b = start + min(count, (p + 1) * fanout)
+        first[out_start + p] = a
+        cnt[out_start + p] = b - a
+        lo = np.empty(d)
+        hi = np.empty(d)
+        for k in range(d):
+            lo[k] = cen[a, k] - half[a, k]
+            hi[k] = cen[a, k] + half[a, k]
+        for c in range(a + 1, b):
+            for k in range(d):
+                ref = 0.5 * (lo[k] + hi[k])
+                cc = ref + _wrap(cen[c, k] - ref, period[k])
+                lo[k] = min(lo[k], cc - half[c, k])
+                hi[k] = max(hi[k], cc + half[c, k])
+        for k in range(d):
+            c = 0.5 * (lo[k] + hi[k])
+            h = 0.5 * (hi[k] - lo[k])
+            if np.isfinite(period[k]):
+                if h >= 0.5 * period[k]:
+                    h = 0.5 * period[k]
+                c = c - period[k] * np.floor(c / period[k])
+                if c >= period[k]:
+                    c = 0.0
+            cen[out_start + p, k] = c
+            half[out_start + p, k] = h
+
+
+@numba.njit(cache=True, inline="always")
+def _box_test(cen, half, e, qc, qh, i, r2, kind, period):
+    """Whether entry ``e`` passes query ``i`` (Algorithms 3 and 5, or a ball)."""
+    d = cen.shape[1]
+    if kind == INTERSECT:
+        for k in range(d):
+            if abs(_wrap(qc[i, k] - cen[e, k], period[k])) > qh[i, k] + half[e, k]:
+                return False
+        return True
+    s = 0.0
+    for k in range(d):
+        g = abs(_wrap(qc[i, k] - cen[e, k], period[k])) - half[e, k]
+        if g > 0.0:
+            s += g * g
+    if kind == BALL_OPEN:
+        return s < r2
+    return s <= r2
+
+
+@numba.njit(cache=True)
+def _traverse(cen, half, first, cnt, nbox, qc, qh, i, r2, kind, period, out, write_at,
+              exclude_zero, stack):
+    """Depth-first search for query ``i``; count hits, writing them if ``write_at >= 0``.
+
+    Arrays are passed whole with an index (no row views): views inside
+    parallel loops cost atomic reference counting.
+    """
+    root = cen.shape[0] - 1
+    node_kind = BALL_CLOSED if kind != INTERSECT else INTERSECT
+    hits = 0
+    if nbox == 1:
+        stack[0] = 0
+    elif not _box_test(cen, half, root, qc, qh, i, r2, node_kind, period):
+        return 0
+    else:
+        stack[0] = root
+    top = 1
+    while top > 0:
+        top -= 1
+        e = stack[top]
+        if e < nbox:
+            if _box_test(cen, half, e, qc, qh, i, r2, kind, period):
+                if exclude_zero:
+                    s = 0.0
+                    for q in range(cen.shape[1]):
+                        g = _wrap(qc[i, q] - cen[e, q], period[q])
+                        s += g * g
+                    if s == 0.0:
+                        continue
+                if write_at >= 0:
+                    out[write_at + hits] = e
+                hits += 1
+            continue
+        for c in range(first[e], first[e] + cnt[e]):
+            if c < nbox or _box_test(cen, half, c, qc, qh, i, r2, node_kind, period):
+                stack[top] = c
+                top += 1
+    return hits
+
+
+@numba.njit(cache=True, parallel=True)
+def query(cen, half, first, cnt, nbox, depth, fanout, order, qcen, qhalf, radius, kind,
+          period, exclude_zero, nch):
+    """Bulk query: CSR ``(offsets, indices)`` of the boxes hit by each query.
+
+    ``radius`` is ``(q,)`` (ignored for ``INTERSECT``); ``order`` maps sorted
+    positions back to the caller's box indices; ``nch`` work chunks share the
+    queries between threads.
+    """
+    q = qcen.shape[0]
+    counts = np.zeros(q, dtype=np.int64)
+    dummy = np.empty(0, dtype=np.int64)
+    nch = max(1, min(nch, q))
+    for ch in numba.prange(nch):
+        stack = np.empty((depth + 2) * fanout + 1, dtype=np.int64)
+        for i in range(ch * q // nch, (ch + 1) * q // nch):
+            r2 = radius[i] * radius[i]
+            counts[i] = _traverse(cen, half, first, cnt, nbox, qcen, qhalf, i, r2, kind,
+                                  period, dummy, -1, exclude_zero, stack)
+    offsets = np.zeros(q + 1, dtype=np.int64)
+    for i in range(q):
+        offsets[i + 1] = offsets[i] + counts[i]
+    local = np.empty(offsets[q], dtype=np.int64)
+    for ch in numba.prange(nch):
+        stack = np.empty((depth + 2) * fanout + 1, dtype=np.int64)
+        for i in range(ch * q // nch, (ch + 1) * q // nch):
+            r2 = radius[i] * radius[i]
+            _traverse(cen, half, first, cnt, nbox, qcen, qhalf, i, r2, kind, period,
+                      local, offsets[i], exclude_zero, stack)
+    indices = np.empty(offsets[q], dtype=np.int64)
+    for k in numba.prange(offsets[q]):
+        indices[k] = order[local[k]]
+    return offsets, indices
+
+
+@numba.njit(cache=True)
+def _box_dist2(cen, half, e, pts, i, period):
+    s = 0.0
+    for k in range(cen.shape[1]):
+        g = abs(_wrap(pts[i, k] - cen[e, k], period[k])) - half[e, k]
+        if g > 0.0:
+            s += g * g
+    return s
+
+
+@numba.njit(cache=True)
+def _nearest_one(cen, half, first, cnt, nbox, order, points, i, period, root, stack, stack_d):
+    """Nearest box to point ``i``: ``(index, squared distance)``."""
+    stack[0] = root
+    stack_d[0] = _box_dist2(cen, half, root, points, i, period)
+    top = 1
+    bd = np.inf
+    bi = -1
+    while top > 0:
+        top -= 1
+        if stack_d[top] > bd:
+            continue
+        e = stack[top]
+        if e < nbox:
+            if stack_d[top] < bd or order[e] < bi:
+                bd = stack_d[top]
+                bi = order[e]
+            continue
+        for c in range(first[e], first[e] + cnt[e]):
+            d2 = _box_dist2(cen, half, c, points, i, period)
+            if d2 <= bd:
+                stack[top] = c
+                stack_d[top] = d2
+                top += 1
+    return bi, bd
+
+
+@numba.njit(cache=True, parallel=True)
+def nearest(cen, half, first, cnt, nbox, depth, fanout, order, points, period, nch):
+    """Index of the nearest box to each point and its distance (branch and bound)."""
+    q = points.shape[0]
+    best_idx = np.full(q, -1, dtype=np.int64)
+    best_d = np.full(q, np.inf)
+    root = cen.shape[0] - 1 if nbox > 1 else 0
+    nch = max(1, min(nch, q))
+    for ch in numba.prange(nch):
+        stack = np.empty((depth + 2) * fanout + 1, dtype=np.int64)
+        stack_d = np.empty((depth + 2) * fanout + 1)
+        for i in range(ch * q // nch, (ch + 1) * q // nch):
+            bi, bd = _nearest_one(cen, half, first, cnt, nbox, order, points, i, period, root,
+                                  stack, stack_d)
+            best_idx[i] = bi
+            best_d[i] = np.sqrt(bd)
+    return best_idx, best_d

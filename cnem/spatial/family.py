@@ -1,0 +1,194 @@
+"""Peridynamic family search: every ``j`` with ``0 < |x_j - x_i| < horizon_i``.
+
+Four interchangeable methods return the same sets: a cell list (``"cells"``,
+the region partitioning of Vazic et al. done as a proper cell list), the packed
+R-tree (``"rtree"``), scipy's cKDTree (``"kdtree"``) and a brute-force
+reference (``"brute"``, small clouds only).
+
+>>> import numpy as np
+>>> from cnem.spatial import family_search
+>>> pts = np.array([[0.0, 0.0], [1.0, 0.0], [2.5, 0.0]])
+>>> fam = family_search(pts, 1.6)
+>>> [sorted(fam.row(i).tolist()) for i in range(3)]
+[[1], [0, 2], [1]]
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from . import _family_kernels as K
+from .rtree import RTree, as_points, check_period, work_chunks
+
+__all__ = ["Family", "family_search", "METHODS", "BRUTE_LIMIT"]
+
+METHODS = ("auto", "rtree", "cells", "kdtree", "brute")
+
+#: Largest cloud the brute-force method accepts.
+BRUTE_LIMIT = 20_000
+
+#: Cells per horizon along each axis in the cell list.
+CELLS_PER_HORIZON = 2
+
+
+@dataclass(frozen=True, repr=False)
+class Family:
+    """Families of a point cloud in CSR form.
+
+    Attributes
+    ----------
+    offsets : (n + 1,) int64 ndarray
+    indices : (k,) int32 or int64 ndarray
+        Members of the family of ``i``: ``indices[offsets[i]:offsets[i + 1]]``
+        (int32 when the cloud has fewer than 2**31 points).
+    horizon : (n,) ndarray
+    period : (d,) ndarray
+        ``inf`` on open axes.
+    """
+
+    offsets: np.ndarray
+    indices: np.ndarray
+    horizon: np.ndarray
+    period: np.ndarray
+
+    def __len__(self):
+        return len(self.offsets) - 1
+
+    @property
+    def counts(self):
+        """(n,) int64 ndarray: family sizes."""
+        return np.diff(self.offsets)
+
+    def row(self, i):
+        """Family members of point ``i``."""
+        return self.indices[self.offsets[i]:self.offsets[i + 1]]
+
+    def pairs(self):
+        """All bonds as ``(k, 2)`` int64 ``(i, j)`` pairs."""
+        rows = np.repeat(np.arange(len(self), dtype=np.int64), self.counts)
+        return np.column_stack([rows, self.indices.astype(np.int64)])
+
+    def __repr__(self):
+        c = self.counts
+        mean = c.mean() if len(c) else 0.0
+        return f"<Family {len(self)} points, {len(self.indices)} bonds, mean {mean:.1f} per point>"
+
+
+def _index_dtype(n):
+    return np.int32 if n < 2**31 - 1 else np.int64
+
+
+def _cells(pts3, horizon, period3):
+    hmax = float(horizon.max())
+    size = np.empty(3)
+    nc = np.empty(3, dtype=np.int64)
+    origin = np.zeros(3)
+    for k in range(3):
+        if np.isfinite(period3[k]):
+            nc[k] = max(1, int(np.floor(period3[k] * CELLS_PER_HORIZON / hmax)))
+            size[k] = period3[k] / nc[k]
+        else:
+            lo, hi = pts3[:, k].min(), pts3[:, k].max()
+            size[k] = hmax / CELLS_PER_HORIZON
+            origin[k] = lo
+            nc[k] = max(1, int(np.floor((hi - lo) / size[k])) + 1)
+    total = float(np.prod(nc.astype(float)))
+    if total > 4 * len(pts3) + 64:          # sparse grid: coarsen so memory stays O(n)
+        scale = (total / (4 * len(pts3) + 64)) ** (1 / 3)
+        for k in range(3):
+            if nc[k] > 1:
+                nc[k] = max(1, int(nc[k] / scale))
+                span = period3[k] if np.isfinite(period3[k]) else \
+                    pts3[:, k].max() - pts3[:, k].min()
+                size[k] = span / nc[k] if np.isfinite(period3[k]) else \
+                    max(size[k], span / max(nc[k] - 1, 1))
+                if not np.isfinite(period3[k]):
+                    nc[k] = int(np.floor(span / size[k])) + 1
+    sample = np.empty(0, dtype=_index_dtype(len(pts3)))
+    return K.cell_family(pts3, horizon, origin, size, nc, period3, sample, 2 * work_chunks())
+
+
+def _kdtree(pts, horizon, period):
+    box = None if not np.isfinite(period).all() else period
+    tree = cKDTree(pts, boxsize=box)
+    pairs = tree.query_pairs(float(horizon.max()), output_type="ndarray")
+    rows = np.concatenate([pairs[:, 0], pairs[:, 1]]).astype(np.int64)
+    cols = np.concatenate([pairs[:, 1], pairs[:, 0]]).astype(np.int64)
+    keep = K.exact_filter(pts, rows, cols, horizon, period)
+    rows, cols = rows[keep], cols[keep]
+    order = np.argsort(rows, kind="stable")
+    offsets = np.zeros(len(pts) + 1, dtype=np.int64)
+    np.cumsum(np.bincount(rows, minlength=len(pts)), out=offsets[1:])
+    return offsets, cols[order]
+
+
+def _rtree(pts, horizon, period):
+    tree = RTree.from_points(pts, period=None if not np.isfinite(period).all() else period)
+    return tree.query_ball(pts, horizon, strict=True, exclude_self=True)
+
+
+def choose_method(horizon):
+    """The fastest method for the data: the R-tree when the horizon varies a lot
+    (graded clouds; a cell list would size its cells for the largest horizon),
+    the cell list otherwise."""
+    if len(horizon) and horizon.max() > 4.0 * horizon.min():
+        return "rtree"
+    return "cells"
+
+
+def family_search(points, horizon, *, period=None, method="auto"):
+    """Family of each point: every ``j`` with ``0 < |x_j - x_i| < horizon_i``.
+
+    Parameters
+    ----------
+    points : (n, d) array_like
+        d = 2 or 3.
+    horizon : float or (n,) array_like
+        Positive horizon (one per point for graded clouds).
+    period : None or (d,) array_like
+        Periodic cell ``[0, L_1) x ... x [0, L_d)``; distances use the minimum image.
+    method : {"auto", "rtree", "cells", "kdtree", "brute"}
+        All give the same sets; ``"auto"`` picks the fastest for the data.
+
+    Returns
+    -------
+    Family
+
+    Raises
+    ------
+    ValueError
+        Bad shapes, non-positive horizon, points outside the periodic cell,
+        unknown method, or ``"brute"`` on more than `BRUTE_LIMIT` points.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, received {method!r}")
+    arr = np.asarray(points, dtype=np.float64)
+    pts = as_points(arr if arr.size else arr.reshape(0, arr.shape[-1] if arr.ndim == 2 else 2))
+    n, d = pts.shape
+    per = check_period(period, d, pts)
+    h = np.ascontiguousarray(np.broadcast_to(np.asarray(horizon, dtype=np.float64), (n,)))
+    if n and (not np.isfinite(h).all() or (h <= 0).any()):
+        raise ValueError(f"horizon must be positive and finite, received min {h.min()!r}")
+    if n == 0:
+        return Family(np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int32), h, per)
+    if method == "auto":
+        method = choose_method(h)
+    if method == "brute":
+        if n > BRUTE_LIMIT:
+            raise ValueError(f"method='brute' tests all n^2 pairs and is limited to "
+                             f"{BRUTE_LIMIT} points, received {n}; use method='auto'")
+        offsets, indices = K.brute_family(pts, h, per)
+    elif method == "cells":
+        pts3 = np.zeros((n, 3))
+        pts3[:, :d] = pts
+        per3 = np.full(3, np.inf)
+        per3[:d] = per
+        offsets, indices = _cells(pts3, h, per3)
+    elif method == "kdtree":
+        offsets, indices = _kdtree(pts, h, per)
+    else:
+        offsets, indices = _rtree(pts, h, per)
+    return Family(offsets, indices.astype(_index_dtype(n), copy=False), h, per)

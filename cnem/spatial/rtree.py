@@ -1,0 +1,246 @@
+"""`RTree`: a packed R-tree over boxes or points, bulk-loaded by Sort-Tile-Recursive.
+
+>>> import numpy as np
+>>> from cnem.spatial import RTree
+>>> tree = RTree.from_points(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 3.0]]))
+>>> offsets, indices = tree.query_ball(np.array([[0.0, 0.0]]), 1.5)
+>>> sorted(indices.tolist())
+[0, 1]
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from . import _rtree_kernels as K
+
+__all__ = ["RTree", "check_period", "as_points", "work_chunks"]
+
+#: Children per node (and boxes per leaf).
+FANOUT = 16
+
+
+def work_chunks():
+    """Number of chunks a parallel loop is cut into (a few per thread)."""
+    return 8 * numba.get_num_threads()
+
+
+def as_points(points, name="points"):
+    """Validate a ``(n, d)`` float64 C-contiguous array with d = 2 or 3."""
+    arr = np.ascontiguousarray(points, dtype=np.float64)
+    if arr.ndim != 2 or arr.shape[1] not in (2, 3):
+        raise ValueError(f"{name}: expected a (n, 2) or (n, 3) array, received shape {arr.shape}")
+    if not np.isfinite(arr).all():
+        raise ValueError(f"{name}: coordinates must be finite, received NaN or inf")
+    return arr
+
+
+def check_period(period, dim, *points):
+    """Period as a ``(d,)`` array (``inf`` where not periodic); points must lie in ``[0, L)``."""
+    if period is None:
+        return np.full(dim, np.inf)
+    per = np.broadcast_to(np.asarray(period, dtype=np.float64), (dim,)).copy()
+    if not (np.isfinite(per) & (per > 0)).all():
+        raise ValueError(f"period: expected {dim} positive lengths, received {period!r}")
+    for arr in points:
+        bad = ((arr < 0) | (arr >= per)).any(axis=1)
+        if bad.any():
+            first = np.flatnonzero(bad)[:3]
+            raise ValueError(
+                f"{bad.sum()} points lie outside the periodic cell [0, L) with L = {per.tolist()}, "
+                f"first {arr[first].tolist()}; wrap them with np.mod(points, L) first")
+    return per
+
+
+def _str_order(centres, fanout):
+    """Sort-Tile-Recursive order of box centres ``(b, d)``."""
+    b, d = centres.shape
+    leaves = -(-b // fanout)
+    slabs = int(np.ceil(leaves ** (1.0 / d)))
+    perm = np.argsort(centres[:, 0], kind="stable").astype(np.int64)
+    run = b
+    for k in range(1, d):
+        run = -(-run // slabs)
+        run = -(-run // fanout) * fanout
+        K.sort_within(np.ascontiguousarray(centres[:, k]), perm, max(run, 1))
+    return perm
+
+
+class RTree:
+    """Packed R-tree (STR bulk loading) over axis-aligned boxes, optionally periodic.
+
+    Parameters
+    ----------
+    lo, hi : (b, d) array_like
+        Lower and upper corners, ``d`` = 2 or 3. Under periodic boundaries a
+        box may straddle the cell boundary: its centre must lie in ``[0, L)``.
+    period : None or (d,) array_like
+        Lengths of the periodic cell ``[0, L_1) x ... x [0, L_d)``.
+
+    Notes
+    -----
+    Boxes and nodes are kept in centre / half-width form; node boxes grow by
+    the minimum image of their children (Niina, Algorithms 1-2) and queries
+    compare wrapped centre distances (Algorithms 3-5). All queries are exact.
+    """
+
+    def __init__(self, lo, hi, *, period=None):
+        lo, hi = as_points(lo, "lo"), as_points(hi, "hi")
+        if lo.shape != hi.shape:
+            raise ValueError(f"lo and hi must have the same shape, received {lo.shape} and {hi.shape}")
+        if (hi < lo).any():
+            raise ValueError(f"{int((hi < lo).any(axis=1).sum())} boxes have hi < lo; "
+                             "pass lower corners as lo and upper corners as hi")
+        centre = 0.5 * (lo + hi)
+        half = 0.5 * (hi - lo)
+        self._build(centre, half, period)
+
+    @classmethod
+    def from_points(cls, points, *, period=None):
+        """A tree over points (zero-size boxes).
+
+        Parameters
+        ----------
+        points : (n, d) array_like
+        period : None or (d,) array_like
+        """
+        pts = as_points(points)
+        tree = cls.__new__(cls)
+        tree._build(pts, np.zeros_like(pts), period)
+        return tree
+
+    def _build(self, centre, half, period):
+        b, d = centre.shape
+        self.dim = d
+        self.period = check_period(period, d, centre)
+        if self.periodic:
+            too_big = (half > 0.5 * self.period).any(axis=1)
+            if too_big.any():
+                raise ValueError(f"{too_big.sum()} boxes are wider than the periodic cell")
+        self.size = b
+        if b == 0:
+            self.order = np.zeros(0, dtype=np.int64)
+            return
+        order = _str_order(centre, FANOUT)
+        sizes = [b]
+        while sizes[-1] > 1:
+            sizes.append(-(-sizes[-1] // FANOUT))
+        level_start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        total = int(level_start[-1])
+        cen, hw = np.empty((total, d)), np.empty((total, d))
+        first, cnt = np.zeros(total, dtype=np.int64), np.zeros(total, dtype=np.int64)
+        cen[:b], hw[:b] = centre[order], half[order]
+        for lev in range(1, len(sizes)):
+            K.build_level(cen, hw, first, cnt, level_start[lev - 1], sizes[lev - 1], FANOUT,
+                          level_start[lev], self.period)
+            if sizes[lev] > FANOUT:     # STR again on this level's nodes before grouping them
+                perm = _str_order(cen[level_start[lev]:level_start[lev + 1]], FANOUT)
+                for arr in (cen, hw, first, cnt):
+                    arr[level_start[lev]:level_start[lev + 1]] = \
+                        arr[level_start[lev]:level_start[lev + 1]][perm]
+        self.order, self.level_start = order, level_start
+        self.centre, self.half, self.first, self.count = cen, hw, first, cnt
+
+    # ----------------------------------------------------------------- queries
+    def _query(self, qcen, qhalf, radius, kind, exclude_zero=False):
+        if self.size == 0 or len(qcen) == 0:
+            return np.zeros(len(qcen) + 1, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        return K.query(self.centre, self.half, self.first, self.count, self.size, self.depth,
+                       FANOUT, self.order, qcen, qhalf, radius, kind, self.period, exclude_zero,
+                       work_chunks())
+
+    def _points(self, points, name, *, in_cell=True):
+        arr = np.asarray(points, dtype=np.float64)
+        if arr.size == 0:
+            return np.zeros((0, self.dim))
+        pts = as_points(arr, name)
+        if pts.shape[1] != self.dim:
+            raise ValueError(f"{name}: expected dimension {self.dim}, received {pts.shape[1]}")
+        if in_cell and self.periodic:
+            check_period(self.period, self.dim, pts)
+        return pts
+
+    @property
+    def periodic(self):
+        """bool: whether the tree has periodic boundaries."""
+        return bool(np.isfinite(self.period).all())
+
+    def query(self, qlo, qhi):
+        """Boxes intersecting each query box (closed boxes).
+
+        Parameters
+        ----------
+        qlo, qhi : (q, d) array_like
+
+        Returns
+        -------
+        offsets : (q + 1,) int64 ndarray
+        indices : (k,) int64 ndarray
+            Box indices hitting query ``i``: ``indices[offsets[i]:offsets[i + 1]]``.
+        """
+        qlo = self._points(qlo, "qlo", in_cell=False)
+        qhi = self._points(qhi, "qhi", in_cell=False)
+        if qlo.shape != qhi.shape or (qhi < qlo).any():
+            raise ValueError("qlo and qhi must have the same shape with qlo <= qhi")
+        qcen = 0.5 * (qlo + qhi)
+        if self.periodic:
+            qcen = np.mod(qcen, self.period)
+        return self._query(qcen, 0.5 * (qhi - qlo), np.zeros(len(qlo)), K.INTERSECT)
+
+    def query_ball(self, points, r, *, strict=False, exclude_self=False):
+        """Boxes within distance ``r`` of each point.
+
+        Parameters
+        ----------
+        points : (q, d) array_like
+        r : float or (q,) array_like
+        strict : bool
+            ``distance < r`` instead of ``distance <= r``.
+        exclude_self : bool
+            Leave out boxes at distance exactly zero whose centre is the point
+            (the point itself in a tree of points).
+
+        Returns
+        -------
+        offsets : (q + 1,) int64 ndarray
+        indices : (k,) int64 ndarray
+        """
+        pts = self._points(points, "points")
+        radius = np.ascontiguousarray(np.broadcast_to(np.asarray(r, dtype=np.float64), (len(pts),)))
+        if (radius < 0).any() or not np.isfinite(radius).all():
+            raise ValueError("r must be finite and non-negative")
+        kind = K.BALL_OPEN if strict else K.BALL_CLOSED
+        return self._query(pts, np.zeros_like(pts), radius, kind, exclude_self)
+
+    def nearest(self, points):
+        """Nearest box to each point.
+
+        Returns
+        -------
+        index : (q,) int64 ndarray
+            Smallest box index among ties; -1 for an empty tree.
+        distance : (q,) ndarray
+        """
+        pts = self._points(points, "points")
+        if self.size == 0:
+            return np.full(len(pts), -1, dtype=np.int64), np.full(len(pts), np.inf)
+        return K.nearest(self.centre, self.half, self.first, self.count, self.size, self.depth,
+                         FANOUT, self.order, pts, self.period, work_chunks())
+
+    def node_boxes(self, level):
+        """Centre and half-width of the nodes at ``level`` (0: the boxes, sorted)."""
+        a, b = self.level_start[level], self.level_start[level + 1]
+        return self.centre[a:b], self.half[a:b]
+
+    @property
+    def depth(self):
+        """int: number of levels above the boxes."""
+        return 0 if self.size == 0 else len(self.level_start) - 2
+
+    def __len__(self):
+        return self.size
+
+    def __repr__(self):
+        per = f"period {self.period.tolist()}" if self.periodic else "open"
+        return f"<RTree {self.size} boxes, {self.dim}-D, depth {self.depth}, {per}>"
