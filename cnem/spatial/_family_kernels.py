@@ -94,10 +94,17 @@ def _gap(x, k, origin, size, period):
 
 
 @numba.njit(cache=True)
-def _scan(i, spts, pts, start, perm, origin, size, nc, period, h, write_at, out, buf):
-    """Count (and write if ``write_at >= 0``) the family of point ``i``."""
-    h2 = h * h
-    x0, x1, x2 = pts[i, 0], pts[i, 1], pts[i, 2]
+def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, write_at, out, buf, row):
+    """Count (and write if ``write_at >= 0``) the family of sorted point ``s0``.
+
+    Distances are tested branch-free (about half of the candidates are hits,
+    so a branch would be mispredicted); when writing, candidates go to the
+    scratch ``row`` first so that no row overruns its slice.
+    """
+    h2 = hs2[s0]
+    h = np.sqrt(h2)
+    x0, x1, x2 = spts[s0, 0], spts[s0, 1], spts[s0, 2]
+    periodic = np.isfinite(period[0]) or np.isfinite(period[1]) or np.isfinite(period[2])
     n0 = _axis_cells(x0, origin[0], size[0], nc[0], h, period[0], buf, 0)
     n1 = _axis_cells(x1, origin[1], size[1], nc[1], h, period[1], buf, 1)
     n2 = _axis_cells(x2, origin[2], size[2], nc[2], h, period[2], buf, 2)
@@ -118,12 +125,26 @@ def _scan(i, spts, pts, start, perm, origin, size, nc, period, h, write_at, out,
                 if g1 + g2 * g2 >= h2:
                     continue
                 cell = base + buf[2, c]
-                for s in range(start[cell], start[cell + 1]):
-                    d2 = _dist2(pts, i, spts, s, period)
-                    if d2 < h2 and d2 > 0.0:
+                if periodic:
+                    for s in range(start[cell], start[cell + 1]):
+                        d2 = _dist2(spts, s0, spts, s, period)
                         if write_at >= 0:
-                            out[write_at + hits] = perm[s]
-                        hits += 1
+                            row[hits] = s
+                        hits += (d2 < h2) & (d2 > 0.0)
+                else:
+                    for s in range(start[cell], start[cell + 1]):
+                        d = spts[s, 0] - x0
+                        d2 = d * d
+                        d = spts[s, 1] - x1
+                        d2 += d * d
+                        d = spts[s, 2] - x2
+                        d2 += d * d
+                        if write_at >= 0:
+                            row[hits] = s
+                        hits += (d2 < h2) & (d2 > 0.0)
+    if write_at >= 0:
+        for k in range(hits):
+            out[write_at + k] = perm[row[k]]
     return hits
 
 
@@ -153,6 +174,9 @@ def cell_family(pts, horizon, origin, size, nc, period, index_dtype_sample, nch)
     for s in numba.prange(n):
         for k in range(3):
             spts[s, k] = pts[perm[s], k]
+    hs2 = np.empty(n)
+    for s in numba.prange(n):
+        hs2[s] = horizon[perm[s]] * horizon[perm[s]]
     width = 1
     for k in range(3):
         width = max(width, nc[k])
@@ -161,20 +185,23 @@ def cell_family(pts, horizon, origin, size, nc, period, index_dtype_sample, nch)
     nch = max(1, min(n, nch))
     for ch in numba.prange(nch):
         buf = np.empty((3, width + 1), dtype=np.int64)
+        row = np.empty(0, dtype=np.int64)
         for s in range(ch * n // nch, (ch + 1) * n // nch):
-            i = perm[s]
-            counts[i] = _scan(i, spts, pts, start, perm, origin, size, nc, period, horizon[i],
-                              -1, dummy, buf)
+            counts[perm[s]] = _scan(s, spts, hs2, start, perm, origin, size, nc, period, -1,
+                                    dummy, buf, row)
     offsets = np.zeros(n + 1, dtype=np.int64)
     for i in range(n):
         offsets[i + 1] = offsets[i] + counts[i]
     out = np.empty(offsets[n], dtype=index_dtype_sample.dtype)
     for ch in numba.prange(nch):
         buf = np.empty((3, width + 1), dtype=np.int64)
+        row = np.empty(16, dtype=np.int64)
         for s in range(ch * n // nch, (ch + 1) * n // nch):
             i = perm[s]
-            _scan(i, spts, pts, start, perm, origin, size, nc, period, horizon[i], offsets[i],
-                  out, buf)
+            if counts[i] + 1 > row.shape[0]:
+                row = np.empty(2 * counts[i] + 1, dtype=np.int64)
+            _scan(s, spts, hs2, start, perm, origin, size, nc, period, offsets[i], out, buf,
+                  row)
     return offsets, out
 
 
