@@ -3,7 +3,7 @@
 >>> import cnem
 >>> dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.5, 0.5]]])
 >>> model = cnem.discretize(cnem.nodes.regular(dom, 0.1))
->>> round(model.cells.area.sum(), 12)
+>>> float(round(model.cells.area.sum(), 12))
 1.0
 """
 

@@ -21,6 +21,12 @@ from cnem import geometry, nodes
 EDGE_CRACK = [[0.0, 0.5], [0.5, 0.5]]
 #: Kinked internal crack (two tips).
 KINKED_CRACK = [[0.2, 0.3], [0.5, 0.5], [0.8, 0.45]]
+#: Three regions whose shared boundaries have different vertices on each side.
+THREE_RECTANGLES = [
+    [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+    [[1.0, 0.0], [2.0, 0.0], [2.0, 0.5], [1.0, 0.5]],
+    [[1.0, 0.5], [1.3, 0.5], [2.0, 0.5], [2.0, 1.0], [1.0, 1.0]],
+]
 #: Inclined internal crack (two tips) for the graded cloud.
 INCLINED_CRACK = [[0.3, 0.35], [0.7, 0.62]]
 
@@ -76,6 +82,13 @@ def graded_inclined_crack():
     return dom, nodes.graded(dom, 0.1, near=dom.tips, h_min=0.02, growth=0.3, seed=1)
 
 
+def three_rectangles_irregular():
+    # interfaces given with different vertices on each side: (1, 0.5) and
+    # (1.3, 0.5) lie inside edges of the other regions; (1, 0.5) is a triple point
+    dom = cnem.Domain(THREE_RECTANGLES)
+    return dom, nodes.irregular(dom, 0.07, seed=4)
+
+
 #: Points put exactly on the boundary of the unit square by `random_points`.
 RANDOM_ON_BOUNDARY = np.array([[0.3, 0.0], [0.71, 0.0], [1.0, 0.45], [0.5, 1.0],
                                [0.0, 0.62], [0.0, 0.2]])
@@ -92,10 +105,14 @@ def random_points():
 CASES = {f.__name__: f for f in [
     square_regular, square_irregular, lshape_regular, lshape_irregular,
     plate_hole_irregular, annulus_full_irregular, annulus_sector_regular,
-    edge_crack_regular, kinked_crack_irregular, graded_inclined_crack, random_points,
+    three_rectangles_irregular, edge_crack_regular, kinked_crack_irregular,
+    graded_inclined_crack, random_points,
 ]}
 
 NAMES = list(CASES)
+#: Cases with cracks, and with material interfaces.
+CRACKED = ["edge_crack_regular", "kinked_crack_irregular", "graded_inclined_crack"]
+INTERFACES = ["annulus_full_irregular", "annulus_sector_regular", "three_rectangles_irregular"]
 
 
 @functools.lru_cache(maxsize=None)

