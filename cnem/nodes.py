@@ -74,7 +74,9 @@ def _keep_interior(dom, pts, clearance):
     """
     inside = dom.region_of(pts) >= 0
     pts = pts[inside]
-    clearance = np.broadcast_to(clearance, inside.shape)[inside]
+    # a hair below the clearance, so that lattice rows exactly at it are kept
+    # on every side alike whatever the rounding
+    clearance = np.broadcast_to(clearance, inside.shape)[inside] * (1 - 1e-9)
     tree = shapely.STRtree(_edge_lines(dom))
     near, _ = tree.query(shapely.points(pts), predicate="dwithin", distance=clearance)
     keep = np.ones(len(pts), dtype=bool)
@@ -112,7 +114,7 @@ def regular(domain, h):
     h = _check_spacing(domain, h)
     spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
     lattice = _lattice(domain, h)
-    interior = _keep_interior(domain, lattice, CLEARANCE * h * (1 - 1e-9))
+    interior = _keep_interior(domain, lattice, CLEARANCE * h)
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
 
 

@@ -138,13 +138,6 @@ def image_shifts(period, dim):
     return combos.reshape(-1, dim) * per
 
 
-def _sum_sq(diff):
-    s = diff[..., 0] * diff[..., 0]
-    for k in range(1, diff.shape[-1]):
-        s = s + diff[..., k] * diff[..., k]
-    return s
-
-
 def _rows_to_csr(rows):
     offsets = np.zeros(len(rows) + 1, dtype=np.int64)
     offsets[1:] = np.cumsum([len(r) for r in rows])
@@ -268,8 +261,8 @@ def csr_row_differences(offsets, indices, ref_offsets, ref_indices, limit=5):
         got = np.asarray(indices[offsets[i]:offsets[i + 1]]).tolist()
         ref = np.asarray(ref_indices[ref_offsets[i]:ref_offsets[i + 1]]).tolist()
         if sorted(got) != sorted(ref):
-            extra = sorted(set(got) - set(ref)) or "repeats"
-            out.append((i, sorted(set(ref) - set(got)), extra))
+            missing, extra = sorted(set(ref) - set(got)), sorted(set(got) - set(ref))
+            out.append((i, missing, extra if missing or extra else "repeats"))
             if len(out) >= limit:
                 break
     return out

@@ -7,13 +7,17 @@ nearer. A node on an interface owns one cell per region.
 
 Two paths compute the cells:
 
-* the *fast path* (numba, `._kernels.fast_cells`): a node with no incident
-  constraint whose circumcentres are all visible from it and whose dual polygon
-  is star-shaped owns exactly the polygon of its circumcentres;
-* the *exact path* (shapely), for every other node and region: the cell is the
-  part of a bounding box that node ``i`` sees (its wedge between its constraint
-  edges minus the shadows of every constraint segment), minus, for each nearby
-  node ``j`` of the region, the points nearer to ``j`` that ``j`` sees.
+* the *fast path* (numba, `._kernels.fast_cells`): a node whose circumcentres
+  are all visible from it and whose dual polygon is star-shaped around it owns
+  exactly the polygon of its circumcentres (closed by the node and the
+  midpoints of its two constraint edges when it sits on a straight boundary or
+  a convex corner);
+* the *exact path* (shapely, snap-rounded overlays), for every other node and
+  region (reflex corners, crack tips, interfaces, circumcentres behind a
+  constraint): the cell is the part of a bounding box that node ``i`` sees
+  (its wedge between its constraint edges minus the shadows of every
+  constraint segment), minus, for each nearby node ``j`` of the region, the
+  points nearer to ``j`` that ``j`` sees.
 """
 
 from __future__ import annotations
@@ -92,6 +96,13 @@ def _polygonal(geom):
         return geom
     parts = [g for g in shapely.get_parts(geom) if g.geom_type == "Polygon"]
     return shapely.MultiPolygon(parts) if parts else shapely.Polygon()
+
+
+def _drop_repeats(ring, tol):
+    """Remove vertices closer than ``tol`` to the previous one (snap-grid leftovers)."""
+    step = np.linalg.norm(ring - np.roll(ring, 1, axis=0), axis=1)
+    keep = step > tol
+    return ring[keep] if keep.sum() >= 3 else ring
 
 
 def _splice_hole(ring, hole, i, x):
@@ -217,7 +228,7 @@ class _ExactCells:
             raise GeometryError(f"the cell of node {i} at {self.nodes[i].tolist()} in region {r} "
                                 "is not connected; the node cloud is too coarse near this node")
         poly = shapely.geometry.polygon.orient(parts[0], 1.0)
-        ring = np.asarray(poly.exterior.coords)[:-1]
+        ring = _drop_repeats(np.asarray(poly.exterior.coords)[:-1], 10 * self.grid)
         for hole in poly.interiors:
             ring = _splice_hole(ring, np.asarray(hole.coords)[:-1], i, self.nodes[i])
         return ring

@@ -65,7 +65,12 @@ def build_level(cen, half, first, cnt, start, count, fanout, out_start, period):
         for k in range(d):
             c = 0.5 * (lo[k] + hi[k])
             h = 0.5 * (hi[k] - lo[k])
+            # round outwards, in the arithmetic of the tests (|p - c| - h <= 0 for
+            # every p in [lo, hi]; rounding is monotone so the ends suffice)
+            while (hi[k] - c) - h > 0.0 or (c - lo[k]) - h > 0.0:
+                h = np.nextafter(h, np.inf)
             if np.isfinite(period[k]):
+                h += 4.0 * np.finfo(np.float64).eps * period[k]   # wrapping rounds too
                 if h >= 0.5 * period[k]:
                     h = 0.5 * period[k]
                 c = c - period[k] * np.floor(c / period[k])
@@ -81,7 +86,10 @@ def _box_test(cen, half, e, qc, qh, i, r2, kind, period):
     d = cen.shape[1]
     if kind == INTERSECT:
         for k in range(d):
-            if abs(_wrap(qc[i, k] - cen[e, k], period[k])) > qh[i, k] + half[e, k]:
+            # slack of a few ulps: the query's centre and half-width are rounded
+            reach = qh[i, k] + half[e, k]
+            slack = 4e-16 * (reach + abs(qc[i, k]) + abs(cen[e, k]))
+            if abs(_wrap(qc[i, k] - cen[e, k], period[k])) > reach + slack:
                 return False
         return True
     s = 0.0
@@ -94,14 +102,34 @@ def _box_test(cen, half, e, qc, qh, i, r2, kind, period):
     return s <= r2
 
 
+@numba.njit(cache=True, inline="always")
+def _leaf_test(blo, bhi, e, qlo, qhi, i, r2, kind):
+    """Exact leaf test in corner form for open trees (no centre/half rounding)."""
+    d = blo.shape[1]
+    if kind == INTERSECT:
+        for k in range(d):
+            if qlo[i, k] > bhi[e, k] or blo[e, k] > qhi[i, k]:
+                return False
+        return True
+    s = 0.0
+    for k in range(d):
+        g = max(blo[e, k] - qlo[i, k], qlo[i, k] - bhi[e, k], 0.0)
+        s += g * g
+    if kind == BALL_OPEN:
+        return s < r2
+    return s <= r2
+
+
 @numba.njit(cache=True)
 def _traverse(cen, half, first, cnt, nbox, qc, qh, i, r2, kind, period, out, write_at,
-              exclude_zero, stack):
+              exclude_zero, stack, blo, bhi, qlo, qhi):
     """Depth-first search for query ``i``; count hits, writing them if ``write_at >= 0``.
 
     Arrays are passed whole with an index (no row views): views inside
-    parallel loops cost atomic reference counting.
+    parallel loops cost atomic reference counting. Open trees test their
+    leaves exactly in corner form (``blo, bhi`` against ``qlo, qhi``).
     """
+    periodic = np.isfinite(period[0])
     root = cen.shape[0] - 1
     node_kind = BALL_CLOSED if kind != INTERSECT else INTERSECT
     hits = 0
@@ -116,7 +144,11 @@ def _traverse(cen, half, first, cnt, nbox, qc, qh, i, r2, kind, period, out, wri
         top -= 1
         e = stack[top]
         if e < nbox:
-            if _box_test(cen, half, e, qc, qh, i, r2, kind, period):
+            if periodic:
+                hit = _box_test(cen, half, e, qc, qh, i, r2, kind, period)
+            else:
+                hit = _leaf_test(blo, bhi, e, qlo, qhi, i, r2, kind)
+            if hit:
                 if exclude_zero:
                     s = 0.0
                     for q in range(cen.shape[1]):
@@ -137,7 +169,7 @@ def _traverse(cen, half, first, cnt, nbox, qc, qh, i, r2, kind, period, out, wri
 
 @numba.njit(cache=True, parallel=True)
 def query(cen, half, first, cnt, nbox, depth, fanout, order, qcen, qhalf, radius, kind,
-          period, exclude_zero, nch):
+          period, exclude_zero, nch, blo, bhi, qlo, qhi):
     """Bulk query: CSR ``(offsets, indices)`` of the boxes hit by each query.
 
     ``radius`` is ``(q,)`` (ignored for ``INTERSECT``); ``order`` maps sorted
@@ -153,7 +185,7 @@ def query(cen, half, first, cnt, nbox, depth, fanout, order, qcen, qhalf, radius
         for i in range(ch * q // nch, (ch + 1) * q // nch):
             r2 = radius[i] * radius[i]
             counts[i] = _traverse(cen, half, first, cnt, nbox, qcen, qhalf, i, r2, kind,
-                                  period, dummy, -1, exclude_zero, stack)
+                                  period, dummy, -1, exclude_zero, stack, blo, bhi, qlo, qhi)
     offsets = np.zeros(q + 1, dtype=np.int64)
     for i in range(q):
         offsets[i + 1] = offsets[i] + counts[i]
@@ -163,7 +195,7 @@ def query(cen, half, first, cnt, nbox, depth, fanout, order, qcen, qhalf, radius
         for i in range(ch * q // nch, (ch + 1) * q // nch):
             r2 = radius[i] * radius[i]
             _traverse(cen, half, first, cnt, nbox, qcen, qhalf, i, r2, kind, period,
-                      local, offsets[i], exclude_zero, stack)
+                      local, offsets[i], exclude_zero, stack, blo, bhi, qlo, qhi)
     indices = np.empty(offsets[q], dtype=np.int64)
     for k in numba.prange(offsets[q]):
         indices[k] = order[local[k]]

@@ -40,7 +40,10 @@ def check_period(period, dim, *points):
     """Period as a ``(d,)`` array (``inf`` where not periodic); points must lie in ``[0, L)``."""
     if period is None:
         return np.full(dim, np.inf)
-    per = np.broadcast_to(np.asarray(period, dtype=np.float64), (dim,)).copy()
+    per = np.asarray(period, dtype=np.float64)
+    if per.ndim > 1 or per.size not in (1, dim):
+        raise ValueError(f"period: expected a number or {dim} lengths, received {period!r}")
+    per = np.broadcast_to(per, (dim,)).copy()
     if not (np.isfinite(per) & (per > 0)).all():
         raise ValueError(f"period: expected {dim} positive lengths, received {period!r}")
     for arr in points:
@@ -86,15 +89,15 @@ class RTree:
     """
 
     def __init__(self, lo, hi, *, period=None):
+        self._corners = None
         lo, hi = as_points(lo, "lo"), as_points(hi, "hi")
         if lo.shape != hi.shape:
             raise ValueError(f"lo and hi must have the same shape, received {lo.shape} and {hi.shape}")
         if (hi < lo).any():
             raise ValueError(f"{int((hi < lo).any(axis=1).sum())} boxes have hi < lo; "
                              "pass lower corners as lo and upper corners as hi")
-        centre = 0.5 * (lo + hi)
-        half = 0.5 * (hi - lo)
-        self._build(centre, half, period)
+        self._corners = (lo, hi)
+        self._build(0.5 * (lo + hi), 0.5 * (hi - lo), period)
 
     @classmethod
     def from_points(cls, points, *, period=None):
@@ -107,6 +110,7 @@ class RTree:
         """
         pts = as_points(points)
         tree = cls.__new__(cls)
+        tree._corners = (pts, pts)
         tree._build(pts, np.zeros_like(pts), period)
         return tree
 
@@ -140,15 +144,19 @@ class RTree:
                     arr[level_start[lev]:level_start[lev + 1]] = \
                         arr[level_start[lev]:level_start[lev + 1]][perm]
         self.order, self.level_start = order, level_start
+        self.lo = np.ascontiguousarray(self._corners[0][order])
+        self.hi = np.ascontiguousarray(self._corners[1][order])
         self.centre, self.half, self.first, self.count = cen, hw, first, cnt
 
     # ----------------------------------------------------------------- queries
-    def _query(self, qcen, qhalf, radius, kind, exclude_zero=False):
+    def _query(self, qcen, qhalf, radius, kind, exclude_zero=False, qlo=None, qhi=None):
         if self.size == 0 or len(qcen) == 0:
             return np.zeros(len(qcen) + 1, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        qlo = qcen if qlo is None else qlo
+        qhi = qcen if qhi is None else qhi
         return K.query(self.centre, self.half, self.first, self.count, self.size, self.depth,
                        FANOUT, self.order, qcen, qhalf, radius, kind, self.period, exclude_zero,
-                       work_chunks())
+                       work_chunks(), self.lo, self.hi, qlo, qhi)
 
     def _points(self, points, name, *, in_cell=True):
         arr = np.asarray(points, dtype=np.float64)
@@ -186,7 +194,8 @@ class RTree:
         qcen = 0.5 * (qlo + qhi)
         if self.periodic:
             qcen = np.mod(qcen, self.period)
-        return self._query(qcen, 0.5 * (qhi - qlo), np.zeros(len(qlo)), K.INTERSECT)
+        return self._query(qcen, 0.5 * (qhi - qlo), np.zeros(len(qlo)), K.INTERSECT,
+                           qlo=qlo, qhi=qhi)
 
     def query_ball(self, points, r, *, strict=False, exclude_self=False):
         """Boxes within distance ``r`` of each point.

@@ -1,0 +1,367 @@
+"""Files: integration cells and nodes of a `Model` through meshio (VTU).
+
+`write` stores one unstructured grid that ParaView opens directly:
+
+* points: the ``n`` nodes first (point ``i`` is node ``i``), then every
+  distinct vertex of the integration cells, as float64 with ``z = 0``;
+* cells: one ``vertex`` cell per node, then the integration cells as
+  ``polygon`` cells, grouped by vertex count (meshio keeps one block per
+  polygon size);
+* cell data ``region``, ``node`` (owner node), ``area`` and ``cell`` (index of
+  the integration cell in ``model.cells``; ``-1`` on the vertex cells), plus
+  the caller's arrays;
+* point data ``node_of_point`` plus the caller's per-node arrays.
+
+Arrays are written in binary, so `read` gives back the cells bit for bit.
+
+>>> import tempfile, pathlib, numpy as np, cnem, cnem.io
+>>> from cnem.geometry import rectangle
+>>> dom = rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.5, 0.5]]])
+>>> model = cnem.discretize(cnem.nodes.regular(dom, 0.1))
+>>> path = cnem.io.write(model, pathlib.Path(tempfile.mkdtemp()) / "cells.vtu")
+>>> back = cnem.io.read(path)
+>>> np.array_equal(back.vertices, model.cells.vertices), np.array_equal(back.node, model.cells.node)
+(True, True)
+
+XDMF is not offered: meshio's XDMF writer has no polygon topology. Legacy
+``.vtk`` is not offered either: it pads two-component arrays to three, so
+point data would not come back as written.
+"""
+
+from __future__ import annotations
+
+import logging
+import pathlib
+from dataclasses import dataclass, field
+
+import meshio
+import numpy as np
+
+from .errors import CNEMError
+from .geometry.model import Cells
+
+__all__ = ["write", "write_nodes", "read", "CellMesh", "FormatError", "SUFFIXES"]
+
+log = logging.getLogger(__name__)
+
+#: File suffixes `write` and `read` accept, with the meshio format of each.
+SUFFIXES = {".vtu": "vtu"}
+
+#: Cell-data names `write` reserves for itself.
+RESERVED = ("region", "node", "area", "cell")
+
+
+class FormatError(CNEMError, ValueError):
+    """A file name or a file's contents that `cnem.io` cannot handle."""
+
+
+def _format(path):
+    path = pathlib.Path(path)
+    suffix = path.suffix.lower()
+    if suffix in SUFFIXES:
+        return path, SUFFIXES[suffix]
+    supported = ", ".join(SUFFIXES)
+    if suffix == ".vtk":
+        raise FormatError(f"cannot use {path.name!r}: legacy VTK pads 2-component arrays to 3, "
+                          f"so files would not read back as written; supported suffixes: "
+                          f"{supported}")
+    if suffix in (".xdmf", ".xmf", ".h5"):
+        raise FormatError(f"cannot use {path.name!r}: meshio's XDMF writer has no polygon "
+                          f"topology for the integration cells; supported suffixes: "
+                          f"{supported} (open .vtu files in ParaView)")
+    raise FormatError(f"unknown file suffix {suffix or '(none)'!r} in {str(path)!r}; "
+                      f"supported suffixes: {supported}")
+
+
+def cell_topology(cells):
+    """Distinct vertices and polygon connectivity of integration cells.
+
+    Vertices that are bit-for-bit equal become one point, so neighbouring
+    cells share their points and the coordinates are never altered.
+
+    Parameters
+    ----------
+    cells : Cells
+        ``model.cells``, ``m`` cells with ``k`` vertices in all.
+
+    Returns
+    -------
+    points : (q, 2) float64 ndarray
+        Distinct cell vertices.
+    offsets : (m + 1,) int64 ndarray
+        Cell ``c`` is ``points[connectivity[offsets[c]:offsets[c + 1]]]``.
+    connectivity : (k,) int64 ndarray
+    """
+    vertices = np.ascontiguousarray(cells.vertices, dtype=np.float64)
+    points, connectivity = np.unique(vertices, axis=0, return_inverse=True)
+    return points, np.asarray(cells.offsets, np.int64), connectivity.reshape(-1).astype(np.int64)
+
+
+def _blocks(offsets, connectivity, shift):
+    """meshio ``polygon`` blocks (one per vertex count) and the cell order they use."""
+    sizes = np.diff(offsets)
+    order = np.argsort(sizes, kind="stable")
+    blocks, ids = [], []
+    for size in np.unique(sizes):
+        members = order[sizes[order] == size]
+        rows = offsets[members][:, None] + np.arange(size)
+        blocks.append(meshio.CellBlock("polygon", connectivity[rows] + shift))
+        ids.append(members)
+    return blocks, ids
+
+
+def _checked(value, count, name):
+    """``value`` as an array of ``count`` rows and its fill value (NaN, or -1 for integers)."""
+    arr = np.asarray(value)
+    if arr.ndim == 0 or len(arr) != count:
+        raise FormatError(f"{name}: expected an array of {count} rows, received shape "
+                          f"{np.shape(value)}")
+    if arr.dtype.kind in "biu":
+        arr = arr.astype(np.int64)
+        fill = -1
+    elif arr.dtype.kind == "f":
+        fill = np.nan
+    else:
+        raise FormatError(f"{name}: expected a numeric array, received dtype {arr.dtype}")
+    return arr, fill
+
+
+def write(model, path, *, point_data=None, cell_data=None):
+    """Write the nodes and integration cells of a model to a ``.vtu`` file.
+
+    Parameters
+    ----------
+    model : Model
+        From `cnem.discretize`: ``n`` nodes, ``m`` integration cells.
+    path : str or os.PathLike
+        Suffix ``.vtu``.
+    point_data : dict of str -> (n,) or (n, c) array_like, optional
+        Values at the nodes (displacements, say). The cell vertices that are
+        not nodes get NaN (``-1`` for integer arrays).
+    cell_data : dict of str -> (m,) or (m, c) array_like, optional
+        Values on the integration cells (stresses, say); the node vertex
+        cells get NaN (``-1``). The names ``region``, ``node``, ``area`` and
+        ``cell`` are reserved.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    FormatError
+        Unsupported suffix, arrays of the wrong length, reserved names.
+    """
+    path, fmt = _format(path)
+    cells, nodes = model.cells, np.asarray(model.nodes, np.float64)
+    n, m = len(nodes), len(cells)
+    vpoints, offsets, connectivity = cell_topology(cells)
+    points = np.zeros((n + len(vpoints), 3))
+    points[:n, :2] = nodes
+    points[n:, :2] = vpoints
+    blocks, ids = _blocks(offsets, connectivity, n)
+    all_ids = [np.full(n, -1, dtype=np.int64)] + ids
+
+    def per_block(values, fill):
+        """Split ``values`` (m rows) over the blocks; the vertex block gets ``fill``."""
+        head = np.full((n,) + values.shape[1:], fill, dtype=values.dtype)
+        return [head] + [values[i] for i in ids]
+
+    cdata = {
+        "region": per_block(np.asarray(cells.region, np.int64), -1),
+        "node": [np.arange(n, dtype=np.int64)] + [np.asarray(cells.node, np.int64)[i] for i in ids],
+        "area": per_block(np.asarray(cells.area, np.float64), np.nan),
+        "cell": all_ids,
+    }
+    for name, value in (cell_data or {}).items():
+        if name in RESERVED:
+            raise FormatError(f"cell_data name {name!r} is reserved by cnem.io "
+                              f"({', '.join(RESERVED)}); rename it")
+        arr, fill = _checked(value, m, f"cell_data[{name!r}]")
+        cdata[name] = per_block(arr, fill)
+
+    pdata = {"node_of_point": np.concatenate(
+        [np.asarray(model.node_of_point, np.int64), np.full(len(vpoints), -1, np.int64)])}
+    for name, value in (point_data or {}).items():
+        if name == "node_of_point":
+            raise FormatError("point_data name 'node_of_point' is reserved by cnem.io; rename it")
+        arr, fill = _checked(value, n, f"point_data[{name!r}]")
+        full = np.full((len(points),) + arr.shape[1:], fill, dtype=arr.dtype)
+        full[:n] = arr
+        pdata[name] = full
+
+    vertex = meshio.CellBlock("vertex", np.arange(n, dtype=np.int64)[:, None])
+    mesh = meshio.Mesh(points, [vertex] + blocks, point_data=pdata, cell_data=cdata)
+    meshio.write(path, mesh, file_format=fmt, binary=True)
+    log.info("cnem.io.write: %d nodes, %d cells, %d polygon sizes -> %s", n, m, len(blocks), path)
+    return path
+
+
+def write_nodes(model, path, *, point_data=None):
+    """Write the nodes, the constrained Delaunay triangles and the constraint segments.
+
+    Parameters
+    ----------
+    model : Model
+        ``n`` nodes, ``t`` triangles, ``s`` constraint segments.
+    path : str or os.PathLike
+        Suffix ``.vtu``.
+    point_data : dict of str -> (n,) or (n, c) array_like, optional
+        Values at the nodes.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Notes
+    -----
+    Cell data ``region`` holds the region of each triangle (``-1`` on the
+    segments) and ``kind`` the kind of each segment (0 boundary, 1 interface,
+    2 crack face; ``-1`` on the triangles). Point data ``node_of_point`` maps
+    each node to ``model.cloud.points``.
+    """
+    path, fmt = _format(path)
+    nodes = np.asarray(model.nodes, np.float64)
+    n = len(nodes)
+    points = np.zeros((n, 3))
+    points[:, :2] = nodes
+    tri = np.asarray(model.triangles, np.int64)
+    seg = np.asarray(model.segments, np.int64)
+    pdata = {"node_of_point": np.asarray(model.node_of_point, np.int64)}
+    for name, value in (point_data or {}).items():
+        arr, _ = _checked(value, n, f"point_data[{name!r}]")
+        pdata[name] = arr
+    cells = [meshio.CellBlock("triangle", tri), meshio.CellBlock("line", seg)]
+    cdata = {
+        "region": [np.asarray(model.triangle_region, np.int64), np.full(len(seg), -1, np.int64)],
+        "kind": [np.full(len(tri), -1, np.int64), np.asarray(model.segment_kind, np.int64)],
+    }
+    meshio.write(path, meshio.Mesh(points, cells, point_data=pdata, cell_data=cdata),
+                 file_format=fmt, binary=True)
+    return path
+
+
+@dataclass(frozen=True, repr=False)
+class CellMesh:
+    """Nodes and integration cells read back from a file written by `write`.
+
+    Attributes
+    ----------
+    nodes : (n, 2) float64 ndarray
+    node_of_point : (n,) int64 ndarray
+    offsets : (m + 1,) int64 ndarray
+    vertices : (k, 2) float64 ndarray
+        Cell ``c`` is ``vertices[offsets[c]:offsets[c + 1]]``, in the order
+        and orientation of ``model.cells``.
+    node : (m,) int64 ndarray
+        Owner node of each cell.
+    region : (m,) int64 ndarray
+    area : (m,) float64 ndarray
+    point_data : dict of str -> (n, ...) ndarray
+        The caller's per-node arrays.
+    cell_data : dict of str -> (m, ...) ndarray
+        The caller's per-cell arrays.
+    """
+
+    nodes: np.ndarray
+    node_of_point: np.ndarray
+    offsets: np.ndarray
+    vertices: np.ndarray
+    node: np.ndarray
+    region: np.ndarray
+    area: np.ndarray
+    point_data: dict = field(default_factory=dict)
+    cell_data: dict = field(default_factory=dict)
+
+    def __len__(self):
+        return len(self.node)
+
+    def polygon(self, i):
+        """Vertices of cell ``i``, ``(k, 2)``, counter-clockwise."""
+        return self.vertices[self.offsets[i]:self.offsets[i + 1]]
+
+    @property
+    def cells(self):
+        """The cells as a `cnem.geometry.Cells` (areas recomputed from the vertices)."""
+        return Cells(self.node, self.region, self.offsets, self.vertices)
+
+    def __repr__(self):
+        extra = list(self.point_data) + list(self.cell_data)
+        return (f"<CellMesh {len(self.nodes)} nodes, {len(self.node)} cells, "
+                f"{len(np.unique(self.region))} regions"
+                + (f", data: {', '.join(extra)}" if extra else "") + ">")
+
+
+def read(path):
+    """Read nodes and integration cells from a file written by `write`.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ``.vtu`` file from `write`.
+
+    Returns
+    -------
+    CellMesh
+        ``read(write(model, p))`` holds exactly ``model.cells.vertices``,
+        ``offsets``, ``node``, ``region`` and ``area`` (float64, bit for bit)
+        and ``model.nodes``.
+
+    Raises
+    ------
+    FormatError
+        Unsupported suffix, or a file that `write` did not produce.
+    """
+    path, fmt = _format(path)
+    mesh = meshio.read(path, file_format=fmt)
+    missing = [k for k in RESERVED if k not in mesh.cell_data]
+    if missing:
+        raise FormatError(f"{str(path)!r} lacks the cell data {missing} that cnem.io.write "
+                          f"stores; it was not written by cnem.io.write")
+    points = np.asarray(mesh.points, np.float64)[:, :2]
+    node_ids, polys = [], []
+    for k, block in enumerate(mesh.cells):
+        data = {name: np.asarray(mesh.cell_data[name][k]) for name in mesh.cell_data}
+        if block.type == "vertex":
+            node_ids.append(np.asarray(block.data, np.int64)[:, 0])
+        elif block.type in ("polygon", "triangle", "quad"):
+            polys.append((np.asarray(block.data, np.int64), data))
+        else:
+            raise FormatError(f"{str(path)!r}: unexpected cell type {block.type!r}; "
+                              f"expected vertex and polygon cells from cnem.io.write")
+    if not node_ids or not polys:
+        raise FormatError(f"{str(path)!r}: expected vertex cells (nodes) and polygon cells "
+                          f"(integration cells) as written by cnem.io.write")
+    nodes_idx = np.concatenate(node_ids)
+    nodes = points[nodes_idx]
+    cell_ids = np.concatenate([d["cell"].astype(np.int64) for _, d in polys])
+    m = len(cell_ids)
+    if not np.array_equal(np.sort(cell_ids), np.arange(m)):
+        raise FormatError(f"{str(path)!r}: cell indices are not a permutation of 0..{m - 1}")
+    sizes = np.zeros(m, dtype=np.int64)
+    for conn, d in polys:
+        sizes[d["cell"].astype(np.int64)] = conn.shape[1]
+    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    vertices = np.empty((offsets[-1], 2))
+    for conn, d in polys:
+        rows = offsets[d["cell"].astype(np.int64)][:, None] + np.arange(conn.shape[1])
+        vertices[rows] = points[conn]
+
+    def gather(name, dtype=None):
+        first = np.asarray(polys[0][1][name])
+        out = np.empty((m,) + first.shape[1:], dtype=dtype or first.dtype.newbyteorder("="))
+        for _, d in polys:
+            out[d["cell"].astype(np.int64)] = d[name]
+        return out
+
+    user_cells = {name: gather(name) for name in mesh.cell_data if name not in RESERVED}
+    user_points = {name: np.asarray(v)[nodes_idx].astype(np.asarray(v).dtype.newbyteorder("="))
+                   for name, v in mesh.point_data.items() if name != "node_of_point"}
+    nop = mesh.point_data.get("node_of_point")
+    nop = (np.asarray(nop, np.int64)[nodes_idx] if nop is not None
+           else np.arange(len(nodes), dtype=np.int64))
+    return CellMesh(nodes=np.ascontiguousarray(nodes), node_of_point=nop, offsets=offsets,
+                    vertices=vertices, node=gather("node", np.int64),
+                    region=gather("region", np.int64), area=gather("area", np.float64),
+                    point_data=user_points, cell_data=user_cells)

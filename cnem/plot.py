@@ -1,0 +1,212 @@
+"""Pictures of a `Model` with pyvista, off-screen: cells, triangles, nodes, cracks.
+
+pyvista is imported only here, and only when a picture is drawn, so
+``import cnem.plot`` works without it; drawing without it raises `PlotError`
+with the command that installs it (``pip install "cnem[plot]"``).
+
+>>> import cnem, cnem.plot                                  # doctest: +SKIP
+>>> from cnem.geometry import rectangle                     # doctest: +SKIP
+>>> dom = rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.5, 0.5]]])   # doctest: +SKIP
+>>> m = cnem.discretize(cnem.nodes.regular(dom, 0.1))      # doctest: +SKIP
+>>> cnem.plot.model(m, "cells.png").close()                # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import logging
+import pathlib
+
+import numpy as np
+
+from .errors import CNEMError
+from .io import cell_topology
+
+__all__ = ["model", "cells_polydata", "region_color", "PlotError", "REGION_COLORS"]
+
+log = logging.getLogger(__name__)
+
+#: Categorical colours of the regions (RGB, 0-255), light so that the black
+#: cell edges, grey triangles and red cracks stand out; region ``r`` gets
+#: ``REGION_COLORS[r % len(REGION_COLORS)]``.
+REGION_COLORS = np.array([
+    [166, 206, 227],   # light blue
+    [253, 191, 111],   # light orange
+    [178, 223, 138],   # light green
+    [251, 154, 153],   # light red
+    [202, 178, 214],   # light purple
+    [255, 255, 153],   # light yellow
+    [141, 211, 199],   # teal
+    [217, 217, 217],   # light grey
+    [252, 205, 229],   # pink
+    [204, 235, 197],   # mint
+], dtype=np.uint8)
+
+INSTALL_HINT = 'install the plotting extra: pip install "cnem[plot]"'
+
+
+class PlotError(CNEMError, RuntimeError):
+    """pyvista is missing or cannot render off-screen."""
+
+
+def _pyvista():
+    """pyvista, set to render off-screen, or a `PlotError` saying how to get it."""
+    try:
+        import pyvista
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise PlotError(f"cnem.plot needs pyvista, which cannot be imported ({exc}); "
+                        f"{INSTALL_HINT}") from exc
+    pyvista.OFF_SCREEN = True
+    return pyvista
+
+
+def region_color(region):
+    """RGB colour (0-255) of each region, ``(r, 3)`` uint8 for ``(r,)`` region indices."""
+    return REGION_COLORS[np.asarray(region, dtype=np.int64) % len(REGION_COLORS)]
+
+
+def _lift(points2d, z):
+    out = np.zeros((len(points2d), 3))
+    out[:, :2] = points2d
+    out[:, 2] = z
+    return out
+
+
+def _lines(pv, points2d, pairs, z):
+    """PolyData of the segments ``pairs (s, 2)`` between ``points2d`` at height ``z``."""
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    lines = np.column_stack([np.full(len(pairs), 2), pairs]).ravel()
+    return pv.PolyData(_lift(points2d, z), lines=lines)
+
+
+def cells_polydata(model):
+    """The integration cells as a pyvista ``PolyData`` (one polygon per cell).
+
+    Parameters
+    ----------
+    model : Model
+        ``m`` integration cells.
+
+    Returns
+    -------
+    pyvista.PolyData
+        ``m`` polygons in the order of ``model.cells``, points at ``z = 0``,
+        cell data ``region``, ``node``, ``area`` and ``cell`` (0..m-1) and
+        ``color`` (``(m, 3)`` uint8, the region's colour).
+    """
+    pv = _pyvista()
+    points, offsets, connectivity = cell_topology(model.cells)
+    sizes = np.diff(offsets)
+    faces = np.insert(connectivity, offsets[:-1], sizes)
+    poly = pv.PolyData(_lift(points, 0.0), faces=faces)
+    cells = model.cells
+    poly.cell_data["region"] = np.asarray(cells.region, np.int64)
+    poly.cell_data["node"] = np.asarray(cells.node, np.int64)
+    poly.cell_data["area"] = np.asarray(cells.area, np.float64)
+    poly.cell_data["cell"] = np.arange(len(cells), dtype=np.int64)
+    poly.cell_data["color"] = region_color(cells.region)
+    return poly
+
+
+def _triangle_edges(triangles):
+    t = np.asarray(triangles, dtype=np.int64)
+    e = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+    return np.unique(np.sort(e, axis=1), axis=0)
+
+
+def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks=True,
+          window_size=(1200, 1200), bounds=None, node_size=None):
+    """Top view of a model: constrained Voronoi cells, Delaunay triangles, nodes, cracks.
+
+    Cells are filled with their region's colour (`REGION_COLORS`, unlit so the
+    colours in the picture are exact) with black edges; triangle edges are
+    thin grey lines, nodes black dots and crack faces thick red lines.
+
+    Parameters
+    ----------
+    model : Model
+        From `cnem.discretize`.
+    path : str or os.PathLike, optional
+        Write a PNG there (parent folders are created).
+    show_triangles, show_nodes, show_cracks : bool
+        Draw the constrained Delaunay triangles, the nodes, the crack faces
+        (segments with ``segment_kind == 2``).
+    window_size : (2,) int
+        Picture size in pixels, ``(width, height)``.
+    bounds : (4,) float, optional
+        ``(xmin, xmax, ymin, ymax)`` to show (a zoom); default the whole domain.
+    node_size : float, optional
+        Node dot size in pixels; default from the smallest node spacing in view.
+
+    Returns
+    -------
+    pyvista.Plotter
+        Off-screen; call ``.close()`` when done with it.
+
+    Raises
+    ------
+    PlotError
+        pyvista missing, or the picture cannot be rendered.
+    """
+    pv = _pyvista()
+    mdl = model
+    dom = mdl.domain
+    xmin, ymin, xmax, ymax = dom.bounds
+    if bounds is None:
+        bounds = (xmin, xmax, ymin, ymax)
+    bx0, bx1, by0, by1 = map(float, bounds)
+    if not (bx1 > bx0 and by1 > by0):
+        raise PlotError(f"bounds must be (xmin, xmax, ymin, ymax) with xmin < xmax and "
+                        f"ymin < ymax, received {tuple(bounds)}")
+    width, height = map(int, window_size)
+    lift = 1e-4 * dom.diameter        # draw lines above the cells (parallel view: no shift)
+    try:
+        pl = pv.Plotter(off_screen=True, window_size=(width, height))
+    except Exception as exc:  # pragma: no cover - depends on the environment
+        raise PlotError(f"pyvista cannot open an off-screen window ({exc}); {INSTALL_HINT} "
+                        f"and make sure VTK has an off-screen backend (OSMesa/EGL) or a display"
+                        ) from exc
+    pl.set_background("white")
+    # pixels per unit length in the final view
+    scale = min(width / (bx1 - bx0), height / (by1 - by0)) / 1.04
+    pl.add_mesh(cells_polydata(mdl), scalars="color", rgb=True, lighting=False,
+                show_edges=True, edge_color="black", line_width=max(1.0, width / 1200),
+                show_scalar_bar=False)
+    if show_triangles and len(mdl.triangles):
+        pl.add_mesh(_lines(pv, mdl.nodes, _triangle_edges(mdl.triangles), lift),
+                    color=(0.55, 0.55, 0.55), line_width=max(0.5, 0.5 * width / 1200),
+                    lighting=False)
+    if show_cracks:
+        crack = np.asarray(mdl.segments)[np.asarray(mdl.segment_kind) == 2]
+        if len(crack):
+            pl.add_mesh(_lines(pv, mdl.nodes, crack, 2 * lift), color="red",
+                        line_width=max(3.0, 4.0 * width / 1200), lighting=False)
+    if show_nodes:
+        nodes = np.asarray(mdl.nodes)
+        if node_size is None:
+            spacing = np.asarray(mdl.cloud.spacing)
+            seen = ((mdl.cloud.points[:, 0] >= bx0) & (mdl.cloud.points[:, 0] <= bx1)
+                    & (mdl.cloud.points[:, 1] >= by0) & (mdl.cloud.points[:, 1] <= by1))
+            h = spacing[seen].min() if seen.any() else spacing.min()
+            node_size = float(np.clip(0.25 * h * scale, 2.0, 10.0))
+        pl.add_mesh(pv.PolyData(_lift(nodes, 3 * lift)), color="black",
+                    point_size=node_size, render_points_as_spheres=True, lighting=False)
+    pl.view_xy()
+    pl.enable_parallel_projection()
+    cx, cy = 0.5 * (bx0 + bx1), 0.5 * (by0 + by1)
+    cam = pl.camera
+    cam.focal_point = (cx, cy, 0.0)
+    cam.position = (cx, cy, 10.0 * dom.diameter)
+    cam.up = (0.0, 1.0, 0.0)
+    cam.parallel_scale = 0.5 * 1.04 * max(by1 - by0, (bx1 - bx0) * height / width)
+    pl.reset_camera_clipping_range()
+    if path is not None:
+        path = pathlib.Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            pl.screenshot(str(path))
+        except Exception as exc:  # pragma: no cover - depends on the environment
+            pl.close()
+            raise PlotError(f"pyvista could not render {str(path)!r} off-screen ({exc}); "
+                            f"{INSTALL_HINT}, with a VTK that renders off-screen") from exc
+        log.info("cnem.plot.model: wrote %s", path)
+    return pl

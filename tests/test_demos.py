@@ -1,0 +1,65 @@
+"""Every demo runs at a small size and returns the numbers it promises."""
+
+import importlib.util
+import pathlib
+
+import numpy as np
+import pytest
+import shapely
+
+import cnem
+import cnem.io
+from cnem.geometry import rectangle
+
+DEMOS = pathlib.Path(__file__).resolve().parents[1] / "demos"
+
+
+def _load(name):
+    spec = importlib.util.spec_from_file_location(name, DEMOS / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _has_pyvista():
+    return importlib.util.find_spec("pyvista") is not None
+
+
+@pytest.mark.parametrize("gamma", [30.0, 0.0])
+def test_cracked_plate_geometry(tmp_path, gamma):
+    demo = _load("cracked_plate_geometry")
+    h, h_min, growth = 0.2, 0.04, 0.3
+    plot = _has_pyvista() and gamma == 30.0
+    res = demo.main(h=h, h_min=h_min, gamma_deg=gamma, growth=growth, outdir=tmp_path,
+                    plot=plot, window_size=(300, 300))
+
+    # the plate 2W = 2 is partitioned by the cells
+    assert res["exact_area"] == 4.0
+    assert abs(res["cell_area"] - 4.0) <= 1e-12 * 4.0
+    assert res["area_error"] <= 1e-12
+    assert res["n_cells"] == res["n_nodes"]          # one region: one cell per node
+
+    # independently: the crack 2a = 0.2 through the origin at angle gamma
+    g = np.deg2rad(gamma)
+    tip = 0.1 * np.array([np.cos(g), np.sin(g)])
+    np.testing.assert_allclose(np.sort(res["tips"], axis=0), np.sort([-tip, tip], axis=0),
+                               atol=1e-15)
+    dom = rectangle(2.0, 2.0, origin=(-1.0, -1.0), cracks=[[-tip, tip]])
+    cloud = cnem.nodes.graded(dom, h, near=dom.tips, h_min=h_min, growth=growth)
+    crack = shapely.LineString([-tip, tip])
+    on_crack = shapely.distance(shapely.points(cloud.points), crack) <= 1e-12
+    at_tip = np.linalg.norm(cloud.points[:, None] - np.array([-tip, tip])[None], axis=2) <= 1e-12
+    assert res["n_points"] == len(cloud.points)
+    assert res["n_crack_points"] == on_crack.sum() >= 3
+    assert at_tip.sum() == 2 and on_crack[at_tip.any(axis=1)].all()
+    assert res["n_split"] == on_crack.sum() - 2
+    assert res["n_nodes"] == len(cloud.points) + on_crack.sum() - 2
+
+    files = res["files"]
+    assert pathlib.Path(files["vtu"]).stat().st_size > 0
+    back = cnem.io.read(files["vtu"])
+    assert len(back) == res["n_cells"]
+    if plot:
+        for key in ("cells", "tip"):
+            assert pathlib.Path(files[key]).stat().st_size > 1000
+            assert pathlib.Path(files[key]).parent == tmp_path

@@ -1,0 +1,70 @@
+"""Pictures (cnem.plot): a non-empty, non-uniform PNG in the region colours."""
+
+import numpy as np
+import pytest
+
+pv = pytest.importorskip("pyvista")
+
+import cnem.plot  # noqa: E402
+from cases import model  # noqa: E402
+
+
+def _rgb(path):
+    """(height, width, 3) int64 pixels of a PNG (read with VTK, which pyvista brings)."""
+    image = pv.read(path)
+    nx, ny, _ = image.dimensions
+    pixels = np.asarray(image.point_data.active_scalars)
+    return pixels.reshape(ny, nx, -1)[::-1, :, :3].astype(np.int64)
+
+
+def _has_color(img, rgb, tol=2):
+    return np.count_nonzero(np.abs(img - np.asarray(rgb, np.int64)).max(axis=-1) <= tol)
+
+
+def test_bimaterial_picture_shows_both_regions(tmp_path):
+    _, _, m = model("annulus_sector_regular")
+    path = tmp_path / "annulus.png"
+    pl = cnem.plot.model(m, path, window_size=(400, 400))
+    pl.close()
+    assert path.stat().st_size > 1000
+    img = _rgb(path)
+    assert img.shape == (400, 400, 3)
+    assert img.reshape(-1, 3).var(axis=0).sum() > 0
+    for r in (0, 1):
+        assert _has_color(img, cnem.plot.region_color([r])[0]) > 0.02 * 400 * 400, r
+    assert not _has_color(img, (255, 0, 0), tol=30)      # no crack here
+
+
+def test_cracked_picture_shows_red_crack(tmp_path):
+    _, _, m = model("graded_inclined_crack")
+    path = tmp_path / "crack.png"
+    cnem.plot.model(m, path, window_size=(400, 400)).close()
+    img = _rgb(path)
+    assert _has_color(img, cnem.plot.region_color([0])[0]) > 0.2 * 400 * 400
+    assert _has_color(img, (255, 0, 0), tol=30) > 50
+    path2 = tmp_path / "nocrack.png"
+    cnem.plot.model(m, path2, window_size=(400, 400), show_cracks=False).close()
+    assert not _has_color(_rgb(path2), (255, 0, 0), tol=30)
+
+
+def test_cells_polydata_matches_cells():
+    _, _, m = model("annulus_full_irregular")
+    poly = cnem.plot.cells_polydata(m)
+    assert poly.n_cells == len(m.cells)
+    np.testing.assert_array_equal(poly.cell_data["region"], m.cells.region)
+    np.testing.assert_array_equal(poly.cell_data["node"], m.cells.node)
+    # every polygon has the cell's vertices, in order (parse the VTK face stream)
+    faces, pts = np.asarray(poly.faces), np.asarray(poly.points)
+    k = 0
+    for i in range(len(m.cells)):
+        size = faces[k]
+        np.testing.assert_array_equal(pts[faces[k + 1:k + 1 + size], :2], m.cells.polygon(i))
+        k += 1 + size
+    assert k == len(faces)
+    assert np.all(pts[:, 2] == 0)
+
+
+def test_bad_bounds(tmp_path):
+    _, _, m = model("graded_inclined_crack")
+    with pytest.raises(cnem.plot.PlotError, match="bounds"):
+        cnem.plot.model(m, bounds=(1.0, 0.0, 0.0, 1.0))
