@@ -16,7 +16,21 @@ INTERSECT, BALL_CLOSED, BALL_OPEN = 0, 1, 2
 
 @numba.njit(cache=True, inline="always")
 def _wrap(d, period):
-    """Minimum image of a coordinate difference (RestrictVector)."""
+    """Minimum image of a coordinate difference (RestrictVector).
+
+    Every coordinate lies in ``[0, L)``, so ``|d| < L`` and one shift at most
+    is needed; with ``L = inf`` both comparisons fail and ``d`` is returned.
+    """
+    if d > 0.5 * period:
+        return d - period
+    if d < -0.5 * period:
+        return d + period
+    return d
+
+
+@numba.njit(cache=True, inline="always")
+def _wrap_any(d, period):
+    """Minimum image of any coordinate difference (several periods allowed)."""
     if np.isfinite(period):
         return d - period * np.floor(d / period + 0.5)
     return d
@@ -59,7 +73,7 @@ def build_level(cen, half, first, cnt, start, count, fanout, out_start, period):
         for c in range(a + 1, b):
             for k in range(d):
                 ref = 0.5 * (lo[k] + hi[k])
-                cc = ref + _wrap(cen[c, k] - ref, period[k])
+                cc = ref + _wrap_any(cen[c, k] - ref, period[k])
                 lo[k] = min(lo[k], cc - half[c, k])
                 hi[k] = max(hi[k], cc + half[c, k])
         for k in range(d):
@@ -103,21 +117,25 @@ def _box_test(cen, half, e, qc, qh, i, r2, kind, period):
 
 
 @numba.njit(cache=True, inline="always")
-def _leaf_test(blo, bhi, e, qlo, qhi, i, r2, kind):
-    """Exact leaf test in corner form for open trees (no centre/half rounding)."""
-    d = blo.shape[1]
-    if kind == INTERSECT:
-        for k in range(d):
-            if qlo[i, k] > bhi[e, k] or blo[e, k] > qhi[i, k]:
+def _leaf_test(blo, bhi, e, qlo, qhi, i, period):
+    """Exact box-box intersection in corner form (no centre/half rounding).
+
+    Under periodic boundaries the box is also tried shifted by -L and +L
+    along each axis (centres lie in ``[0, L)`` and boxes are at most ``L``
+    wide, so these images suffice).
+    """
+    for k in range(blo.shape[1]):
+        if np.isfinite(period[k]):
+            ok = False
+            for m in range(-1, 2):
+                v = m * period[k]
+                if qlo[i, k] <= bhi[e, k] + v and blo[e, k] + v <= qhi[i, k]:
+                    ok = True
+            if not ok:
                 return False
-        return True
-    s = 0.0
-    for k in range(d):
-        g = max(blo[e, k] - qlo[i, k], qlo[i, k] - bhi[e, k], 0.0)
-        s += g * g
-    if kind == BALL_OPEN:
-        return s < r2
-    return s <= r2
+        elif qlo[i, k] > bhi[e, k] or blo[e, k] > qhi[i, k]:
+            return False
+    return True
 
 
 @numba.njit(cache=True)
@@ -126,10 +144,11 @@ def _traverse(cen, half, first, cnt, nbox, qc, qh, i, r2, kind, period, out, wri
     """Depth-first search for query ``i``; count hits, writing them if ``write_at >= 0``.
 
     Arrays are passed whole with an index (no row views): views inside
-    parallel loops cost atomic reference counting. Open trees test their
-    leaves exactly in corner form (``blo, bhi`` against ``qlo, qhi``).
+    parallel loops cost atomic reference counting. Box-box intersections of
+    leaves are tested exactly in corner form (``blo, bhi`` against ``qlo,
+    qhi``); ball tests against points are exact in centre form.
     """
-    periodic = np.isfinite(period[0])
+    corners = kind == INTERSECT
     root = cen.shape[0] - 1
     node_kind = BALL_CLOSED if kind != INTERSECT else INTERSECT
     hits = 0
@@ -144,10 +163,10 @@ def _traverse(cen, half, first, cnt, nbox, qc, qh, i, r2, kind, period, out, wri
         top -= 1
         e = stack[top]
         if e < nbox:
-            if periodic:
-                hit = _box_test(cen, half, e, qc, qh, i, r2, kind, period)
+            if corners:
+                hit = _leaf_test(blo, bhi, e, qlo, qhi, i, period)
             else:
-                hit = _leaf_test(blo, bhi, e, qlo, qhi, i, r2, kind)
+                hit = _box_test(cen, half, e, qc, qh, i, r2, kind, period)
             if hit:
                 if exclude_zero:
                     s = 0.0
