@@ -176,7 +176,9 @@ def box_dist2(points, lo, hi, period=None):
         x = points[rows, None, :]
 
         def term(k, v):
-            g = np.maximum(np.maximum((lo[None, :, k] + v) - x[..., k], x[..., k] - (hi[None, :, k] + v)), 0.0)
+            below = (lo[None, :, k] + v) - x[..., k]
+            above = x[..., k] - (hi[None, :, k] + v)
+            g = np.maximum(np.maximum(below, above), 0.0)
             return g * g
 
         out[rows] = _min_over_images(term, shifts, (len(x), len(lo)))
@@ -205,15 +207,13 @@ def brute_ball(points, lo, hi, r, period=None, strict=False, exclude_self=False)
     of each point (``<= r``, or ``< r`` if ``strict``); ``exclude_self`` leaves out
     boxes whose centre is the point."""
     points, lo, hi = (np.asarray(a, dtype=float) for a in (points, lo, hi))
-    if np.array_equal(lo, hi):
-        d2 = point_dist2(points, lo, period)
-    else:
-        d2 = box_dist2(points, lo, hi, period)
+    zero_size = np.array_equal(lo, hi)
+    d2 = point_dist2(points, lo, period) if zero_size else box_dist2(points, lo, hi, period)
     r = np.broadcast_to(np.asarray(r, dtype=float), (len(points),))
     r2 = (r * r)[:, None]
     hit = d2 < r2 if strict else d2 <= r2
     if exclude_self:
-        hit &= point_dist2(points, 0.5 * (lo + hi), period) > 0.0
+        hit &= (d2 if zero_size else point_dist2(points, 0.5 * (lo + hi), period)) > 0.0
     return _rows_to_csr([np.flatnonzero(row) for row in hit])
 
 
@@ -256,6 +256,14 @@ def csr_row_differences(offsets, indices, ref_offsets, ref_indices, limit=5):
     offsets, ref_offsets = np.asarray(offsets), np.asarray(ref_offsets)
     if len(offsets) != len(ref_offsets):
         return [("row count", len(offsets) - 1, len(ref_offsets) - 1)]
+    n = len(offsets) - 1
+    if len(indices) == len(ref_indices):         # fast path: same sorted (row, column) keys
+        rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(offsets))
+        ref_rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(ref_offsets))
+        keys = np.sort(rows * (n + 1) + np.asarray(indices, dtype=np.int64))
+        ref_keys = np.sort(ref_rows * (n + 1) + np.asarray(ref_indices, dtype=np.int64))
+        if np.array_equal(keys, ref_keys):
+            return []
     out = []
     for i in range(len(offsets) - 1):
         got = np.asarray(indices[offsets[i]:offsets[i + 1]]).tolist()

@@ -19,7 +19,7 @@ from cnem.spatial import RTree
 
 CASES = [(kind, dim, periodic) for kind in R.SPATIAL_KINDS for dim in (2, 3)
          for periodic in (False, True)]
-SIZES = {2: 1500, 3: 1000}
+SIZES = {2: 1200, 3: 800}
 
 
 def case_id(case):
@@ -199,6 +199,25 @@ def test_query_straddling_box_from_the_other_side():
 
 
 @pytest.mark.parametrize("dim", [2, 3])
+def test_query_boxes_translated_by_whole_periods(dim):
+    """Under periodic boundaries a query box and its translate by any whole number
+    of periods hit the same boxes (query boxes need not lie in the cell)."""
+    L = np.array([1.0, 0.75, 0.5][:dim])
+    rng = np.random.default_rng(20 + dim)
+    lo, hi = random_boxes(rng, 1000, L, periodic=True)
+    tree = RTree(lo, hi, period=L)
+    qlo, qhi = query_boxes(rng, 300, L)
+    ref = R.brute_box_query(qlo, qhi, lo, hi, L)
+    shifts = np.zeros((len(qlo), dim))
+    shifts[:, 0] = rng.integers(-3, 4, len(qlo))
+    shifts[:, -1] = rng.integers(-3, 4, len(qlo))
+    assert (shifts != 0).sum() > len(qlo)
+    for k in (1, -1, 3, -2):
+        assert_same_rows(tree.query(qlo + k * L, qhi + k * L), ref, f"shifted by {k} L")
+    assert_same_rows(tree.query(qlo + shifts * L, qhi + shifts * L), ref, "shifted by n L")
+
+
+@pytest.mark.parametrize("dim", [2, 3])
 def test_points_on_the_cell_faces(dim):
     """Points at 0 and at np.nextafter(L, 0) are neighbours across the boundary."""
     L = np.array([1.0, 0.75, 0.5][:dim])
@@ -335,13 +354,13 @@ def test_node_boxes_contain_their_children(dim, periodic, what):
     rng = np.random.default_rng(dim)
     period = ext if periodic else None
     if what.startswith("points"):
-        lo = hi = R.spatial_cloud(what.split("-")[1], dim, 5000, periodic=periodic, seed=3)[0]
+        lo = hi = R.spatial_cloud(what.split("-")[1], dim, 3000, periodic=periodic, seed=3)[0]
         tree = RTree.from_points(lo, period=period)
     else:
         if what == "dyadic":
-            lo, hi = dyadic_boxes(rng, 5000, ext, periodic)
+            lo, hi = dyadic_boxes(rng, 3000, ext, periodic)
         else:
-            lo, hi = random_boxes(rng, 5000, ext, periodic)
+            lo, hi = random_boxes(rng, 3000, ext, periodic)
         if what == "full-width":     # boxes as wide as the cell along x (exactly, dyadic)
             lo[::97, 0], hi[::97, 0] = -0.25 * ext[0], 0.75 * ext[0]
             if not periodic:
@@ -426,38 +445,46 @@ def test_nearest_duplicates_take_the_smallest_index():
 
 
 # ---------------------------------------------------- exactness at (near-)ties
-def test_closed_ball_keeps_points_at_exactly_r():
+@pytest.mark.parametrize("periodic", [False, True], ids=["open", "periodic"])
+def test_ball_at_exactly_r(periodic):
     """Query points moved off a data point along x only: the data point is at
     distance r = |dx| exactly (r * r equals the squared distance), so the closed
-    ball must contain it, and the strict ball with r = nextafter(|dx|, inf) too.
-    The cloud sits away from the origin, where node boxes in centre / half-width
-    form round."""
+    ball must contain it, the strict ball with r + 1 ulp too, and neither the
+    closed ball with r - 1 ulp nor the strict ball with r. The cloud sits away
+    from the origin, where node boxes in centre / half-width form round."""
     rng = np.random.default_rng(7)
     pts = 10.0 + rng.random((3000, 2))
-    tree = RTree.from_points(pts)
+    period = np.array([16.0, 16.0]) if periodic else None
+    tree = RTree.from_points(pts, period=period)
     q = pts.copy()
     q[:, 0] += rng.uniform(-0.05, 0.05, len(q))
     r = np.abs(q[:, 0] - pts[:, 0])
     assert ((q - pts)[:, 0] ** 2 == r * r).all()
-    assert_same_rows(tree.query_ball(q, r), R.brute_ball(q, pts, pts, r), "closed, r = |dx|")
-    r_up = np.nextafter(r, np.inf)
-    assert_same_rows(tree.query_ball(q, r_up, strict=True),
-                     R.brute_ball(q, pts, pts, r_up, strict=True), "strict, r = |dx| + 1 ulp")
+    for radius, strict in ((r, False), (np.nextafter(r, np.inf), True),
+                           (np.nextafter(r, 0), False), (r, True)):
+        ref = R.brute_ball(q, pts, pts, radius, period, strict=strict)
+        assert_same_rows(tree.query_ball(q, radius, strict=strict), ref,
+                         f"strict={strict}, r = |dx| {'' if radius is r else '-+ 1 ulp'}")
 
 
-def test_query_box_touching_a_box_exactly():
-    """Closed boxes: a query whose lower x equals a box's upper x intersects it
-    (random, non-dyadic corners)."""
+@pytest.mark.parametrize("periodic", [False, True], ids=["open", "periodic"])
+def test_query_box_touching_or_one_ulp_apart(periodic):
+    """Closed boxes with random (non-dyadic) corners: a query whose lower x equals
+    a box's upper x intersects it; one whose lower x is 1 ulp above does not."""
     rng = np.random.default_rng(8)
-    lo = rng.random((2000, 2))
+    lo = 0.2 + 0.6 * rng.random((2000, 2))
     hi = lo + 0.02 * rng.random((2000, 2))
-    tree = RTree(lo, hi)
+    period = np.ones(2) if periodic else None
+    tree = RTree(lo, hi, period=period)
     pick = rng.integers(0, len(lo), 500)
-    qlo = np.column_stack([hi[pick, 0], lo[pick, 1] - 0.01])
-    qhi = qlo + 0.02 * rng.random((500, 2)) + [0.0, 0.01]
-    ref = R.brute_box_query(qlo, qhi, lo, hi)
-    assert all(p in ref[1][ref[0][i]:ref[0][i + 1]] for i, p in enumerate(pick))
-    assert_same_rows(tree.query(qlo, qhi), ref, "touching query boxes")
+    for gap in (False, True):
+        x = np.nextafter(hi[pick, 0], np.inf) if gap else hi[pick, 0]
+        qlo = np.column_stack([x, lo[pick, 1] - 0.01])
+        qhi = qlo + 0.02 * rng.random((500, 2)) + [0.0, 0.01]
+        ref = R.brute_box_query(qlo, qhi, lo, hi, period)
+        hit = [p in ref[1][ref[0][i]:ref[0][i + 1]] for i, p in enumerate(pick)]
+        assert not any(hit) if gap else all(hit)
+        assert_same_rows(tree.query(qlo, qhi), ref, "1 ulp apart" if gap else "touching")
 
 
 # ---------------------------------------------------------------------- errors

@@ -83,14 +83,15 @@ def _axis_cells(x, origin, size, nc, reach, period, out, row):
 
 @numba.njit(cache=True, inline="always")
 def _gap(x, k, origin, size, period):
-    """Distance from coordinate ``x`` to the slab of cell ``k`` along one axis."""
+    """Distance from coordinate ``x`` to the slab of cell ``k`` along one axis,
+    rounded down by a hair (a cell is never skipped because of rounding)."""
     if np.isfinite(period):
         centre = origin + (k + 0.5) * size
         g = abs(_wrap(x - centre, period)) - 0.5 * size
     else:
         lo = origin + k * size
         g = max(lo - x, x - lo - size)
-    return max(g, 0.0)
+    return max(g - 1e-12 * size, 0.0)
 
 
 @numba.njit(cache=True)

@@ -47,13 +47,11 @@ def remove_crossing(family, points, segments):
     tree = RTree(lo, hi)
     reach = np.zeros(len(pts))
     idx = family.indices.astype(np.int64)
-    if len(idx):
-        rows = np.repeat(np.arange(len(pts)), family.counts)
-        np.maximum.at(reach, rows, np.linalg.norm(pts[idx] - pts[rows], axis=1))
+    rows = np.repeat(np.arange(len(pts)), family.counts)
+    np.maximum.at(reach, rows, np.linalg.norm(pts[idx] - pts[rows], axis=1))
     cand_off, cand_idx = tree.query_ball(pts, reach)
     keep = K.crossing_mask(pts, family.offsets, idx, seg, cand_off, cand_idx)
-    counts = np.add.reduceat(keep, family.offsets[:-1]) if len(keep) else np.zeros(len(pts))
-    counts[family.counts == 0] = 0
+    counts = np.bincount(rows[keep], minlength=len(pts))
     offsets = np.zeros(len(pts) + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
     return Family(offsets, family.indices[keep], family.horizon, family.period)

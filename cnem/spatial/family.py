@@ -81,32 +81,30 @@ def _index_dtype(n):
     return np.int32 if n < 2**31 - 1 else np.int64
 
 
-def _cells(pts3, horizon, period3):
-    hmax = float(horizon.max())
-    size = np.empty(3)
-    nc = np.empty(3, dtype=np.int64)
+def _grid(pts3, hmax, period3, dim):
+    """Cell list grid: origin, cell sizes and counts, at most ~4 cells per point."""
+    n = len(pts3)
+    span = np.where(np.isfinite(period3), period3, np.ptp(pts3, axis=0) if n else 0.0)
+    size = np.full(3, hmax / CELLS_PER_HORIZON)
+    active = span[:dim] > 0
+    volume = np.prod(span[:dim][active]) if active.any() else 0.0
+    if volume > 0:                       # sparse clouds: larger cells, memory stays O(n)
+        size[:dim] = np.maximum(size[:dim], (volume / (4 * n + 64)) ** (1 / active.sum()))
+    nc = np.ones(3, dtype=np.int64)
     origin = np.zeros(3)
-    for k in range(3):
+    for k in range(dim):
         if np.isfinite(period3[k]):
-            nc[k] = max(1, int(np.floor(period3[k] * CELLS_PER_HORIZON / hmax)))
+            nc[k] = max(1, int(np.floor(period3[k] / size[k])))
             size[k] = period3[k] / nc[k]
         else:
-            lo, hi = pts3[:, k].min(), pts3[:, k].max()
-            size[k] = hmax / CELLS_PER_HORIZON
-            origin[k] = lo
-            nc[k] = max(1, int(np.floor((hi - lo) / size[k])) + 1)
-    total = float(np.prod(nc.astype(float)))
-    if total > 4 * len(pts3) + 64:          # sparse grid: coarsen so memory stays O(n)
-        scale = (total / (4 * len(pts3) + 64)) ** (1 / 3)
-        for k in range(3):
-            if nc[k] > 1:
-                nc[k] = max(1, int(nc[k] / scale))
-                span = period3[k] if np.isfinite(period3[k]) else \
-                    pts3[:, k].max() - pts3[:, k].min()
-                size[k] = span / nc[k] if np.isfinite(period3[k]) else \
-                    max(size[k], span / max(nc[k] - 1, 1))
-                if not np.isfinite(period3[k]):
-                    nc[k] = int(np.floor(span / size[k])) + 1
+            origin[k] = pts3[:, k].min()
+            nc[k] = int(np.floor(span[k] / size[k])) + 1
+    size[dim:] = 1.0
+    return origin, size, nc
+
+
+def _cells(pts3, horizon, period3, dim):
+    origin, size, nc = _grid(pts3, float(horizon.max()), period3, dim)
     sample = np.empty(0, dtype=_index_dtype(len(pts3)))
     return K.cell_family(pts3, horizon, origin, size, nc, period3, sample, 2 * work_chunks())
 
@@ -186,7 +184,7 @@ def family_search(points, horizon, *, period=None, method="auto"):
         pts3[:, :d] = pts
         per3 = np.full(3, np.inf)
         per3[:d] = per
-        offsets, indices = _cells(pts3, h, per3)
+        offsets, indices = _cells(pts3, h, per3, d)
     elif method == "kdtree":
         offsets, indices = _kdtree(pts, h, per)
     else:

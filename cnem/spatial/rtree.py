@@ -192,8 +192,10 @@ class RTree:
         if qlo.shape != qhi.shape or (qhi < qlo).any():
             raise ValueError("qlo and qhi must have the same shape with qlo <= qhi")
         qcen = 0.5 * (qlo + qhi)
-        if self.periodic:
-            qcen = np.mod(qcen, self.period)
+        if self.periodic:                # translate each query box into the cell
+            shift = self.period * np.floor(qcen / self.period)
+            qlo, qhi = qlo - shift, qhi - shift
+            qcen = 0.5 * (qlo + qhi)
         return self._query(qcen, 0.5 * (qhi - qlo), np.zeros(len(qlo)), K.INTERSECT,
                            qlo=qlo, qhi=qhi)
 
