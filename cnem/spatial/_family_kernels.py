@@ -95,12 +95,14 @@ def _gap(x, k, origin, size, period):
 
 
 @numba.njit(cache=True)
-def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, write_at, out, buf, row):
-    """Count (and write if ``write_at >= 0``) the family of sorted point ``s0``.
+def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, dest, pos, cap, buf):
+    """Family of sorted point ``s0``: its size, members written to ``dest[pos:cap]``.
 
-    Distances are tested branch-free (about half of the candidates are hits,
-    so a branch would be mispredicted); when writing, candidates go to the
-    scratch ``row`` first so that no row overruns its slice.
+    Every candidate is written at the next free slot while room is left and
+    the slot is kept only if the candidate is a member (a branch-free test:
+    about half of the candidates are members, so a branch would be
+    mispredicted). With ``cap <= pos`` nothing is written (counting only);
+    a return value larger than ``cap - pos`` means the members did not fit.
     """
     h2 = hs2[s0]
     h = np.sqrt(h2)
@@ -109,6 +111,7 @@ def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, write_at, out, b
     n0 = _axis_cells(x0, origin[0], size[0], nc[0], h, period[0], buf, 0)
     n1 = _axis_cells(x1, origin[1], size[1], nc[1], h, period[1], buf, 1)
     n2 = _axis_cells(x2, origin[2], size[2], nc[2], h, period[2], buf, 2)
+    room = cap - pos
     hits = 0
     for a in range(n0):
         g0 = _gap(x0, buf[0, a], origin[0], size[0], period[0])
@@ -127,31 +130,37 @@ def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, write_at, out, b
                     continue
                 cell = base + buf[2, c]
                 if periodic:
-                    for s in range(start[cell], start[cell + 1]):
-                        d2 = _dist2(spts, s0, spts, s, period)
-                        if write_at >= 0:
-                            row[hits] = s
+                    for q in range(start[cell], start[cell + 1]):
+                        d2 = _dist2(spts, s0, spts, q, period)
+                        if hits < room:
+                            dest[pos + hits] = perm[q]
+                        hits += (d2 < h2) & (d2 > 0.0)
+                elif room > 0:
+                    for q in range(start[cell], start[cell + 1]):
+                        d = spts[q, 0] - x0
+                        d2 = d * d
+                        d = spts[q, 1] - x1
+                        d2 += d * d
+                        d = spts[q, 2] - x2
+                        d2 += d * d
+                        if hits < room:
+                            dest[pos + hits] = perm[q]
                         hits += (d2 < h2) & (d2 > 0.0)
                 else:
-                    for s in range(start[cell], start[cell + 1]):
-                        d = spts[s, 0] - x0
+                    for q in range(start[cell], start[cell + 1]):
+                        d = spts[q, 0] - x0
                         d2 = d * d
-                        d = spts[s, 1] - x1
+                        d = spts[q, 1] - x1
                         d2 += d * d
-                        d = spts[s, 2] - x2
+                        d = spts[q, 2] - x2
                         d2 += d * d
-                        if write_at >= 0:
-                            row[hits] = s
                         hits += (d2 < h2) & (d2 > 0.0)
-    if write_at >= 0:
-        for k in range(hits):
-            out[write_at + k] = perm[row[k]]
     return hits
 
 
 @numba.njit(cache=True, parallel=True)
 def cell_family(pts, horizon, origin, size, nc, period, index_dtype_sample, nch):
-    """Family of every point with a cell list (both passes in parallel).
+    """Family of every point with a cell list: a counting pass, then a filling pass.
 
     Parameters
     ----------
@@ -172,37 +181,32 @@ def cell_family(pts, horizon, origin, size, nc, period, index_dtype_sample, nch)
     n = pts.shape[0]
     perm, start = bin_points(pts, origin, size, nc, period)
     spts = np.empty_like(pts)
+    hs2 = np.empty(n)
     for s in numba.prange(n):
         for k in range(3):
             spts[s, k] = pts[perm[s], k]
-    hs2 = np.empty(n)
-    for s in numba.prange(n):
         hs2[s] = horizon[perm[s]] * horizon[perm[s]]
     width = 1
     for k in range(3):
         width = max(width, nc[k])
-    counts = np.zeros(n, dtype=np.int64)
-    dummy = np.empty(0, dtype=index_dtype_sample.dtype)
     nch = max(1, min(n, nch))
+    dummy = np.empty(0, dtype=index_dtype_sample.dtype)
+    counts = np.zeros(n, dtype=np.int64)
     for ch in numba.prange(nch):
         buf = np.empty((3, width + 1), dtype=np.int64)
-        row = np.empty(0, dtype=np.int64)
         for s in range(ch * n // nch, (ch + 1) * n // nch):
-            counts[perm[s]] = _scan(s, spts, hs2, start, perm, origin, size, nc, period, -1,
-                                    dummy, buf, row)
+            counts[perm[s]] = _scan(s, spts, hs2, start, perm, origin, size, nc, period,
+                                    dummy, 0, 0, buf)
     offsets = np.zeros(n + 1, dtype=np.int64)
     for i in range(n):
         offsets[i + 1] = offsets[i] + counts[i]
     out = np.empty(offsets[n], dtype=index_dtype_sample.dtype)
     for ch in numba.prange(nch):
         buf = np.empty((3, width + 1), dtype=np.int64)
-        row = np.empty(16, dtype=np.int64)
         for s in range(ch * n // nch, (ch + 1) * n // nch):
             i = perm[s]
-            if counts[i] + 1 > row.shape[0]:
-                row = np.empty(2 * counts[i] + 1, dtype=np.int64)
-            _scan(s, spts, hs2, start, perm, origin, size, nc, period, offsets[i], out, buf,
-                  row)
+            _scan(s, spts, hs2, start, perm, origin, size, nc, period, out, offsets[i],
+                  offsets[i + 1], buf)
     return offsets, out
 
 
