@@ -59,8 +59,14 @@ def bin_points(pts, origin, size, nc, period):
 
 
 @numba.njit(cache=True, inline="always")
-def _axis_cells(x, origin, size, nc, reach, period, out, row):
-    """Cells along one axis that may hold points within ``reach`` of ``x`` (into ``out[row]``)."""
+def _axis_cells(x, origin, size, nc, reach, period, out, row, shift):
+    """Cells along one axis that may hold points within ``reach`` of ``x``.
+
+    Writes the cells to ``out[row]`` and, to ``shift[row]``, the periodic
+    shift (0, +L or -L) that brings each cell's points to their minimum image
+    as seen from ``x``; NaN when the reach spans the whole period (then no
+    single shift is right and distances are wrapped one by one).
+    """
     periodic = np.isfinite(period)
     c = _cell_axis(x, origin, size, nc)
     r = int(np.ceil(reach / size))
@@ -68,15 +74,22 @@ def _axis_cells(x, origin, size, nc, reach, period, out, row):
     if periodic and 2 * r + 1 >= nc:
         for k in range(nc):
             out[row, m] = k
+            shift[row, m] = np.nan
             m += 1
         return m
     for o in range(-r, r + 1):
         k = c + o
+        s = 0.0
         if periodic:
+            if k < 0:
+                s = -period
+            elif k >= nc:
+                s = period
             k = k % nc
         elif k < 0 or k >= nc:
             continue
         out[row, m] = k
+        shift[row, m] = s
         m += 1
     return m
 
@@ -95,7 +108,8 @@ def _gap(x, k, origin, size, period):
 
 
 @numba.njit(cache=True)
-def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, dest, pos, cap, buf):
+def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, dest, pos, cap, buf,
+          shift):
     """Family of sorted point ``s0``: its size, members written to ``dest[pos:cap]``.
 
     Every candidate is written at the next free slot while room is left and
@@ -107,10 +121,9 @@ def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, dest, pos, cap, 
     h2 = hs2[s0]
     h = np.sqrt(h2)
     x0, x1, x2 = spts[s0, 0], spts[s0, 1], spts[s0, 2]
-    periodic = np.isfinite(period[0]) or np.isfinite(period[1]) or np.isfinite(period[2])
-    n0 = _axis_cells(x0, origin[0], size[0], nc[0], h, period[0], buf, 0)
-    n1 = _axis_cells(x1, origin[1], size[1], nc[1], h, period[1], buf, 1)
-    n2 = _axis_cells(x2, origin[2], size[2], nc[2], h, period[2], buf, 2)
+    n0 = _axis_cells(x0, origin[0], size[0], nc[0], h, period[0], buf, 0, shift)
+    n1 = _axis_cells(x1, origin[1], size[1], nc[1], h, period[1], buf, 1, shift)
+    n2 = _axis_cells(x2, origin[2], size[2], nc[2], h, period[2], buf, 2, shift)
     room = cap - pos
     hits = 0
     for a in range(n0):
@@ -129,7 +142,10 @@ def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, dest, pos, cap, 
                 if g1 + g2 * g2 >= h2:
                     continue
                 cell = base + buf[2, c]
-                if periodic:
+                # x_q - x_i + shift is exactly the minimum-image difference
+                # that _wrap computes, so all methods agree to the last bit
+                s0_, s1_, s2_ = shift[0, a], shift[1, b], shift[2, c]
+                if np.isnan(s0_) or np.isnan(s1_) or np.isnan(s2_):
                     for q in range(start[cell], start[cell + 1]):
                         d2 = _dist2(spts, s0, spts, q, period)
                         if hits < room:
@@ -137,22 +153,22 @@ def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, dest, pos, cap, 
                         hits += (d2 < h2) & (d2 > 0.0)
                 elif room > 0:
                     for q in range(start[cell], start[cell + 1]):
-                        d = spts[q, 0] - x0
+                        d = (spts[q, 0] - x0) + s0_
                         d2 = d * d
-                        d = spts[q, 1] - x1
+                        d = (spts[q, 1] - x1) + s1_
                         d2 += d * d
-                        d = spts[q, 2] - x2
+                        d = (spts[q, 2] - x2) + s2_
                         d2 += d * d
                         if hits < room:
                             dest[pos + hits] = perm[q]
                         hits += (d2 < h2) & (d2 > 0.0)
                 else:
                     for q in range(start[cell], start[cell + 1]):
-                        d = spts[q, 0] - x0
+                        d = (spts[q, 0] - x0) + s0_
                         d2 = d * d
-                        d = spts[q, 1] - x1
+                        d = (spts[q, 1] - x1) + s1_
                         d2 += d * d
-                        d = spts[q, 2] - x2
+                        d = (spts[q, 2] - x2) + s2_
                         d2 += d * d
                         hits += (d2 < h2) & (d2 > 0.0)
     return hits
@@ -194,19 +210,21 @@ def cell_family(pts, horizon, origin, size, nc, period, index_dtype_sample, nch)
     counts = np.zeros(n, dtype=np.int64)
     for ch in numba.prange(nch):
         buf = np.empty((3, width + 1), dtype=np.int64)
+        shift = np.empty((3, width + 1))
         for s in range(ch * n // nch, (ch + 1) * n // nch):
             counts[perm[s]] = _scan(s, spts, hs2, start, perm, origin, size, nc, period,
-                                    dummy, 0, 0, buf)
+                                    dummy, 0, 0, buf, shift)
     offsets = np.zeros(n + 1, dtype=np.int64)
     for i in range(n):
         offsets[i + 1] = offsets[i] + counts[i]
     out = np.empty(offsets[n], dtype=index_dtype_sample.dtype)
     for ch in numba.prange(nch):
         buf = np.empty((3, width + 1), dtype=np.int64)
+        shift = np.empty((3, width + 1))
         for s in range(ch * n // nch, (ch + 1) * n // nch):
             i = perm[s]
             _scan(s, spts, hs2, start, perm, origin, size, nc, period, out, offsets[i],
-                  offsets[i + 1], buf)
+                  offsets[i + 1], buf, shift)
     return offsets, out
 
 
