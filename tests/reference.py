@@ -352,3 +352,14 @@ def spatial_cloud(kind, dim, n, *, periodic=False, seed=0):
         pts = np.mod(pts, ext)
         pts = np.where(pts >= ext, 0.0, pts)      # np.mod(-tiny, L) == L
     return np.ascontiguousarray(pts), ext, spacing
+
+
+#: Cases of the spatial tests: (cloud kind, dimension, periodic).
+SPATIAL_CASES = [(kind, dim, periodic) for kind in SPATIAL_KINDS for dim in (2, 3)
+                 for periodic in (False, True)]
+
+
+def spatial_case_id(case):
+    """Readable pytest id of a spatial case."""
+    kind, dim, periodic = case
+    return f"{kind}-{dim}d-{'periodic' if periodic else 'open'}"

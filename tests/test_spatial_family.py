@@ -18,16 +18,11 @@ import reference as R
 from cnem.spatial import Family, family_search
 
 METHODS = ["auto", "rtree", "cells", "kdtree", "brute"]
-CASES = [(kind, dim, periodic) for kind in R.SPATIAL_KINDS for dim in (2, 3)
-         for periodic in (False, True)]
+CASES = R.SPATIAL_CASES
+case_id = R.spatial_case_id
 SIZES = {2: 1200, 3: 800}
 #: Integer horizons on the integer lattice: 5**2 = 3**2 + 4**2, many exact ties.
 LATTICE_HORIZON = {2: 5.0, 3: 2.0}
-
-
-def case_id(case):
-    kind, dim, periodic = case
-    return f"{kind}-{dim}d-{'periodic' if periodic else 'open'}"
 
 
 @functools.lru_cache(maxsize=None)

@@ -17,14 +17,9 @@ import pytest
 import reference as R
 from cnem.spatial import RTree
 
-CASES = [(kind, dim, periodic) for kind in R.SPATIAL_KINDS for dim in (2, 3)
-         for periodic in (False, True)]
+CASES = R.SPATIAL_CASES
+case_id = R.spatial_case_id
 SIZES = {2: 1200, 3: 800}
-
-
-def case_id(case):
-    kind, dim, periodic = case
-    return f"{kind}-{dim}d-{'periodic' if periodic else 'open'}"
 
 
 @functools.lru_cache(maxsize=None)

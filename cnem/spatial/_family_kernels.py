@@ -151,7 +151,7 @@ def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, dest, pos, cap, 
                         if hits < room:
                             dest[pos + hits] = perm[q]
                         hits += (d2 < h2) & (d2 > 0.0)
-                elif room > 0:
+                else:
                     for q in range(start[cell], start[cell + 1]):
                         d = (spts[q, 0] - x0) + s0_
                         d2 = d * d
@@ -161,15 +161,6 @@ def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, dest, pos, cap, 
                         d2 += d * d
                         if hits < room:
                             dest[pos + hits] = perm[q]
-                        hits += (d2 < h2) & (d2 > 0.0)
-                else:
-                    for q in range(start[cell], start[cell + 1]):
-                        d = (spts[q, 0] - x0) + s0_
-                        d2 = d * d
-                        d = (spts[q, 1] - x1) + s1_
-                        d2 += d * d
-                        d = (spts[q, 2] - x2) + s2_
-                        d2 += d * d
                         hits += (d2 < h2) & (d2 > 0.0)
     return hits
 
