@@ -162,6 +162,8 @@ def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, dest, pos, cap, 
                         if hits < room:
                             dest[pos + hits] = perm[q]
                         hits += (d2 < h2) & (d2 > 0.0)
+                if 0 < room <= hits:
+                    return hits          # the row is full: no member is left
     return hits
 
 
