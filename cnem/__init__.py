@@ -7,11 +7,11 @@
 1.0
 """
 
-from . import geometry, io, nodes, plot
+from . import geometry, io, nodes, plot, shape, spatial
 from .errors import CNEMError, GeometryError, SolveError
 from .geometry import Domain, Model, NodeCloud, discretize
 
 __version__ = "0.1.0"
 
-__all__ = ["Domain", "NodeCloud", "Model", "discretize", "nodes", "geometry", "io", "plot",
+__all__ = ["Domain", "NodeCloud", "Model", "discretize", "nodes", "geometry", "io", "plot", "shape", "spatial",
            "CNEMError", "GeometryError", "SolveError", "__version__"]

@@ -17,3 +17,7 @@ MERGE_TOL = 1e-13
 #: Relative grid (times the extent of the nodes) on which the exact cell
 #: clipping is snap-rounded, so that neighbouring cells share their vertices.
 GRID_TOL = 1e-13
+
+#: Relative distance (times the domain diameter) under which a query point is
+#: taken to be at a node or on a constraint edge in the shape functions.
+SHAPE_TOL = 1e-12

@@ -102,11 +102,22 @@ class Model:
     segment_kind: np.ndarray
     cells: Cells
     timings: dict
+    _cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def domain(self):
         """Domain: the body this model discretises."""
         return self.cloud.domain
+
+    def shape_functions(self, points, *, kind="sibson"):
+        """Constrained natural-neighbour coordinates, see `cnem.shape.shape_functions`.
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix, shape (p, n)
+        """
+        from ..shape import shape_functions
+        return shape_functions(self, points, kind=kind)
 
     def __repr__(self):
         dom = self.domain

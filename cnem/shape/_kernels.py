@@ -1,0 +1,273 @@
+"""Numba kernels of the constrained natural-neighbour coordinates (arrays and scalars only).
+
+For a query point ``x`` in triangle ``t`` of the constrained Delaunay
+triangulation (cracks opened, neighbours across region boundaries cut):
+
+* ``x`` at a vertex: the Kronecker delta;
+* ``x`` on a constraint edge (boundary, interface side, crack face): the
+  limit of the coordinates, linear interpolation between the edge's ends
+  (C-NEM paper §3.5, Figure 8);
+* otherwise the constrained Bowyer-Watson cavity of ``x`` (triangles whose
+  circumcircle holds ``x``, reached from ``t`` across unconstrained edges
+  only) gives the natural neighbours, its boundary vertices. The Sibson
+  coordinate of neighbour ``i`` (eq. 3-4) is the area that ``x``'s Voronoi
+  cell takes from ``i``'s: the polygon of the two new Voronoi vertices
+  (circumcentres of ``x`` with the two cavity-boundary edges at ``i``) and
+  the old ones (circumcentres of the cavity triangles around ``i``), all
+  computed relative to ``x`` (Watson's formula).
+"""
+
+import numba
+import numpy as np
+
+#: Row kinds returned by the counting pass.
+CAVITY, AT_NODE, ON_EDGE, FAILED = 0, 1, 2, 3
+
+#: Largest cavity (triangles) and neighbour count handled.
+MAX_CAVITY = 512
+
+
+@numba.njit(cache=True, inline="always")
+def _orient(ax, ay, bx, by, cx, cy):
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+
+
+@numba.njit(cache=True, inline="always")
+def _circumcentre(ax, ay, bx, by, cx, cy):
+    """Circumcentre of (a, b, c), computed relative to ``a``."""
+    bx -= ax
+    by -= ay
+    cx -= ax
+    cy -= ay
+    d = 2.0 * (bx * cy - by * cx)
+    b2 = bx * bx + by * by
+    c2 = cx * cx + cy * cy
+    return ax + (cy * b2 - by * c2) / d, ay + (bx * c2 - cx * b2) / d
+
+
+@numba.njit(cache=True, inline="always")
+def _in_circle(nodes, tri, t, x, y):
+    """Whether (x, y) lies strictly inside the circumcircle of CCW triangle ``t``."""
+    ax, ay = nodes[tri[t, 0], 0] - x, nodes[tri[t, 0], 1] - y
+    bx, by = nodes[tri[t, 1], 0] - x, nodes[tri[t, 1], 1] - y
+    cx, cy = nodes[tri[t, 2], 0] - x, nodes[tri[t, 2], 1] - y
+    det = ((ax * ax + ay * ay) * (bx * cy - by * cx)
+           - (bx * bx + by * by) * (ax * cy - ay * cx)
+           + (cx * cx + cy * cy) * (ax * by - ay * bx))
+    return det > 0.0
+
+
+@numba.njit(cache=True)
+def _special(nodes, tri, nb, t, x, y, node_tol, edge_tol):
+    """Node or constraint-edge case: ``(kind, a, b, s)`` (phi_a = 1 - s, phi_b = s)."""
+    for k in range(3):
+        v = tri[t, k]
+        if abs(nodes[v, 0] - x) <= node_tol and abs(nodes[v, 1] - y) <= node_tol:
+            return AT_NODE, v, v, 0.0
+    for k in range(3):
+        if nb[t, k] >= 0:
+            continue
+        a, b = tri[t, (k + 1) % 3], tri[t, (k + 2) % 3]
+        ex, ey = nodes[b, 0] - nodes[a, 0], nodes[b, 1] - nodes[a, 1]
+        length2 = ex * ex + ey * ey
+        rx, ry = x - nodes[a, 0], y - nodes[a, 1]
+        dist = abs(ex * ry - ey * rx) / np.sqrt(length2)
+        if dist <= edge_tol:
+            s = (ex * rx + ey * ry) / length2
+            return ON_EDGE, a, b, min(max(s, 0.0), 1.0)
+    return CAVITY, -1, -1, 0.0
+
+
+@numba.njit(cache=True)
+def _cavity(nodes, tri, nb, t, x, y, cav):
+    """Constrained Bowyer-Watson cavity of (x, y) from triangle ``t``; its size or -1."""
+    cav[0] = t
+    size = 1
+    head = 0
+    while head < size:
+        c = cav[head]
+        head += 1
+        for k in range(3):
+            o = nb[c, k]
+            if o < 0:
+                continue
+            seen = False
+            for m in range(size):
+                if cav[m] == o:
+                    seen = True
+                    break
+            if seen or not _in_circle(nodes, tri, o, x, y):
+                continue
+            if size == cav.shape[0]:
+                return -1
+            cav[size] = o
+            size += 1
+    return size
+
+
+@numba.njit(cache=True)
+def _in_cavity(cav, size, o):
+    if o < 0:
+        return False
+    for m in range(size):
+        if cav[m] == o:
+            return True
+    return False
+
+
+@numba.njit(cache=True)
+def _sibson_row(nodes, tri, nb, x, y, cav, size, cols, vals):
+    """Sibson coordinates from a cavity: the neighbour count, or -1 if inconsistent."""
+    count = 0
+    total = 0.0
+    for m in range(size):
+        c = cav[m]
+        for k in range(3):
+            if _in_cavity(cav, size, nb[c, k]):
+                continue
+            # boundary edge (i, j), CCW in its cavity triangle: neighbour i
+            i, j = tri[c, (k + 1) % 3], tri[c, (k + 2) % 3]
+            # previous boundary edge (h, i): walk clockwise around i from c
+            # accumulating the old Voronoi vertices on the way
+            area = 0.0
+            qx, qy = _circumcentre(nodes[i, 0] - x, nodes[i, 1] - y,
+                                   nodes[j, 0] - x, nodes[j, 1] - y, 0.0, 0.0)
+            fx, fy = qx, qy         # new vertex on the (i, j) bisector, start of the polygon
+            s = c
+            steps = 0
+            while True:
+                p = 0
+                while tri[s, p] != i:
+                    p += 1
+                ox, oy = _circumcentre(nodes[tri[s, 0], 0] - x, nodes[tri[s, 0], 1] - y,
+                                       nodes[tri[s, 1], 0] - x, nodes[tri[s, 1], 1] - y,
+                                       nodes[tri[s, 2], 0] - x, nodes[tri[s, 2], 1] - y)
+                area += qx * oy - qy * ox
+                qx, qy = ox, oy
+                h = tri[s, (p + 2) % 3]
+                nxt = nb[s, (p + 1) % 3]          # across edge (i, h)
+                if not _in_cavity(cav, size, nxt):
+                    break
+                s = nxt
+                steps += 1
+                if steps > size:
+                    return -1
+            ox, oy = _circumcentre(nodes[h, 0] - x, nodes[h, 1] - y,
+                                   nodes[i, 0] - x, nodes[i, 1] - y, 0.0, 0.0)
+            area += qx * oy - qy * ox
+            area += ox * fy - oy * fx
+            if count == cols.shape[0]:
+                return -1
+            cols[count] = i
+            vals[count] = 0.5 * area
+            total += 0.5 * area
+            count += 1
+    if not total > 0.0:
+        return -1
+    for m in range(count):
+        vals[m] /= total
+    return count
+
+
+@numba.njit(cache=True)
+def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals):
+    """Coordinates of one point: ``(kind, count)`` with the row in ``cols, vals``."""
+    kind, a, b, s = _special(nodes, tri, nb, t, x, y, node_tol, edge_tol)
+    if kind == AT_NODE:
+        cols[0], vals[0] = a, 1.0
+        return kind, 1
+    if kind == ON_EDGE:
+        cols[0], vals[0] = a, 1.0 - s
+        cols[1], vals[1] = b, s
+        return kind, 2
+    size = _cavity(nodes, tri, nb, t, x, y, cav)
+    if size < 0:
+        return FAILED, 0
+    count = _sibson_row(nodes, tri, nb, x, y, cav, size, cols, vals)
+    if count < 0:
+        return FAILED, 0
+    return CAVITY, count
+
+
+@numba.njit(cache=True, parallel=True)
+def sibson(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch):
+    """Sibson coordinates of many points as CSR.
+
+    Parameters
+    ----------
+    nodes : (n, 2) float64
+    tri : (t, 3) int64, counter-clockwise
+    nb : (t, 3) int64
+        Neighbour across the edge opposite each vertex; -1 across constraints.
+    points : (p, 2) float64
+    tri_of : (p,) int64
+        A triangle containing each point.
+    node_tol, edge_tol : float
+        Distances under which a point is at a node / on a constraint edge.
+    nch : int
+        Work chunks shared between threads.
+
+    Returns
+    -------
+    offsets : (p + 1,) int64
+    cols : (k,) int64
+    vals : (k,) float64
+    failed : (p,) bool
+        Points whose cavity was inconsistent (their rows are empty).
+    """
+    p = points.shape[0]
+    counts = np.zeros(p, dtype=np.int64)
+    failed = np.zeros(p, dtype=np.bool_)
+    nch = max(1, min(p, nch))
+    for ch in numba.prange(nch):
+        cav = np.empty(MAX_CAVITY, dtype=np.int64)
+        cols = np.empty(MAX_CAVITY, dtype=np.int64)
+        vals = np.empty(MAX_CAVITY)
+        for q in range(ch * p // nch, (ch + 1) * p // nch):
+            kind, c = _row(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1], node_tol,
+                           edge_tol, cav, cols, vals)
+            counts[q] = c
+            failed[q] = kind == FAILED
+    offsets = np.zeros(p + 1, dtype=np.int64)
+    for q in range(p):
+        offsets[q + 1] = offsets[q] + counts[q]
+    out_cols = np.empty(offsets[p], dtype=np.int64)
+    out_vals = np.empty(offsets[p])
+    for ch in numba.prange(nch):
+        cav = np.empty(MAX_CAVITY, dtype=np.int64)
+        cols = np.empty(MAX_CAVITY, dtype=np.int64)
+        vals = np.empty(MAX_CAVITY)
+        for q in range(ch * p // nch, (ch + 1) * p // nch):
+            kind, c = _row(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1], node_tol,
+                           edge_tol, cav, cols, vals)
+            out_cols[offsets[q]:offsets[q] + c] = cols[:c]
+            out_vals[offsets[q]:offsets[q] + c] = vals[:c]
+    return offsets, out_cols, out_vals, failed
+
+
+@numba.njit(cache=True, parallel=True)
+def locate(nodes, tri, points, cand_off, cand_idx, tol):
+    """The candidate triangle that contains each point best (-1 if none within ``tol``).
+
+    "Best" is the largest smallest-barycentric-orientation, so a point on an
+    edge or at a node picks a triangle deterministically.
+    """
+    p = points.shape[0]
+    out = np.full(p, -1, dtype=np.int64)
+    for q in numba.prange(p):
+        x, y = points[q, 0], points[q, 1]
+        best = -np.inf
+        for c in range(cand_off[q], cand_off[q + 1]):
+            t = cand_idx[c]
+            worst = np.inf
+            for k in range(3):
+                a, b = tri[t, k], tri[t, (k + 1) % 3]
+                ex, ey = nodes[b, 0] - nodes[a, 0], nodes[b, 1] - nodes[a, 1]
+                o = _orient(nodes[a, 0], nodes[a, 1], nodes[b, 0], nodes[b, 1], x, y)
+                o /= np.sqrt(ex * ex + ey * ey)      # signed distance to the edge
+                worst = min(worst, o)
+            if worst > best:
+                best = worst
+                if worst >= -tol:
+                    out[q] = t
+    return out

@@ -1,0 +1,82 @@
+"""Constrained natural-neighbour shape functions (C-NEM paper §2.2, §3)."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from .. import config
+from ..errors import CNEMError, GeometryError
+from ..spatial.rtree import RTree, work_chunks
+from ..geometry.topology import triangle_neighbors
+from . import _kernels as K
+
+__all__ = ["shape_functions", "KINDS"]
+
+KINDS = ("sibson", "laplace")
+
+
+def _topology(model):
+    """Neighbours (cut across constraints) and an R-tree over the triangles, cached."""
+    cache = model._cache
+    if "shape" not in cache:
+        tri = model.triangles
+        corners = model.nodes[tri]
+        tree = RTree(corners.min(axis=1), corners.max(axis=1))
+        cache["shape"] = (triangle_neighbors(tri, model.triangle_region), tree)
+    return cache["shape"]
+
+
+def shape_functions(model, points, *, kind="sibson"):
+    """Constrained natural-neighbour coordinates of points.
+
+    Parameters
+    ----------
+    model : Model
+    points : (p, 2) array_like
+        Points of the closed domain.
+    kind : {"sibson", "laplace"}
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (p, n)
+        Row ``k`` holds the coordinates of ``points[k]`` with respect to the
+        nodes: rows sum to 1, ``Phi @ model.nodes`` gives back the points, a
+        point at a node gets its unit row, a point on a boundary, interface or
+        crack-face segment interpolates linearly between the segment's ends,
+        and no node has weight at a point it cannot see.
+
+    Raises
+    ------
+    GeometryError
+        Points outside the domain (how many, and the first few).
+    """
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, received {kind!r}")
+    if kind == "laplace":
+        raise NotImplementedError("Laplace coordinates are not implemented yet; use kind='sibson'")
+    pts = np.ascontiguousarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise GeometryError(f"points: expected a (p, 2) array, received shape {pts.shape}")
+    if not np.isfinite(pts).all():
+        raise GeometryError("points: coordinates must be finite, received NaN or inf")
+    n = len(model.nodes)
+    if len(pts) == 0:
+        return sp.csr_matrix((0, n))
+    nb, tree = _topology(model)
+    tol = config.SHAPE_TOL * model.domain.diameter
+    cand_off, cand_idx = tree.query(pts - tol, pts + tol)
+    tri_of = K.locate(model.nodes, model.triangles, pts, cand_off, cand_idx, tol)
+    outside = np.flatnonzero(tri_of < 0)
+    if outside.size:
+        raise GeometryError(
+            f"{outside.size} of {len(pts)} points lie outside the domain, first (index: point) "
+            + ", ".join(f"{i}: {pts[i].tolist()}" for i in outside[:5]))
+    offsets, cols, vals, failed = K.sibson(model.nodes, model.triangles, nb, pts, tri_of, tol,
+                                           tol, work_chunks())
+    if failed.any():
+        bad = np.flatnonzero(failed)
+        raise CNEMError(
+            f"the natural-neighbour cavity of {bad.size} points was inconsistent (round-off on "
+            f"a circumcircle), first {pts[bad[:3]].tolist()}; please report this case")
+    return sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n))
