@@ -109,7 +109,7 @@ class Model:
         """Domain: the body this model discretises."""
         return self.cloud.domain
 
-    def shape_functions(self, points, *, kind="sibson"):
+    def shape_functions(self, points, *, kind="sibson", triangles=None):
         """Constrained natural-neighbour coordinates, see `cnem.shape.shape_functions`.
 
         Returns
@@ -117,7 +117,7 @@ class Model:
         scipy.sparse.csr_matrix, shape (p, n)
         """
         from ..shape import shape_functions
-        return shape_functions(self, points, kind=kind)
+        return shape_functions(self, points, kind=kind, triangles=triangles)
 
     def __repr__(self):
         dom = self.domain

@@ -116,8 +116,12 @@ def _in_cavity(cav, size, o):
 
 
 @numba.njit(cache=True)
-def _sibson_row(nodes, tri, nb, x, y, cav, size, cols, vals):
-    """Sibson coordinates from a cavity: the neighbour count, or -1 if inconsistent."""
+def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, laplace):
+    """Sibson (or Laplace) coordinates from a cavity: the neighbour count, -1 if inconsistent.
+
+    Laplace: ``w_i = |Voronoi edge between x and i| / |x - x_i|``, normalised;
+    the Voronoi edge joins the two new circumcentres at ``i``.
+    """
     count = 0
     total = 0.0
     for m in range(size):
@@ -158,9 +162,13 @@ def _sibson_row(nodes, tri, nb, x, y, cav, size, cols, vals):
             area += ox * fy - oy * fx
             if count == cols.shape[0]:
                 return -1
+            if laplace:
+                weight = np.hypot(fx - ox, fy - oy) / np.hypot(nodes[i, 0] - x, nodes[i, 1] - y)
+            else:
+                weight = 0.5 * area
             cols[count] = i
-            vals[count] = 0.5 * area
-            total += 0.5 * area
+            vals[count] = weight
+            total += weight
             count += 1
     if not total > 0.0:
         return -1
@@ -170,7 +178,7 @@ def _sibson_row(nodes, tri, nb, x, y, cav, size, cols, vals):
 
 
 @numba.njit(cache=True)
-def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals):
+def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, laplace):
     """Coordinates of one point: ``(kind, count)`` with the row in ``cols, vals``."""
     kind, a, b, s = _special(nodes, tri, nb, t, x, y, node_tol, edge_tol)
     if kind == AT_NODE:
@@ -183,15 +191,15 @@ def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals):
     size = _cavity(nodes, tri, nb, t, x, y, cav)
     if size < 0:
         return FAILED, 0
-    count = _sibson_row(nodes, tri, nb, x, y, cav, size, cols, vals)
+    count = _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, laplace)
     if count < 0:
         return FAILED, 0
     return CAVITY, count
 
 
 @numba.njit(cache=True, parallel=True)
-def sibson(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch):
-    """Sibson coordinates of many points as CSR.
+def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace):
+    """Sibson (or Laplace) coordinates of many points as CSR.
 
     Parameters
     ----------
@@ -206,6 +214,8 @@ def sibson(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch):
         Distances under which a point is at a node / on a constraint edge.
     nch : int
         Work chunks shared between threads.
+    laplace : bool
+        Laplace (non-Sibsonian) instead of Sibson coordinates.
 
     Returns
     -------
@@ -225,7 +235,7 @@ def sibson(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch):
         vals = np.empty(MAX_CAVITY)
         for q in range(ch * p // nch, (ch + 1) * p // nch):
             kind, c = _row(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1], node_tol,
-                           edge_tol, cav, cols, vals)
+                           edge_tol, cav, cols, vals, laplace)
             counts[q] = c
             failed[q] = kind == FAILED
     offsets = np.zeros(p + 1, dtype=np.int64)
@@ -239,7 +249,7 @@ def sibson(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch):
         vals = np.empty(MAX_CAVITY)
         for q in range(ch * p // nch, (ch + 1) * p // nch):
             kind, c = _row(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1], node_tol,
-                           edge_tol, cav, cols, vals)
+                           edge_tol, cav, cols, vals, laplace)
             out_cols[offsets[q]:offsets[q] + c] = cols[:c]
             out_vals[offsets[q]:offsets[q] + c] = vals[:c]
     return offsets, out_cols, out_vals, failed

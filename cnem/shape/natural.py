@@ -27,7 +27,7 @@ def _topology(model):
     return cache["shape"]
 
 
-def shape_functions(model, points, *, kind="sibson"):
+def shape_functions(model, points, *, kind="sibson", triangles=None):
     """Constrained natural-neighbour coordinates of points.
 
     Parameters
@@ -36,6 +36,10 @@ def shape_functions(model, points, *, kind="sibson"):
     points : (p, 2) array_like
         Points of the closed domain.
     kind : {"sibson", "laplace"}
+    triangles : (p,) array_like of int, optional
+        A triangle of ``model.triangles`` holding each point. A point exactly on
+        a crack face lies in triangles of both faces; give the triangle on the
+        side wanted. By default the triangle the point is deepest inside.
 
     Returns
     -------
@@ -53,8 +57,6 @@ def shape_functions(model, points, *, kind="sibson"):
     """
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}, received {kind!r}")
-    if kind == "laplace":
-        raise NotImplementedError("Laplace coordinates are not implemented yet; use kind='sibson'")
     pts = np.ascontiguousarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise GeometryError(f"points: expected a (p, 2) array, received shape {pts.shape}")
@@ -65,15 +67,24 @@ def shape_functions(model, points, *, kind="sibson"):
         return sp.csr_matrix((0, n))
     nb, tree = _topology(model)
     tol = config.SHAPE_TOL * model.domain.diameter
-    cand_off, cand_idx = tree.query(pts - tol, pts + tol)
+    if triangles is None:
+        cand_off, cand_idx = tree.query(pts - tol, pts + tol)
+    else:
+        cand_idx = np.asarray(triangles, dtype=np.int64).reshape(-1)
+        if cand_idx.shape != (len(pts),) or (cand_idx < 0).any() or \
+                (cand_idx >= len(model.triangles)).any():
+            raise GeometryError(f"triangles: expected {len(pts)} indices into the "
+                                f"{len(model.triangles)} triangles, received {cand_idx.shape}")
+        cand_off = np.arange(len(pts) + 1, dtype=np.int64)
     tri_of = K.locate(model.nodes, model.triangles, pts, cand_off, cand_idx, tol)
     outside = np.flatnonzero(tri_of < 0)
     if outside.size:
+        where = "the domain" if triangles is None else "their given triangles"
         raise GeometryError(
-            f"{outside.size} of {len(pts)} points lie outside the domain, first (index: point) "
+            f"{outside.size} of {len(pts)} points lie outside {where}, first (index: point) "
             + ", ".join(f"{i}: {pts[i].tolist()}" for i in outside[:5]))
-    offsets, cols, vals, failed = K.sibson(model.nodes, model.triangles, nb, pts, tri_of, tol,
-                                           tol, work_chunks())
+    offsets, cols, vals, failed = K.natural(model.nodes, model.triangles, nb, pts, tri_of, tol,
+                                            tol, work_chunks(), kind == "laplace")
     if failed.any():
         bad = np.flatnonzero(failed)
         raise CNEMError(
