@@ -1,7 +1,9 @@
 """Node clouds on a `Domain`: regular, irregular, graded, or the user's own points.
 
-Every polygon corner, interface vertex and crack vertex is a node, and every
-boundary, interface and crack edge carries nodes about one local spacing apart.
+Every polygon corner, interface vertex and crack vertex is a node; the generated
+clouds put nodes about one local spacing apart along every boundary, interface
+and crack edge (and at least one inside a crack edge between two tips, so that
+the crack can open).
 
 >>> import cnem
 >>> from cnem.geometry import rectangle
@@ -41,21 +43,35 @@ def _edge_lines(dom):
     return shapely.linestrings(np.stack([v[e[:, 0]], v[e[:, 1]]], axis=1))
 
 
+def _tip_to_tip(dom):
+    """(e,) bool: crack edges whose both ends are crack tips.
+
+    Such a crack has no node that could be split to open it, so it needs one
+    inside (a crack opens by duplicating its non-tip nodes).
+    """
+    v, edges, kinds = dom.pslg.vertices, dom.pslg.edges, dom.pslg.kind
+    if len(dom.tips) == 0:
+        return np.zeros(len(edges), dtype=bool)
+    is_tip = cKDTree(dom.tips).query(v)[0] <= dom.tolerance
+    return (kinds == 2) & is_tip[edges[:, 0]] & is_tip[edges[:, 1]]
+
+
 def _boundary_nodes(dom, spacing_of, jitter=None):
     """Nodes along every PSLG edge, about ``spacing_of(x)`` apart.
 
     Returns ``points (n0, 2), segments (s, 2), kind (s,)``.
     """
     v, edges, kinds = dom.pslg.vertices, dom.pslg.edges, dom.pslg.kind
+    needs_split = _tip_to_tip(dom)
     points, segments, seg_kind = [v], [], []
     count = len(v)
     samples = np.linspace(0.0, 1.0, 65)
-    for (a, b), k in zip(edges, kinds):
+    for (a, b), k, split in zip(edges, kinds, needs_split):
         pa, pb = v[a], v[b]
         length = np.linalg.norm(pb - pa)
         dens = length / spacing_of(pa + samples[:, None] * (pb - pa))
         cum = np.concatenate([[0.0], np.cumsum(0.5 * (dens[1:] + dens[:-1]) * np.diff(samples))])
-        pieces = max(1, int(round(cum[-1])))
+        pieces = max(2 if split else 1, int(round(cum[-1])))
         t = np.interp(np.linspace(0, cum[-1], pieces + 1)[1:-1], cum, samples)
         if jitter is not None and len(t):
             t = np.sort(t + jitter.uniform(-0.2, 0.2, len(t)) / pieces)
@@ -84,8 +100,16 @@ def _keep_interior(dom, pts, clearance):
     return pts[keep]
 
 
-def _lattice(dom, h, offset=0.0):
+def _lattice(dom, h, offset=0.0, near=None, reach=np.inf):
+    """Square lattice of spacing ``h`` over the domain's bounding box, or only over
+    the part of it within ``reach`` of the points ``near`` (box around them)."""
     xmin, ymin, xmax, ymax = dom.bounds
+    if near is not None and np.isfinite(reach):
+        lo, hi = near.min(axis=0) - reach, near.max(axis=0) + reach
+        # stay on the same lattice: snap the box to lattice lines of the full box
+        x0 = xmin + np.floor(max(lo[0] - xmin, 0) / h) * h
+        y0 = ymin + np.floor(max(lo[1] - ymin, 0) / h) * h
+        xmin, ymin, xmax, ymax = x0, y0, min(xmax, hi[0]), min(ymax, hi[1])
     xs = xmin + offset + h * np.arange(int(np.ceil((xmax - xmin) / h)) + 1)
     ys = ymin + offset + h * np.arange(int(np.ceil((ymax - ymin) / h)) + 1)
     gx, gy = np.meshgrid(xs, ys)
@@ -173,11 +197,13 @@ def graded(domain, h, *, near, h_min, growth=0.3, seed=None):
     def spacing_of(x):
         return np.minimum(h, h_min + growth * tree.query(x)[0])
 
-    levels = int(np.ceil(np.log2(h / h_min))) if h > h_min else 0
+    levels = int(np.floor(np.log2(h / h_min))) if h > h_min else 0
     interior = []
     for k in range(levels + 1):
         hk = h / 2 ** k
-        pts = _lattice(domain, hk, offset=0.5 * hk)
+        # level k is used only where s(x) < 2 hk, i.e. near the centres
+        reach = np.inf if k == 0 else (2 * hk - h_min) / growth
+        pts = _lattice(domain, hk, offset=0.5 * hk, near=centres, reach=reach)
         s = spacing_of(pts)
         level = np.clip(np.floor(np.log2(h / s)), 0, levels)
         interior.append(pts[level == k])
@@ -242,6 +268,11 @@ def from_points(domain, points):
         raise GeometryError(
             f"{len(pairs)} pairs of duplicated points (closer than {tol:.3g}), first "
             + ", ".join(f"{i} and {j}" for i, j in pairs[:5]) + "; remove the duplicates")
+    # a crack edge between two tips with no point on it gets its midpoint
+    lonely = np.flatnonzero(_tip_to_tip(domain) & ~np.isin(np.arange(len(edges)), seg_of))
+    mids = 0.5 * (v[edges[lonely, 0]] + v[edges[lonely, 1]])
+    seg_of = np.concatenate([seg_of, lonely])
+    pts = np.concatenate([pts, mids])
     # the user's points keep their order; missing vertices are appended
     vertex_node = np.full(len(v), -1)
     vertex_node[iv[on_vertex]] = np.flatnonzero(on_vertex)

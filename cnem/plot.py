@@ -133,7 +133,8 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
     window_size : (2,) int
         Picture size in pixels, ``(width, height)``.
     bounds : (4,) float, optional
-        ``(xmin, xmax, ymin, ymax)`` to show (a zoom); default the whole domain.
+        ``(xmin, ymin, xmax, ymax)`` to show (a zoom; the order of
+        ``Domain.bounds``); default the whole domain.
     node_size : float, optional
         Node dot size in pixels; default from the smallest node spacing in view.
 
@@ -152,10 +153,10 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
     dom = mdl.domain
     xmin, ymin, xmax, ymax = dom.bounds
     if bounds is None:
-        bounds = (xmin, xmax, ymin, ymax)
-    bx0, bx1, by0, by1 = map(float, bounds)
+        bounds = (xmin, ymin, xmax, ymax)
+    bx0, by0, bx1, by1 = map(float, bounds)
     if not (bx1 > bx0 and by1 > by0):
-        raise PlotError(f"bounds must be (xmin, xmax, ymin, ymax) with xmin < xmax and "
+        raise PlotError(f"bounds must be (xmin, ymin, xmax, ymax) with xmin < xmax and "
                         f"ymin < ymax, received {tuple(bounds)}")
     width, height = map(int, window_size)
     lift = 1e-4 * dom.diameter        # draw lines above the cells (parallel view: no shift)

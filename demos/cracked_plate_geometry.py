@@ -110,7 +110,7 @@ def main(h=0.1, h_min=0.01, gamma_deg=30.0, growth=0.1, outdir="out", plot=True,
         half = max(HALF_CRACK, 6 * h_min)      # a square of one crack length around the tip
         files["tip"] = out / "cracked_plate_tip.png"
         cnem.plot.model(model, files["tip"], window_size=window_size,
-                        bounds=(tip[0] - half, tip[0] + half, tip[1] - half, tip[1] + half)
+                        bounds=(tip[0] - half, tip[1] - half, tip[0] + half, tip[1] + half)
                         ).close()
     return {
         "n_points": len(cloud.points),

@@ -67,4 +67,4 @@ def test_cells_polydata_matches_cells():
 def test_bad_bounds(tmp_path):
     _, _, m = model("graded_inclined_crack")
     with pytest.raises(cnem.plot.PlotError, match="bounds"):
-        cnem.plot.model(m, bounds=(1.0, 0.0, 0.0, 1.0))
+        cnem.plot.model(m, bounds=(1.0, 0.0, 0.0, 1.0))   # xmin > xmax

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import GeometryError
 from .pslg import BOUNDARY, CRACK
 from .topology import vertex_triangles
 
@@ -101,4 +102,10 @@ def split_cracks(points, triangles, segments, kind):
     kind_new = np.asarray(kind_new, dtype=np.int8)
     _, first = np.unique(seg_new, axis=0, return_index=True)
     first = np.sort(first)
+    opened = np.count_nonzero(kind_new[first] == CRACK)
+    if opened != 2 * len(crack):
+        raise GeometryError(
+            f"{2 * len(crack) - opened} crack segments could not be opened: a crack between "
+            "two tips needs a node inside it (cnem.nodes adds one; with from_points, put a "
+            "point on the crack)")
     return points[node_of_point], node_of_point, new_tri, seg_new[first], kind_new[first]

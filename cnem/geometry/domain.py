@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
-from shapely.geometry import LineString, Polygon
+from shapely.geometry import LineString, MultiPolygon, Polygon
 from shapely.geometry.polygon import orient
 from shapely.validation import explain_validity
 
@@ -32,7 +32,7 @@ def _check_ring(coords, what):
                             f"received shape {arr.shape}")
     if not np.isfinite(arr).all():
         raise GeometryError(f"{what}: vertices must be finite, received NaN or inf")
-    if np.allclose(arr[0], arr[-1]):
+    if np.array_equal(arr[0], arr[-1]):      # an explicitly closed ring
         arr = arr[:-1]
     return arr
 
@@ -76,8 +76,12 @@ def _as_polygon(obj, index, tol):
 
 def _is_single_polygon(obj):
     """Whether ``obj`` is one polygon rather than a list of polygons."""
-    if isinstance(obj, (Polygon, tuple)):
+    if isinstance(obj, Polygon):
         return True
+    if isinstance(obj, tuple) and len(obj) == 2 and isinstance(obj[1], (list, tuple)) \
+            and not np.isscalar(obj[1]) and all(np.ndim(h) == 2 for h in obj[1]) \
+            and np.ndim(obj[0]) == 2:
+        return True                          # (shell, [hole, ...])
     try:
         arr = np.asarray(obj, dtype=float)
     except (ValueError, TypeError):
@@ -106,8 +110,16 @@ class Domain:
     """
 
     def __init__(self, regions, cracks=()):
-        if _is_single_polygon(regions):
+        if isinstance(regions, MultiPolygon):
+            regions = list(regions.geoms)
+        elif _is_single_polygon(regions):
             regions = [regions]
+        elif isinstance(regions, tuple) and len(regions) == 2 and np.ndim(regions[0]) == 2:
+            regions = list(regions)              # two regions given as a tuple
+        if not isinstance(regions, (list, tuple)):
+            raise GeometryError(
+                f"regions: expected a polygon ((k, 2) array, (shell, [holes]) or shapely "
+                f"Polygon) or a list of them, received {type(regions).__name__}")
         regions = list(regions)
         if len(regions) == 0:
             raise GeometryError("expected at least one region, received an empty list")
@@ -257,8 +269,7 @@ class Domain:
         -------
         (p,) bool ndarray
         """
-        pts = np.asarray(points, dtype=float).reshape(-1, 2)
-        return self.region_of(pts) >= 0
+        return self.region_of(points) >= 0
 
     def region_of(self, points):
         """Index of the region (closure) containing each point, -1 outside.
@@ -272,7 +283,14 @@ class Domain:
         (p,) int64 ndarray
             The lowest region index for points on an interface.
         """
-        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        pts = np.asarray(points, dtype=float)
+        if pts.shape == (2,):
+            pts = pts[None]
+        if pts.ndim != 2 or pts.shape[1] != 2:
+            raise GeometryError(f"points: expected a (2,) or (p, 2) array, received shape "
+                                f"{pts.shape}")
+        if not np.isfinite(pts).all():
+            raise GeometryError("points: coordinates must be finite, received NaN or inf")
         out = np.full(len(pts), -1, dtype=np.int64)
         for i in reversed(range(len(self._regions))):
             shapely.prepare(self._regions[i])

@@ -42,12 +42,24 @@ class Cells:
     area: np.ndarray = field(init=False)
 
     def __post_init__(self):
-        x, y = self.vertices[:, 0], self.vertices[:, 1]
-        nxt = np.arange(len(x)) + 1
+        object.__setattr__(self, "area", self._moments()[0])
+
+    def _moments(self):
+        """Areas and centroids by the shoelace formula, relative to each cell's first
+        vertex (no cancellation far from the origin)."""
+        if len(self.vertices) == 0:
+            return np.zeros(0), np.zeros((0, 2))
+        first = np.repeat(self.offsets[:-1], np.diff(self.offsets))
+        rel = self.vertices - self.vertices[first]
+        nxt = np.arange(len(rel)) + 1
         nxt[self.offsets[1:] - 1] = self.offsets[:-1]
+        x, y = rel[:, 0], rel[:, 1]
         cross = x * y[nxt] - x[nxt] * y
-        area = 0.5 * np.add.reduceat(cross, self.offsets[:-1]) if len(x) else np.zeros(0)
-        object.__setattr__(self, "area", area)
+        area = 0.5 * np.add.reduceat(cross, self.offsets[:-1])
+        cx = np.add.reduceat((x + x[nxt]) * cross, self.offsets[:-1])
+        cy = np.add.reduceat((y + y[nxt]) * cross, self.offsets[:-1])
+        centroid = np.column_stack([cx, cy]) / (6.0 * area[:, None])
+        return area, centroid + self.vertices[self.offsets[:-1]]
 
     def __len__(self):
         return len(self.node)
@@ -58,13 +70,7 @@ class Cells:
 
     def centroid(self):
         """Centroids of all cells, ``(m, 2)``."""
-        x, y = self.vertices[:, 0], self.vertices[:, 1]
-        nxt = np.arange(len(x)) + 1
-        nxt[self.offsets[1:] - 1] = self.offsets[:-1]
-        cross = x * y[nxt] - x[nxt] * y
-        cx = np.add.reduceat((x + x[nxt]) * cross, self.offsets[:-1])
-        cy = np.add.reduceat((y + y[nxt]) * cross, self.offsets[:-1])
-        return np.column_stack([cx, cy]) / (6.0 * self.area[:, None])
+        return self._moments()[1]
 
     def __repr__(self):
         return f"<Cells {len(self.node)} cells, {len(self.vertices)} vertices>"
@@ -158,7 +164,10 @@ def discretize(cloud, *, progress=None):
     nodes, node_of_point, tri, segments, kind = split_cracks(
         cloud.points, tri, cloud.segments, cloud.segment_kind)
     t2 = time.perf_counter()
-    node, cell_region, offsets, vertices = voronoi_cells(nodes, tri, region, progress=progress)
+    shift = nodes.min(axis=0)        # a local frame keeps the snap grid above round-off
+    node, cell_region, offsets, vertices = voronoi_cells(nodes - shift, tri, region,
+                                                         progress=progress)
+    vertices += shift
     t3 = time.perf_counter()
     timings.update(triangulation=t1 - t0, splitting=t2 - t1, cells=t3 - t2)
     log.info("discretize: %d nodes, %s", len(nodes),
