@@ -8,6 +8,8 @@ the crack and the crack faces become boundaries of the triangulation.
 from __future__ import annotations
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from ..errors import GeometryError
 from .pslg import BOUNDARY, CRACK
@@ -17,27 +19,24 @@ __all__ = ["split_cracks"]
 
 
 def _fan_groups(v, fan, triangles, crack_neighbors):
-    """Group the triangles around node ``v`` into sides separated by crack segments."""
-    parent = {t: t for t in fan}
+    """Group the triangles around node ``v`` into sides separated by crack segments.
 
-    def find(t):
-        while parent[t] != t:
-            parent[t] = parent[parent[t]]
-            t = parent[t]
-        return t
-
+    Two triangles of the fan are on the same side when they share an edge
+    ``(v, w)`` that is not a crack segment.
+    """
     by_other = {}
-    for t in fan:
+    for k, t in enumerate(fan):
         for w in triangles[t]:
             if w != v:
-                by_other.setdefault(int(w), []).append(t)
-    for w, ts in by_other.items():
-        if len(ts) == 2 and w not in crack_neighbors:
-            parent[find(ts[0])] = find(ts[1])
-    groups = {}
-    for t in fan:
-        groups.setdefault(find(t), []).append(t)
-    return sorted(groups.values(), key=min)
+                by_other.setdefault(int(w), []).append(k)
+    links = np.array([ks for w, ks in by_other.items()
+                      if len(ks) == 2 and w not in crack_neighbors], dtype=np.int64).reshape(-1, 2)
+    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])),
+                       shape=(len(fan), len(fan)))
+    _, label = connected_components(graph, directed=False)
+    fan = np.asarray(fan)
+    groups = [fan[label == g].tolist() for g in range(label.max() + 1)]
+    return sorted(groups, key=min)
 
 
 def split_cracks(points, triangles, segments, kind):

@@ -11,6 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
@@ -49,24 +51,16 @@ def ring_coordinates(polygon):
 
 def _merge_vertices(points, tol):
     """Merge points closer than ``tol``; return (unique points, index map)."""
-    tree = cKDTree(points)
-    pairs = tree.query_pairs(tol, output_type="ndarray")
-    parent = np.arange(len(points))
-    for a, b in sorted(map(tuple, pairs)):
-        ra, rb = a, b
-        while parent[ra] != ra:
-            ra = parent[ra]
-        while parent[rb] != rb:
-            rb = parent[rb]
-        if ra != rb:
-            parent[max(ra, rb)] = min(ra, rb)
-    for i in range(len(parent)):
-        r = i
-        while parent[r] != r:
-            r = parent[r]
-        parent[i] = r
-    roots, inverse = np.unique(parent, return_inverse=True)
-    return points[roots], inverse
+    pairs = cKDTree(points).query_pairs(tol, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])),
+                       shape=(len(points), len(points)))
+    _, label = connected_components(graph, directed=False)
+    first = np.full(label.max() + 1, len(points))
+    np.minimum.at(first, label, np.arange(len(points)))   # keep each group's first point
+    order = np.argsort(first)
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return points[first[order]], rank[label]
 
 
 def _split_edge(a, b, vertices, tree, tol):
