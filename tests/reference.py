@@ -363,3 +363,215 @@ def spatial_case_id(case):
     """Readable pytest id of a spatial case."""
     kind, dim, periodic = case
     return f"{kind}-{dim}d-{'periodic' if periodic else 'open'}"
+
+
+# ---------------------------------------------------------------- cnem.shape
+# Constrained natural-neighbour coordinates from their definition (C-NEM §2.2,
+# §3.4-3.5, eq. 3-4 and 13), for points strictly inside the domain: Voronoi
+# cells as half-plane intersections (Sutherland-Hodgman, one line at a time),
+# areas and lengths by shapely. Slow: a few hundredths of a second per point.
+#
+# Polygons carry, for each edge, the key of the line it lies on; after every cut
+# each vertex is recomputed as the intersection of its two edge lines, so the
+# vertices are as accurate as the bisectors themselves (not limited by the
+# far-away corners of the big box the construction starts from).
+# (shapely's overlay is not used to intersect the cells: GEOS 3.14 returned an
+# empty intersection for two cells sharing an edge up to 1e-14; the cuts are
+# exact set intersections anyway.)
+
+
+def _clip_halfplane(poly, labels, lines, key):
+    """Convex polygon ``poly (k, 2)`` cut by the half-plane ``lines[key]``.
+
+    A half-plane ``(m, nrm)`` is ``{y : (y - m) . nrm <= 0}`` (points on the line
+    are kept). ``labels[k]`` is the key of the line carrying edge
+    ``poly[k] -> poly[k+1]``; the new edge gets ``key``.
+    """
+    m, nrm = lines[key]
+    f = (poly - m) @ nrm
+    out, lab = [], []
+    k = len(poly)
+    for a in range(k):
+        b = (a + 1) % k
+        p, q, fp, fq = poly[a], poly[b], f[a], f[b]
+        if fp <= 0.0:
+            out.append(p)
+            lab.append(labels[a])
+            if fq > 0.0:                           # leaves: the edge goes on along the new line
+                out.append(p + (fp / (fp - fq)) * (q - p))
+                lab.append(key)
+        elif fq <= 0.0:                            # enters: the rest of the old edge
+            out.append(p + (fp / (fp - fq)) * (q - p))
+            lab.append(labels[a])
+    if len(out) < 3:
+        return np.zeros((0, 2)), []
+    out = np.asarray(out)
+    for v in range(len(out)):                      # vertex v = line of edge v-1 ∩ line of edge v
+        (ma, na), (mb, nb) = lines[lab[v - 1]], lines[lab[v]]
+        det = na[0] * nb[1] - na[1] * nb[0]
+        if lab[v - 1] != lab[v] and abs(det) > 1e-9 * np.linalg.norm(na) * np.linalg.norm(nb):
+            ca, cb = na @ ma, nb @ mb
+            out[v] = [(ca * nb[1] - cb * na[1]) / det, (na[0] * cb - nb[0] * ca) / det]
+    return out, lab
+
+
+def _box(centre, half, lines):
+    """Square of half-width ``half`` around ``centre`` (counter-clockwise), edge keys in ``lines``."""
+    corners = centre + half * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+    outward = np.array([[0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])
+    keys = []
+    for k in range(4):
+        lines["box", k] = (corners[k], outward[k])
+        keys.append(("box", k))
+    return corners, keys
+
+
+def _natural_neighbour_cell(model, x, region, box_factor=1e3):
+    """Voronoi cell of ``x`` among ``{x}`` and the nodes of ``region`` visible from ``x``.
+
+    Returns ``(cell, labels, lines, vis, members, dist)``: the cell ``(k, 2)``
+    (counter-clockwise), the line key of each edge (``("x", j)``: bisector of
+    ``x`` and node ``j``), the lines, a cached visibility test ``vis(j)``, and the
+    region's nodes sorted by distance from ``x`` with their distances.
+    """
+    x = np.asarray(x, dtype=float)
+    members = np.unique(model.triangles[model.triangle_region == region])
+    d = np.linalg.norm(model.nodes[members] - x, axis=1)
+    order = np.argsort(d, kind="stable")
+    members, d = members[order], d[order]
+    cache = {}
+
+    def vis(j):
+        j = int(j)
+        if j not in cache:
+            cache[j] = visible(model, j, x)
+        return cache[j]
+
+    lo, hi = model.nodes.min(axis=0), model.nodes.max(axis=0)
+    half = box_factor * float(np.linalg.norm(hi - lo))
+    for _ in range(4):                 # enlarge the box until no edge of the cell lies on it
+        lines = {}
+        cell, labels = _box(x, half, lines)
+        for j, dj in zip(members, d):
+            # the bisector of x and j is at distance dj / 2 from x: beyond the
+            # farthest vertex of the cell it cannot cut it, nor can any farther
+            # node's -- stopping here is exact.
+            if dj > 2.0 * np.max(np.linalg.norm(cell - x, axis=1)):
+                break
+            if dj == 0.0:
+                raise ValueError(f"x = {x.tolist()} is node {j}: the reference needs x off the nodes")
+            if not vis(j):
+                continue
+            lines["x", int(j)] = _bisector(x, model.nodes[j])
+            cell, labels = _clip_halfplane(cell, labels, lines, ("x", int(j)))
+        if not any(key[0] == "box" for key in labels):
+            return cell, labels, lines, vis, members, d
+        half *= 1e3
+    raise ValueError(f"the Voronoi cell of x = {x.tolist()} is unbounded: x must be strictly "
+                     "inside the domain (not on a boundary, interface or crack)")
+
+
+def _bisector(a, b):
+    """Half-plane of the points at least as close to ``a`` as to ``b``: ``(m, nrm)``."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    return 0.5 * (a + b), b - a
+
+
+def sibson_reference(model, x, region):
+    """Constrained Sibson coordinates of ``x`` from their definition (C-NEM eq. 3-4, 13).
+
+    V = the nodes of ``region`` visible from ``x`` (`visible`: the segment to the
+    node crosses no boundary, interface or crack; crack-face copies on their own
+    side). cell_x = the Voronoi cell of ``x`` among ``{x} ∪ V``: the intersection
+    of the half-planes ``|y - x| <= |y - x_j|``, j in V, inside a square box of
+    half-width 1e3 x the model's diameter around ``x`` -- *not* clipped to the
+    domain (the cells of the construction extend past the boundary, paper
+    Figure 7b). cell_i = the Voronoi cell of node i in V among V (without
+    ``x``): the half-planes ``|y - x_i| <= |y - x_j|``, j in V \\ {i}, in the same
+    box. phi_i = area(cell_x ∩ cell_i) / area(cell_x).
+
+    Why the box does not matter: for ``x`` strictly inside the domain, ``x`` is
+    strictly inside the convex hull of V, so cell_x is bounded. If no edge of
+    cell_x lies on the box (checked; otherwise the box is enlarged x 1e3 and the
+    cell recomputed), cell_x is the same for every larger box, and because
+    cell_x ⊂ box, cell_x ∩ (box ∩ cell_i) = cell_x ∩ cell_i for any such box.
+    So cell_x ∩ cell_i is computed by cutting cell_x itself with the half-planes
+    of i -- the same set as intersecting it with the boxed cell_i. Two exact
+    shortcuts: with R the distance from ``x`` to the farthest vertex of cell_x and
+    d0 that of the nearest visible node, a node j with ``|x_j - x| >= |x_i - x| + 2R``
+    is farther than ``x_i`` from every point of the disc B(x, R) ⊃ cell_x (its
+    half-plane contains cell_x, the cut is a no-op), and a node i with
+    ``|x_i - x| > 2R + d0`` is farther from every point of that disc than the
+    nearest visible node (cell_i misses cell_x).
+
+    Parameters
+    ----------
+    model : cnem.Model
+    x : (2,) array-like
+        A point strictly inside region ``region``: off the nodes and off every
+        constraint segment (cell_x is unbounded on a segment).
+    region : int
+
+    Returns
+    -------
+    dict
+        node -> phi, the entries with phi >= 1e-14.
+
+    Raises
+    ------
+    ValueError
+        x on a node, or cell_x unbounded (x not strictly inside the visible hull).
+    """
+    x = np.asarray(x, dtype=float)
+    cell_x, labels_x, lines, vis, members, d = _natural_neighbour_cell(model, x, region)
+    R = float(np.max(np.linalg.norm(cell_x - x, axis=1)))
+    area_x = shapely.Polygon(cell_x).area
+    d0 = min(dj for j, dj in zip(members, d) if vis(j))
+    out = {}
+    for i, di in zip(members, d):
+        if di > 2.0 * R + d0:
+            break
+        if not vis(i):
+            continue
+        piece, lab = cell_x, list(labels_x)
+        for j, dj in zip(members, d):
+            if dj >= di + 2.0 * R:
+                break
+            if j == i or not vis(j):
+                continue
+            key = ("i", int(i), int(j))
+            lines[key] = _bisector(model.nodes[i], model.nodes[j])
+            piece, lab = _clip_halfplane(piece, lab, lines, key)
+            if len(piece) == 0:
+                break
+        if len(piece) == 0:
+            continue
+        phi = shapely.Polygon(piece).area / area_x
+        if phi >= 1e-14:
+            out[int(i)] = phi
+    return out
+
+
+def laplace_reference(model, x, region):
+    """Laplace (non-Sibsonian) coordinates of ``x`` from their definition.
+
+    With cell_x the Voronoi cell of ``x`` among ``{x} ∪ V`` exactly as in
+    `sibson_reference` (visible nodes of ``region``, half-plane intersection in
+    a big box, not clipped to the domain), ``w_i = |e_i| / |x - x_i|`` where
+    ``e_i`` is the edge of cell_x on the bisector of ``x`` and node i (length by
+    shapely), and ``phi_i = w_i / sum_j w_j``. Same conditions on ``x``.
+
+    Returns
+    -------
+    dict
+        node -> phi, the entries with phi >= 1e-14.
+    """
+    x = np.asarray(x, dtype=float)
+    cell, labels, _, _, _, _ = _natural_neighbour_cell(model, x, region)
+    w = {}
+    for k, key in enumerate(labels):
+        j = key[1]
+        edge = shapely.LineString([cell[k], cell[(k + 1) % len(cell)]])
+        w[j] = w.get(j, 0.0) + edge.length / float(np.linalg.norm(x - model.nodes[j]))
+    total = sum(w.values())
+    return {j: v / total for j, v in w.items() if v / total >= 1e-14}
