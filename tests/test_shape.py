@@ -424,3 +424,34 @@ def test_triangle_hint_chooses_the_crack_face():
     assert checked >= 2
     with pytest.raises(cnem.GeometryError, match="given triangles"):
         model.shape_functions(x, triangles=[int(np.argmax(centroid[:, 0]))])
+
+
+# ------------------------------------------------------------------------ gradients
+@pytest.mark.parametrize("name", NAMES)
+def test_gradients_match_central_differences(name):
+    """Analytic Sibson gradients against central differences of Phi, at points
+    away from circumcircles (where Phi is only C1) and constraints."""
+    _, _, model = cases.model(name)
+    pts = interior_points(name, 80, seed=3, margin=1e-4)
+    cc, radius = _circumcircles(model)
+    gap = np.abs(np.linalg.norm(pts[:, None, :] - cc[None], axis=2) - radius[None]).min(axis=1)
+    pts = pts[gap > 1e-4]
+    phi, dx, dy = model.shape_functions(pts, gradient=True)
+    # same pattern as Phi (checked first: sparse arithmetic may sort indices in place)
+    assert (dx.indices == phi.indices).all() and (dy.indptr == phi.indptr).all()
+    h = 1e-6 * _scale(model)
+    for d, got in (([h, 0.0], dx), ([0.0, h], dy)):
+        fd = (model.shape_functions(pts + d) - model.shape_functions(pts - d)) / (2 * h)
+        assert abs(fd - got).max() < 1e-5 * max(1.0, abs(got).max())
+    # gradients reproduce the gradient of linear fields and sum to zero
+    np.testing.assert_allclose(dx @ model.nodes, np.tile([1.0, 0.0], (len(pts), 1)), atol=1e-10)
+    np.testing.assert_allclose(dy @ model.nodes, np.tile([0.0, 1.0], (len(pts), 1)), atol=1e-10)
+    assert abs(dx.sum(axis=1)).max() < 1e-10 and abs(dy.sum(axis=1)).max() < 1e-10
+
+
+def test_gradients_refused_at_nodes_and_on_constraints():
+    _, _, model = cases.model(NAMES[0])
+    with pytest.raises(cnem.GeometryError, match="not defined"):
+        model.shape_functions(model.nodes[:3], gradient=True)
+    with pytest.raises(NotImplementedError, match="sibson"):
+        model.shape_functions(model.nodes[:1], kind="laplace", gradient=True)

@@ -115,15 +115,16 @@ class Model:
         """Domain: the body this model discretises."""
         return self.cloud.domain
 
-    def shape_functions(self, points, *, kind="sibson", triangles=None):
+    def shape_functions(self, points, *, kind="sibson", triangles=None, gradient=False):
         """Constrained natural-neighbour coordinates, see `cnem.shape.shape_functions`.
 
         Returns
         -------
         scipy.sparse.csr_matrix, shape (p, n)
+            Or ``(Phi, dPhi_dx, dPhi_dy)`` with ``gradient=True``.
         """
         from ..shape import shape_functions
-        return shape_functions(self, points, kind=kind, triangles=triangles)
+        return shape_functions(self, points, kind=kind, triangles=triangles, gradient=gradient)
 
     def __repr__(self):
         dom = self.domain

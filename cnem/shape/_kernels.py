@@ -116,11 +116,16 @@ def _in_cavity(cav, size, o):
 
 
 @numba.njit(cache=True)
-def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, laplace):
+def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, laplace):
     """Sibson (or Laplace) coordinates from a cavity: the neighbour count, -1 if inconsistent.
 
     Laplace: ``w_i = |Voronoi edge between x and i| / |x - x_i|``, normalised;
     the Voronoi edge joins the two new circumcentres at ``i``.
+
+    Sibson gradients (Piper; Braun and Sambridge) go to ``gx, gy``: the area
+    ``A_i`` taken from ``i`` changes as ``grad A_i = s_i / r_i (m_i - x)`` with
+    ``s_i`` the length and ``m_i`` the midpoint of that Voronoi edge and
+    ``r_i = |x_i - x|``; then ``grad phi_i = (grad A_i - phi_i grad A) / A``.
     """
     count = 0
     total = 0.0
@@ -162,23 +167,29 @@ def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, laplace):
             area += ox * fy - oy * fx
             if count == cols.shape[0]:
                 return -1
-            if laplace:
-                weight = np.hypot(fx - ox, fy - oy) / np.hypot(nodes[i, 0] - x, nodes[i, 1] - y)
-            else:
-                weight = 0.5 * area
+            edge = np.hypot(fx - ox, fy - oy) / np.hypot(nodes[i, 0] - x, nodes[i, 1] - y)
+            weight = edge if laplace else 0.5 * area
             cols[count] = i
             vals[count] = weight
+            gx[count] = 0.5 * edge * (fx + ox)
+            gy[count] = 0.5 * edge * (fy + oy)
             total += weight
             count += 1
     if not total > 0.0:
         return -1
+    sum_gx, sum_gy = 0.0, 0.0
+    for m in range(count):
+        sum_gx += gx[m]
+        sum_gy += gy[m]
     for m in range(count):
         vals[m] /= total
+        gx[m] = (gx[m] - vals[m] * sum_gx) / total
+        gy[m] = (gy[m] - vals[m] * sum_gy) / total
     return count
 
 
 @numba.njit(cache=True)
-def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, laplace):
+def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, laplace):
     """Coordinates of one point: ``(kind, count)`` with the row in ``cols, vals``."""
     kind, a, b, s = _special(nodes, tri, nb, t, x, y, node_tol, edge_tol)
     if kind == AT_NODE:
@@ -191,14 +202,14 @@ def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, laplace):
     size = _cavity(nodes, tri, nb, t, x, y, cav)
     if size < 0:
         return FAILED, 0
-    count = _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, laplace)
+    count = _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, laplace)
     if count < 0:
         return FAILED, 0
     return CAVITY, count
 
 
 @numba.njit(cache=True, parallel=True)
-def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace):
+def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace, gradient):
     """Sibson (or Laplace) coordinates of many points as CSR.
 
     Parameters
@@ -216,43 +227,54 @@ def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace):
         Work chunks shared between threads.
     laplace : bool
         Laplace (non-Sibsonian) instead of Sibson coordinates.
+    gradient : bool
+        Also return the Sibson gradients (rows at nodes and on constraint
+        edges, where they are not defined, stay zero).
 
     Returns
     -------
     offsets : (p + 1,) int64
     cols : (k,) int64
-    vals : (k,) float64
-    failed : (p,) bool
-        Points whose cavity was inconsistent (their rows are empty).
+    vals, gx, gy : (k,) float64
+        Values and gradients (``gx, gy`` empty unless ``gradient``).
+    kinds : (p,) int8
+        ``CAVITY``, ``AT_NODE``, ``ON_EDGE`` or ``FAILED`` (an inconsistent
+        cavity; the row is empty).
     """
     p = points.shape[0]
     counts = np.zeros(p, dtype=np.int64)
-    failed = np.zeros(p, dtype=np.bool_)
+    kinds = np.zeros(p, dtype=np.int8)
     nch = max(1, min(p, nch))
     for ch in numba.prange(nch):
         cav = np.empty(MAX_CAVITY, dtype=np.int64)
         cols = np.empty(MAX_CAVITY, dtype=np.int64)
-        vals = np.empty(MAX_CAVITY)
+        vals, gx, gy = np.empty(MAX_CAVITY), np.empty(MAX_CAVITY), np.empty(MAX_CAVITY)
         for q in range(ch * p // nch, (ch + 1) * p // nch):
             kind, c = _row(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1], node_tol,
-                           edge_tol, cav, cols, vals, laplace)
+                           edge_tol, cav, cols, vals, gx, gy, laplace)
             counts[q] = c
-            failed[q] = kind == FAILED
+            kinds[q] = kind
     offsets = np.zeros(p + 1, dtype=np.int64)
     for q in range(p):
         offsets[q + 1] = offsets[q] + counts[q]
     out_cols = np.empty(offsets[p], dtype=np.int64)
     out_vals = np.empty(offsets[p])
+    out_gx = np.zeros(offsets[p] if gradient else 0)
+    out_gy = np.zeros(offsets[p] if gradient else 0)
     for ch in numba.prange(nch):
         cav = np.empty(MAX_CAVITY, dtype=np.int64)
         cols = np.empty(MAX_CAVITY, dtype=np.int64)
-        vals = np.empty(MAX_CAVITY)
+        vals, gx, gy = np.empty(MAX_CAVITY), np.empty(MAX_CAVITY), np.empty(MAX_CAVITY)
         for q in range(ch * p // nch, (ch + 1) * p // nch):
             kind, c = _row(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1], node_tol,
-                           edge_tol, cav, cols, vals, laplace)
-            out_cols[offsets[q]:offsets[q] + c] = cols[:c]
-            out_vals[offsets[q]:offsets[q] + c] = vals[:c]
-    return offsets, out_cols, out_vals, failed
+                           edge_tol, cav, cols, vals, gx, gy, laplace)
+            a = offsets[q]
+            out_cols[a:a + c] = cols[:c]
+            out_vals[a:a + c] = vals[:c]
+            if gradient and kind == CAVITY:
+                out_gx[a:a + c] = gx[:c]
+                out_gy[a:a + c] = gy[:c]
+    return offsets, out_cols, out_vals, out_gx, out_gy, kinds
 
 
 @numba.njit(cache=True, parallel=True)

@@ -27,7 +27,7 @@ def _topology(model):
     return cache["shape"]
 
 
-def shape_functions(model, points, *, kind="sibson", triangles=None):
+def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=False):
     """Constrained natural-neighbour coordinates of points.
 
     Parameters
@@ -40,10 +40,16 @@ def shape_functions(model, points, *, kind="sibson", triangles=None):
         A triangle of ``model.triangles`` holding each point. A point exactly on
         a crack face lies in triangles of both faces; give the triangle on the
         side wanted. By default the triangle the point is deepest inside.
+    gradient : bool
+        Also return the derivatives of the Sibson coordinates (analytic, Piper
+        / Braun-Sambridge), for points inside cells: not at nodes nor on
+        constraint segments, where they are not defined.
 
     Returns
     -------
-    scipy.sparse.csr_matrix, shape (p, n)
+    Phi : scipy.sparse.csr_matrix, shape (p, n)
+        With ``gradient=True`` the tuple ``(Phi, dPhi_dx, dPhi_dy)``, three CSR
+        matrices with the same pattern.
         Row ``k`` holds the coordinates of ``points[k]`` with respect to the
         nodes: rows sum to 1, ``Phi @ model.nodes`` gives back the points, a
         point at a node gets its unit row, a point on a boundary, interface or
@@ -57,6 +63,8 @@ def shape_functions(model, points, *, kind="sibson", triangles=None):
     """
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}, received {kind!r}")
+    if gradient and kind != "sibson":
+        raise NotImplementedError("gradients are available for kind='sibson' only")
     pts = np.ascontiguousarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise GeometryError(f"points: expected a (p, 2) array, received shape {pts.shape}")
@@ -64,7 +72,8 @@ def shape_functions(model, points, *, kind="sibson", triangles=None):
         raise GeometryError("points: coordinates must be finite, received NaN or inf")
     n = len(model.nodes)
     if len(pts) == 0:
-        return sp.csr_matrix((0, n))
+        empty = sp.csr_matrix((0, n))
+        return (empty, empty.copy(), empty.copy()) if gradient else empty
     nb, tree = _topology(model)
     tol = config.SHAPE_TOL * model.domain.diameter
     if triangles is None:
@@ -83,11 +92,22 @@ def shape_functions(model, points, *, kind="sibson", triangles=None):
         raise GeometryError(
             f"{outside.size} of {len(pts)} points lie outside {where}, first (index: point) "
             + ", ".join(f"{i}: {pts[i].tolist()}" for i in outside[:5]))
-    offsets, cols, vals, failed = K.natural(model.nodes, model.triangles, nb, pts, tri_of, tol,
-                                            tol, work_chunks(), kind == "laplace")
-    if failed.any():
-        bad = np.flatnonzero(failed)
+    offsets, cols, vals, gx, gy, kinds = K.natural(
+        model.nodes, model.triangles, nb, pts, tri_of, tol, tol, work_chunks(),
+        kind == "laplace", gradient)
+    failed = np.flatnonzero(kinds == K.FAILED)
+    if failed.size:
         raise CNEMError(
-            f"the natural-neighbour cavity of {bad.size} points was inconsistent (round-off on "
-            f"a circumcircle), first {pts[bad[:3]].tolist()}; please report this case")
-    return sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n))
+            f"the natural-neighbour cavity of {failed.size} points was inconsistent (round-off "
+            f"on a circumcircle), first {pts[failed[:3]].tolist()}; please report this case")
+    phi = sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n))
+    if not gradient:
+        return phi
+    singular = np.flatnonzero(kinds != K.CAVITY)
+    if singular.size:
+        raise GeometryError(
+            f"{singular.size} points lie at a node or on a boundary, interface or crack "
+            f"segment, where the gradients are not defined, first {pts[singular[:3]].tolist()}; "
+            "evaluate gradients inside the cells")
+    return (phi, sp.csr_matrix((gx, cols, offsets), shape=phi.shape),
+            sp.csr_matrix((gy, cols, offsets), shape=phi.shape))
