@@ -51,10 +51,14 @@ def _in_circle(nodes, tri, t, x, y):
     ax, ay = nodes[tri[t, 0], 0] - x, nodes[tri[t, 0], 1] - y
     bx, by = nodes[tri[t, 1], 0] - x, nodes[tri[t, 1], 1] - y
     cx, cy = nodes[tri[t, 2], 0] - x, nodes[tri[t, 2], 1] - y
-    det = ((ax * ax + ay * ay) * (bx * cy - by * cx)
-           - (bx * bx + by * by) * (ax * cy - ay * cx)
-           + (cx * cx + cy * cy) * (ax * by - ay * bx))
-    return det > 0.0
+    a2, b2, c2 = ax * ax + ay * ay, bx * bx + by * by, cx * cx + cy * cy
+    det = a2 * (bx * cy - by * cx) - b2 * (ax * cy - ay * cx) + c2 * (ax * by - ay * bx)
+    # a filtered predicate: when round-off could flip the sign (x on the circle
+    # to working precision) the triangle is left out, consistently; its share
+    # of the coordinates is zero there anyway (they are C1 across circles)
+    permanent = (a2 * (abs(bx * cy) + abs(by * cx)) + b2 * (abs(ax * cy) + abs(ay * cx))
+                 + c2 * (abs(ax * by) + abs(ay * bx)))
+    return det > 1e-14 * permanent
 
 
 @numba.njit(cache=True)
