@@ -152,3 +152,28 @@ def test_errors():
     fam = family_search(pts, 0.1)
     with pytest.raises(ValueError, match=r"\(100, 2\).*\(99, 2\)"):
         remove_crossing(fam, pts[:99], crack)
+
+
+def test_bond_through_an_inner_vertex_of_a_polyline_is_cut():
+    """A bond through the shared vertex of two crack segments crosses the crack
+    when the segments leave on opposite sides of it; through a tip it only touches."""
+    pts = np.array([[1.0, -0.5], [1.0, 0.5], [3.0, -0.5], [3.0, 0.5]])
+    fam = family_search(pts, 1.5)
+    polyline = [[[0.0, 0.0], [1.0, 0.0]], [[1.0, 0.0], [2.0, 0.0]], [[2.0, 0.0], [4.0, 0.0]]]
+    assert len(remove_crossing(fam, pts, polyline).indices) == 0
+    # a "^" kink at the bond: its legs leave on both sides of the bond, which it cuts
+    apex = [[[0.0, -1.0], [1.0, 0.0]], [[1.0, 0.0], [2.0, -1.0]]]
+    assert [0, 1] not in remove_crossing(fam, pts, apex).pairs().tolist()
+    # a "<" kink whose legs both leave on the left of the bond: touching, kept
+    kink = [[[0.0, -1.0], [1.0, 0.0]], [[1.0, 0.0], [0.0, 1.0]]]
+    kept = remove_crossing(fam, pts, kink).pairs().tolist()
+    assert [0, 1] in kept and [1, 0] in kept
+    # the crack's tip on the bond: touching, kept
+    tip = remove_crossing(fam, pts, [[[0.0, 0.0], [1.0, 0.0]]]).pairs().tolist()
+    assert [0, 1] in tip and [2, 3] in tip
+
+
+def test_segments_of_the_wrong_shape_are_refused():
+    pts = np.array([[0.0, 0.0], [1.0, 0.0]])
+    with pytest.raises(ValueError, match=r"\(s, 2, 2\)"):
+        remove_crossing(family_search(pts, 1.5), pts, np.zeros((3, 2, 3)))

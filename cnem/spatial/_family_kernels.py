@@ -266,11 +266,16 @@ def _orient(ax, ay, bx, by, cx, cy):
 
 
 @numba.njit(cache=True, parallel=True)
-def crossing_mask(pts, offsets, indices, seg, cand_off, cand_idx):
-    """Mask of bonds that properly cross none of their point's candidate segments.
+def crossing_mask(pts, offsets, indices, seg, far, cand_off, cand_idx):
+    """Mask of bonds that cross none of their point's candidate segments.
 
-    ``seg`` is ``(s, 4)``: ``ax, ay, bx, by``; candidates of point ``i`` are
-    ``cand_idx[cand_off[i]:cand_off[i + 1]]``.
+    ``seg`` is ``(s, 4)``: ``ax, ay, bx, by``; ``far`` is ``(s, 2, 2)``: for
+    each end of each segment, the far end of the other segment that shares
+    that end (a polyline's inner vertex), NaN when none does. A bond crosses
+    a segment when their interiors cross, or when it passes through an inner
+    vertex of a polyline whose two segments leave on opposite sides of the
+    bond; a bond through a crack tip or along a segment only touches it.
+    Candidates of point ``i`` are ``cand_idx[cand_off[i]:cand_off[i + 1]]``.
     """
     n = offsets.shape[0] - 1
     keep = np.ones(indices.shape[0], dtype=np.bool_)
@@ -290,5 +295,16 @@ def crossing_mask(pts, offsets, indices, seg, cand_off, cand_idx):
                 o4 = _orient(xi, yi, xj, yj, bx, by)
                 if o3 * o4 < 0.0:
                     keep[k] = False
+                    break
+                # the bond passes through an end of the segment: through an
+                # inner vertex of a polyline it crosses when the neighbouring
+                # segment leaves on the other side of the bond
+                for end in range(2):
+                    o_end, o_other = (o3, o4) if end == 0 else (o4, o3)
+                    fx, fy = far[s, end, 0], far[s, end, 1]
+                    if o_end == 0.0 and o_other != 0.0 and not np.isnan(fx):
+                        if o_other * _orient(xi, yi, xj, yj, fx, fy) < 0.0:
+                            keep[k] = False
+                if not keep[k]:
                     break
     return keep

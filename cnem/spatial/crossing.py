@@ -11,12 +11,27 @@ from .rtree import RTree
 __all__ = ["remove_crossing"]
 
 
-def remove_crossing(family, points, segments):
-    """Drop every bond ``(i, j)`` whose straight segment properly crosses a segment.
+def _far_ends(seg):
+    """(s, 2, 2): for each segment end, the far end of another segment sharing it (NaN if none)."""
+    ends = seg.reshape(-1, 2)                       # end e of segment s is row 2 s + e
+    far = np.full_like(ends, np.nan)
+    _, group, size = np.unique(ends, axis=0, return_inverse=True, return_counts=True)
+    group = group.reshape(-1)
+    for g in np.flatnonzero(size == 2):
+        a, b = np.flatnonzero(group == g)
+        far[a] = ends[b ^ 1]                        # the other end of b's segment
+        far[b] = ends[a ^ 1]
+    return far.reshape(-1, 2, 2)
 
-    A bond that only touches a segment (an end on it, or passing through a
-    segment's end point) is kept: a point on a crack line, or a crack tip, does
-    not cut bonds.
+
+def remove_crossing(family, points, segments):
+    """Drop every bond ``(i, j)`` whose straight segment crosses a segment.
+
+    A bond crosses when the interiors cross, or when it passes through an
+    inner vertex of a polyline (two segments sharing an end) whose segments
+    leave on opposite sides of it. A bond that only touches (an end on a
+    segment, passing through a crack tip, running along a segment) is kept: a
+    point on a crack line, or a crack tip, does not cut bonds.
 
     Parameters
     ----------
@@ -33,7 +48,14 @@ def remove_crossing(family, points, segments):
         Same points and horizon, fewer bonds.
     """
     pts = np.ascontiguousarray(points, dtype=np.float64)
-    seg = np.ascontiguousarray(np.asarray(segments, dtype=np.float64).reshape(-1, 4))
+    seg = np.asarray(segments, dtype=np.float64)
+    if seg.ndim == 2 and seg.shape[1] == 4:
+        seg = seg.reshape(-1, 2, 2)
+    if seg.ndim != 3 or seg.shape[1:] != (2, 2):
+        raise ValueError(f"segments: expected an (s, 2, 2) array of end points, received "
+                         f"shape {seg.shape}")
+    far = _far_ends(seg)
+    seg = np.ascontiguousarray(seg.reshape(-1, 4))
     if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) != len(family):
         raise ValueError(f"points: expected ({len(family)}, 2) 2-D points of the family, "
                          f"received shape {pts.shape}")
@@ -50,7 +72,7 @@ def remove_crossing(family, points, segments):
     rows = np.repeat(np.arange(len(pts)), family.counts)
     np.maximum.at(reach, rows, np.linalg.norm(pts[idx] - pts[rows], axis=1))
     cand_off, cand_idx = tree.query_ball(pts, reach)
-    keep = K.crossing_mask(pts, family.offsets, idx, seg, cand_off, cand_idx)
+    keep = K.crossing_mask(pts, family.offsets, idx, seg, far, cand_off, cand_idx)
     counts = np.bincount(rows[keep], minlength=len(pts))
     offsets = np.zeros(len(pts) + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
