@@ -213,7 +213,8 @@ def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, l
 
 
 @numba.njit(cache=True, parallel=True)
-def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace, gradient):
+def natural(nodes, tri, nb, points, tri_of, order, node_tol, edge_tol, nch, laplace,
+            gradient):
     """Sibson (or Laplace) coordinates of many points as CSR.
 
     Parameters
@@ -225,6 +226,9 @@ def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace, gr
     points : (p, 2) float64
     tri_of : (p,) int64
         A triangle containing each point.
+    order : (p,) int64
+        The order in which to visit the points (neighbouring points one after
+        the other keep the triangulation in cache).
     node_tol, edge_tol : float
         Distances under which a point is at a node / on a constraint edge.
     nch : int
@@ -253,7 +257,8 @@ def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace, gr
         cav = np.empty(MAX_CAVITY, dtype=np.int64)
         cols = np.empty(MAX_CAVITY, dtype=np.int64)
         vals, gx, gy = np.empty(MAX_CAVITY), np.empty(MAX_CAVITY), np.empty(MAX_CAVITY)
-        for q in range(ch * p // nch, (ch + 1) * p // nch):
+        for s in range(ch * p // nch, (ch + 1) * p // nch):
+            q = order[s]
             kind, c = _row(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1], node_tol,
                            edge_tol, cav, cols, vals, gx, gy, laplace)
             counts[q] = c
@@ -269,7 +274,8 @@ def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace, gr
         cav = np.empty(MAX_CAVITY, dtype=np.int64)
         cols = np.empty(MAX_CAVITY, dtype=np.int64)
         vals, gx, gy = np.empty(MAX_CAVITY), np.empty(MAX_CAVITY), np.empty(MAX_CAVITY)
-        for q in range(ch * p // nch, (ch + 1) * p // nch):
+        for s in range(ch * p // nch, (ch + 1) * p // nch):
+            q = order[s]
             kind, c = _row(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1], node_tol,
                            edge_tol, cav, cols, vals, gx, gy, laplace)
             a = offsets[q]
@@ -306,4 +312,46 @@ def locate(nodes, tri, points, cand_off, cand_idx, tol):
                 best = worst
                 if worst >= -tol:
                     out[q] = t
+    return out
+
+
+@numba.njit(cache=True)
+def _walk(nodes, tri, nb, t, x, y, max_steps):
+    """Visibility walk from triangle ``t`` to the one holding (x, y); -1 if it leaves
+    the triangulation (a hole, a crack face, the outside) or takes too long."""
+    for _ in range(max_steps):
+        moved = False
+        for k in range(3):
+            a, b = tri[t, (k + 1) % 3], tri[t, (k + 2) % 3]
+            if _orient(nodes[a, 0], nodes[a, 1], nodes[b, 0], nodes[b, 1], x, y) < 0.0:
+                t = nb[t, k]
+                if t < 0:
+                    return -1
+                moved = True
+                break
+        if not moved:
+            return t
+    return -1
+
+
+@numba.njit(cache=True, parallel=True)
+def locate_walk(nodes, tri, nb, points, order, seeds, nch):
+    """Triangles holding sorted points by walking from one point to the next.
+
+    ``order`` sorts the points along a space-filling path; chunk ``c`` of it
+    starts from triangle ``seeds[c]``. Points the walk cannot reach get -1
+    (locate them with the R-tree).
+    """
+    p = order.shape[0]
+    out = np.full(p, -1, dtype=np.int64)
+    for ch in numba.prange(nch):
+        t = seeds[ch]
+        for s in range(ch * p // nch, (ch + 1) * p // nch):
+            q = order[s]
+            if t < 0:
+                break
+            found = _walk(nodes, tri, nb, t, points[q, 0], points[q, 1], 4096)
+            if found >= 0:
+                out[q] = found
+                t = found
     return out

@@ -17,14 +17,40 @@ KINDS = ("sibson", "laplace")
 
 
 def _topology(model):
-    """Neighbours (cut across constraints) and an R-tree over the triangles, cached."""
+    """Neighbours cut across constraints, all neighbours (for walking) and an R-tree
+    over the triangles, cached on the model."""
     cache = model._cache
     if "shape" not in cache:
         tri = model.triangles
         corners = model.nodes[tri]
         tree = RTree(corners.min(axis=1), corners.max(axis=1))
-        cache["shape"] = (triangle_neighbors(tri, model.triangle_region), tree)
+        cache["shape"] = (triangle_neighbors(tri, model.triangle_region),
+                          triangle_neighbors(tri), tree)
     return cache["shape"]
+
+
+def _path_order(pts, bounds):
+    """Order of the points along a serpentine path through a grid (locality for walks)."""
+    k = max(1, int(np.sqrt(len(pts) / 4)))
+    lo, hi = np.asarray(bounds[:2]), np.asarray(bounds[2:])
+    cell = np.clip(((pts - lo) / np.maximum(hi - lo, 1e-300) * k).astype(np.int64), 0, k - 1)
+    ix = np.where(cell[:, 1] % 2 == 1, k - 1 - cell[:, 0], cell[:, 0])
+    return np.argsort(cell[:, 1] * k + ix, kind="stable")
+
+
+def _locate(model, pts, tol, order):
+    """A triangle holding each point (-1 outside): walks along ``order``, R-tree elsewhere."""
+    nb, nb_all, tree = _topology(model)
+    nch = work_chunks()
+    starts = order[(np.arange(nch) * len(pts)) // nch]
+    off, idx = tree.query(pts[starts] - tol, pts[starts] + tol)
+    seeds = K.locate(model.nodes, model.triangles, pts[starts], off, idx, tol)
+    tri_of = K.locate_walk(model.nodes, model.triangles, nb_all, pts, order, seeds, nch)
+    lost = np.flatnonzero(tri_of < 0)
+    if lost.size:
+        off, idx = tree.query(pts[lost] - tol, pts[lost] + tol)
+        tri_of[lost] = K.locate(model.nodes, model.triangles, pts[lost], off, idx, tol)
+    return tri_of
 
 
 def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=False):
@@ -74,18 +100,19 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
     if len(pts) == 0:
         empty = sp.csr_matrix((0, n))
         return (empty, empty.copy(), empty.copy()) if gradient else empty
-    nb, tree = _topology(model)
+    nb = _topology(model)[0]
     tol = config.SHAPE_TOL * model.domain.diameter
+    order = _path_order(pts, model.domain.bounds)
     if triangles is None:
-        cand_off, cand_idx = tree.query(pts - tol, pts + tol)
+        tri_of = _locate(model, pts, tol, order)
     else:
         cand_idx = np.asarray(triangles, dtype=np.int64).reshape(-1)
         if cand_idx.shape != (len(pts),) or (cand_idx < 0).any() or \
                 (cand_idx >= len(model.triangles)).any():
             raise GeometryError(f"triangles: expected {len(pts)} indices into the "
                                 f"{len(model.triangles)} triangles, received {cand_idx.shape}")
-        cand_off = np.arange(len(pts) + 1, dtype=np.int64)
-    tri_of = K.locate(model.nodes, model.triangles, pts, cand_off, cand_idx, tol)
+        tri_of = K.locate(model.nodes, model.triangles, pts,
+                          np.arange(len(pts) + 1, dtype=np.int64), cand_idx, tol)
     outside = np.flatnonzero(tri_of < 0)
     if outside.size:
         where = "the domain" if triangles is None else "their given triangles"
@@ -93,7 +120,7 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
             f"{outside.size} of {len(pts)} points lie outside {where}, first (index: point) "
             + ", ".join(f"{i}: {pts[i].tolist()}" for i in outside[:5]))
     offsets, cols, vals, gx, gy, kinds = K.natural(
-        model.nodes, model.triangles, nb, pts, tri_of, tol, tol, work_chunks(),
+        model.nodes, model.triangles, nb, pts, tri_of, order, tol, tol, work_chunks(),
         kind == "laplace", gradient)
     failed = np.flatnonzero(kinds == K.FAILED)
     if failed.size:
