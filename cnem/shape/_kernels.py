@@ -110,17 +110,18 @@ def _cavity(nodes, tri, nb, t, x, y, cav):
 
 
 @numba.njit(cache=True)
-def _in_cavity(cav, size, o):
+def _cavity_index(cav, size, o):
+    """Position of triangle ``o`` in the cavity, -1 if it is not in it."""
     if o < 0:
-        return False
+        return -1
     for m in range(size):
         if cav[m] == o:
-            return True
-    return False
+            return m
+    return -1
 
 
 @numba.njit(cache=True)
-def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, laplace):
+def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, ccx, ccy, laplace):
     """Sibson (or Laplace) coordinates from a cavity: the neighbour count, -1 if inconsistent.
 
     Laplace: ``w_i = |Voronoi edge between x and i| / |x - x_i|``, normalised;
@@ -130,13 +131,20 @@ def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, laplace):
     ``A_i`` taken from ``i`` changes as ``grad A_i = s_i / r_i (m_i - x)`` with
     ``s_i`` the length and ``m_i`` the midpoint of that Voronoi edge and
     ``r_i = |x_i - x|``; then ``grad phi_i = (grad A_i - phi_i grad A) / A``.
+    ``ccx, ccy`` are scratch for the circumcentres of the cavity triangles
+    (relative to ``x``), each computed once.
     """
+    for m in range(size):
+        s = cav[m]
+        ccx[m], ccy[m] = _circumcentre(nodes[tri[s, 0], 0] - x, nodes[tri[s, 0], 1] - y,
+                                       nodes[tri[s, 1], 0] - x, nodes[tri[s, 1], 1] - y,
+                                       nodes[tri[s, 2], 0] - x, nodes[tri[s, 2], 1] - y)
     count = 0
     total = 0.0
     for m in range(size):
         c = cav[m]
         for k in range(3):
-            if _in_cavity(cav, size, nb[c, k]):
+            if _cavity_index(cav, size, nb[c, k]) >= 0:
                 continue
             # boundary edge (i, j), CCW in its cavity triangle: neighbour i
             i, j = tri[c, (k + 1) % 3], tri[c, (k + 2) % 3]
@@ -147,19 +155,19 @@ def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, laplace):
                                    nodes[j, 0] - x, nodes[j, 1] - y, 0.0, 0.0)
             fx, fy = qx, qy         # new vertex on the (i, j) bisector, start of the polygon
             s = c
+            ms = m
             steps = 0
             while True:
                 p = 0
                 while tri[s, p] != i:
                     p += 1
-                ox, oy = _circumcentre(nodes[tri[s, 0], 0] - x, nodes[tri[s, 0], 1] - y,
-                                       nodes[tri[s, 1], 0] - x, nodes[tri[s, 1], 1] - y,
-                                       nodes[tri[s, 2], 0] - x, nodes[tri[s, 2], 1] - y)
+                ox, oy = ccx[ms], ccy[ms]
                 area += qx * oy - qy * ox
                 qx, qy = ox, oy
                 h = tri[s, (p + 2) % 3]
                 nxt = nb[s, (p + 1) % 3]          # across edge (i, h)
-                if not _in_cavity(cav, size, nxt):
+                ms = _cavity_index(cav, size, nxt)
+                if ms < 0:
                     break
                 s = nxt
                 steps += 1
@@ -193,7 +201,27 @@ def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, laplace):
 
 
 @numba.njit(cache=True)
-def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, laplace):
+def _row_size(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav):
+    """Number of natural neighbours of one point (its cavity's boundary edges)."""
+    kind, a, b, s = _special(nodes, tri, nb, t, x, y, node_tol, edge_tol)
+    if kind == AT_NODE:
+        return 1
+    if kind == ON_EDGE:
+        return 2
+    size = _cavity(nodes, tri, nb, t, x, y, cav)
+    if size < 0:
+        return 0
+    count = 0
+    for m in range(size):
+        for k in range(3):
+            if _cavity_index(cav, size, nb[cav[m], k]) < 0:
+                count += 1
+    return count
+
+
+@numba.njit(cache=True)
+def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, ccx, ccy,
+         laplace):
     """Coordinates of one point: ``(kind, count)`` with the row in ``cols, vals``."""
     kind, a, b, s = _special(nodes, tri, nb, t, x, y, node_tol, edge_tol)
     if kind == AT_NODE:
@@ -206,7 +234,8 @@ def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, l
     size = _cavity(nodes, tri, nb, t, x, y, cav)
     if size < 0:
         return FAILED, 0
-    count = _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, laplace)
+    count = _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, ccx, ccy,
+                         laplace)
     if count < 0:
         return FAILED, 0
     return CAVITY, count
@@ -255,14 +284,10 @@ def natural(nodes, tri, nb, points, tri_of, order, node_tol, edge_tol, nch, lapl
     nch = max(1, min(p, nch))
     for ch in numba.prange(nch):
         cav = np.empty(MAX_CAVITY, dtype=np.int64)
-        cols = np.empty(MAX_CAVITY, dtype=np.int64)
-        vals, gx, gy = np.empty(MAX_CAVITY), np.empty(MAX_CAVITY), np.empty(MAX_CAVITY)
         for s in range(ch * p // nch, (ch + 1) * p // nch):
             q = order[s]
-            kind, c = _row(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1], node_tol,
-                           edge_tol, cav, cols, vals, gx, gy, laplace)
-            counts[q] = c
-            kinds[q] = kind
+            counts[q] = _row_size(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1],
+                                  node_tol, edge_tol, cav)
     offsets = np.zeros(p + 1, dtype=np.int64)
     for q in range(p):
         offsets[q + 1] = offsets[q] + counts[q]
@@ -274,10 +299,15 @@ def natural(nodes, tri, nb, points, tri_of, order, node_tol, edge_tol, nch, lapl
         cav = np.empty(MAX_CAVITY, dtype=np.int64)
         cols = np.empty(MAX_CAVITY, dtype=np.int64)
         vals, gx, gy = np.empty(MAX_CAVITY), np.empty(MAX_CAVITY), np.empty(MAX_CAVITY)
+        ccx, ccy = np.empty(MAX_CAVITY), np.empty(MAX_CAVITY)
         for s in range(ch * p // nch, (ch + 1) * p // nch):
             q = order[s]
             kind, c = _row(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1], node_tol,
-                           edge_tol, cav, cols, vals, gx, gy, laplace)
+                           edge_tol, cav, cols, vals, gx, gy, ccx, ccy, laplace)
+            kinds[q] = kind
+            if kind == FAILED or c != counts[q]:
+                kinds[q] = FAILED
+                continue
             a = offsets[q]
             out_cols[a:a + c] = cols[:c]
             out_vals[a:a + c] = vals[:c]
