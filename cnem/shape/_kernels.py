@@ -121,7 +121,8 @@ def _cavity_index(cav, size, o):
 
 
 @numba.njit(cache=True)
-def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, ccx, ccy, laplace):
+def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, ccx, ccy, laplace,
+                 need_edges):
     """Sibson (or Laplace) coordinates from a cavity: the neighbour count, -1 if inconsistent.
 
     Laplace: ``w_i = |Voronoi edge between x and i| / |x - x_i|``, normalised;
@@ -179,12 +180,17 @@ def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, ccx, ccy, 
             area += ox * fy - oy * fx
             if count == cols.shape[0]:
                 return -1
-            edge = np.hypot(fx - ox, fy - oy) / np.hypot(nodes[i, 0] - x, nodes[i, 1] - y)
-            weight = edge if laplace else 0.5 * area
+            if need_edges:
+                edge = np.hypot(fx - ox, fy - oy) / np.hypot(nodes[i, 0] - x, nodes[i, 1] - y)
+                gx[count] = 0.5 * edge * (fx + ox)
+                gy[count] = 0.5 * edge * (fy + oy)
+                weight = edge if laplace else 0.5 * area
+            else:
+                weight = 0.5 * area
+                gx[count] = 0.0
+                gy[count] = 0.0
             cols[count] = i
             vals[count] = weight
-            gx[count] = 0.5 * edge * (fx + ox)
-            gy[count] = 0.5 * edge * (fy + oy)
             total += weight
             count += 1
     if not total > 0.0:
@@ -221,7 +227,7 @@ def _row_size(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav):
 
 @numba.njit(cache=True)
 def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, ccx, ccy,
-         laplace):
+         laplace, need_edges):
     """Coordinates of one point: ``(kind, count)`` with the row in ``cols, vals``."""
     kind, a, b, s = _special(nodes, tri, nb, t, x, y, node_tol, edge_tol)
     if kind == AT_NODE:
@@ -235,7 +241,7 @@ def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, c
     if size < 0:
         return FAILED, 0
     count = _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, ccx, ccy,
-                         laplace)
+                         laplace, need_edges)
     if count < 0:
         return FAILED, 0
     return CAVITY, count
@@ -253,11 +259,12 @@ def natural(nodes, tri, nb, points, tri_of, order, node_tol, edge_tol, nch, lapl
     nb : (t, 3) int64
         Neighbour across the edge opposite each vertex; -1 across constraints.
     points : (p, 2) float64
+        The points in the order they are visited (neighbouring points one
+        after the other keep the triangulation in cache).
     tri_of : (p,) int64
-        A triangle containing each point.
+        A triangle containing each point (same order).
     order : (p,) int64
-        The order in which to visit the points (neighbouring points one after
-        the other keep the triangulation in cache).
+        Row of the output of each point: point ``s`` fills row ``order[s]``.
     node_tol, edge_tol : float
         Distances under which a point is at a node / on a constraint edge.
     nch : int
@@ -286,7 +293,7 @@ def natural(nodes, tri, nb, points, tri_of, order, node_tol, edge_tol, nch, lapl
         cav = np.empty(MAX_CAVITY, dtype=np.int64)
         for s in range(ch * p // nch, (ch + 1) * p // nch):
             q = order[s]
-            counts[q] = _row_size(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1],
+            counts[q] = _row_size(nodes, tri, nb, tri_of[s], points[s, 0], points[s, 1],
                                   node_tol, edge_tol, cav)
     offsets = np.zeros(p + 1, dtype=np.int64)
     for q in range(p):
@@ -302,8 +309,9 @@ def natural(nodes, tri, nb, points, tri_of, order, node_tol, edge_tol, nch, lapl
         ccx, ccy = np.empty(MAX_CAVITY), np.empty(MAX_CAVITY)
         for s in range(ch * p // nch, (ch + 1) * p // nch):
             q = order[s]
-            kind, c = _row(nodes, tri, nb, tri_of[q], points[q, 0], points[q, 1], node_tol,
-                           edge_tol, cav, cols, vals, gx, gy, ccx, ccy, laplace)
+            kind, c = _row(nodes, tri, nb, tri_of[s], points[s, 0], points[s, 1], node_tol,
+                           edge_tol, cav, cols, vals, gx, gy, ccx, ccy, laplace,
+                           laplace or gradient)
             kinds[q] = kind
             if kind == FAILED or c != counts[q]:
                 kinds[q] = FAILED
@@ -365,23 +373,22 @@ def _walk(nodes, tri, nb, t, x, y, max_steps):
 
 
 @numba.njit(cache=True, parallel=True)
-def locate_walk(nodes, tri, nb, points, order, seeds, nch):
-    """Triangles holding sorted points by walking from one point to the next.
+def locate_walk(nodes, tri, nb, points, seeds, nch):
+    """Triangles holding points by walking from one point to the next.
 
-    ``order`` sorts the points along a space-filling path; chunk ``c`` of it
+    The points are ordered along a space-filling path; chunk ``c`` of them
     starts from triangle ``seeds[c]``. Points the walk cannot reach get -1
     (locate them with the R-tree).
     """
-    p = order.shape[0]
+    p = points.shape[0]
     out = np.full(p, -1, dtype=np.int64)
     for ch in numba.prange(nch):
         t = seeds[ch]
         for s in range(ch * p // nch, (ch + 1) * p // nch):
-            q = order[s]
             if t < 0:
                 break
-            found = _walk(nodes, tri, nb, t, points[q, 0], points[q, 1], 4096)
+            found = _walk(nodes, tri, nb, t, points[s, 0], points[s, 1], 4096)
             if found >= 0:
-                out[q] = found
+                out[s] = found
                 t = found
     return out

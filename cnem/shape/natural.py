@@ -33,23 +33,27 @@ def _path_order(pts, bounds):
     """Order of the points along a serpentine path through a grid (locality for walks)."""
     k = max(1, int(np.sqrt(len(pts) / 4)))
     lo, hi = np.asarray(bounds[:2]), np.asarray(bounds[2:])
-    cell = np.clip(((pts - lo) / np.maximum(hi - lo, 1e-300) * k).astype(np.int64), 0, k - 1)
-    ix = np.where(cell[:, 1] % 2 == 1, k - 1 - cell[:, 0], cell[:, 0])
-    return np.argsort(cell[:, 1] * k + ix, kind="stable")
+    scale = k / np.maximum(hi - lo, 1e-300)
+    ix = np.clip(((pts[:, 0] - lo[0]) * scale[0]).astype(np.int64), 0, k - 1)
+    iy = np.clip(((pts[:, 1] - lo[1]) * scale[1]).astype(np.int64), 0, k - 1)
+    odd = (iy & 1) == 1
+    ix[odd] = k - 1 - ix[odd]
+    return np.argsort(iy * k + ix)
 
 
-def _locate(model, pts, tol, order):
-    """A triangle holding each point (-1 outside): walks along ``order``, R-tree elsewhere."""
+def _locate_sorted(model, spts, tol):
+    """A triangle holding each of the path-ordered points ``spts`` (-1 outside):
+    a walk from each point to the next, the R-tree where the walk cannot go."""
     nb, nb_all, tree = _topology(model)
     nch = work_chunks()
-    starts = order[(np.arange(nch) * len(pts)) // nch]
-    off, idx = tree.query(pts[starts] - tol, pts[starts] + tol)
-    seeds = K.locate(model.nodes, model.triangles, pts[starts], off, idx, tol)
-    tri_of = K.locate_walk(model.nodes, model.triangles, nb_all, pts, order, seeds, nch)
+    starts = (np.arange(nch) * len(spts)) // nch
+    off, idx = tree.query(spts[starts] - tol, spts[starts] + tol)
+    seeds = K.locate(model.nodes, model.triangles, spts[starts], off, idx, tol)
+    tri_of = K.locate_walk(model.nodes, model.triangles, nb_all, spts, seeds, nch)
     lost = np.flatnonzero(tri_of < 0)
     if lost.size:
-        off, idx = tree.query(pts[lost] - tol, pts[lost] + tol)
-        tri_of[lost] = K.locate(model.nodes, model.triangles, pts[lost], off, idx, tol)
+        off, idx = tree.query(spts[lost] - tol, spts[lost] + tol)
+        tri_of[lost] = K.locate(model.nodes, model.triangles, spts[lost], off, idx, tol)
     return tri_of
 
 
@@ -103,24 +107,24 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
     nb = _topology(model)[0]
     tol = config.SHAPE_TOL * model.domain.diameter
     order = _path_order(pts, model.domain.bounds)
+    spts = np.ascontiguousarray(pts[order])
     if triangles is None:
-        tri_of = _locate(model, pts, tol, order)
+        tri_of = _locate_sorted(model, spts, tol)
     else:
-        cand_idx = np.asarray(triangles, dtype=np.int64).reshape(-1)
-        if cand_idx.shape != (len(pts),) or (cand_idx < 0).any() or \
-                (cand_idx >= len(model.triangles)).any():
+        hint = np.asarray(triangles, dtype=np.int64).reshape(-1)
+        if hint.shape != (len(pts),) or (hint < 0).any() or (hint >= len(model.triangles)).any():
             raise GeometryError(f"triangles: expected {len(pts)} indices into the "
-                                f"{len(model.triangles)} triangles, received {cand_idx.shape}")
-        tri_of = K.locate(model.nodes, model.triangles, pts,
-                          np.arange(len(pts) + 1, dtype=np.int64), cand_idx, tol)
-    outside = np.flatnonzero(tri_of < 0)
+                                f"{len(model.triangles)} triangles, received {hint.shape}")
+        tri_of = K.locate(model.nodes, model.triangles, spts,
+                          np.arange(len(pts) + 1, dtype=np.int64), hint[order], tol)
+    outside = np.sort(order[tri_of < 0])
     if outside.size:
         where = "the domain" if triangles is None else "their given triangles"
         raise GeometryError(
             f"{outside.size} of {len(pts)} points lie outside {where}, first (index: point) "
             + ", ".join(f"{i}: {pts[i].tolist()}" for i in outside[:5]))
     offsets, cols, vals, gx, gy, kinds = K.natural(
-        model.nodes, model.triangles, nb, pts, tri_of, order, tol, tol, work_chunks(),
+        model.nodes, model.triangles, nb, spts, tri_of, order, tol, tol, work_chunks(),
         kind == "laplace", gradient)
     failed = np.flatnonzero(kinds == K.FAILED)
     if failed.size:
