@@ -46,7 +46,6 @@ How to run
 import argparse
 import multiprocessing as mp
 import os
-import resource
 import statistics
 import sys
 import tempfile
@@ -55,17 +54,13 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
+from _harness import fmt_n, peak_rss_bytes
+
 CRACK = [[[0.0, 0.5], [0.5, 0.5]]]
 TARGET_RATIO_AT = 100_000
 TARGET_RATIO = 3.0
 TARGET_1M_SECONDS = 60.0
 TARGET_1M_MEMORY_GB = 4.0
-
-
-def _peak_rss_bytes():
-    """Peak resident set size of this process (ru_maxrss is KiB on Linux, bytes on macOS)."""
-    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return rss if sys.platform == "darwin" else rss * 1024
 
 
 # --------------------------------------------------------------------------- children
@@ -83,7 +78,7 @@ def _cnem_child(n, repeat, points_file):
 
     cloud = cnem.nodes.irregular(dom, h=1.0 / np.sqrt(n), seed=0)
     np.save(points_file, cloud.points)
-    rss_before = _peak_rss_bytes()
+    rss_before = peak_rss_bytes()
 
     runs = []
     for _ in range(repeat):
@@ -95,7 +90,7 @@ def _cnem_child(n, repeat, points_file):
         n_nodes, n_cells = len(model.nodes), len(model.cells)
         del model
     return dict(points=len(cloud.points), nodes=n_nodes, cells=n_cells, area=area,
-                warmup=warmup, runs=runs, rss_before=rss_before, rss=_peak_rss_bytes())
+                warmup=warmup, runs=runs, rss_before=rss_before, rss=peak_rss_bytes())
 
 
 def _voronoi_clip(points):
@@ -130,14 +125,14 @@ def _baseline_child(points_file, repeat):
     import shapely
 
     points = np.load(points_file)
-    rss_before = _peak_rss_bytes()
+    rss_before = peak_rss_bytes()
     runs = []
     for _ in range(repeat):
         polys, t_vor, t_clip = _voronoi_clip(points)
         runs.append(dict(voronoi=t_vor, clip=t_clip, total=t_vor + t_clip))
         area = float(shapely.area(polys).sum())
         del polys
-    return dict(area=area, runs=runs, rss_before=rss_before, rss=_peak_rss_bytes())
+    return dict(area=area, runs=runs, rss_before=rss_before, rss=peak_rss_bytes())
 
 
 def _in_child(fn, *args):
@@ -153,13 +148,6 @@ def _median(runs, key):
     return statistics.median(r[key] for r in runs)
 
 
-def _fmt_n(n):
-    for div, suffix in ((1_000_000, "M"), (1_000, "k")):
-        if n >= div and n % div == 0:
-            return f"{n // div}{suffix}"
-    return str(n)
-
-
 def run(sizes, repeat=None):
     """Benchmark every size; returns a list of per-size result dicts."""
     results = []
@@ -167,7 +155,7 @@ def run(sizes, repeat=None):
         for n in sizes:
             rep = repeat if repeat is not None else (3 if n <= 100_000 else 1)
             points_file = os.path.join(tmp, f"points_{n}.npy")
-            print(f"  n = {_fmt_n(n)}: cnem x{rep} ...", end="", flush=True)
+            print(f"  n = {fmt_n(n)}: cnem x{rep} ...", end="", flush=True)
             cn = _in_child(_cnem_child, n, rep, points_file)
             print(f" baseline x{rep} ...", end="", flush=True)
             bl = _in_child(_baseline_child, points_file, rep)
@@ -193,7 +181,7 @@ def report(results):
     for r in results:
         cn, bl = r["cnem"], r["baseline"]
         c_tot, b_tot = _median(cn["runs"], "total"), _median(bl["runs"], "total")
-        print(f"{_fmt_n(r['n']):>6} {cn['points']:>9d} {r['repeat']:>3d} | "
+        print(f"{fmt_n(r['n']):>6} {cn['points']:>9d} {r['repeat']:>3d} | "
               f"{_median(cn['runs'], 'triangulation'):7.3f} "
               f"{_median(cn['runs'], 'splitting'):7.3f} {_median(cn['runs'], 'cells'):7.3f} "
               f"{c_tot:7.3f} | {_median(bl['runs'], 'voronoi'):7.3f} "
@@ -207,7 +195,7 @@ def report(results):
     print("checks:")
     for r in results:
         cn, bl = r["cnem"], r["baseline"]
-        print(f"  {_fmt_n(r['n']):>6}: cnem {cn['nodes']} nodes (crack opened), {cn['cells']} cells, "
+        print(f"  {fmt_n(r['n']):>6}: cnem {cn['nodes']} nodes (crack opened), {cn['cells']} cells, "
               f"area {cn['area']:.12f}; baseline area {bl['area']:.12f}; "
               f"numba warm-up {cn['warmup']:.2f} s; RSS before timed runs "
               f"cnem {cn['rss_before'] / 2**20:.0f} MB, baseline {bl['rss_before'] / 2**20:.0f} MB")

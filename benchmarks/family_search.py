@@ -93,8 +93,6 @@ to the nearest cube.
 import argparse
 import multiprocessing as mp
 import os
-import resource
-import statistics
 import sys
 import tempfile
 import time
@@ -102,6 +100,8 @@ from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
+
+from _harness import fmt_n, median, mem_available_bytes, peak_rss_bytes
 
 HORIZON = 3.0001
 DEFAULT_SIZES = [27_000, 125_000, 343_000, 1_000_000]
@@ -233,33 +233,6 @@ def make_cloud(spec):
 
 
 # --------------------------------------------------------------------------- helpers
-
-
-def peak_rss_bytes():
-    """Peak resident set size of this process's own address space.
-
-    Linux: ``VmHWM`` (``ru_maxrss`` inherits the parent's peak across ``exec``).
-    """
-    try:
-        with open("/proc/self/status") as f:
-            for line in f:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return rss if sys.platform == "darwin" else rss * 1024
-
-
-def mem_available_bytes():
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return None
 
 
 def bond_hash(offsets, indices):
@@ -433,19 +406,6 @@ def in_child(task):
 
 
 # --------------------------------------------------------------------------- driver
-
-
-def median(xs):
-    return statistics.median(xs) if xs else float("nan")
-
-
-def fmt_n(n):
-    for div, suffix in ((1_000_000, "M"), (1_000, "k")):
-        if n >= div and n % div == 0:
-            return f"{n // div}{suffix}"
-    if n >= 1000:
-        return f"{n / 1000:.0f}k"
-    return str(n)
 
 
 def default_repeat(n, repeat):

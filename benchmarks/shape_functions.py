@@ -88,8 +88,6 @@ import argparse
 import gc
 import multiprocessing as mp
 import os
-import resource
-import statistics
 import sys
 import tempfile
 import time
@@ -97,6 +95,8 @@ from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
+
+from _harness import fmt_n, median, peak_rss_bytes, reset_peak_rss
 
 DOMAINS = {
     "square": dict(),
@@ -128,45 +128,9 @@ WATSON_ANCHOR = (100_000, 1.4, 5.4)   # plain numba Watson kernel, two threads (
 # --------------------------------------------------------------------------- helpers
 
 
-def peak_rss_bytes():
-    """High-water resident set size of this process (``VmHWM``; ``ru_maxrss`` elsewhere)."""
-    try:
-        with open("/proc/self/status") as f:
-            for line in f:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return rss if sys.platform == "darwin" else rss * 1024
-
-
-def reset_peak_rss():
-    """Reset ``VmHWM`` to the current RSS (Linux >= 4.0); True if it worked."""
-    try:
-        with open("/proc/self/clear_refs", "w") as f:
-            f.write("5")
-        return True
-    except OSError:
-        return False
-
-
 def query_points(q):
     """The benchmark's query points: uniform random in the unit square, fixed seed."""
     return np.random.default_rng(QUERY_SEED).random((q, 2))
-
-
-def fmt_n(n):
-    for div, suffix in ((1_000_000, "M"), (1_000, "k")):
-        if n >= div and n % div == 0:
-            return f"{n // div}{suffix}"
-    if n >= 1000:
-        return f"{n / 1000:.0f}k"
-    return str(n)
-
-
-def median(xs):
-    return statistics.median(xs) if xs else float("nan")
 
 
 def cell(x, fmt="{:8.3f}", width=8):
