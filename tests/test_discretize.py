@@ -284,3 +284,24 @@ def test_tiny_clouds_partition_the_square(tiny):
     for x in rng.uniform(0, 1, (40, 2)):
         owners = reference.cell_owner(model, x, 0)
         assert owners and set(owners) <= set(reference.nearest_visible_nodes(model, x, 0))
+
+
+def test_short_internal_crack_is_opened():
+    """A crack between two tips shorter than the spacing still gets a node to split."""
+    dom = cnem.geometry.rectangle(cracks=[[[0.4, 0.5], [0.6, 0.5]]])
+    for cloud in (cnem.nodes.regular(dom, 0.25),
+                  cnem.nodes.from_points(dom, np.random.default_rng(1).random((200, 2)) * 0.98 + 0.01)):
+        model = cnem.discretize(cloud, progress=False)
+        assert len(model.nodes) == len(cloud.points) + 1
+        assert np.count_nonzero(model.segment_kind == 2) == 2 * np.count_nonzero(cloud.segment_kind == 2)
+        assert abs(model.cells.area.sum() - dom.area) <= 1e-12 * dom.area
+
+
+def test_far_from_the_origin():
+    """Coordinates of 3e4 with spacing 0.05: the cells still partition the domain."""
+    dom = cnem.geometry.rectangle(origin=(3e4, 3e4))
+    model = cnem.discretize(cnem.nodes.irregular(dom, 0.05, seed=1), progress=False)
+    assert abs(model.cells.area.sum() - dom.area) <= 1e-10 * dom.area
+    assert (model.cells.area > 0).all()
+    centroid = model.cells.centroid()
+    assert (np.linalg.norm(centroid - model.nodes[model.cells.node], axis=1) < 0.1).all()
