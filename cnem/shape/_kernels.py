@@ -121,7 +121,7 @@ def _cavity_index(cav, size, o):
 
 
 @numba.njit(cache=True)
-def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, ccx, ccy, laplace,
+def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, scratch, laplace,
                  need_edges):
     """Sibson (or Laplace) coordinates from a cavity: the neighbour count, -1 if inconsistent.
 
@@ -132,67 +132,79 @@ def _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, ccx, ccy, 
     ``A_i`` taken from ``i`` changes as ``grad A_i = s_i / r_i (m_i - x)`` with
     ``s_i`` the length and ``m_i`` the midpoint of that Voronoi edge and
     ``r_i = |x_i - x|``; then ``grad phi_i = (grad A_i - phi_i grad A) / A``.
-    ``ccx, ccy`` are scratch for the circumcentres of the cavity triangles
-    (relative to ``x``), each computed once.
+
+    ``scratch`` is a ``(MAX_CAVITY, 8)`` float work array: the circumcentres of
+    the cavity triangles and of the new triangles, each computed once, and the
+    cavity adjacency (everything relative to ``x``).
     """
+    # columns 0-1: old Voronoi vertices (cavity), 2-3: new ones (one per boundary edge)
     for m in range(size):
         s = cav[m]
-        ccx[m], ccy[m] = _circumcentre(nodes[tri[s, 0], 0] - x, nodes[tri[s, 0], 1] - y,
+        scratch[m, 0], scratch[m, 1] = _circumcentre(nodes[tri[s, 0], 0] - x, nodes[tri[s, 0], 1] - y,
                                        nodes[tri[s, 1], 0] - x, nodes[tri[s, 1], 1] - y,
                                        nodes[tri[s, 2], 0] - x, nodes[tri[s, 2], 1] - y)
+    # boundary edges (i, j), CCW in their cavity triangle m: cols holds i,
+    # the adjacency of the cavity goes to scratch columns 4-6 (-1: boundary)
     count = 0
-    total = 0.0
     for m in range(size):
         c = cav[m]
         for k in range(3):
-            if _cavity_index(cav, size, nb[c, k]) >= 0:
+            o = _cavity_index(cav, size, nb[c, k])
+            scratch[m, 4 + k] = o
+            if o >= 0:
                 continue
-            # boundary edge (i, j), CCW in its cavity triangle: neighbour i
-            i, j = tri[c, (k + 1) % 3], tri[c, (k + 2) % 3]
-            # previous boundary edge (h, i): walk clockwise around i from c
-            # accumulating the old Voronoi vertices on the way
-            area = 0.0
-            qx, qy = _circumcentre(nodes[i, 0] - x, nodes[i, 1] - y,
-                                   nodes[j, 0] - x, nodes[j, 1] - y, 0.0, 0.0)
-            fx, fy = qx, qy         # new vertex on the (i, j) bisector, start of the polygon
-            s = c
-            ms = m
-            steps = 0
-            while True:
-                p = 0
-                while tri[s, p] != i:
-                    p += 1
-                ox, oy = ccx[ms], ccy[ms]
-                area += qx * oy - qy * ox
-                qx, qy = ox, oy
-                h = tri[s, (p + 2) % 3]
-                nxt = nb[s, (p + 1) % 3]          # across edge (i, h)
-                ms = _cavity_index(cav, size, nxt)
-                if ms < 0:
-                    break
-                s = nxt
-                steps += 1
-                if steps > size:
-                    return -1
-            ox, oy = _circumcentre(nodes[h, 0] - x, nodes[h, 1] - y,
-                                   nodes[i, 0] - x, nodes[i, 1] - y, 0.0, 0.0)
-            area += qx * oy - qy * ox
-            area += ox * fy - oy * fx
             if count == cols.shape[0]:
                 return -1
-            if need_edges:
-                edge = np.hypot(fx - ox, fy - oy) / np.hypot(nodes[i, 0] - x, nodes[i, 1] - y)
-                gx[count] = 0.5 * edge * (fx + ox)
-                gy[count] = 0.5 * edge * (fy + oy)
-                weight = edge if laplace else 0.5 * area
-            else:
-                weight = 0.5 * area
-                gx[count] = 0.0
-                gy[count] = 0.0
+            i, j = tri[c, (k + 1) % 3], tri[c, (k + 2) % 3]
+            scratch[count, 2], scratch[count, 3] = _circumcentre(
+                nodes[i, 0] - x, nodes[i, 1] - y, nodes[j, 0] - x, nodes[j, 1] - y, 0.0, 0.0)
             cols[count] = i
-            vals[count] = weight
-            total += weight
+            scratch[count, 7] = m                     # cavity triangle of edge `count`
             count += 1
+    total = 0.0
+    for e in range(count):
+        i = cols[e]
+        fx, fy = scratch[e, 2], scratch[e, 3]     # new vertex on the (i, j) bisector
+        qx, qy = fx, fy
+        area = 0.0
+        m = int(scratch[e, 7])
+        steps = 0
+        while True:                      # counter-clockwise around i through the cavity
+            s = cav[m]
+            p = 0
+            while tri[s, p] != i:
+                p += 1
+            area += qx * scratch[m, 1] - qy * scratch[m, 0]
+            qx, qy = scratch[m, 0], scratch[m, 1]
+            nxt = int(scratch[m, 4 + (p + 1) % 3])    # across edge (i, tri[s, p + 2])
+            if nxt < 0:
+                break
+            m = nxt
+            steps += 1
+            if steps > size:
+                return -1
+        h = tri[cav[m], (p + 2) % 3]     # the previous boundary edge is (h, i)
+        prev = -1
+        for f in range(count):
+            if cols[f] == h and int(scratch[f, 7]) == m:
+                prev = f
+                break
+        if prev < 0:
+            return -1
+        ox, oy = scratch[prev, 2], scratch[prev, 3]
+        area += qx * oy - qy * ox
+        area += ox * fy - oy * fx
+        if need_edges:
+            edge = np.hypot(fx - ox, fy - oy) / np.hypot(nodes[i, 0] - x, nodes[i, 1] - y)
+            gx[e] = 0.5 * edge * (fx + ox)
+            gy[e] = 0.5 * edge * (fy + oy)
+            weight = edge if laplace else 0.5 * area
+        else:
+            weight = 0.5 * area
+            gx[e] = 0.0
+            gy[e] = 0.0
+        vals[e] = weight
+        total += weight
     if not total > 0.0:
         return -1
     sum_gx, sum_gy = 0.0, 0.0
@@ -226,7 +238,7 @@ def _row_size(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav):
 
 
 @numba.njit(cache=True)
-def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, ccx, ccy,
+def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, scratch,
          laplace, need_edges):
     """Coordinates of one point: ``(kind, count)`` with the row in ``cols, vals``."""
     kind, a, b, s = _special(nodes, tri, nb, t, x, y, node_tol, edge_tol)
@@ -240,7 +252,7 @@ def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, c
     size = _cavity(nodes, tri, nb, t, x, y, cav)
     if size < 0:
         return FAILED, 0
-    count = _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, ccx, ccy,
+    count = _natural_row(nodes, tri, nb, x, y, cav, size, cols, vals, gx, gy, scratch,
                          laplace, need_edges)
     if count < 0:
         return FAILED, 0
@@ -306,22 +318,24 @@ def natural(nodes, tri, nb, points, tri_of, order, node_tol, edge_tol, nch, lapl
         cav = np.empty(MAX_CAVITY, dtype=np.int64)
         cols = np.empty(MAX_CAVITY, dtype=np.int64)
         vals, gx, gy = np.empty(MAX_CAVITY), np.empty(MAX_CAVITY), np.empty(MAX_CAVITY)
-        ccx, ccy = np.empty(MAX_CAVITY), np.empty(MAX_CAVITY)
+        scratch = np.empty((MAX_CAVITY, 8))
         for s in range(ch * p // nch, (ch + 1) * p // nch):
             q = order[s]
             kind, c = _row(nodes, tri, nb, tri_of[s], points[s, 0], points[s, 1], node_tol,
-                           edge_tol, cav, cols, vals, gx, gy, ccx, ccy, laplace,
+                           edge_tol, cav, cols, vals, gx, gy, scratch, laplace,
                            laplace or gradient)
             kinds[q] = kind
             if kind == FAILED or c != counts[q]:
                 kinds[q] = FAILED
                 continue
             a = offsets[q]
-            out_cols[a:a + c] = cols[:c]
-            out_vals[a:a + c] = vals[:c]
+            for e in range(c):           # element-wise: slices would cost atomic
+                out_cols[a + e] = cols[e]    # reference counts in a parallel loop
+                out_vals[a + e] = vals[e]
             if gradient and kind == CAVITY:
-                out_gx[a:a + c] = gx[:c]
-                out_gy[a:a + c] = gy[:c]
+                for e in range(c):
+                    out_gx[a + e] = gx[e]
+                    out_gy[a + e] = gy[e]
     return offsets, out_cols, out_vals, out_gx, out_gy, kinds
 
 
@@ -391,4 +405,74 @@ def locate_walk(nodes, tri, nb, points, seeds, nch):
             if found >= 0:
                 out[s] = found
                 t = found
+    return out
+
+
+@numba.njit(cache=True, parallel=True)
+def permute_rows(offsets, cols, vals, gx, gy, order):
+    """CSR rows ``s`` moved to rows ``order[s]``.
+
+    Filling rows in the order the points were visited and moving them
+    afterwards (sequential writes, random reads) is much cheaper than
+    writing every row straight to its final, random, place.
+    """
+    p = order.shape[0]
+    counts = np.empty(p, dtype=np.int64)
+    for s in numba.prange(p):
+        counts[order[s]] = offsets[s + 1] - offsets[s]
+    new = np.zeros(p + 1, dtype=np.int64)
+    for q in range(p):
+        new[q + 1] = new[q] + counts[q]
+    inv = np.empty(p, dtype=np.int64)
+    for s in numba.prange(p):
+        inv[order[s]] = s
+    out_cols = np.empty_like(cols)
+    out_vals = np.empty_like(vals)
+    out_gx = np.empty_like(gx)
+    out_gy = np.empty_like(gy)
+    grad = gx.shape[0] > 0
+    for q in numba.prange(p):
+        a, b = offsets[inv[q]], new[q]
+        for e in range(counts[q]):
+            out_cols[b + e] = cols[a + e]
+            out_vals[b + e] = vals[a + e]
+            if grad:
+                out_gx[b + e] = gx[a + e]
+                out_gy[b + e] = gy[a + e]
+    return new, out_cols, out_vals, out_gx, out_gy
+
+
+@numba.njit(cache=True)
+def path_order(points, x0, y0, sx, sy, k):
+    """Order of points along a serpentine path through a ``k x k`` grid.
+
+    A counting sort by grid cell, rows of cells alternating in direction, so
+    that consecutive points are close (cheap walks, cache-friendly).
+    """
+    p = points.shape[0]
+    key = np.empty(p, dtype=np.int64)
+    count = np.zeros(k * k + 1, dtype=np.int64)
+    for q in range(p):
+        ix = min(max(int((points[q, 0] - x0) * sx), 0), k - 1)
+        iy = min(max(int((points[q, 1] - y0) * sy), 0), k - 1)
+        if iy & 1:
+            ix = k - 1 - ix
+        key[q] = iy * k + ix
+        count[key[q] + 1] += 1
+    for c in range(k * k):
+        count[c + 1] += count[c]
+    order = np.empty(p, dtype=np.int64)
+    for q in range(p):
+        order[count[key[q]]] = q
+        count[key[q]] += 1
+    return order
+
+
+@numba.njit(cache=True, parallel=True)
+def gather_rows(points, order):
+    """``points[order]`` for a ``(p, 2)`` array, in parallel."""
+    out = np.empty((order.shape[0], 2))
+    for s in numba.prange(order.shape[0]):
+        out[s, 0] = points[order[s], 0]
+        out[s, 1] = points[order[s], 1]
     return out

@@ -32,13 +32,9 @@ def _topology(model):
 def _path_order(pts, bounds):
     """Order of the points along a serpentine path through a grid (locality for walks)."""
     k = max(1, int(np.sqrt(len(pts) / 4)))
-    lo, hi = np.asarray(bounds[:2]), np.asarray(bounds[2:])
+    lo, hi = np.asarray(bounds[:2], dtype=float), np.asarray(bounds[2:], dtype=float)
     scale = k / np.maximum(hi - lo, 1e-300)
-    ix = np.clip(((pts[:, 0] - lo[0]) * scale[0]).astype(np.int64), 0, k - 1)
-    iy = np.clip(((pts[:, 1] - lo[1]) * scale[1]).astype(np.int64), 0, k - 1)
-    odd = (iy & 1) == 1
-    ix[odd] = k - 1 - ix[odd]
-    return np.argsort(iy * k + ix)
+    return K.path_order(pts, lo[0], lo[1], scale[0], scale[1], k)
 
 
 def _locate_sorted(model, spts, tol):
@@ -107,7 +103,7 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
     nb = _topology(model)[0]
     tol = config.SHAPE_TOL * model.domain.diameter
     order = _path_order(pts, model.domain.bounds)
-    spts = np.ascontiguousarray(pts[order])
+    spts = K.gather_rows(pts, order)
     if triangles is None:
         tri_of = _locate_sorted(model, spts, tol)
     else:
@@ -123,10 +119,12 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
         raise GeometryError(
             f"{outside.size} of {len(pts)} points lie outside {where}, first (index: point) "
             + ", ".join(f"{i}: {pts[i].tolist()}" for i in outside[:5]))
+    visit = np.arange(len(pts), dtype=np.int64)   # rows filled in path order, then moved
     offsets, cols, vals, gx, gy, kinds = K.natural(
-        model.nodes, model.triangles, nb, spts, tri_of, order, tol, tol, work_chunks(),
+        model.nodes, model.triangles, nb, spts, tri_of, visit, tol, tol, work_chunks(),
         kind == "laplace", gradient)
-    failed = np.flatnonzero(kinds == K.FAILED)
+    offsets, cols, vals, gx, gy = K.permute_rows(offsets, cols, vals, gx, gy, order)
+    failed = np.sort(order[kinds == K.FAILED])            # kinds are in path order
     if failed.size:
         raise CNEMError(
             f"the natural-neighbour cavity of {failed.size} points was inconsistent (round-off "
@@ -134,7 +132,7 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
     phi = sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n))
     if not gradient:
         return phi
-    singular = np.flatnonzero(kinds != K.CAVITY)
+    singular = np.sort(order[kinds != K.CAVITY])
     if singular.size:
         raise GeometryError(
             f"{singular.size} points lie at a node or on a boundary, interface or crack "
