@@ -20,6 +20,7 @@ from scipy.spatial import cKDTree
 
 from .errors import GeometryError
 from .geometry.cloud import NodeCloud
+from .geometry.pslg import segment_projection
 
 __all__ = ["regular", "irregular", "graded", "from_points", "NodeCloud"]
 
@@ -254,9 +255,8 @@ def from_points(domain, points):
     pi, ei = pi[keep], ei[keep]
     seg_of[pi] = ei
     a, b = v[edges[ei, 0]], v[edges[ei, 1]]
-    d = b - a
-    t = np.einsum("ij,ij->i", pts[pi] - a, d) / np.einsum("ij,ij->i", d, d)
-    pts[pi] = a + np.clip(t, 0, 1)[:, None] * d
+    t, _ = segment_projection(pts[pi], a, b)
+    pts[pi] = a + np.clip(t, 0, 1)[:, None] * (b - a)
     outside = np.flatnonzero((domain.region_of(pts) < 0) & (seg_of < 0) & ~on_vertex)
     if outside.size:
         raise GeometryError(

@@ -14,13 +14,10 @@ clipping path.
 import numba
 import numpy as np
 
+from .._predicates import orient2d as _orient
+
 #: Status codes of the fast path.
 FAST, SLOW = 0, 1
-
-
-@numba.njit(cache=True, inline="always")
-def _orient(ax, ay, bx, by, cx, cy):
-    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
 
 
 @numba.njit(cache=True)

@@ -17,7 +17,7 @@ from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
 
-__all__ = ["PSLG", "BOUNDARY", "INTERFACE", "CRACK", "build_pslg"]
+__all__ = ["PSLG", "BOUNDARY", "INTERFACE", "CRACK", "build_pslg", "segment_projection"]
 
 #: Edge kinds.
 BOUNDARY, INTERFACE, CRACK = 0, 1, 2
@@ -63,6 +63,29 @@ def _merge_vertices(points, tol):
     return points[first[order]], rank[label]
 
 
+def segment_projection(points, a, b):
+    """Position along and distance from segments of points.
+
+    Parameters
+    ----------
+    points, a, b : (p, 2) or (2,) array_like
+        Points and segment ends (broadcast together).
+
+    Returns
+    -------
+    t : (p,) ndarray
+        Parameter of the projection on the line, 0 at ``a`` and 1 at ``b``.
+    dist : (p,) ndarray
+        Distance from the line through ``a`` and ``b``.
+    """
+    points, a, b = (np.atleast_2d(np.asarray(v, dtype=float)) for v in (points, a, b))
+    d, rel = b - a, points - a
+    length2 = np.einsum("ij,ij->i", d, d)
+    t = np.einsum("ij,ij->i", rel, d) / length2
+    dist = np.abs(rel[:, 0] * d[:, 1] - rel[:, 1] * d[:, 0]) / np.sqrt(length2)
+    return t, dist
+
+
 def _split_edge(a, b, vertices, tree, tol):
     """Indices of vertices strictly inside segment ``a-b`` sorted along it."""
     pa, pb = vertices[a], vertices[b]
@@ -71,11 +94,7 @@ def _split_edge(a, b, vertices, tree, tol):
     cand = cand[(cand != a) & (cand != b)]
     if cand.size == 0:
         return np.empty(0, dtype=np.int64)
-    d = pb - pa
-    length2 = d @ d
-    rel = vertices[cand] - pa
-    t = rel @ d / length2
-    dist = np.abs(rel[:, 0] * d[1] - rel[:, 1] * d[0]) / np.sqrt(length2)
+    t, dist = segment_projection(vertices[cand], pa, pb)
     keep = (dist <= tol) & (t > 0) & (t < 1)
     order = np.argsort(t[keep])
     return cand[keep][order]

@@ -6,6 +6,7 @@ import numpy as np
 import triangle
 
 from ..errors import GeometryError
+from .pslg import segment_projection
 
 __all__ = ["constrained_delaunay"]
 
@@ -18,12 +19,9 @@ def _orient(points, tri):
 def _steiner_error(points, segments, extra, tol):
     """Name the constraint segments that meet at inserted (Steiner) points."""
     a, b = points[segments[:, 0]], points[segments[:, 1]]
-    d = b - a
     msgs = []
     for p in extra[:3]:
-        rel = p - a
-        t = np.einsum("ij,ij->i", rel, d) / np.einsum("ij,ij->i", d, d)
-        dist = np.abs(rel[:, 0] * d[:, 1] - rel[:, 1] * d[:, 0]) / np.linalg.norm(d, axis=1)
+        t, dist = segment_projection(p, a, b)
         hit = np.flatnonzero((dist <= max(tol, 1e-12)) & (t > -1e-12) & (t < 1 + 1e-12))
         msgs.append(f"at ({p[0]:.6g}, {p[1]:.6g}) segments "
                     + ", ".join(f"{s} {points[segments[s]].tolist()}" for s in hit[:4]))

@@ -20,16 +20,13 @@ triangulation (cracks opened, neighbours across region boundaries cut):
 import numba
 import numpy as np
 
+from .._predicates import orient2d as _orient
+
 #: Row kinds returned by the counting pass.
 CAVITY, AT_NODE, ON_EDGE, FAILED = 0, 1, 2, 3
 
 #: Largest cavity (triangles) and neighbour count handled.
 MAX_CAVITY = 512
-
-
-@numba.njit(cache=True, inline="always")
-def _orient(ax, ay, bx, by, cx, cy):
-    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
 
 
 @numba.njit(cache=True, inline="always")

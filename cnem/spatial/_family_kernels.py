@@ -8,6 +8,8 @@ so that all methods return identical sets even at ties.
 import numba
 import numpy as np
 
+from .._predicates import orient2d as _orient
+
 from ._rtree_kernels import _wrap
 
 
@@ -258,11 +260,6 @@ def exact_filter(pts, rows, cols, horizon, period):
         d2 = _dist2(pts, i, pts, cols[k], period)
         keep[k] = d2 < horizon[i] * horizon[i] and d2 > 0.0
     return keep
-
-
-@numba.njit(cache=True, inline="always")
-def _orient(ax, ay, bx, by, cx, cy):
-    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
 
 
 @numba.njit(cache=True, parallel=True)

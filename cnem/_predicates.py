@@ -1,0 +1,9 @@
+"""Geometric predicates shared by the numba kernels (arrays and scalars only)."""
+
+import numba
+
+
+@numba.njit(cache=True, inline="always")
+def orient2d(ax, ay, bx, by, cx, cy):
+    """Twice the signed area of triangle (a, b, c): > 0 when counter-clockwise."""
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
