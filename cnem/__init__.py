@@ -7,11 +7,13 @@
 1.0
 """
 
-from . import geometry, io, nodes, plot, shape, spatial
+from . import assembly, exact, geometry, io, models, nodes, plot, shape, spatial
 from .errors import CNEMError, GeometryError, SolveError
 from .geometry import Domain, Model, NodeCloud, discretize
+from .models import ElasticSolution, Elasticity
 
 __version__ = "0.1.0"
 
-__all__ = ["Domain", "NodeCloud", "Model", "discretize", "nodes", "geometry", "io", "plot", "shape", "spatial",
+__all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
+           "nodes", "geometry", "assembly", "models", "exact", "io", "plot", "shape", "spatial",
            "CNEMError", "GeometryError", "SolveError", "__version__"]

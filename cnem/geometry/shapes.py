@@ -23,7 +23,7 @@ def _positive(name, value):
     return float(value)
 
 
-def arc(center, radius, start, stop, spacing):
+def arc(center, radius, start, stop, spacing, *, pieces=None):
     """Points on a circular arc, ends included, about ``spacing`` apart.
 
     Parameters
@@ -32,14 +32,19 @@ def arc(center, radius, start, stop, spacing):
     radius, start, stop, spacing : float
         Angles in radians; the count of pieces depends only on the radius,
         the angle span and the spacing, so arcs of equal radius match.
+    pieces : int, optional
+        Exact number of chords instead (``spacing`` is then ignored).
 
     Returns
     -------
     (k, 2) ndarray
     """
-    _positive("spacing", spacing)
     span = stop - start
-    pieces = max(2, int(np.ceil(abs(span) * radius / spacing)))
+    if pieces is None:
+        _positive("spacing", spacing)
+        pieces = max(2, int(np.ceil(abs(span) * radius / spacing)))
+    elif int(pieces) < 2:
+        raise GeometryError(f"pieces must be an integer >= 2, received {pieces!r}")
     t = np.linspace(start, stop, pieces + 1)
     return np.asarray(center, float) + radius * np.column_stack([np.cos(t), np.sin(t)])
 
@@ -78,7 +83,7 @@ def plate_with_hole(width=1.0, height=1.0, radius=0.2, *, center=None, spacing=N
     return Domain([(shell, [ring[::-1]])], cracks=cracks)
 
 
-def annulus(radii, *, angles=None, center=(0.0, 0.0), spacing=None, cracks=()):
+def annulus(radii, *, angles=None, center=(0.0, 0.0), spacing=None, segments=None, cracks=()):
     """Concentric annular regions (a multi-material cylinder section).
 
     Parameters
@@ -90,6 +95,8 @@ def annulus(radii, *, angles=None, center=(0.0, 0.0), spacing=None, cracks=()):
         ``(start, stop)`` in radians for a sector; default a full annulus.
     spacing : float, optional
         Chord length of the arcs, default ``(r_k - r_0) / 10``.
+    segments : int, optional
+        The same number of chords on every arc instead (polar node lattices).
     """
     radii = np.asarray(radii, dtype=float)
     if radii.ndim != 1 or len(radii) < 2 or radii[0] <= 0 or (np.diff(radii) <= 0).any():
@@ -98,15 +105,15 @@ def annulus(radii, *, angles=None, center=(0.0, 0.0), spacing=None, cracks=()):
     regions = []
     for r_in, r_out in zip(radii[:-1], radii[1:]):
         if angles is None:
-            outer = arc(center, r_out, 0, 2 * np.pi, spacing)[:-1]
-            inner = arc(center, r_in, 0, 2 * np.pi, spacing)[:-1]
+            outer = arc(center, r_out, 0, 2 * np.pi, spacing, pieces=segments)[:-1]
+            inner = arc(center, r_in, 0, 2 * np.pi, spacing, pieces=segments)[:-1]
             regions.append((outer, [inner[::-1]]))
         else:
             a0, a1 = map(float, angles)
             if not 0 < a1 - a0 < 2 * np.pi:
                 raise GeometryError(f"angles must satisfy 0 < stop - start < 2 pi, received {angles}")
-            outer = arc(center, r_out, a0, a1, spacing)
-            inner = arc(center, r_in, a0, a1, spacing)[::-1]
+            outer = arc(center, r_out, a0, a1, spacing, pieces=segments)
+            inner = arc(center, r_in, a0, a1, spacing, pieces=segments)[::-1]
             regions.append(np.concatenate([outer, inner]))
     return Domain(regions, cracks=cracks)
 

@@ -63,9 +63,10 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
         Points of the closed domain.
     kind : {"sibson", "laplace"}
     triangles : (p,) array_like of int, optional
-        A triangle of ``model.triangles`` holding each point. A point exactly on
-        a crack face lies in triangles of both faces; give the triangle on the
-        side wanted. By default the triangle the point is deepest inside.
+        A triangle of ``model.triangles`` holding each point, or -1 to let the
+        point be located. A point exactly on a crack face lies in triangles of
+        both faces; give the triangle on the side wanted. By default (and for
+        -1) the triangle the point is deepest inside.
     gradient : bool
         Also return the derivatives of the Sibson coordinates (analytic, Piper
         / Braun-Sambridge), for points inside cells: not at nodes nor on
@@ -108,14 +109,20 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
         tri_of = _locate_sorted(model, spts, tol)
     else:
         hint = np.asarray(triangles, dtype=np.int64).reshape(-1)
-        if hint.shape != (len(pts),) or (hint < 0).any() or (hint >= len(model.triangles)).any():
+        if hint.shape != (len(pts),) or (hint < -1).any() or (hint >= len(model.triangles)).any():
             raise GeometryError(f"triangles: expected {len(pts)} indices into the "
-                                f"{len(model.triangles)} triangles, received {hint.shape}")
-        tri_of = K.locate(model.nodes, model.triangles, spts,
-                          np.arange(len(pts) + 1, dtype=np.int64), hint[order], tol)
+                                f"{len(model.triangles)} triangles (or -1), received "
+                                f"shape {hint.shape}, range [{hint.min()}, {hint.max()}]")
+        hint = hint[order]
+        given = hint >= 0
+        tri_of = np.full(len(pts), -1, dtype=np.int64)
+        tri_of[given] = K.locate(model.nodes, model.triangles, spts[given],
+                                 np.arange(given.sum() + 1, dtype=np.int64), hint[given], tol)
+        if not given.all():
+            tri_of[~given] = _locate_sorted(model, spts[~given], tol)
     outside = np.sort(order[tri_of < 0])
     if outside.size:
-        where = "the domain" if triangles is None else "their given triangles"
+        where = "the domain" if triangles is None else "the domain (or their given triangles)"
         raise GeometryError(
             f"{outside.size} of {len(pts)} points lie outside {where}, first (index: point) "
             + ", ".join(f"{i}: {pts[i].tolist()}" for i in outside[:5]))

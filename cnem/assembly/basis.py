@@ -1,0 +1,176 @@
+"""`CellBasis`: the C-NEM shape functions seen at the SCNI integration cells."""
+
+from __future__ import annotations
+
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+from skfem.element import DiscreteField
+
+from .scni import smoothed_gradient
+
+__all__ = ["CellBasis"]
+
+
+def _spread(op, component, ncomp):
+    """Move the columns of a node operator ``(m, n)`` to the dofs of one
+    component of an interleaved vector field ``(m, ncomp * n)``."""
+    op = op.tocsr()
+    return sp.csr_matrix((op.data, op.indices * ncomp + component, op.indptr),
+                         shape=(op.shape[0], op.shape[1] * ncomp))
+
+
+class CellBasis:
+    """Shape functions of a model on its integration cells, scikit-fem style.
+
+    At cell ``k`` a field has the value at the cell's node (nodal integration,
+    the Kronecker delta property) and the smoothed gradient ``b~`` of eq.
+    26-32. Vector fields interleave their dofs like scikit-fem and the paper
+    (eq. 30): ``[u_x(0), u_y(0), u_x(1), ...]``.
+
+    Parameters
+    ----------
+    model : Model
+        ``n`` nodes, ``m`` integration cells.
+    vector : bool
+        Two components per node.
+    gauss : int
+        Gauss points per edge piece for ``b~`` (see `smoothed_gradient`).
+
+    Attributes
+    ----------
+    N : int
+        Number of dofs, ``n`` or ``2 n``.
+    dx : (m,) ndarray
+        Quadrature weights: the cell areas.
+    x : (2, m) ndarray
+        Cell centroids (``w.x`` in forms).
+    nodes : (2, m) ndarray
+        The node of each cell.
+    """
+
+    def __init__(self, model, *, vector=False, gauss=2):
+        self.model = model
+        self.vector = bool(vector)
+        self.ncomp = 2 if vector else 1
+        self.grad = smoothed_gradient(model, gauss=gauss)
+        cells = model.cells
+        m, n = len(cells.area), len(model.nodes)
+        self.N = self.ncomp * n
+        self.dx = cells.area
+        self.x = cells.centroid().T
+        self.nodes = model.nodes[cells.node].T
+        self._value = sp.csr_matrix((np.ones(m), (np.arange(m), cells.node)), shape=(m, n))
+
+    def __repr__(self):
+        kind = "vector" if self.vector else "scalar"
+        return f"<CellBasis {kind}, {self.N} dofs, {len(self.dx)} cells>"
+
+    @cached_property
+    def operators(self):
+        """Sparse operators from the dofs to the field descriptors at the cells.
+
+        Returns
+        -------
+        list of scipy.sparse.csr_matrix, shape (m, N)
+            Scalar: ``[value, d/dx, d/dy]``. Vector: ``[u_0, u_1, du_0/dx,
+            du_0/dy, du_1/dx, du_1/dy]`` (row-major ``grad[i, j] = du_i/dx_j``).
+        """
+        node_ops = [self._value, self.grad.x, self.grad.y]
+        if not self.vector:
+            return [op.tocsr() for op in node_ops]
+        values = [_spread(self._value, c, 2) for c in range(2)]
+        return values + [_spread(g, c, 2) for c in range(2) for g in node_ops[1:]]
+
+    @staticmethod
+    def _field(flat, vector):
+        """A DiscreteField from descriptor values ``flat`` (c, ...)."""
+        if vector:
+            return DiscreteField(flat[:2], flat[2:6].reshape((2, 2) + flat.shape[1:]))
+        return DiscreteField(flat[0], flat[1:3])
+
+    def unit_fields(self):
+        """One DiscreteField per descriptor, with that descriptor 1 and the rest 0
+        (a trailing axis of length 1 broadcasts against per-cell arrays ``(m,)``)."""
+        eye = np.eye(3 * self.ncomp)[:, :, None]
+        return [self._field(row, self.vector) for row in eye]
+
+    def zero_field(self):
+        """A DiscreteField with every descriptor 0."""
+        return self._field(np.zeros((3 * self.ncomp, 1)), self.vector)
+
+    def interpolate(self, u):
+        """A dof vector seen at the cells.
+
+        Parameters
+        ----------
+        u : (N,) array_like
+
+        Returns
+        -------
+        DiscreteField
+            Value ``(m,)`` or ``(2, m)``, ``grad`` ``(2, m)`` or ``(2, 2, m)``.
+        """
+        u = np.asarray(u, dtype=float)
+        if u.shape != (self.N,):
+            raise ValueError(f"u: expected {self.N} dof values, received shape {u.shape}")
+        return self._field(np.array([op @ u for op in self.operators]), self.vector)
+
+    def get_dofs(self, where, component=None):
+        """Dofs of the nodes selected by ``where``.
+
+        Parameters
+        ----------
+        where : callable ``(p, 2) -> (p,) bool``, or a boolean mask or index array over nodes
+        component : {None, 0, 1}
+            For a vector basis: one component, or both.
+
+        Returns
+        -------
+        (k,) int64 ndarray
+        """
+        nodes = select_nodes(self.model.nodes, where)
+        if not self.vector:
+            if component not in (None, 0):
+                raise ValueError(f"component: a scalar basis has component 0 only, received {component!r}")
+            return nodes
+        if component is None:
+            return np.sort(np.concatenate([2 * nodes, 2 * nodes + 1]))
+        if component not in (0, 1):
+            raise ValueError(f"component: expected 0, 1 or None, received {component!r}")
+        return 2 * nodes + component
+
+
+def select_nodes(nodes, where):
+    """Indices of the nodes picked by a predicate, a boolean mask or an index array.
+
+    Parameters
+    ----------
+    nodes : (n, 2) ndarray
+    where : callable ``(p, 2) -> (p,) bool``, (n,) bool array_like, or int array_like
+
+    Returns
+    -------
+    (k,) int64 ndarray, sorted
+    """
+    n = len(nodes)
+    if callable(where):
+        mask = np.asarray(where(nodes))
+        if mask.shape != (n,) or mask.dtype != bool:
+            raise ValueError(f"where(nodes) must return a (n,) bool array for the {n} nodes, "
+                             f"received dtype {mask.dtype} shape {mask.shape}")
+        return np.flatnonzero(mask)
+    arr = np.asarray(where)
+    if arr.dtype == bool:
+        if arr.shape != (n,):
+            raise ValueError(f"where: a boolean mask needs one entry per node ({n}), "
+                             f"received shape {arr.shape}")
+        return np.flatnonzero(arr)
+    if arr.size and not np.issubdtype(arr.dtype, np.integer):
+        raise ValueError(f"where: expected a callable, a boolean mask or node indices, "
+                         f"received an array of dtype {arr.dtype}")
+    idx = np.unique(arr.astype(np.int64).reshape(-1))
+    if idx.size and (idx[0] < 0 or idx[-1] >= n):
+        raise ValueError(f"where: node indices must lie in [0, {n}), received [{idx[0]}, {idx[-1]}]")
+    return idx

@@ -1,0 +1,18 @@
+"""Physical models on C-NEM: plane linear elasticity.
+
+>>> import cnem
+>>> model = cnem.discretize(cnem.nodes.regular(cnem.geometry.rectangle(), 0.2))
+>>> prob = cnem.Elasticity(model, (1.0, 0.3), plane="strain")
+>>> prob.add_dirichlet(lambda p: p[:, 1] < 1e-12, None)
+>>> prob.add_body_force([0.0, -1.0])
+>>> sol = prob.solve(progress=False)
+>>> bool(sol.u[:, 1].min() < 0)
+True
+"""
+
+from .elasticity import Elasticity, elasticity_form
+from .material import lame, stiffness_matrix
+from .solution import ElasticSolution, von_mises
+
+__all__ = ["Elasticity", "ElasticSolution", "elasticity_form", "lame", "stiffness_matrix",
+           "von_mises"]

@@ -1,0 +1,260 @@
+"""`Elasticity`: small-strain linear elasticity by C-NEM with SCNI (paper §4.1-4.2)."""
+
+from __future__ import annotations
+
+import logging
+import sys
+import time
+
+import numpy as np
+from skfem import condense
+from skfem.helpers import ddot, sym_grad
+from skfem.models.elasticity import linear_stress
+from tqdm.auto import tqdm
+
+from ..assembly import BilinearForm, CellBasis, select_nodes
+from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
+from ..errors import SolveError
+from ..geometry.topology import constraint_edges, triangle_neighbors
+from .material import lame, parse_materials, stiffness_matrix
+from .solution import ElasticSolution
+
+__all__ = ["Elasticity", "elasticity_form"]
+
+log = logging.getLogger(__name__)
+
+
+@BilinearForm
+def elasticity_form(u, v, w):
+    """``sigma(u) : eps(v)`` with per-cell Lamé parameters ``w.lam``, ``w.mu``."""
+    return ddot(linear_stress(w.lam, w.mu)(sym_grad(u)), sym_grad(v))
+
+
+def _per_point(value, points, width, what):
+    """A constant or a callable evaluated at points, as a ``(p, width)`` array."""
+    arr = np.asarray(value(points) if callable(value) else value, dtype=float)
+    if width == 1 and arr.shape == (len(points),):
+        arr = arr[:, None]
+    try:
+        arr = np.broadcast_to(arr, (len(points), width))
+    except ValueError:
+        raise ValueError(f"{what}: expected a number or one value per point, shape "
+                         f"({len(points)}, {width}), received shape {arr.shape}") from None
+    if not np.isfinite(arr).all():
+        raise ValueError(f"{what}: values must be finite, received NaN or inf")
+    return arr
+
+
+class Elasticity:
+    """Plane linear elasticity on a C-NEM model.
+
+    Parameters
+    ----------
+    model : Model
+        From `cnem.discretize`: ``n`` nodes, ``m`` integration cells.
+    materials : (E, nu) pair, or a list of pairs indexed by region
+    plane : {"stress", "strain"}
+    gauss : int
+        Gauss points per cell-edge piece in the smoothed gradients.
+
+    Examples
+    --------
+    >>> import numpy as np, cnem
+    >>> model = cnem.discretize(cnem.nodes.irregular(cnem.geometry.rectangle(2.0, 1.0), 0.1, seed=1))
+    >>> prob = cnem.Elasticity(model, (1000.0, 0.3))
+    >>> prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, 0)
+    >>> prob.add_dirichlet(lambda p: (p[:, 0] < 1e-9) & (p[:, 1] < 1e-9), 1)
+    >>> prob.add_traction(lambda x, n: n[:, 0] > 0.5, [10.0, 0.0])
+    >>> sol = prob.solve(progress=False)
+    >>> bool(np.allclose(sol.stress[:, 0], 10.0))                  # uniform tension
+    True
+    """
+
+    def __init__(self, model, materials, *, plane="stress", gauss=2):
+        self.model = model
+        self.materials = parse_materials(materials, len(model.domain.regions))
+        lame(1.0, 0.0, plane)                       # validates `plane`
+        self.plane = plane
+        self.gauss = gauss
+        self._dirichlet = []
+        self._tractions = []
+        self._body = []
+        self._basis = None
+        self._K = None
+
+    def __repr__(self):
+        return (f"<Elasticity plane {self.plane}, {len(self.model.nodes)} nodes, "
+                f"{len(self._dirichlet)} Dirichlet, {len(self._tractions)} traction, "
+                f"{len(self._body)} body-force conditions>")
+
+    # -- conditions ---------------------------------------------------------------------
+    def add_dirichlet(self, where, component, value=0.0):
+        """Prescribe displacements at nodes (direct imposition: Kronecker delta).
+
+        Parameters
+        ----------
+        where : callable ``(p, 2) -> (p,) bool``, or a boolean mask / index array over nodes
+        component : {0, 1, None}
+            ``None`` prescribes both.
+        value : float, or callable ``(p, 2) -> (p,)`` (``(p, 2)`` for both components)
+        """
+        if component not in (0, 1, None):
+            raise ValueError(f"component: expected 0, 1 or None, received {component!r}")
+        nodes = select_nodes(self.model.nodes, where)
+        if nodes.size == 0:
+            raise ValueError("add_dirichlet: `where` selects no node; check the predicate "
+                             "against model.nodes (boundary nodes lie exactly on the boundary)")
+        comps = [0, 1] if component is None else [component]
+        vals = _per_point(value, self.model.nodes[nodes], len(comps), "add_dirichlet value")
+        for k, c in enumerate(comps):
+            self._dirichlet.append((2 * nodes + c, vals[:, k]))
+
+    def boundary_edges(self):
+        """Edges of the outer boundary, holes and crack faces.
+
+        Returns
+        -------
+        edges : (e, 2) int64 ndarray
+            Node pairs, the body on the left (counter-clockwise).
+        normal : (e, 2) ndarray
+            Outward unit normals.
+        """
+        tri = self.model.triangles
+        edges, _ = constraint_edges(tri, triangle_neighbors(tri))
+        d = self.model.nodes[edges[:, 1]] - self.model.nodes[edges[:, 0]]
+        normal = np.column_stack([d[:, 1], -d[:, 0]]) / np.linalg.norm(d, axis=1)[:, None]
+        return edges, normal
+
+    def add_traction(self, where, t):
+        """Tractions on the boundary edges (outer, holes, crack faces).
+
+        Parameters
+        ----------
+        where : callable ``(x, nrm) -> (e,) bool``
+            Midpoints ``(e, 2)`` and outward unit normals ``(e, 2)`` of the edges.
+        t : (2,) array_like, or callable ``(x, nrm) -> (q, 2)``
+            Traction vectors; integrated by 3-point Gauss quadrature on each
+            edge (exact for tractions up to quadratic along an edge).
+        """
+        edges, normal = self.boundary_edges()
+        x = self.model.nodes
+        mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
+        pick = np.asarray(where(mid, normal)) if callable(where) else np.asarray(where)
+        if pick.shape != (len(edges),) or pick.dtype != bool:
+            raise ValueError(f"add_traction: where(x, nrm) must return a ({len(edges)},) bool "
+                             f"array, received dtype {pick.dtype} shape {pick.shape}")
+        if not pick.any():
+            raise ValueError("add_traction: `where` selects no boundary edge")
+        self._tractions.append((edges[pick], normal[pick], t))
+
+    def add_body_force(self, b):
+        """Body force per unit area: ``b(x) -> (p, 2)`` or a constant ``(2,)``
+        (nodal integration: the value at each cell's node times its area)."""
+        self._body.append(b)
+
+    # -- assembly -----------------------------------------------------------------------
+    @property
+    def basis(self):
+        """The vector `CellBasis` (built on first use)."""
+        if self._basis is None:
+            self._basis = CellBasis(self.model, vector=True, gauss=self.gauss)
+        return self._basis
+
+    def cell_materials(self):
+        """``(m, 2)`` ``(E, nu)`` of every integration cell."""
+        return self.materials[self.model.cells.region]
+
+    def stiffness(self):
+        """Global stiffness ``K`` (eq. 33), ``(2 n, 2 n)`` CSR."""
+        if self._K is None:
+            E, nu = self.cell_materials().T
+            lam, mu = lame(E, nu, self.plane)
+            self._K = elasticity_form.assemble(self.basis, lam=lam, mu=mu)
+        return self._K
+
+    def load(self):
+        """Load vector ``f`` (eq. 21), ``(2 n,)``."""
+        n = len(self.model.nodes)
+        f = np.zeros((n, 2))
+        g, w = np.polynomial.legendre.leggauss(3)
+        s, w = 0.5 * (g + 1.0), 0.5 * w
+        x = self.model.nodes
+        for edges, normal, t in self._tractions:
+            a, b = x[edges[:, 0]], x[edges[:, 1]]
+            length = np.linalg.norm(b - a, axis=1)
+            for sk, wk in zip(s, w):
+                pts = a + sk * (b - a)
+                tr = _per_point(t(pts, normal) if callable(t) else t, pts, 2, "traction")
+                np.add.at(f, edges[:, 0], (wk * (1.0 - sk) * length)[:, None] * tr)
+                np.add.at(f, edges[:, 1], (wk * sk * length)[:, None] * tr)
+        cells = self.model.cells
+        for b in self._body:
+            pts = x[cells.node]
+            np.add.at(f, cells.node, cells.area[:, None] * _per_point(b, pts, 2, "body force"))
+        return f.reshape(-1)
+
+    def _prescribed(self):
+        dofs = np.zeros(0, dtype=np.int64)
+        values = np.zeros(0)
+        for d, v in self._dirichlet:            # later conditions win
+            dofs, values = np.concatenate([dofs, d]), np.concatenate([values, v])
+        last = len(dofs) - 1 - np.unique(dofs[::-1], return_index=True)[1]
+        return dofs[last], values[last]
+
+    # -- solve --------------------------------------------------------------------------
+    def solve(self, *, method="auto", tol=1e-10, progress=None):
+        """Solve ``K d = f`` with the Dirichlet values imposed.
+
+        Parameters
+        ----------
+        method : {"auto", "direct", "amg"}
+            ``"auto"``: sparse direct up to 200k unknowns, pyamg smoothed
+            aggregation (rigid-body modes) + CG above.
+        tol : float
+            Relative residual of the iterative solver.
+        progress : bool, optional
+            Progress bar over the stages (default: on a terminal).
+
+        Returns
+        -------
+        ElasticSolution
+
+        Raises
+        ------
+        SolveError
+            Rigid motions not fixed by the Dirichlet conditions (named).
+        """
+        if progress is None:
+            progress = sys.stderr.isatty()
+        timings = {}
+        bar = tqdm(total=3, desc="elasticity", disable=not progress, leave=False)
+        t0 = time.perf_counter()
+        bar.set_postfix_str("smoothed gradients")
+        self.basis.grad
+        t1 = time.perf_counter()
+        bar.update()
+        bar.set_postfix_str("stiffness")
+        K = self.stiffness()
+        f = self.load()
+        t2 = time.perf_counter()
+        bar.update()
+        D, values = self._prescribed()
+        free = free_rigid_motions(K, self.model.nodes, D)
+        if free:
+            bar.close()
+            raise SolveError("the system is singular: the Dirichlet conditions leave free the "
+                             + "; ".join(free) + ". Fix them with add_dirichlet")
+        bar.set_postfix_str("solve")
+        x = np.zeros(K.shape[0])
+        x[D] = values
+        A, b, _, interior = condense(K, f, x=x, D=D)
+        modes = rigid_modes(self.model.nodes)[interior]
+        x[interior] = solve_spd(A, b, modes=modes, tol=tol, method=method)
+        t3 = time.perf_counter()
+        bar.update()
+        bar.close()
+        timings.update(gradients=t1 - t0, assembly=t2 - t1, solve=t3 - t2)
+        log.info("elasticity: %s", ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
+        E, nu = self.cell_materials().T
+        C = stiffness_matrix(E, nu, self.plane)
+        return ElasticSolution(self, x.reshape(-1, 2), C, timings)

@@ -1,0 +1,64 @@
+"""Isotropic linear elastic materials in plane stress and plane strain (eq. 24-25)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["PLANES", "parse_materials", "lame", "stiffness_matrix"]
+
+PLANES = ("stress", "strain")
+
+
+def parse_materials(materials, nregions):
+    """``(r, 2)`` array of ``(E, nu)`` per region from one pair or a list of pairs."""
+    try:
+        arr = np.asarray(materials, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"materials: expected an (E, nu) pair or a list of {nregions} pairs, "
+                         f"received {materials!r}") from None
+    if arr.shape == (2,):
+        arr = np.tile(arr, (nregions, 1))
+    if arr.shape != (nregions, 2):
+        raise ValueError(f"materials: expected an (E, nu) pair or one pair per region "
+                         f"({nregions} regions), received shape {arr.shape}")
+    E, nu = arr[:, 0], arr[:, 1]
+    if not (np.isfinite(arr).all() and (E > 0).all()):
+        raise ValueError(f"materials: Young's moduli must be positive and finite, received {E.tolist()}")
+    if not ((nu > -1.0) & (nu < 0.5)).all():
+        raise ValueError(f"materials: Poisson ratios must lie in (-1, 0.5), received {nu.tolist()}")
+    return arr
+
+
+def lame(E, nu, plane):
+    """Lamé parameters of the 2-D law: ``sigma = 2 mu eps + lam tr(eps) I``.
+
+    In plane stress ``lam`` is ``lambda* = 2 lambda mu / (lambda + 2 mu)``.
+
+    Returns
+    -------
+    lam, mu : ndarray
+    """
+    if plane not in PLANES:
+        raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
+    E, nu = np.asarray(E, dtype=float), np.asarray(nu, dtype=float)
+    mu = E / (2.0 * (1.0 + nu))
+    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    if plane == "stress":
+        lam = 2.0 * lam * mu / (lam + 2.0 * mu)
+    return lam, mu
+
+
+def stiffness_matrix(E, nu, plane):
+    """The matrix ``C`` of eq. 24 (strain) or 25 (stress), Voigt ``[xx, yy, xy]``
+    with engineering shear strain.
+
+    Returns
+    -------
+    (..., 3, 3) ndarray
+    """
+    lam, mu = lame(E, nu, plane)
+    C = np.zeros(np.shape(lam) + (3, 3))
+    C[..., 0, 0] = C[..., 1, 1] = lam + 2.0 * mu
+    C[..., 0, 1] = C[..., 1, 0] = lam
+    C[..., 2, 2] = mu
+    return C

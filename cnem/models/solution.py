@@ -1,0 +1,123 @@
+"""`ElasticSolution`: displacements, SCNI cell strains and stresses, errors, files and pictures."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..assembly.quadrature import cell_quadrature
+
+__all__ = ["ElasticSolution", "von_mises"]
+
+
+def von_mises(stress):
+    """Plane von Mises stress of ``(..., 3)`` ``[sxx, syy, sxy]`` (in-plane components)."""
+    sxx, syy, sxy = stress[..., 0], stress[..., 1], stress[..., 2]
+    return np.sqrt(sxx ** 2 - sxx * syy + syy ** 2 + 3.0 * sxy ** 2)
+
+
+class ElasticSolution:
+    """The solution of an `Elasticity` problem.
+
+    Attributes
+    ----------
+    u : (n, 2) ndarray
+        Nodal displacements (the displacement at node ``i`` is ``u[i]``).
+    strain : (m, 3) ndarray
+        ``[exx, eyy, 2 exy]`` per integration cell (smoothed, eq. 29).
+    stress : (m, 3) ndarray
+        ``[sxx, syy, sxy]`` per integration cell (eq. 34).
+    C : (m, 3, 3) ndarray
+        Elastic matrix of each cell.
+    timings : dict
+        Seconds spent in each stage.
+    """
+
+    def __init__(self, problem, u, C, timings):
+        self.problem = problem
+        self.model = problem.model
+        self.plane = problem.plane
+        self.u = u
+        self.C = C
+        self.timings = timings
+        grad = problem.basis.grad
+        ux, uy = u[:, 0], u[:, 1]
+        self.strain = np.column_stack([grad.x @ ux, grad.y @ uy, grad.y @ ux + grad.x @ uy])
+        self.stress = np.einsum("kij,kj->ki", C, self.strain)
+
+    def __repr__(self):
+        return (f"<ElasticSolution {len(self.u)} nodes, {len(self.stress)} cells, "
+                f"max |u| {np.abs(self.u).max():.3e}, max von Mises {self.von_mises.max():.3e}>")
+
+    @property
+    def von_mises(self):
+        """``(m,)`` von Mises stress per cell."""
+        return von_mises(self.stress)
+
+    def displacement(self, points):
+        """Displacements at points through the shape functions.
+
+        Parameters
+        ----------
+        points : (p, 2) array_like
+
+        Returns
+        -------
+        (p, 2) ndarray
+        """
+        return self.model.shape_functions(points) @ self.u
+
+    def energy_error(self, exact_stress, *, order=4):
+        """Error in the energy norm against an exact stress field.
+
+        ``sqrt(sum_k ∫_{cell k} (σh - σ)ᵀ C⁻¹ (σh - σ) dΩ)`` with the constant
+        SCNI stress ``σh`` of each cell and a quadrature on each cell polygon.
+
+        Parameters
+        ----------
+        exact_stress : callable ``(q, 2) -> (q, 3)``
+            ``[sxx, syy, sxy]`` at points.
+        order : int
+            Degree of the triangle rule on the triangles of each cell.
+
+        Returns
+        -------
+        float
+        """
+        cell, points, weights = cell_quadrature(self.model.cells, order)
+        exact = np.asarray(exact_stress(points), dtype=float)
+        if exact.shape != (len(points), 3):
+            raise ValueError(f"exact_stress must return ({len(points)}, 3) values "
+                             f"[sxx, syy, sxy], received shape {exact.shape}")
+        diff = self.stress[cell] - exact
+        compliance = np.linalg.inv(self.C)[cell]
+        density = np.einsum("qi,qij,qj->q", diff, compliance, diff)
+        return float(np.sqrt(weights @ density))
+
+    def energy(self):
+        """Strain energy ``1/2 sum_k A_k σ_k · ε_k``."""
+        return 0.5 * float(self.model.cells.area @ (self.stress * self.strain).sum(axis=1))
+
+    def fields(self):
+        """Nodal and cell fields for files and pictures.
+
+        Returns
+        -------
+        point_data : dict of str -> (n, ...) ndarray
+        cell_data : dict of str -> (m, ...) ndarray
+        """
+        return ({"u": self.u},
+                {"stress": self.stress, "strain": self.strain, "von_mises": self.von_mises})
+
+    def write(self, path):
+        """Write nodes and cells with ``u``, ``stress``, ``strain`` and
+        ``von_mises`` (``.vtu``, see `cnem.io.write`)."""
+        from .. import io
+        point_data, cell_data = self.fields()
+        io.write(self.model, path, point_data=point_data, cell_data=cell_data)
+        return path
+
+    def plot(self, path=None, *, field="von_mises", scale=None, **kwargs):
+        """Off-screen picture of the deformed cells coloured by a field
+        (see `cnem.plot.solution`)."""
+        from .. import plot
+        return plot.solution(self, path, field=field, scale=scale, **kwargs)
