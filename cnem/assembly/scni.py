@@ -18,6 +18,7 @@ import logging
 
 import numpy as np
 import scipy.sparse as sp
+import shapely
 
 from .. import config
 from ..geometry.topology import circumcenters, constraint_edges, triangle_neighbors
@@ -96,7 +97,81 @@ def _pieces(model, a, b):
     return edge[:-1][same], t[:-1][same], t[1:][same]
 
 
-def _face_triangles(model, a, b):
+def _crack_faces(model):
+    """Crack-face edges, each oriented with its own face's triangle on the left.
+
+    Returns
+    -------
+    p, q : (f, 2) ndarray
+        Ends.
+    owner : (f,) int64 ndarray
+        The triangle of that face.
+    """
+    crack = model.segments[model.segment_kind == 2]
+    n = len(model.nodes)
+    edges, owner = constraint_edges(model.triangles,
+                                    triangle_neighbors(model.triangles, model.triangle_region))
+    is_face = np.isin(np.sort(edges, axis=1) @ [n, 1], np.sort(crack, axis=1) @ [n, 1])
+    edges, owner = edges[is_face], owner[is_face]
+    return model.nodes[edges[:, 0]], model.nodes[edges[:, 1]], owner
+
+
+def _slit_edges(model, faces):
+    """Crack faces running inside cells (near crack tips a cell can wrap around the
+    end of a crack; its polygon then does not show the slit, but the slit's two
+    faces are part of the cell's boundary, with different shape functions).
+
+    Returns
+    -------
+    cell : (s,) int64 ndarray
+    a, b : (s, 2) ndarray
+        Slit edges, oriented like their face (the face's material on the left).
+    hint : (s,) int64 ndarray
+        The triangle of the face.
+    """
+    p, q, owner = faces
+    cells = model.cells
+    if len(p) == 0:
+        return np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0, np.int64)
+    first = np.repeat(np.arange(len(cells.area)), np.diff(cells.offsets))
+    lo = np.full((len(cells.area), 2), np.inf)
+    hi = np.full((len(cells.area), 2), -np.inf)
+    np.minimum.at(lo, first, cells.vertices)
+    np.maximum.at(hi, first, cells.vertices)
+    off, idx = RTree(lo, hi).query(np.minimum(p, q), np.maximum(p, q))
+    out = []
+    for f in range(len(p)):
+        face = shapely.LineString([p[f], q[f]])
+        for c in idx[off[f]:off[f + 1]]:
+            polygon = shapely.Polygon(cells.polygon(c))
+            eps = 1e-6 * np.sqrt(cells.area[c])
+            for piece in _line_parts(face.intersection(polygon)):
+                xy = np.asarray(piece.coords)
+                d = xy[-1] - xy[0]
+                length = np.hypot(*d)
+                if length <= eps:
+                    continue
+                mid = 0.5 * (xy[0] + xy[-1])
+                side = eps * np.array([-d[1], d[0]]) / length
+                if polygon.contains(shapely.Point(mid + side)) and \
+                        polygon.contains(shapely.Point(mid - side)):
+                    out.append((c, xy[0], xy[-1], owner[f]))
+    if not out:
+        return np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0, np.int64)
+    cell, a, b, hint = zip(*out)
+    return np.array(cell, np.int64), np.array(a), np.array(b), np.array(hint, np.int64)
+
+
+def _line_parts(geom):
+    """The line pieces of a shapely intersection result."""
+    if isinstance(geom, shapely.LineString):
+        return [geom] if not geom.is_empty else []
+    if hasattr(geom, "geoms"):
+        return [g for g in geom.geoms if isinstance(g, shapely.LineString)]
+    return []
+
+
+def _face_triangles(model, a, b, faces):
     """For cell edges lying on a crack face, the triangle of that face on the
     cell's side (the shape functions there depend on the side); -1 elsewhere.
 
@@ -105,16 +180,7 @@ def _face_triangles(model, a, b):
     (e,) int64 ndarray
     """
     hint = np.full(len(a), -1, dtype=np.int64)
-    crack = model.segments[model.segment_kind == 2]
-    if len(crack) == 0:
-        return hint
-    edges, owner = constraint_edges(model.triangles,
-                                    triangle_neighbors(model.triangles, model.triangle_region))
-    key = np.sort(edges, axis=1)
-    is_face = np.isin(key[:, 0] * len(model.nodes) + key[:, 1],
-                      np.sort(crack, axis=1) @ [len(model.nodes), 1])
-    edges, owner = edges[is_face], owner[is_face]
-    p, q = model.nodes[edges[:, 0]], model.nodes[edges[:, 1]]
+    p, q, owner = faces
     tol = config.SNAP_TOL * model.domain.diameter
     mid = 0.5 * (a + b)
     off, idx = RTree(np.minimum(p, q) - tol, np.maximum(p, q) + tol).query(mid, mid)
@@ -156,15 +222,26 @@ def smoothed_gradient(model, *, gauss=2):
         return model._cache[key]
     cells = model.cells
     cell, a, b = cell_edges(cells)
+    hint = np.full(len(a), -1, dtype=np.int64)
+    if (model.segment_kind == 2).any():
+        faces = _crack_faces(model)
+        hint = _face_triangles(model, a, b, faces)
+        slit = _slit_edges(model, faces)
+        cell, a, b, hint = (np.concatenate([x, y]) for x, y in zip((cell, a, b, hint), slit))
+    # each edge is integrated from its lexicographically smaller end, so that the
+    # two cells sharing it evaluate phi at bit-identical points and cancel exactly
+    flip = (a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1]))
+    a, b = np.where(flip[:, None], b, a), np.where(flip[:, None], a, b)
+    sign = np.where(flip, -1.0, 1.0)
     edge, t0, t1 = _pieces(model, a, b)
     s, w = np.polynomial.legendre.leggauss(gauss)
     s, w = 0.5 * (s + 1.0), 0.5 * w
     d = b - a
     t = t0[:, None] + (t1 - t0)[:, None] * s
     points = (a[edge][:, None, :] + t[:, :, None] * d[edge][:, None, :]).reshape(-1, 2)
-    hint = np.repeat(_face_triangles(model, a, b)[edge], gauss)
-    phi = model.shape_functions(points, triangles=hint)
-    weight = ((t1 - t0)[:, None] * w).reshape(-1) / cells.area[np.repeat(cell[edge], gauss)]
+    phi = model.shape_functions(points, triangles=np.repeat(hint[edge], gauss))
+    weight = ((t1 - t0)[:, None] * w * sign[edge][:, None]).reshape(-1)
+    weight /= cells.area[np.repeat(cell[edge], gauss)]
     rows = np.repeat(cell[edge], gauss)
     cols = np.arange(len(points))
     shape = (len(cells.area), len(points))

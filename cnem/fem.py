@@ -1,0 +1,514 @@
+"""`P1Elasticity`: a linear finite element (scikit-fem P1 triangles) anchor for C-NEM.
+
+The same problem definition as `cnem.Elasticity` (Dirichlet conditions on
+nodes, tractions on boundary facets, body forces), solved on a quality mesh
+of the domain made by `triangle`: every triangle lies in one region, material
+interfaces are mesh edges and cracks are opened (their nodes duplicated, tips
+excepted), so that crack faces are traction-free boundaries.
+
+>>> import numpy as np, cnem, cnem.fem
+>>> dom = cnem.geometry.rectangle(2.0, 1.0)
+>>> prob = cnem.fem.P1Elasticity(dom, (1000.0, 0.3), nodes=200)
+>>> prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, 0)
+>>> prob.add_dirichlet(lambda p: (p[:, 0] < 1e-9) & (p[:, 1] < 1e-9), 1)
+>>> prob.add_traction(lambda x, n: n[:, 0] > 0.5, [10.0, 0.0])
+>>> sol = prob.solve()
+>>> bool(np.allclose(sol.stress, [10.0, 0.0, 0.0]))           # uniform tension
+True
+>>> sol.energy_error(lambda x: np.tile([10.0, 0.0, 0.0], (len(x), 1))) < 1e-9
+True
+"""
+
+from __future__ import annotations
+
+import inspect
+import logging
+import time
+
+import numpy as np
+import triangle
+from shapely.geometry import Polygon
+from skfem import Basis, ElementTriP1, ElementVector, FacetBasis, LinearForm, MeshTri, condense
+from skfem.helpers import dot, sym_grad
+from skfem.models.elasticity import linear_elasticity
+
+from .assembly import select_nodes
+from .assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
+from .errors import GeometryError, SolveError
+from .geometry.cracks import split_cracks
+from .geometry.pslg import BOUNDARY, CRACK
+from .models.elasticity import _per_point
+from .models.material import lame, parse_materials, stiffness_matrix
+from .models.solution import von_mises
+
+__all__ = ["P1Elasticity", "P1Solution", "mesh_domain"]
+
+log = logging.getLogger(__name__)
+
+#: Segment markers handed to `triangle` are ``kind + _MARK`` (0 and 1 are its own).
+_MARK = 2
+#: Node-count tolerance and number of area corrections of `mesh_domain`.
+_NODES_RTOL, _NODES_TRIES = 0.05, 5
+
+
+# ---------------------------------------------------------------------- meshing
+def _hole_points(domain):
+    """One point inside each connected empty area enclosed by the domain."""
+    union = domain.polygon
+    pieces = getattr(union, "geoms", [union])
+    points = []
+    for piece in pieces:
+        for ring in piece.interiors:
+            empty = Polygon(ring).difference(union)
+            for part in getattr(empty, "geoms", [empty]):
+                if part.area > 0:
+                    points.append(part.representative_point().coords[0])
+    return np.asarray(points, dtype=float).reshape(-1, 2)
+
+
+def _pslg_input(domain):
+    """`triangle` input: PSLG vertices and segments (crack edges between two
+    tips split at their midpoint so that they can be opened), region seeds, holes."""
+    pslg = domain.pslg
+    vertices, edges, kind = pslg.vertices, pslg.edges, pslg.kind
+    crack = edges[kind == CRACK]
+    degree = np.bincount(crack.ravel(), minlength=len(vertices))
+    on_boundary = np.zeros(len(vertices), dtype=bool)
+    on_boundary[edges[kind == BOUNDARY].ravel()] = True
+    fixed = (degree >= 2) | on_boundary
+    lone = np.flatnonzero((kind == CRACK) & ~fixed[edges].any(axis=1))
+    if lone.size:
+        mid = np.arange(len(vertices), len(vertices) + lone.size)
+        vertices = np.concatenate([vertices, vertices[edges[lone]].mean(axis=1)])
+        halves = np.column_stack([edges[lone, 0], mid, mid, edges[lone, 1]]).reshape(-1, 2)
+        keep = np.ones(len(edges), dtype=bool)
+        keep[lone] = False
+        edges = np.concatenate([edges[keep], halves])
+        kind = np.concatenate([kind[keep], np.full(len(halves), CRACK, dtype=kind.dtype)])
+    seeds = [[*region.representative_point().coords[0], i, 0.0]
+             for i, region in enumerate(domain.regions)]
+    data = {"vertices": np.ascontiguousarray(vertices, dtype=float),
+            "segments": np.ascontiguousarray(edges, dtype=np.int32),
+            "segment_markers": (kind.astype(np.int32) + _MARK)[:, None],
+            "regions": np.asarray(seeds, dtype=float)}
+    holes = _hole_points(domain)
+    if len(holes):
+        data["holes"] = holes
+    return data
+
+
+def _triangulate(data, quality, max_area):
+    switches = f"pq{quality:g}AQ" + ("" if max_area is None else f"a{max_area:.17g}")
+    return triangle.triangulate(data, switches)
+
+
+def mesh_domain(domain, *, nodes=None, max_area=None, quality=30.0):
+    """Quality triangle mesh of a domain, opened along its cracks.
+
+    Parameters
+    ----------
+    domain : Domain
+    nodes : int, optional
+        Target node count (before crack opening): the maximum triangle area
+        is corrected until the count lies within 5 % of it.
+    max_area : float, optional
+        Maximum triangle area (``triangle``'s ``a`` switch). Give at most one
+        of ``nodes`` and ``max_area``; with neither, only the quality bound
+        applies (the coarsest quality mesh).
+    quality : float
+        Minimum angle in degrees (``triangle``'s ``q`` switch), at most 34.
+
+    Returns
+    -------
+    points : (n, 2) ndarray
+        Node coordinates; crack nodes appear once per crack face.
+    triangles : (t, 3) int64 ndarray
+        Counter-clockwise triangles.
+    region : (t,) int64 ndarray
+        Region index of each triangle.
+
+    Raises
+    ------
+    ValueError
+        Both ``nodes`` and ``max_area`` given, non-positive values, a quality
+        above 34 degrees, or a target node count below the coarsest mesh.
+    GeometryError
+        If a crack cannot be opened.
+    """
+    if nodes is not None and max_area is not None:
+        raise ValueError(f"give either nodes or max_area, received nodes={nodes!r} and "
+                         f"max_area={max_area!r}")
+    if not 0.0 < float(quality) <= 34.0:
+        raise ValueError(f"quality: expected a minimum angle in (0, 34] degrees, received "
+                         f"{quality!r} (triangle may not terminate above 34)")
+    if max_area is not None and not float(max_area) > 0.0:
+        raise ValueError(f"max_area: expected a positive number, received {max_area!r}")
+    data = _pslg_input(domain)
+    if nodes is None:
+        out = _triangulate(data, quality, max_area)
+    else:
+        out = _mesh_for_nodes(data, domain.area, int(nodes), quality)
+    points = out["vertices"]
+    tri = out["triangles"].astype(np.int64)
+    region = np.rint(out["triangle_attributes"][:, 0]).astype(np.int64)
+    a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
+    flip = np.cross(b - a, c - a) < 0
+    tri[flip] = tri[flip][:, [0, 2, 1]]
+    segments = out["segments"].astype(np.int64)
+    kind = (out["segment_markers"].ravel() - _MARK).astype(np.int8)
+    if (kind < 0).any():
+        raise GeometryError("triangle returned segments that are not in the domain's PSLG; "
+                            "check the domain for crossing boundaries")
+    points, _, tri, _, _ = split_cracks(points, tri, segments, kind)
+    return points, tri, region
+
+
+def _mesh_for_nodes(data, area, target, quality):
+    """Mesh whose node count is within `_NODES_RTOL` of ``target`` (secant on
+    ``log count`` against ``log max_area``)."""
+    if target < 3:
+        raise ValueError(f"nodes: expected a target node count >= 3, received {target}")
+    coarsest = _triangulate(data, quality, None)
+    if len(coarsest["vertices"]) >= (1.0 - _NODES_RTOL) * target:
+        if len(coarsest["vertices"]) <= (1.0 + _NODES_RTOL) * target:
+            return coarsest
+        raise ValueError(f"nodes: the coarsest quality-{quality:g} mesh of this domain already "
+                         f"has {len(coarsest['vertices'])} nodes, more than the target {target}; "
+                         "ask for more nodes or a coarser domain description")
+    tries = []
+    max_area = 2.0 * area / target
+    for _ in range(_NODES_TRIES):
+        out = _triangulate(data, quality, max_area)
+        count = len(out["vertices"])
+        tries.append((abs(count / target - 1.0), count, max_area, out))
+        if abs(count / target - 1.0) <= _NODES_RTOL:
+            break
+        slope = -1.0
+        if len(tries) >= 2 and tries[-1][2] != tries[-2][2] and tries[-1][1] != tries[-2][1]:
+            slope = (np.log(tries[-1][1] / tries[-2][1])
+                     / np.log(tries[-1][2] / tries[-2][2]))
+            slope = min(max(slope, -2.0), -0.5)
+        max_area *= (target / count) ** (1.0 / slope)
+    best = min(tries, key=lambda item: item[0])
+    if best[0] > _NODES_RTOL:
+        log.warning("mesh_domain: %d nodes for a target of %d (max area %.3g)",
+                    best[1], target, best[2])
+    log.info("mesh_domain: %d nodes (target %d) after %d meshes", best[1], target, len(tries))
+    return best[3]
+
+
+# ------------------------------------------------------------------------ problem
+class P1Elasticity:
+    """Plane linear elasticity with linear triangles (scikit-fem), the reference
+    for `cnem.Elasticity`.
+
+    The mesh is built at construction, so that conditions can be given on its
+    nodes (`nodes`, `mesh`).
+
+    Parameters
+    ----------
+    domain : Domain
+    materials : (E, nu) pair, or a list of pairs indexed by region
+    plane : {"stress", "strain"}
+    nodes : int, optional
+        Target node count of the mesh (within about 5 %).
+    max_area : float, optional
+        Maximum triangle area instead.
+    quality : float
+        Minimum angle of the triangles in degrees.
+
+    Attributes
+    ----------
+    mesh : skfem.MeshTri
+        ``n`` nodes (``mesh.p`` is ``(2, n)``), ``t`` triangles.
+    region : (t,) int64 ndarray
+        Region index of each triangle.
+    basis : skfem.Basis
+        Vector P1 basis; dofs interleaved ``[u0x, u0y, u1x, ...]``.
+    timings : dict
+        Seconds spent meshing (``"mesh"``).
+    """
+
+    def __init__(self, domain, materials, *, plane="stress", nodes=None, max_area=None,
+                 quality=30.0):
+        self.domain = domain
+        self.materials = parse_materials(materials, len(domain.regions))
+        lame(1.0, 0.0, plane)                       # validates `plane`
+        self.plane = plane
+        t0 = time.perf_counter()
+        points, tri, self.region = mesh_domain(domain, nodes=nodes, max_area=max_area,
+                                               quality=quality)
+        self.mesh = MeshTri(np.ascontiguousarray(points.T), np.ascontiguousarray(tri.T))
+        self.basis = Basis(self.mesh, ElementVector(ElementTriP1()))
+        self.timings = {"mesh": time.perf_counter() - t0}
+        self._values = np.full(self.basis.N, np.nan)    # prescribed displacements
+        self._tractions = []
+        self._body = []
+        self._boundary = None
+
+    def __repr__(self):
+        return (f"<P1Elasticity plane {self.plane}, {len(self.nodes)} nodes, "
+                f"{self.mesh.t.shape[1]} triangles, {np.count_nonzero(~np.isnan(self._values))} "
+                f"prescribed dofs, {len(self._tractions)} traction, {len(self._body)} "
+                "body-force conditions>")
+
+    @property
+    def nodes(self):
+        """``(n, 2)`` node coordinates (crack nodes once per face)."""
+        return self.mesh.p.T
+
+    # -- conditions ---------------------------------------------------------------------
+    def add_dirichlet(self, where, component, value=0.0):
+        """Prescribe nodal displacements (later conditions win on shared dofs).
+
+        Parameters
+        ----------
+        where : callable ``(n, 2) -> (n,) bool``, or a boolean mask / index array over nodes
+        component : {0, 1, None}
+            ``None`` prescribes both.
+        value : float, or callable ``(p, 2) -> (p,)`` (``(p, 2)`` for both components)
+        """
+        if component not in (0, 1, None):
+            raise ValueError(f"component: expected 0, 1 or None, received {component!r}")
+        picked = select_nodes(self.nodes, where)
+        if picked.size == 0:
+            raise ValueError("add_dirichlet: `where` selects no node; check the predicate "
+                             "against prob.nodes (boundary nodes lie exactly on the boundary)")
+        comps = [0, 1] if component is None else [component]
+        vals = _per_point(value, self.nodes[picked], len(comps), "add_dirichlet value")
+        dofs = 2 * picked[:, None] + np.asarray(comps)[None, :]
+        self._values[dofs] = vals
+
+    def boundary_facets(self):
+        """Facets of the outer boundary, holes and crack faces.
+
+        Returns
+        -------
+        facets : (e,) int ndarray
+            Indices into ``mesh.facets``.
+        midpoint : (e, 2) ndarray
+        normal : (e, 2) ndarray
+            Outward unit normals.
+        """
+        if self._boundary is None:
+            facets = self.mesh.boundary_facets()
+            fb = FacetBasis(self.mesh, ElementTriP1(), facets=facets, intorder=1)
+            midpoint = self.mesh.p[:, self.mesh.facets[:, facets]].mean(axis=1).T
+            self._boundary = facets, midpoint, fb.normals.value[:, :, 0].T
+        return self._boundary
+
+    def add_traction(self, where, t):
+        """Tractions on boundary facets (outer boundary, holes, crack faces).
+
+        Parameters
+        ----------
+        where : callable ``(x, nrm) -> (e,) bool``, or an ``(e,)`` bool mask
+            Midpoints ``(e, 2)`` and outward unit normals ``(e, 2)`` of the
+            facets of `boundary_facets`.
+        t : (2,) array_like, or callable ``(x, nrm) -> (q, 2)``
+            Traction vectors at points ``x (q, 2)`` with normals ``nrm (q, 2)``;
+            3-point Gauss on each facet (exact up to quadratic tractions).
+        """
+        facets, midpoint, normal = self.boundary_facets()
+        pick = np.asarray(where(midpoint, normal)) if callable(where) else np.asarray(where)
+        if pick.shape != (len(facets),) or pick.dtype != bool:
+            raise ValueError(f"add_traction: where(x, nrm) must return a ({len(facets)},) bool "
+                             f"array, received dtype {pick.dtype} shape {pick.shape}")
+        if not pick.any():
+            raise ValueError("add_traction: `where` selects no boundary facet")
+        self._tractions.append((facets[pick], t))
+
+    def add_body_force(self, b):
+        """Body force per unit area: ``b(x) -> (p, 2)`` or a constant ``(2,)``
+        (Gauss quadrature on the triangles)."""
+        self._body.append(b)
+
+    # -- assembly -----------------------------------------------------------------------
+    def element_materials(self):
+        """``(t, 2)`` ``(E, nu)`` of every triangle."""
+        return self.materials[self.region]
+
+    def stiffness(self):
+        """Global stiffness ``(2 n, 2 n)`` CSR, per-triangle Lamé parameters."""
+        E, nu = self.element_materials().T
+        lam, mu = lame(E, nu, self.plane)
+        return linear_elasticity(lam[:, None], mu[:, None]).assemble(self.basis)
+
+    def load(self):
+        """Load vector ``(2 n,)`` of the tractions and body forces."""
+        f = np.zeros(self.basis.N)
+        element = ElementVector(ElementTriP1())
+        for facets, t in self._tractions:
+            fb = FacetBasis(self.mesh, element, facets=facets, intorder=5)
+            f += _vector_load(t, "traction", normal=True).assemble(fb)
+        for b in self._body:
+            f += _vector_load(b, "body force", normal=False).assemble(self.basis)
+        return f
+
+    # -- solve --------------------------------------------------------------------------
+    def solve(self, *, method="auto", tol=1e-10):
+        """Solve ``K u = f`` with the Dirichlet values imposed.
+
+        Parameters
+        ----------
+        method : {"auto", "direct", "amg"}
+            See `cnem.assembly.linsolve.solve_spd`.
+        tol : float
+            Relative residual of the iterative solver.
+
+        Returns
+        -------
+        P1Solution
+
+        Raises
+        ------
+        SolveError
+            Rigid motions not fixed by the Dirichlet conditions (named).
+        """
+        t0 = time.perf_counter()
+        K = self.stiffness()
+        f = self.load()
+        t1 = time.perf_counter()
+        D = np.flatnonzero(~np.isnan(self._values))
+        free = free_rigid_motions(K, self.nodes, D)
+        if free:
+            raise SolveError("the system is singular: the Dirichlet conditions leave free the "
+                             + "; ".join(free) + ". Fix them with add_dirichlet")
+        x = np.zeros(K.shape[0])
+        x[D] = self._values[D]
+        A, b, _, interior = condense(K, f, x=x, D=D)
+        x[interior] = solve_spd(A, b, modes=rigid_modes(self.nodes)[interior], tol=tol,
+                                method=method)
+        t2 = time.perf_counter()
+        timings = dict(self.timings, assembly=t1 - t0, solve=t2 - t1)
+        log.info("P1 elasticity: %s", ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
+        return P1Solution(self, x, timings)
+
+
+def _vector_load(value, what, *, normal):
+    """`LinearForm` of ``value . v`` with ``value`` a constant ``(2,)`` or a callable
+    of the quadrature points (and the outward normals when ``normal``)."""
+
+    @LinearForm
+    def form(v, w):
+        shape = w.x.shape                                   # (2, elements, points)
+        x = w.x.reshape(2, -1).T
+        if callable(value):
+            args = (x, w.n.reshape(2, -1).T) if normal else (x,)
+            vals = _per_point(value(*args), x, 2, what)
+        else:
+            vals = _per_point(value, x, 2, what)
+        return dot(vals.T.reshape(shape), v)
+
+    return form
+
+
+# ----------------------------------------------------------------------- solution
+def _takes_region(func):
+    """Whether ``func`` accepts two positional arguments ``(x, region)``."""
+    try:
+        inspect.signature(func).bind(None, None)
+    except TypeError:
+        return False
+    except ValueError:                                      # no signature available
+        return False
+    return True
+
+
+class P1Solution:
+    """The solution of a `P1Elasticity` problem.
+
+    Attributes
+    ----------
+    u : (n, 2) ndarray
+        Nodal displacements.
+    strain : (t, 3) ndarray
+        ``[exx, eyy, 2 exy]`` per triangle (constant on each).
+    stress : (t, 3) ndarray
+        ``[sxx, syy, sxy]`` per triangle.
+    C : (t, 3, 3) ndarray
+        Elastic matrix of each triangle.
+    mesh : skfem.MeshTri
+    region : (t,) int64 ndarray
+        Region index of each triangle.
+    timings : dict
+        Seconds spent in ``"mesh"``, ``"assembly"`` and ``"solve"``.
+    """
+
+    def __init__(self, problem, x, timings):
+        self.problem = problem
+        self.mesh = problem.mesh
+        self.region = problem.region
+        self.basis = problem.basis
+        self.plane = problem.plane
+        self.timings = timings
+        self.u = x.reshape(-1, 2)
+        eps = sym_grad(self.basis.interpolate(x))[:, :, :, 0]          # (2, 2, t)
+        self.strain = np.column_stack([eps[0, 0], eps[1, 1], 2.0 * eps[0, 1]])
+        E, nu = problem.element_materials().T
+        self.C = stiffness_matrix(E, nu, self.plane)
+        self.stress = np.einsum("kij,kj->ki", self.C, self.strain)
+
+    def __repr__(self):
+        return (f"<P1Solution {len(self.u)} nodes, {len(self.stress)} triangles, "
+                f"max |u| {np.abs(self.u).max():.3e}, max von Mises {self.von_mises.max():.3e}>")
+
+    @property
+    def von_mises(self):
+        """``(t,)`` von Mises stress per triangle."""
+        return von_mises(self.stress)
+
+    def displacement(self, points):
+        """Displacements at points (inside the mesh) through the P1 shape functions.
+
+        Parameters
+        ----------
+        points : (p, 2) array_like
+
+        Returns
+        -------
+        (p, 2) ndarray
+        """
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        return (self.basis.probes(np.ascontiguousarray(pts.T)) @ self.u.reshape(-1)).reshape(-1, 2)
+
+    def energy_error(self, exact_stress, *, order=4):
+        """Error in the energy norm against an exact stress field.
+
+        ``sqrt(sum_T ∫_T (σh - σ)ᵀ C⁻¹ (σh - σ) dΩ)`` with a triangle rule of
+        degree ``order`` on every triangle.
+
+        Parameters
+        ----------
+        exact_stress : callable ``(q, 2) -> (q, 3)`` or ``(q, 2), (q,) -> (q, 3)``
+            ``[sxx, syy, sxy]`` at points; a function of two arguments also
+            receives the region of the triangle holding each point (for
+            fields discontinuous across material interfaces).
+        order : int
+            Degree of the quadrature rule.
+
+        Returns
+        -------
+        float
+        """
+        quad = Basis(self.mesh, ElementTriP1(), intorder=order)
+        x = quad.global_coordinates().value                              # (2, t, q)
+        nq = x.shape[2]
+        points = x.reshape(2, -1).T
+        if _takes_region(exact_stress):
+            exact = exact_stress(points, np.repeat(self.region, nq))
+        else:
+            exact = exact_stress(points)
+        exact = np.asarray(exact, dtype=float)
+        if exact.shape != (len(points), 3):
+            raise ValueError(f"exact_stress must return ({len(points)}, 3) values "
+                             f"[sxx, syy, sxy], received shape {exact.shape}")
+        diff = np.repeat(self.stress, nq, axis=0) - exact
+        compliance = np.repeat(np.linalg.inv(self.C), nq, axis=0)
+        density = np.einsum("qi,qij,qj->q", diff, compliance, diff)
+        return float(np.sqrt(quad.dx.reshape(-1) @ density))
+
+    def energy(self):
+        """Strain energy ``1/2 sum_T A_T σ_T · ε_T``."""
+        area = self.basis.dx.sum(axis=1)
+        return 0.5 * float(area @ (self.stress * self.strain).sum(axis=1))
