@@ -1,0 +1,197 @@
+"""Linear elasticity by C-NEM + SCNI (`cnem.Elasticity`), and the scikit-fem style forms.
+
+Physics checks only: the SCNI linear patch test to round-off on every catalogue
+case, symmetric positive semi-definite stiffness with exactly the rigid
+motions as null space, exact uniform states from tractions and body forces,
+singular systems named, Poisson through the same forms.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from skfem.helpers import dot, grad
+
+import cases
+import cnem
+from cnem.assembly import BilinearForm, CellBasis, LinearForm, condense, solve
+
+NAMES = cases.NAMES
+E, NU = 1000.0, 0.3
+
+
+def _boundary_nodes(model):
+    """Nodes on the outer boundary, holes and crack faces."""
+    seg = model.segments[np.isin(model.segment_kind, (0, 2))]
+    return np.unique(seg)
+
+
+def _linear_field(x):
+    return np.column_stack([1e-3 * (1.0 + 2.0 * x[:, 0] - 3.0 * x[:, 1]),
+                            1e-3 * (-0.5 + 1.5 * x[:, 0] + 0.7 * x[:, 1])])
+
+
+@pytest.mark.parametrize("plane", ["stress", "strain"])
+@pytest.mark.parametrize("name", NAMES)
+def test_patch_test(name, plane):
+    """A linear field imposed on every boundary node (crack faces included) is
+    reproduced at every node, and every cell has its exact strain."""
+    _, _, model = cases.model(name)
+    prob = cnem.Elasticity(model, (E, NU), plane=plane)
+    prob.add_dirichlet(_boundary_nodes(model), None, _linear_field)
+    sol = prob.solve(progress=False)
+    exact = _linear_field(model.nodes)
+    np.testing.assert_allclose(sol.u, exact, atol=1e-10 * np.abs(exact).max())
+    strain = 1e-3 * np.array([2.0, 0.7, -3.0 + 1.5])
+    np.testing.assert_allclose(sol.strain, np.broadcast_to(strain, sol.strain.shape), atol=1e-10 * 3e-3)
+    C = cnem.models.stiffness_matrix(E, NU, plane)
+    np.testing.assert_allclose(sol.stress, np.broadcast_to(C @ strain, sol.stress.shape),
+                               atol=1e-10 * np.abs(C @ strain).max())
+
+
+@pytest.mark.parametrize("name", ["lshape_irregular", "annulus_sector_regular",
+                                  "kinked_crack_irregular", "three_rectangles_irregular"])
+def test_stiffness_is_spd_up_to_rigid_motions(name):
+    _, _, model = cases.model(name)
+    nreg = len(model.domain.regions)
+    mats = [(E * (1 + r), NU - 0.1 * r) for r in range(nreg)]
+    K = cnem.Elasticity(model, mats).stiffness().toarray()
+    np.testing.assert_allclose(K, K.T, atol=1e-12 * np.abs(K).max())
+    eig = np.linalg.eigvalsh(K)
+    tol = 1e-10 * eig[-1]
+    assert (eig > -tol).all(), eig[:4]
+    assert (np.abs(eig) <= tol).sum() == 3, eig[:5]
+    modes = cnem.assembly.linsolve.rigid_modes(model.nodes)
+    np.testing.assert_allclose(K @ modes, 0.0, atol=1e-10 * eig[-1])
+
+
+def test_uniform_tension_by_traction():
+    dom = cnem.geometry.rectangle(2.0, 1.0)
+    model = cnem.discretize(cnem.nodes.irregular(dom, 0.1, seed=4))
+    prob = cnem.Elasticity(model, (E, NU))
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-12, 0)
+    prob.add_dirichlet(lambda p: (p[:, 0] < 1e-12) & (p[:, 1] < 1e-12), 1)
+    prob.add_traction(lambda x, n: n[:, 0] > 0.5, [5.0, 0.0])
+    sol = prob.solve(progress=False)
+    np.testing.assert_allclose(sol.stress, np.broadcast_to([5.0, 0.0, 0.0], sol.stress.shape), atol=1e-9)
+    np.testing.assert_allclose(sol.u[:, 0], 5.0 / E * model.nodes[:, 0], atol=1e-12)
+    np.testing.assert_allclose(sol.u[:, 1], -NU * 5.0 / E * model.nodes[:, 1], atol=1e-12)
+    # displacement inside through the shape functions is the same linear field
+    pts = np.array([[0.33, 0.41], [1.7, 0.95]])
+    np.testing.assert_allclose(sol.displacement(pts)[:, 0], 5.0 / E * pts[:, 0], atol=1e-12)
+    assert sol.energy_error(lambda x: np.tile([5.0, 0.0, 0.0], (len(x), 1))) < 1e-10
+
+
+def test_linear_traction_and_body_force_totals():
+    """Loads integrate exactly: total force of a linear traction and of a body force."""
+    dom = cnem.geometry.l_shape(1.0, 0.5)
+    model = cnem.discretize(cnem.nodes.irregular(dom, 0.08, seed=2))
+    prob = cnem.Elasticity(model, (E, NU))
+    prob.add_traction(lambda x, n: n[:, 1] > 0.5, lambda x, n: np.column_stack([x[:, 0], 0 * x[:, 0]]))
+    prob.add_body_force([0.0, -2.0])
+    f = prob.load().reshape(-1, 2)
+    top = 0.5 ** 2 / 2 + (1.0 ** 2 - 0.5 ** 2) / 2       # ∫ x over the edges facing +y (y = 1 and y = 0.5)
+    np.testing.assert_allclose(f.sum(axis=0), [top, -2.0 * dom.area], rtol=1e-12)
+
+
+def test_crack_face_traction_is_on_both_faces():
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[cases.EDGE_CRACK])
+    model = cnem.discretize(cnem.nodes.regular(dom, 0.1))
+    prob = cnem.Elasticity(model, (E, NU))
+    on_crack = lambda x, n: (np.abs(x[:, 1] - 0.5) < 1e-12) & (x[:, 0] < 0.5)
+    prob.add_traction(on_crack, lambda x, n: -1.0 * n)        # pressure in the crack
+    f = prob.load().reshape(-1, 2)
+    np.testing.assert_allclose(f.sum(axis=0), 0.0, atol=1e-14)
+    # each face carries the pressure times its length (0.5); at the tip the pushes
+    # of the two faces' last edges (half their length each) cancel
+    tip = np.flatnonzero(np.hypot(*(model.nodes - [0.5, 0.5]).T) < 1e-12)
+    last = np.sort(np.hypot(*(model.nodes[np.abs(model.nodes[:, 1] - 0.5) < 1e-12] - [0.5, 0.5]).T))
+    last = last[last > 1e-12][0]
+    assert f[tip, 1] == pytest.approx(0.0, abs=1e-15)
+    assert np.abs(f[:, 1]).sum() == pytest.approx(2 * (0.5 - last / 2), rel=1e-12)
+
+
+def test_singular_systems_name_the_free_motion():
+    _, _, model = cases.model("square_regular")
+    prob = cnem.Elasticity(model, (E, NU))
+    with pytest.raises(cnem.SolveError, match="translation in x.*translation in y.*rotation"):
+        prob.solve(progress=False)
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-12, 0)
+    with pytest.raises(cnem.SolveError, match="translation in y") as err:
+        prob.solve(progress=False)
+    assert "rotation" not in str(err.value)
+    centre = np.argmin(np.hypot(*(model.nodes - 0.5).T))      # one node fixed: it can spin
+    prob = cnem.Elasticity(model, (E, NU))
+    prob.add_dirichlet([centre], None)
+    x, y = model.nodes[centre]
+    with pytest.raises(cnem.SolveError, match=rf"rotation about \({x:.6g}, {y:.6g}\)"):
+        prob.solve(progress=False)
+
+
+def test_body_cut_in_two_by_a_crack_is_reported():
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [1.0, 0.5]]])
+    model = cnem.discretize(cnem.nodes.regular(dom, 0.125))
+    prob = cnem.Elasticity(model, (E, NU))
+    prob.add_dirichlet(lambda p: p[:, 1] < 1e-12, None)
+    with pytest.raises(cnem.SolveError, match="part holding node"):
+        prob.solve(progress=False)
+
+
+@pytest.mark.parametrize("bad, match", [
+    ((E,), "pair"), ([(E, NU)] * 3, "one pair per region"), ((-1.0, 0.3), "positive"),
+    ((E, 0.5), r"\(-1, 0.5\)"),
+])
+def test_bad_materials(bad, match):
+    _, _, model = cases.model("square_regular")
+    with pytest.raises(ValueError, match=match):
+        cnem.Elasticity(model, bad)
+
+
+def test_bad_conditions():
+    _, _, model = cases.model("square_regular")
+    prob = cnem.Elasticity(model, (E, NU))
+    with pytest.raises(ValueError, match="plane"):
+        cnem.Elasticity(model, (E, NU), plane="axisymmetric")
+    with pytest.raises(ValueError, match="component"):
+        prob.add_dirichlet(lambda p: p[:, 0] < 1e-12, 2)
+    with pytest.raises(ValueError, match="selects no node"):
+        prob.add_dirichlet(lambda p: p[:, 0] < -1, 0)
+    with pytest.raises(ValueError, match="bool"):
+        prob.add_dirichlet(lambda p: p[:, 0], 0)
+    with pytest.raises(ValueError, match="selects no boundary edge"):
+        prob.add_traction(lambda x, n: n[:, 0] > 2, [1.0, 0.0])
+    with pytest.raises(ValueError, match="shape"):
+        prob.add_dirichlet(lambda p: p[:, 0] < 1e-12, None, lambda p: p[:, 0])
+
+
+def test_poisson_through_the_forms():
+    """-Δu = 0 with linear boundary data: reproduced exactly (scalar basis, forms)."""
+    _, _, model = cases.model("plate_hole_irregular")
+    basis = CellBasis(model)
+    A = BilinearForm(lambda u, v, w: dot(grad(u), grad(v))).assemble(basis)
+    b = LinearForm(lambda v, w: 0.0 * v).assemble(basis)
+    exact = 2.0 - model.nodes[:, 0] + 3.0 * model.nodes[:, 1]
+    D = basis.get_dofs(_boundary_nodes(model))
+    u = solve(*condense(A, b, x=exact, D=D))
+    np.testing.assert_allclose(u, exact, atol=1e-10)
+    with pytest.raises(ValueError, match="not bilinear"):
+        BilinearForm(lambda u, v, w: 1.0 + dot(grad(u), grad(v))).assemble(basis)
+
+
+def test_poisson_converges():
+    """-Δu = f on the unit square with u = sin(pi x) sin(pi y): nodal error falls at
+    least linearly (log-log slope over three clouds)."""
+    errors, hs = [], []
+    for h in (0.1, 0.05, 0.025):
+        model = cnem.discretize(cnem.nodes.irregular(cnem.geometry.rectangle(), h, seed=1))
+        basis = CellBasis(model)
+        A = BilinearForm(lambda u, v, w: dot(grad(u), grad(v))).assemble(basis)
+        f = lambda x: 2 * np.pi ** 2 * np.sin(np.pi * x[0]) * np.sin(np.pi * x[1])
+        b = LinearForm(lambda v, w: f(w.nodes) * v).assemble(basis, nodes=basis.nodes)
+        exact = np.sin(np.pi * model.nodes[:, 0]) * np.sin(np.pi * model.nodes[:, 1])
+        D = basis.get_dofs(lambda p: (np.abs(p - 0.5) > 0.5 - 1e-12).any(axis=1))
+        u = solve(*condense(A, b, x=np.zeros(basis.N), D=D))
+        errors.append(np.abs(u - exact).max())
+        hs.append(h)
+    slope = np.polyfit(np.log(hs), np.log(errors), 1)[0]
+    assert slope > 1.0, (errors, slope)
