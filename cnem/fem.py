@@ -21,7 +21,6 @@ True
 
 from __future__ import annotations
 
-import inspect
 import logging
 import time
 
@@ -39,7 +38,7 @@ from .geometry.cracks import split_cracks
 from .geometry.pslg import BOUNDARY, CRACK
 from .models.elasticity import _per_point
 from .models.material import lame, parse_materials, stiffness_matrix
-from .models.solution import von_mises
+from .models.solution import _takes_region, von_mises
 
 __all__ = ["P1Elasticity", "P1Solution", "mesh_domain"]
 
@@ -47,8 +46,9 @@ log = logging.getLogger(__name__)
 
 #: Segment markers handed to `triangle` are ``kind + _MARK`` (0 and 1 are its own).
 _MARK = 2
-#: Node-count tolerance and number of area corrections of `mesh_domain`.
-_NODES_RTOL, _NODES_TRIES = 0.05, 5
+#: `mesh_domain` with a node target: stop within `_NODES_STOP` (relative) after at
+#: most `_NODES_TRIES` meshes, warn beyond `_NODES_RTOL`.
+_NODES_STOP, _NODES_RTOL, _NODES_TRIES = 0.02, 0.05, 6
 
 
 # ---------------------------------------------------------------------- meshing
@@ -97,8 +97,13 @@ def _pslg_input(domain):
     return data
 
 
+def _number(value):
+    """A positive float as `triangle` parses it: digits and a point, no exponent."""
+    return np.format_float_positional(float(value), trim="-")
+
+
 def _triangulate(data, quality, max_area):
-    switches = f"pq{quality:g}AQ" + ("" if max_area is None else f"a{max_area:.17g}")
+    switches = f"pq{_number(quality)}AQ" + ("" if max_area is None else f"a{_number(max_area)}")
     return triangle.triangulate(data, switches)
 
 
@@ -109,8 +114,10 @@ def mesh_domain(domain, *, nodes=None, max_area=None, quality=30.0):
     ----------
     domain : Domain
     nodes : int, optional
-        Target node count (before crack opening): the maximum triangle area
-        is corrected until the count lies within 5 % of it.
+        Target node count (before crack opening): starting from a maximum
+        triangle area of ``2 * area / nodes``, the area is corrected (at most
+        6 meshes) until the count lies within 2 % of the target; a warning is
+        logged if the best mesh is more than 5 % off.
     max_area : float, optional
         Maximum triangle area (``triangle``'s ``a`` switch). Give at most one
         of ``nodes`` and ``max_area``; with neither, only the quality bound
@@ -151,8 +158,8 @@ def mesh_domain(domain, *, nodes=None, max_area=None, quality=30.0):
     points = out["vertices"]
     tri = out["triangles"].astype(np.int64)
     region = np.rint(out["triangle_attributes"][:, 0]).astype(np.int64)
-    a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
-    flip = np.cross(b - a, c - a) < 0
+    ab, ac = points[tri[:, 1]] - points[tri[:, 0]], points[tri[:, 2]] - points[tri[:, 0]]
+    flip = ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0] < 0
     tri[flip] = tri[flip][:, [0, 2, 1]]
     segments = out["segments"].astype(np.int64)
     kind = (out["segment_markers"].ravel() - _MARK).astype(np.int8)
@@ -164,8 +171,8 @@ def mesh_domain(domain, *, nodes=None, max_area=None, quality=30.0):
 
 
 def _mesh_for_nodes(data, area, target, quality):
-    """Mesh whose node count is within `_NODES_RTOL` of ``target`` (secant on
-    ``log count`` against ``log max_area``)."""
+    """Mesh whose node count is within `_NODES_STOP` of ``target`` if possible
+    (secant on ``log count`` against ``log max_area``)."""
     if target < 3:
         raise ValueError(f"nodes: expected a target node count >= 3, received {target}")
     coarsest = _triangulate(data, quality, None)
@@ -181,7 +188,7 @@ def _mesh_for_nodes(data, area, target, quality):
         out = _triangulate(data, quality, max_area)
         count = len(out["vertices"])
         tries.append((abs(count / target - 1.0), count, max_area, out))
-        if abs(count / target - 1.0) <= _NODES_RTOL:
+        if abs(count / target - 1.0) <= _NODES_STOP:
             break
         slope = -1.0
         if len(tries) >= 2 and tries[-1][2] != tries[-2][2] and tries[-1][1] != tries[-2][1]:
@@ -294,7 +301,7 @@ class P1Elasticity:
             facets = self.mesh.boundary_facets()
             fb = FacetBasis(self.mesh, ElementTriP1(), facets=facets, intorder=1)
             midpoint = self.mesh.p[:, self.mesh.facets[:, facets]].mean(axis=1).T
-            self._boundary = facets, midpoint, fb.normals.value[:, :, 0].T
+            self._boundary = facets, midpoint, np.asarray(fb.normals)[:, :, 0].T
         return self._boundary
 
     def add_traction(self, where, t):
@@ -404,17 +411,6 @@ def _vector_load(value, what, *, normal):
 
 
 # ----------------------------------------------------------------------- solution
-def _takes_region(func):
-    """Whether ``func`` accepts two positional arguments ``(x, region)``."""
-    try:
-        inspect.signature(func).bind(None, None)
-    except TypeError:
-        return False
-    except ValueError:                                      # no signature available
-        return False
-    return True
-
-
 class P1Solution:
     """The solution of a `P1Elasticity` problem.
 
@@ -470,7 +466,8 @@ class P1Solution:
         (p, 2) ndarray
         """
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
-        return (self.basis.probes(np.ascontiguousarray(pts.T)) @ self.u.reshape(-1)).reshape(-1, 2)
+        values = self.basis.probes(np.ascontiguousarray(pts.T)) @ self.u.reshape(-1)
+        return values.reshape(2, -1).T                      # probes give x values, then y
 
     def energy_error(self, exact_stress, *, order=4):
         """Error in the energy norm against an exact stress field.
@@ -492,7 +489,7 @@ class P1Solution:
         float
         """
         quad = Basis(self.mesh, ElementTriP1(), intorder=order)
-        x = quad.global_coordinates().value                              # (2, t, q)
+        x = np.asarray(quad.global_coordinates())             # (2, t, q)
         nq = x.shape[2]
         points = x.reshape(2, -1).T
         if _takes_region(exact_stress):

@@ -1,4 +1,5 @@
-"""Pictures of a `Model` with pyvista, off-screen: cells, triangles, nodes, cracks.
+"""Pictures with pyvista, off-screen: a `Model` (cells, triangles, nodes, cracks) and
+a solution (deformed shape coloured by a field).
 
 pyvista is imported only here, and only when a picture is drawn, so
 ``import cnem.plot`` works without it; drawing without it raises `PlotError`
@@ -21,7 +22,8 @@ import numpy as np
 from .errors import CNEMError
 from .io import cell_topology
 
-__all__ = ["model", "cells_polydata", "region_color", "PlotError", "REGION_COLORS"]
+__all__ = ["model", "solution", "cells_polydata", "region_color", "PlotError", "REGION_COLORS",
+           "SOLUTION_FIELDS"]
 
 log = logging.getLogger(__name__)
 
@@ -160,13 +162,7 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
                         f"ymin < ymax, received {tuple(bounds)}")
     width, height = map(int, window_size)
     lift = 1e-4 * dom.diameter        # draw lines above the cells (parallel view: no shift)
-    try:
-        pl = pv.Plotter(off_screen=True, window_size=(width, height))
-    except Exception as exc:  # pragma: no cover - depends on the environment
-        raise PlotError(f"pyvista cannot open an off-screen window ({exc}); {INSTALL_HINT} "
-                        f"and make sure VTK has an off-screen backend (OSMesa/EGL) or a display"
-                        ) from exc
-    pl.set_background("white")
+    pl = _plotter(pv, width, height)
     # pixels per unit length in the final view
     scale = min(width / (bx1 - bx0), height / (by1 - by0)) / 1.04
     pl.add_mesh(cells_polydata(mdl), scalars="color", rgb=True, lighting=False,
@@ -191,15 +187,38 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
             node_size = float(np.clip(0.25 * h * scale, 2.0, 10.0))
         pl.add_mesh(pv.PolyData(_lift(nodes, 3 * lift)), color="black",
                     point_size=node_size, render_points_as_spheres=True, lighting=False)
+    _top_view(pl, (bx0, by0, bx1, by1), width, height, dom.diameter)
+    return _save(pl, path, "model")
+
+
+def _plotter(pv, width, height):
+    """An off-screen plotter with a white background."""
+    try:
+        pl = pv.Plotter(off_screen=True, window_size=(width, height))
+    except Exception as exc:  # pragma: no cover - depends on the environment
+        raise PlotError(f"pyvista cannot open an off-screen window ({exc}); {INSTALL_HINT} "
+                        f"and make sure VTK has an off-screen backend (OSMesa/EGL) or a display"
+                        ) from exc
+    pl.set_background("white")
+    return pl
+
+
+def _top_view(pl, bounds, width, height, diameter):
+    """Parallel top view of ``bounds = (xmin, ymin, xmax, ymax)`` with a 4 % margin."""
+    bx0, by0, bx1, by1 = bounds
     pl.view_xy()
     pl.enable_parallel_projection()
     cx, cy = 0.5 * (bx0 + bx1), 0.5 * (by0 + by1)
     cam = pl.camera
     cam.focal_point = (cx, cy, 0.0)
-    cam.position = (cx, cy, 10.0 * dom.diameter)
+    cam.position = (cx, cy, 10.0 * diameter)
     cam.up = (0.0, 1.0, 0.0)
     cam.parallel_scale = 0.5 * 1.04 * max(by1 - by0, (bx1 - bx0) * height / width)
     pl.reset_camera_clipping_range()
+
+
+def _save(pl, path, what):
+    """Write a PNG if ``path`` is given; return the plotter."""
     if path is not None:
         path = pathlib.Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -209,5 +228,95 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
             pl.close()
             raise PlotError(f"pyvista could not render {str(path)!r} off-screen ({exc}); "
                             f"{INSTALL_HINT}, with a VTK that renders off-screen") from exc
-        log.info("cnem.plot.model: wrote %s", path)
+        log.info("cnem.plot.%s: wrote %s", what, path)
     return pl
+
+
+#: Fields `solution` can colour by.
+SOLUTION_FIELDS = ("von_mises", "sxx", "syy", "sxy", "exx", "eyy", "gxy", "ux", "uy", "|u|")
+
+
+def nodal_field(sol, field):
+    """A solution field at the nodes: displacements as they are, cell fields
+    (stress, strain) from each node's cell (area-weighted over the cells of a
+    node on an interface).
+
+    Returns
+    -------
+    (n,) ndarray
+    """
+    cells = sol.model.cells
+    n = len(sol.model.nodes)
+    if not isinstance(field, str):
+        values = np.asarray(field, dtype=float)
+        if values.shape == (n,):
+            return values
+        if values.shape != (len(cells.area),):
+            raise PlotError(f"field: expected a name in {SOLUTION_FIELDS}, or values at the "
+                            f"{n} nodes or the {len(cells.area)} cells, received shape {values.shape}")
+        per_cell = values
+    elif field not in SOLUTION_FIELDS:
+        raise PlotError(f"field must be one of {SOLUTION_FIELDS}, received {field!r}")
+    elif field in ("ux", "uy", "|u|"):
+        return {"ux": sol.u[:, 0], "uy": sol.u[:, 1], "|u|": np.hypot(*sol.u.T)}[field]
+    else:
+        per_cell = {"von_mises": sol.von_mises, "sxx": sol.stress[:, 0], "syy": sol.stress[:, 1],
+                    "sxy": sol.stress[:, 2], "exx": sol.strain[:, 0], "eyy": sol.strain[:, 1],
+                    "gxy": sol.strain[:, 2]}[field]
+    weight = np.bincount(cells.node, weights=cells.area, minlength=n)
+    return np.bincount(cells.node, weights=cells.area * per_cell, minlength=n) / weight
+
+
+def solution(sol, path=None, *, field="von_mises", scale=None, window_size=(1200, 1200),
+             show_edges=False, cmap="viridis", title=None):
+    """The deformed body coloured by a field (off-screen).
+
+    The constrained Delaunay triangles are moved by ``scale * u`` (crack faces
+    have their own nodes, so cracks open) and coloured by the field at the
+    nodes (`nodal_field`), interpolated across the triangles.
+
+    Parameters
+    ----------
+    sol : ElasticSolution
+    path : str or os.PathLike, optional
+        Write a PNG there.
+    field : str or ndarray
+        One of `SOLUTION_FIELDS`, or values ``(n,)`` at the nodes or ``(m,)``
+        on the cells.
+    scale : float, optional
+        Displacement magnification; default so the largest displacement is
+        5 % of the domain's diameter.
+    window_size : (2,) int
+    show_edges : bool
+        Draw the triangle edges.
+    cmap : str
+        Matplotlib colour map name.
+    title : str, optional
+        Scalar-bar title (default the field name).
+
+    Returns
+    -------
+    pyvista.Plotter
+    """
+    pv = _pyvista()
+    mdl = sol.model
+    values = nodal_field(sol, field)
+    name = field if isinstance(field, str) else (title or "field")
+    umax = float(np.abs(sol.u).max())
+    if scale is None:
+        scale = 0.05 * mdl.domain.diameter / umax if umax > 0 else 0.0
+    moved = mdl.nodes + scale * sol.u
+    faces = np.column_stack([np.full(len(mdl.triangles), 3), mdl.triangles]).ravel()
+    mesh = pv.PolyData(_lift(moved, 0.0), faces=faces)
+    mesh.point_data[name] = values
+    width, height = map(int, window_size)
+    pl = _plotter(pv, width, height)
+    pl.add_mesh(mesh, scalars=name, cmap=cmap, lighting=False, show_edges=show_edges,
+                edge_color=(0.4, 0.4, 0.4),
+                scalar_bar_args={"title": f"{title or name} (deformation x{scale:.3g})",
+                                 "color": "black", "vertical": False})
+    lo, hi = moved.min(axis=0), moved.max(axis=0)
+    pad = 0.08 * (hi - lo).max()
+    _top_view(pl, (lo[0] - pad, lo[1] - 2 * pad, hi[0] + pad, hi[1] + pad), width, height,
+              mdl.domain.diameter)
+    return _save(pl, path, "solution")

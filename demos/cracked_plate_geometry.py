@@ -128,16 +128,19 @@ def main(h=0.1, h_min=0.01, gamma_deg=30.0, growth=0.1, outdir="out", plot=True,
     }
 
 
-if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def cli(argv=None):
+    """Command line: ``python demos/cracked_plate_geometry.py --help`` or ``cnem demo cracked-plate``."""
+    parser = argparse.ArgumentParser(prog="cnem demo cracked-plate",
+                                     description=__doc__.splitlines()[0])
     parser.add_argument("--h", type=float, default=0.1, help="spacing away from the crack")
     parser.add_argument("--h-min", type=float, default=0.01, help="spacing at the tips")
     parser.add_argument("--gamma", type=float, default=30.0, help="crack angle in degrees")
     parser.add_argument("--growth", type=float, default=0.1, help="spacing grading rate")
-    parser.add_argument("--outdir", default="out", help="folder for files and pictures")
+    parser.add_argument("--out", "--outdir", dest="outdir", default="out",
+                        help="folder for files and pictures")
     parser.add_argument("--no-plot", action="store_true", help="skip the pictures")
     parser.add_argument("--size", type=int, default=1200, help="picture size in pixels")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     res = main(h=args.h, h_min=args.h_min, gamma_deg=args.gamma, growth=args.growth,
                outdir=args.outdir, plot=not args.no_plot, window_size=(args.size, args.size))
     print(f"cracked plate, gamma = {args.gamma:g} deg: {res['n_points']} cloud nodes -> "
@@ -148,3 +151,8 @@ if __name__ == "__main__":
           f"(relative error {res['area_error']:.1e})")
     for name, path in res["files"].items():
         print(f"  {name:5s} {path}")
+    return res
+
+
+if __name__ == "__main__":
+    cli()

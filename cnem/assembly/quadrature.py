@@ -3,57 +3,70 @@
 from __future__ import annotations
 
 import numpy as np
-import shapely
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
 __all__ = ["cell_triangles", "cell_quadrature"]
 
 
-def cell_triangles(cells):
-    """Triangles covering every cell polygon exactly.
+def _fan(apex, verts, nxt):
+    """Twice the signed areas of the fan triangles (apex, v_i, v_i+1)."""
+    a, b = verts - apex, verts[nxt] - apex
+    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
 
-    A fan from the centroid where the polygon is star-shaped from it (the
-    usual case), a constrained Delaunay triangulation of the polygon (shapely)
-    elsewhere.
+
+def cell_triangles(cells, nodes):
+    """Triangles covering every cell polygon exactly (signed weights allowed).
+
+    A fan from the centroid where the polygon is star-shaped from it (the usual
+    case), else a fan from the cell's node where it is star-shaped from that,
+    else a fan from the first vertex with signed areas (exact for any simple
+    polygon when the integrand is smooth across the polygon's hull).
+
+    Parameters
+    ----------
+    cells : Cells
+    nodes : (n, 2) ndarray
+        The model's nodes (``cells.node`` indexes them).
 
     Returns
     -------
     cell : (t,) int64 ndarray
     corners : (t, 3, 2) ndarray
-        Counter-clockwise.
+        Counter-clockwise, except the negative triangles of a signed fan.
     """
     offsets, verts = cells.offsets, cells.vertices
     counts = np.diff(offsets)
     cell = np.repeat(np.arange(len(counts), dtype=np.int64), counts)
     nxt = np.arange(len(verts)) + 1
     nxt[offsets[1:] - 1] = offsets[:-1]
-    centre = cells.centroid()[cell]
-    a, b = verts - centre, verts[nxt] - centre
-    signed = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    apex = cells.centroid()[cell]
+    tol = 1e-12 * cells.area[cell]
     bad = np.zeros(len(counts), dtype=bool)
-    bad[cell[signed <= 0.0]] = True
-    keep = ~bad[cell]
-    corners = [np.stack([centre[keep], verts[keep], verts[nxt][keep]], axis=1)]
-    owner = [cell[keep]]
-    for c in np.flatnonzero(bad):
-        polygon = shapely.Polygon(cells.polygon(c))
-        for tri in shapely.constrained_delaunay_triangles(polygon).geoms:
-            xy = np.asarray(tri.exterior.coords)[:3]
-            if np.cross(xy[1] - xy[0], xy[2] - xy[0]) < 0:
-                xy = xy[::-1]
-            corners.append(xy[None])
-            owner.append(np.array([c]))
-    return np.concatenate(owner), np.concatenate(corners)
+    bad[cell[_fan(apex, verts, nxt) <= tol]] = True
+    node_apex = nodes[cells.node][cell]
+    use_node = bad[cell]
+    apex[use_node] = node_apex[use_node]
+    signed = _fan(apex, verts, nxt)
+    still = np.zeros(len(counts), dtype=bool)
+    still[cell[use_node & (signed < -tol)]] = True
+    first = verts[offsets[:-1]][cell]
+    apex[still[cell]] = first[still[cell]]
+    signed = _fan(apex, verts, nxt)
+    keep = np.abs(signed) > 0.0
+    corners = np.stack([apex, verts, verts[nxt]], axis=1)[keep]
+    return cell[keep], corners
 
 
-def cell_quadrature(cells, order=4):
+def cell_quadrature(cells, nodes, order=4):
     """Quadrature points and weights on every cell polygon.
 
     Parameters
     ----------
     cells : Cells
         ``m`` cells.
+    nodes : (n, 2) ndarray
+        The model's nodes.
     order : int
         Polynomial degree integrated exactly on each triangle of the cells.
 
@@ -65,12 +78,12 @@ def cell_quadrature(cells, order=4):
     weights : (q,) ndarray
         ``sum(weights[cell == k]) == cells.area[k]``.
     """
-    owner, corners = cell_triangles(cells)
+    owner, corners = cell_triangles(cells, nodes)
     ref, w = get_quadrature(RefTri, order)          # reference triangle, area 1/2
     e1 = corners[:, 1] - corners[:, 0]
     e2 = corners[:, 2] - corners[:, 0]
     jac = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
     points = (corners[:, None, 0] + ref[0][None, :, None] * e1[:, None]
               + ref[1][None, :, None] * e2[:, None])
-    weights = jac[:, None] * w[None, :]
+    weights = jac[:, None] * w[None, :]            # signed: negative fan triangles subtract
     return np.repeat(owner, len(w)), points.reshape(-1, 2), weights.reshape(-1)

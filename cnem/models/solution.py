@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import inspect
+
 import numpy as np
 
 from ..assembly.quadrature import cell_quadrature
@@ -13,6 +15,15 @@ def von_mises(stress):
     """Plane von Mises stress of ``(..., 3)`` ``[sxx, syy, sxy]`` (in-plane components)."""
     sxx, syy, sxy = stress[..., 0], stress[..., 1], stress[..., 2]
     return np.sqrt(sxx ** 2 - sxx * syy + syy ** 2 + 3.0 * sxy ** 2)
+
+
+def _takes_region(func):
+    """Whether ``func`` accepts two positional arguments ``(x, region)``."""
+    try:
+        inspect.signature(func).bind(None, None)
+    except (TypeError, ValueError):                  # one argument, or no signature
+        return False
+    return True
 
 
 class ElasticSolution:
@@ -74,8 +85,11 @@ class ElasticSolution:
 
         Parameters
         ----------
-        exact_stress : callable ``(q, 2) -> (q, 3)``
-            ``[sxx, syy, sxy]`` at points.
+        exact_stress : callable ``(q, 2) -> (q, 3)``, or ``(q, 2), (q,) -> (q, 3)``
+            ``[sxx, syy, sxy]`` at points; given a second parameter it also
+            receives the region of the cell holding each point (for fields
+            that jump across a material interface: the polygonal interface
+            of the model need not be the exact one).
         order : int
             Degree of the triangle rule on the triangles of each cell.
 
@@ -83,8 +97,12 @@ class ElasticSolution:
         -------
         float
         """
-        cell, points, weights = cell_quadrature(self.model.cells, order)
-        exact = np.asarray(exact_stress(points), dtype=float)
+        cell, points, weights = cell_quadrature(self.model.cells, self.model.nodes, order)
+        if _takes_region(exact_stress):
+            exact = exact_stress(points, self.model.cells.region[cell])
+        else:
+            exact = exact_stress(points)
+        exact = np.asarray(exact, dtype=float)
         if exact.shape != (len(points), 3):
             raise ValueError(f"exact_stress must return ({len(points)}, 3) values "
                              f"[sxx, syy, sxy], received shape {exact.shape}")

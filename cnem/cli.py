@@ -1,0 +1,87 @@
+"""The ``cnem`` command: run the demos and show what is installed.
+
+    cnem demo list                                   # the demos
+    cnem demo cylinder --nodes 687 --irregular --out results/
+    cnem demo cracked-plate --gamma 45 --out results/
+    cnem info                                        # versions, threads
+
+Each demo keeps its own options (``cnem demo cylinder --help``); the demos
+are the scripts in the ``demos/`` folder of the source tree.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import pathlib
+import sys
+
+__all__ = ["main", "DEMOS"]
+
+#: Command-line name -> script in ``demos/``.
+DEMOS = {
+    "cylinder": "bimaterial_cylinder",
+    "cracked-plate": "cracked_plate_geometry",
+}
+
+
+def demos_folder():
+    """The ``demos/`` folder of the source tree this package was installed from."""
+    folder = pathlib.Path(__file__).resolve().parents[1] / "demos"
+    if not folder.is_dir():
+        raise SystemExit(f"cnem: the demos ship with the source repository and {folder} does "
+                         "not exist; install from a clone with pip install -e .")
+    return folder
+
+
+def load_demo(name):
+    """The demo module for a command-line name (see `DEMOS`)."""
+    if name not in DEMOS:
+        raise SystemExit(f"cnem: unknown demo {name!r}; choose one of {', '.join(DEMOS)}")
+    path = demos_folder() / f"{DEMOS[name]}.py"
+    spec = importlib.util.spec_from_file_location(DEMOS[name], path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _info():
+    import numba
+    import numpy
+    import scipy
+    import skfem
+
+    import cnem
+    print(f"cnem {cnem.__version__} ({pathlib.Path(cnem.__file__).parent})")
+    for mod in (numpy, scipy, numba, skfem):
+        print(f"  {mod.__name__:8s} {mod.__version__}")
+    print(f"  numba threads: {numba.get_num_threads()}")
+
+
+def main(argv=None):
+    """Entry point of the ``cnem`` command (and ``python -m cnem``)."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = argparse.ArgumentParser(prog="cnem", description=__doc__.split("\n")[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter,
+                                     epilog=__doc__.split("\n\n", 1)[1])
+    sub = parser.add_subparsers(dest="command", required=True)
+    demo = sub.add_parser("demo", help="run a demo (cnem demo list)", add_help=False)
+    demo.add_argument("name", help="demo name, or 'list'")
+    sub.add_parser("info", help="versions and threads")
+    args, rest = parser.parse_known_args(argv)
+    if args.command == "info":
+        if rest:
+            parser.error(f"unrecognised arguments: {' '.join(rest)}")
+        _info()
+        return 0
+    if args.name == "list":
+        for name, script in DEMOS.items():
+            doc = (load_demo(name).__doc__ or "").strip().split("\n")[0]
+            print(f"{name:15s} demos/{script}.py  {doc}")
+        return 0
+    load_demo(args.name).cli(rest)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
