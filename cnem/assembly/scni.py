@@ -70,6 +70,12 @@ def cell_edges(cells):
     return cell, cells.vertices, cells.vertices[nxt]
 
 
+def _row_keys(a, b, hint):
+    """One hashable key per edge: its end coordinates (bit for bit) and side hint."""
+    rows = np.ascontiguousarray(np.column_stack([a, b, hint.astype(np.float64)]))
+    return rows.view(np.dtype((np.void, rows.dtype.itemsize * rows.shape[1]))).reshape(-1)
+
+
 def _pieces(model, a, b):
     """Pieces of the edges between circumcircle crossings.
 
@@ -228,11 +234,13 @@ def smoothed_gradient(model, *, gauss=2):
         hint = _face_triangles(model, a, b, faces)
         slit = _slit_edges(model, faces)
         cell, a, b, hint = (np.concatenate([x, y]) for x, y in zip((cell, a, b, hint), slit))
-    # each edge is integrated from its lexicographically smaller end, so that the
-    # two cells sharing it evaluate phi at bit-identical points and cancel exactly
+    # each edge is integrated once, from its lexicographically smaller end: the two
+    # cells sharing it get the same integral with opposite signs (they cancel exactly)
     flip = (a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1]))
     a, b = np.where(flip[:, None], b, a), np.where(flip[:, None], a, b)
     sign = np.where(flip, -1.0, 1.0)
+    _, first, occurrence = np.unique(_row_keys(a, b, hint), return_index=True, return_inverse=True)
+    a, b, hint = a[first], b[first], hint[first]
     edge, t0, t1 = _pieces(model, a, b)
     s, w = np.polynomial.legendre.leggauss(gauss)
     s, w = 0.5 * (s + 1.0), 0.5 * w
@@ -240,14 +248,17 @@ def smoothed_gradient(model, *, gauss=2):
     t = t0[:, None] + (t1 - t0)[:, None] * s
     points = (a[edge][:, None, :] + t[:, :, None] * d[edge][:, None, :]).reshape(-1, 2)
     phi = model.shape_functions(points, triangles=np.repeat(hint[edge], gauss))
-    weight = ((t1 - t0)[:, None] * w * sign[edge][:, None]).reshape(-1)
-    weight /= cells.area[np.repeat(cell[edge], gauss)]
-    rows = np.repeat(cell[edge], gauss)
+    # ∫ phi n over every distinct edge (outward normal of the canonical direction times
+    # length: (dy, -dx)), then summed into the cells with their signs, over the areas
+    weight = ((t1 - t0)[:, None] * w).reshape(-1)
+    rows = np.repeat(edge, gauss)
     cols = np.arange(len(points))
-    shape = (len(cells.area), len(points))
-    normal = np.repeat(d[edge], gauss, axis=0)     # outward normal times length: (dy, -dx)
-    bx = sp.csr_matrix((weight * normal[:, 1], (rows, cols)), shape=shape) @ phi
-    by = sp.csr_matrix((-weight * normal[:, 0], (rows, cols)), shape=shape) @ phi
+    shape = (len(a), len(points))
+    ex = sp.csr_matrix((weight * d[rows, 1], (rows, cols)), shape=shape) @ phi
+    ey = sp.csr_matrix((-weight * d[rows, 0], (rows, cols)), shape=shape) @ phi
+    to_cells = sp.csr_matrix((sign / cells.area[cell], (cell, occurrence.reshape(-1))),
+                             shape=(len(cells.area), len(a)))
+    bx, by = to_cells @ ex, to_cells @ ey
     grad = SmoothedGradient(bx.tocsr(), by.tocsr(), len(points))
     log.info("SCNI: %d cells, %d edge pieces, %d points", len(cells.area), len(edge), len(points))
     model._cache[key] = grad
