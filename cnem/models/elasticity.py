@@ -208,7 +208,7 @@ class Elasticity:
         Parameters
         ----------
         method : {"auto", "direct", "amg"}
-            ``"auto"``: sparse direct up to 200k unknowns, pyamg smoothed
+            ``"auto"``: sparse direct up to 2.5M non-zeros in K (~20k nodes), pyamg smoothed
             aggregation (rigid-body modes) + CG above.
         tol : float
             Relative residual of the iterative solver.
