@@ -7,7 +7,7 @@
 1.0
 """
 
-from . import assembly, exact, geometry, io, models, nodes, plot, shape, spatial
+from . import assembly, exact, fracture, geometry, io, models, nodes, plot, shape, spatial
 from .errors import CNEMError, GeometryError, SolveError
 from .geometry import Domain, Model, NodeCloud, discretize
 from .models import ElasticSolution, Elasticity
@@ -15,5 +15,6 @@ from .models import ElasticSolution, Elasticity
 __version__ = "0.1.0"
 
 __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
-           "nodes", "geometry", "assembly", "models", "exact", "io", "plot", "shape", "spatial",
+           "nodes", "geometry", "assembly", "models", "exact", "fracture", "io", "plot", "shape",
+           "spatial",
            "CNEMError", "GeometryError", "SolveError", "__version__"]

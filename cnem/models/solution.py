@@ -33,6 +33,8 @@ class ElasticSolution:
     ----------
     u : (n, 2) ndarray
         Nodal displacements (the displacement at node ``i`` is ``u[i]``).
+    gradient : (m, 2, 2) ndarray
+        Smoothed displacement gradient per cell, ``[k, i, j] = du_i/dx_j``.
     strain : (m, 3) ndarray
         ``[exx, eyy, 2 exy]`` per integration cell (smoothed, eq. 29).
     stress : (m, 3) ndarray
@@ -52,7 +54,11 @@ class ElasticSolution:
         self.timings = timings
         grad = problem.basis.grad
         ux, uy = u[:, 0], u[:, 1]
-        self.strain = np.column_stack([grad.x @ ux, grad.y @ uy, grad.y @ ux + grad.x @ uy])
+        #: (m, 2, 2) smoothed displacement gradient per cell, ``[i, j] = du_i / dx_j``
+        self.gradient = np.stack([np.column_stack([grad.x @ ux, grad.y @ ux]),
+                                  np.column_stack([grad.x @ uy, grad.y @ uy])], axis=1)
+        g = self.gradient
+        self.strain = np.column_stack([g[:, 0, 0], g[:, 1, 1], g[:, 0, 1] + g[:, 1, 0]])
         self.stress = np.einsum("kij,kj->ki", C, self.strain)
 
     def __repr__(self):

@@ -1,0 +1,20 @@
+"""Fracture with C-NEM: stress intensity factors by the interaction integral.
+
+>>> import numpy as np, cnem
+>>> from cnem.fracture import nodal_williams, sif
+>>> dom = cnem.geometry.rectangle(2.0, 2.0, origin=(-1.0, -1.0), cracks=[[[-1.0, 0.0], [0.0, 0.0]]])
+>>> model = cnem.discretize(cnem.nodes.regular(dom, 0.1))
+>>> prob = cnem.Elasticity(model, (1.0, 0.3), plane="strain")
+>>> exact = nodal_williams(model, (0.0, 0.0), 1.0, 0.0, 1.0, 0.3, "strain")   # mode I, K_I = 1
+>>> boundary = np.unique(model.segments[model.segment_kind != 1])
+>>> prob.add_dirichlet(boundary, None, lambda p: exact[boundary])
+>>> KI, KII = sif(prob.solve(progress=False), (0.0, 0.0), radius=0.6)
+>>> bool(abs(KI - 1.0) < 0.02 and abs(KII) < 0.02)
+True
+"""
+
+from .interaction import SIFResult, sif, tip_frame
+from .williams import effective_modulus, kappa, nodal_williams, polar, williams
+
+__all__ = ["sif", "SIFResult", "tip_frame", "williams", "nodal_williams", "polar", "kappa",
+           "effective_modulus"]

@@ -1,0 +1,128 @@
+"""The Williams near-tip fields (leading terms, modes I and II) in crack-tip coordinates.
+
+Coordinates: ``x1`` along the crack's extension, ``x2`` normal to it, ``r``
+and ``theta`` polar about the tip (``theta = ±pi`` on the two crack faces).
+``kappa = 3 - 4 nu`` (plane strain) or ``(3 - nu) / (1 + nu)`` (plane stress).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..models.material import PLANES
+
+__all__ = ["kappa", "effective_modulus", "williams"]
+
+
+def kappa(nu, plane):
+    """Kolosov's constant."""
+    if plane not in PLANES:
+        raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
+    return 3.0 - 4.0 * nu if plane == "strain" else (3.0 - nu) / (1.0 + nu)
+
+
+def effective_modulus(E, nu, plane):
+    """``E' = E`` (plane stress) or ``E / (1 - nu^2)`` (plane strain): ``G = K^2 / E'``."""
+    kappa(nu, plane)
+    return E if plane == "stress" else E / (1.0 - nu * nu)
+
+
+def williams(r, theta, KI, KII, E, nu, plane):
+    """Displacements, stresses and x1-derivatives of the displacements of the
+    leading Williams terms.
+
+    Parameters
+    ----------
+    r, theta : (p,) ndarray
+        Polar coordinates about the tip, ``theta`` in ``[-pi, pi]``.
+    KI, KII : float
+        Stress intensity factors.
+    E, nu : float
+    plane : {"stress", "strain"}
+
+    Returns
+    -------
+    u : (p, 2) ndarray
+        ``[u1, u2]``.
+    stress : (p, 3) ndarray
+        ``[s11, s22, s12]``.
+    du_dx1 : (p, 2) ndarray
+        ``[du1/dx1, du2/dx1]``.
+    """
+    r = np.asarray(r, dtype=float)
+    theta = np.asarray(theta, dtype=float)
+    k = kappa(nu, plane)
+    mu = E / (2.0 * (1.0 + nu))
+    s, c = np.sin(theta / 2), np.cos(theta / 2)
+    s3, c3 = np.sin(1.5 * theta), np.cos(1.5 * theta)
+    amp = np.sqrt(r / (2 * np.pi)) / (2 * mu)
+    # angular parts f(theta) of u = amp * f and their derivatives f'(theta)
+    f1 = KI * c * (k - 1 + 2 * s * s) + KII * s * (k + 1 + 2 * c * c)
+    f2 = KI * s * (k + 1 - 2 * c * c) - KII * c * (k - 1 - 2 * s * s)
+    d1 = (KI * (-0.5 * s * (k - 1 + 2 * s * s) + 2 * s * c * c)
+          + KII * (0.5 * c * (k + 1 + 2 * c * c) - 2 * s * s * c))
+    d2 = (KI * (0.5 * c * (k + 1 - 2 * c * c) + 2 * s * s * c)
+          + KII * (0.5 * s * (k - 1 - 2 * s * s) + 2 * s * c * c))
+    u = np.stack([amp * f1, amp * f2], axis=-1)
+    # d/dx1 = cos(theta) d/dr - sin(theta) / r d/dtheta, with du/dr = u / (2 r)
+    ct, st = np.cos(theta), np.sin(theta)
+    du = np.stack([amp * (ct * f1 / (2 * r) - st * d1 / r),
+                   amp * (ct * f2 / (2 * r) - st * d2 / r)], axis=-1)
+    scale = 1.0 / np.sqrt(2 * np.pi * r)
+    s11 = scale * (KI * c * (1 - s * s3) - KII * s * (2 + c * c3))
+    s22 = scale * (KI * c * (1 + s * s3) + KII * s * c * c3)
+    s12 = scale * (KI * s * c * c3 + KII * c * (1 - s * s3))
+    return u, np.stack([s11, s22, s12], axis=-1), du
+
+
+def polar(points, tip, direction):
+    """Crack-tip polar coordinates ``(r, theta)`` of global points.
+
+    Parameters
+    ----------
+    points : (p, 2) ndarray
+    tip, direction : (2,) ndarray
+        The tip and the unit crack direction (out of the crack).
+    """
+    rel = np.asarray(points, dtype=float) - tip
+    x1 = rel @ direction
+    x2 = rel @ np.array([-direction[1], direction[0]])
+    return np.hypot(x1, x2), np.arctan2(x2, x1)
+
+
+def nodal_williams(model, tip, KI, KII, E, nu, plane):
+    """The Williams displacement at every node of a model, in global axes.
+
+    A node on a crack face takes the value of its own face (``theta = ±pi``
+    decided by the side its integration cell lies on), so that the crack
+    opens.
+
+    Parameters
+    ----------
+    model : Model
+    tip : (2,) array_like
+        A point; the crack tip nearest to it is used (see `tip_frame`).
+    KI, KII, E, nu : float
+    plane : {"stress", "strain"}
+
+    Returns
+    -------
+    (n, 2) ndarray
+    """
+    from .interaction import tip_frame
+    at, d = tip_frame(model.domain, tip)
+    r, theta = polar(model.nodes, at, d)
+    # the side of each node: where its cells lie (area-weighted centroid)
+    cells = model.cells
+    n = len(model.nodes)
+    weight = np.bincount(cells.node, weights=cells.area, minlength=n)
+    centre = np.column_stack([np.bincount(cells.node, weights=cells.area * c, minlength=n)
+                              for c in cells.centroid().T]) / weight[:, None]
+    _, side = polar(centre, at, d)
+    on_face = np.abs(np.abs(theta) - np.pi) < 1e-9
+    theta[on_face] = np.pi * np.sign(side[on_face])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = williams(r, theta, KI, KII, E, nu, plane)[0]
+    u[r == 0.0] = 0.0
+    back = np.array([[d[0], -d[1]], [d[1], d[0]]])          # crack-tip frame -> global
+    return u @ back.T
