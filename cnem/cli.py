@@ -21,6 +21,8 @@ __all__ = ["main", "DEMOS"]
 #: Command-line name -> script in ``demos/``.
 DEMOS = {
     "cylinder": "bimaterial_cylinder",
+    "inclined-crack": "inclined_crack",
+    "mode1-crack": "mode1_crack",
     "cracked-plate": "cracked_plate_geometry",
 }
 
