@@ -245,7 +245,7 @@ def nodal_field(sol, field):
     -------
     (n,) ndarray
     """
-    cells = sol.model.cells
+    cells = sol.cells
     n = len(sol.model.nodes)
     if not isinstance(field, str):
         values = np.asarray(field, dtype=float)

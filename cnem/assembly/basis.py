@@ -37,11 +37,16 @@ class CellBasis:
         Two components per node.
     gauss : int
         Gauss points per edge piece for ``b~`` (see `smoothed_gradient`).
+    cells : Cells, optional
+        Integration cells (default ``model.cells``; sub-cells for enrichment).
+    extra : (gx, gy) sparse (m, e), optional
+        Smoothed gradients of ``e`` more functions that vanish at every node
+        (enrichment); their dofs follow the nodes' (function ``n + i``).
 
     Attributes
     ----------
     N : int
-        Number of dofs, ``n`` or ``2 n``.
+        Number of dofs, ``nfun`` or ``2 nfun`` (``nfun = n`` without extra functions).
     dx : (m,) ndarray
         Quadrature weights: the cell areas.
     x : (2, m) ndarray
@@ -50,18 +55,26 @@ class CellBasis:
         The node of each cell.
     """
 
-    def __init__(self, model, *, vector=False, gauss=2):
+    def __init__(self, model, *, vector=False, gauss=2, extra=None, cells=None):
         self.model = model
         self.vector = bool(vector)
         self.ncomp = 2 if vector else 1
-        self.grad = smoothed_gradient(model, gauss=gauss)
-        cells = model.cells
+        self.cells = cells = model.cells if cells is None else cells
+        self.grad = smoothed_gradient(model, gauss=gauss, cells=None if cells is model.cells else cells)
         m, n = len(cells.area), len(model.nodes)
-        self.N = self.ncomp * n
         self.dx = cells.area
         self.x = cells.centroid().T
         self.nodes = model.nodes[cells.node].T
-        self._value = sp.csr_matrix((np.ones(m), (np.arange(m), cells.node)), shape=(m, n))
+        value = sp.csr_matrix((np.ones(m), (np.arange(m), cells.node)), shape=(m, n))
+        gx, gy = self.grad.x, self.grad.y
+        if extra is not None:           # functions that vanish at the nodes (enrichment)
+            ex, ey = extra
+            value = sp.hstack([value, sp.csr_matrix(ex.shape)], format="csr")
+            gx, gy = sp.hstack([gx, ex], format="csr"), sp.hstack([gy, ey], format="csr")
+        #: number of functions: the nodes' shape functions, then the extra ones
+        self.nfun = value.shape[1]
+        self.N = self.ncomp * self.nfun
+        self._node_ops = (value, gx, gy)
 
     def __repr__(self):
         kind = "vector" if self.vector else "scalar"
@@ -77,11 +90,11 @@ class CellBasis:
             Scalar: ``[value, d/dx, d/dy]``. Vector: ``[u_0, u_1, du_0/dx,
             du_0/dy, du_1/dx, du_1/dy]`` (row-major ``grad[i, j] = du_i/dx_j``).
         """
-        node_ops = [self._value, self.grad.x, self.grad.y]
+        value, gx, gy = self._node_ops
         if not self.vector:
-            return [op.tocsr() for op in node_ops]
-        values = [_spread(self._value, c, 2) for c in range(2)]
-        return values + [_spread(g, c, 2) for c in range(2) for g in node_ops[1:]]
+            return [op.tocsr() for op in (value, gx, gy)]
+        values = [_spread(value, c, 2) for c in range(2)]
+        return values + [_spread(g, c, 2) for c in range(2) for g in (gx, gy)]
 
     @staticmethod
     def _field(flat, vector):

@@ -6,7 +6,7 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
-__all__ = ["cell_triangles", "cell_quadrature"]
+__all__ = ["cell_triangles", "cell_quadrature", "subdivide"]
 
 
 def _fan(apex, verts, nxt):
@@ -87,3 +87,46 @@ def cell_quadrature(cells, nodes, order=4):
               + ref[1][None, :, None] * e2[:, None])
     weights = jac[:, None] * w[None, :]            # signed: negative fan triangles subtract
     return np.repeat(owner, len(w)), points.reshape(-1, 2), weights.reshape(-1)
+
+
+def subdivide(cells, nodes):
+    """Split every integration cell into the triangles of a fan (sub-cells).
+
+    Used where one smoothed strain per cell is too few (enriched fields:
+    more unknowns per node than strain samples per cell would leave
+    zero-energy modes). Cells that only a signed fan covers stay whole.
+
+    Parameters
+    ----------
+    cells : Cells
+    nodes : (n, 2) ndarray
+
+    Returns
+    -------
+    sub : Cells
+        Triangles (or whole cells), each with its parent's node and region.
+    parent : (s,) int64 ndarray
+        The cell each sub-cell comes from.
+    """
+    from ..geometry.model import Cells
+    owner, corners = cell_triangles(cells, nodes)
+    e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    twice = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    negative = np.zeros(len(cells.area), dtype=bool)
+    negative[owner[twice < 0]] = True
+    # slivers (collinear polygon vertices) would get an ill-defined smoothed gradient
+    keep = ~negative[owner] & (twice > 1e-9 * cells.area[owner])
+    whole = np.flatnonzero(negative)
+    parent = np.concatenate([owner[keep], whole])
+    counts = np.concatenate([np.full(keep.sum(), 3), np.diff(cells.offsets)[whole]])
+    verts = np.concatenate([corners[keep].reshape(-1, 2)]
+                           + [cells.polygon(c) for c in whole]) if len(whole) else \
+        corners[keep].reshape(-1, 2)
+    order = np.argsort(parent, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(counts)])
+    index = np.concatenate([np.arange(starts[i], starts[i + 1]) for i in order]) if len(whole) \
+        else np.arange(len(verts)).reshape(-1, 3)[order].reshape(-1)
+    offsets = np.concatenate([[0], np.cumsum(counts[order])])
+    parent = parent[order]
+    sub = Cells(cells.node[parent], cells.region[parent], offsets, np.ascontiguousarray(verts[index]))
+    return sub, parent

@@ -25,7 +25,8 @@ from ..geometry.topology import circumcenters, constraint_edges, triangle_neighb
 from ..spatial.rtree import RTree
 from . import _kernels as K
 
-__all__ = ["SmoothedGradient", "smoothed_gradient", "cell_edges"]
+__all__ = ["SmoothedGradient", "smoothed_gradient", "BoundaryQuadrature", "boundary_quadrature",
+           "cell_edges"]
 
 log = logging.getLogger(__name__)
 
@@ -122,7 +123,7 @@ def _crack_faces(model):
     return model.nodes[edges[:, 0]], model.nodes[edges[:, 1]], owner
 
 
-def _slit_edges(model, faces):
+def _slit_edges(model, faces, cells):
     """Crack faces running inside cells (near crack tips a cell can wrap around the
     end of a crack; its polygon then does not show the slit, but the slit's two
     faces are part of the cell's boundary, with different shape functions).
@@ -136,7 +137,6 @@ def _slit_edges(model, faces):
         The triangle of the face.
     """
     p, q, owner = faces
-    cells = model.cells
     if len(p) == 0:
         return np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0, np.int64)
     first = np.repeat(np.arange(len(cells.area)), np.diff(cells.offsets))
@@ -203,36 +203,59 @@ def _face_triangles(model, a, b, faces):
     return hint
 
 
-def smoothed_gradient(model, *, gauss=2):
-    """The smoothed gradient operator ``B~`` of a model (cached on the model).
+class BoundaryQuadrature:
+    """Gauss points on the boundaries of all integration cells (each distinct edge once).
 
-    Parameters
+    ``∮_{Γ_k} f n dΓ = (to_cells @ (Wx @ f(points)), ...)`` times ``A_k``: for a
+    function sampled at the points, ``cell_integrals(f)`` gives the ``(1/A_k) ∮ f n``
+    of every cell (the smoothed gradient of ``f``).
+
+    Attributes
     ----------
-    model : Model
-        ``n`` nodes, ``m`` integration cells.
-    gauss : int
-        Gauss points on each piece of a cell edge between circumcircle
-        crossings. The patch test holds for any value; more points make
-        ``b~`` converge to the exact boundary integrals (see docs/scni.md).
+    points : (q, 2) ndarray
+    hint : (q,) int64 ndarray
+        Triangle on the cell's side for points on crack faces, -1 elsewhere.
+    wx, wy : scipy.sparse.csr_matrix, shape (e, q)
+        Weights times the outward normal components of every distinct edge.
+    to_cells : scipy.sparse.csr_matrix, shape (m, e)
+        ``±1 / A_k`` for the edges of cell ``k``.
+    """
+
+    def __init__(self, points, hint, wx, wy, to_cells):
+        self.points, self.hint, self.wx, self.wy, self.to_cells = points, hint, wx, wy, to_cells
+
+    def cell_integrals(self, values):
+        """``(1 / A_k) ∮_{Γ_k} f n dΓ`` for ``values = f(points)``, ``(q, ...)`` array or
+        sparse ``(q, c)``; returns the x and y parts, ``(m, ...)``."""
+        return self.to_cells @ (self.wx @ values), self.to_cells @ (self.wy @ values)
+
+    def shape_functions(self, model, select=None):
+        """The shape functions at the points (or at ``points[select]``), sides respected."""
+        if select is None:
+            return model.shape_functions(self.points, triangles=self.hint)
+        return model.shape_functions(self.points[select], triangles=self.hint[select])
+
+
+def boundary_quadrature(model, *, gauss=2, cells=None):
+    """Gauss points on every cell boundary: each edge cut at circumcircle crossings,
+    ``gauss`` points per piece, crack faces seen from their side, slits in tip cells.
+
+    ``cells``: integration cells other than ``model.cells`` (sub-cells, say).
 
     Returns
     -------
-    SmoothedGradient
-        ``x, y`` sparse ``(m, n)``.
+    BoundaryQuadrature
     """
     gauss = int(gauss)
     if gauss < 1:
         raise ValueError(f"gauss: expected a positive number of Gauss points, received {gauss}")
-    key = ("scni", gauss)
-    if key in model._cache:
-        return model._cache[key]
-    cells = model.cells
+    cells = model.cells if cells is None else cells
     cell, a, b = cell_edges(cells)
     hint = np.full(len(a), -1, dtype=np.int64)
     if (model.segment_kind == 2).any():
         faces = _crack_faces(model)
         hint = _face_triangles(model, a, b, faces)
-        slit = _slit_edges(model, faces)
+        slit = _slit_edges(model, faces, cells)
         cell, a, b, hint = (np.concatenate([x, y]) for x, y in zip((cell, a, b, hint), slit))
     # each edge is integrated once, from its lexicographically smaller end: the two
     # cells sharing it get the same integral with opposite signs (they cancel exactly)
@@ -247,19 +270,45 @@ def smoothed_gradient(model, *, gauss=2):
     d = b - a
     t = t0[:, None] + (t1 - t0)[:, None] * s
     points = (a[edge][:, None, :] + t[:, :, None] * d[edge][:, None, :]).reshape(-1, 2)
-    phi = model.shape_functions(points, triangles=np.repeat(hint[edge], gauss))
-    # ∫ phi n over every distinct edge (outward normal of the canonical direction times
-    # length: (dy, -dx)), then summed into the cells with their signs, over the areas
+    # weights times the outward normal of the canonical direction times length: (dy, -dx)
     weight = ((t1 - t0)[:, None] * w).reshape(-1)
     rows = np.repeat(edge, gauss)
     cols = np.arange(len(points))
     shape = (len(a), len(points))
-    ex = sp.csr_matrix((weight * d[rows, 1], (rows, cols)), shape=shape) @ phi
-    ey = sp.csr_matrix((-weight * d[rows, 0], (rows, cols)), shape=shape) @ phi
+    wx = sp.csr_matrix((weight * d[rows, 1], (rows, cols)), shape=shape)
+    wy = sp.csr_matrix((-weight * d[rows, 0], (rows, cols)), shape=shape)
     to_cells = sp.csr_matrix((sign / cells.area[cell], (cell, occurrence.reshape(-1))),
                              shape=(len(cells.area), len(a)))
-    bx, by = to_cells @ ex, to_cells @ ey
-    grad = SmoothedGradient(bx.tocsr(), by.tocsr(), len(points))
-    log.info("SCNI: %d cells, %d edge pieces, %d points", len(cells.area), len(edge), len(points))
-    model._cache[key] = grad
+    log.info("SCNI quadrature: %d cells, %d edges, %d pieces, %d points", len(cells.area),
+             len(a), len(edge), len(points))
+    return BoundaryQuadrature(points, np.repeat(hint[edge], gauss), wx, wy, to_cells)
+
+
+def smoothed_gradient(model, *, gauss=2, cells=None):
+    """The smoothed gradient operator ``B~`` of a model (cached on the model).
+
+    Parameters
+    ----------
+    model : Model
+        ``n`` nodes, ``m`` integration cells.
+    gauss : int
+        Gauss points on each piece of a cell edge between circumcircle
+        crossings. The patch test holds for any value; more points make
+        ``b~`` converge to the exact boundary integrals (see docs/elasticity.md).
+    cells : Cells, optional
+        Integration cells other than ``model.cells`` (not cached).
+
+    Returns
+    -------
+    SmoothedGradient
+        ``x, y`` sparse ``(m, n)``.
+    """
+    key = ("scni", int(gauss))
+    if cells is None and key in model._cache:
+        return model._cache[key]
+    quad = boundary_quadrature(model, gauss=gauss, cells=cells)
+    bx, by = quad.cell_integrals(quad.shape_functions(model))
+    grad = SmoothedGradient(bx.tocsr(), by.tocsr(), len(quad.points))
+    if cells is None:
+        model._cache[key] = grad
     return grad

@@ -13,8 +13,9 @@
 True
 """
 
+from .enrichment import Enrichment
 from .interaction import SIFResult, sif, tip_frame
 from .williams import effective_modulus, kappa, nodal_williams, polar, williams
 
-__all__ = ["sif", "SIFResult", "tip_frame", "williams", "nodal_williams", "polar", "kappa",
+__all__ = ["sif", "SIFResult", "Enrichment", "tip_frame", "williams", "nodal_williams", "polar", "kappa",
            "effective_modulus"]

@@ -107,14 +107,14 @@ def sif(sol, tip, *, radius=None, order=4):
     radius = float(radius)
     if not np.isfinite(radius) or radius <= 0:
         raise ValueError(f"radius: expected a positive number, received {radius}")
-    cell, points, weights = cell_quadrature(model.cells, model.nodes, order)
+    cell, points, weights = cell_quadrature(sol.cells, model.nodes, order)
     rot = np.array([[d[0], d[1]], [-d[1], d[0]]])            # global -> crack-tip frame
     local = (points - at) @ rot.T
     r = np.hypot(local[:, 0], local[:, 1])
     near = r < radius
     if not near.any():
         raise ValueError(f"radius {radius:g} holds no integration point about the tip {at.tolist()}")
-    regions = np.unique(model.cells.region[cell[near]])
+    regions = np.unique(sol.cells.region[cell[near]])
     if len(regions) > 1:
         raise ValueError(f"the disc of radius {radius:g} about the tip {at.tolist()} reaches "
                          f"into regions {regions.tolist()}; the interaction integral needs one "

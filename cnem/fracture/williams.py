@@ -90,6 +90,31 @@ def polar(points, tip, direction):
     return np.hypot(x1, x2), np.arctan2(x2, x1)
 
 
+def node_sides(model):
+    """A point on the side of each node: the area-weighted centroid of its cells
+    (for the two copies of a crack-face node, a point on each one's face).
+
+    Returns
+    -------
+    (n, 2) ndarray
+    """
+    cells = model.cells
+    n = len(model.nodes)
+    weight = np.bincount(cells.node, weights=cells.area, minlength=n)
+    return np.column_stack([np.bincount(cells.node, weights=cells.area * c, minlength=n)
+                            for c in cells.centroid().T]) / weight[:, None]
+
+
+def sided_polar(points, tip, direction, sides):
+    """`polar`, with ``theta = ±pi`` on the crack line behind the tip chosen by
+    the side of a reference point per point (``sides``, ``(p, 2)``)."""
+    r, theta = polar(points, tip, direction)
+    _, side = polar(sides, tip, direction)
+    behind = np.abs(np.abs(theta) - np.pi) < 1e-9
+    theta[behind] = np.pi * np.where(side[behind] < 0, -1.0, 1.0)
+    return r, theta
+
+
 def nodal_williams(model, tip, KI, KII, E, nu, plane):
     """The Williams displacement at every node of a model, in global axes.
 
@@ -111,16 +136,7 @@ def nodal_williams(model, tip, KI, KII, E, nu, plane):
     """
     from .interaction import tip_frame
     at, d = tip_frame(model.domain, tip)
-    r, theta = polar(model.nodes, at, d)
-    # the side of each node: where its cells lie (area-weighted centroid)
-    cells = model.cells
-    n = len(model.nodes)
-    weight = np.bincount(cells.node, weights=cells.area, minlength=n)
-    centre = np.column_stack([np.bincount(cells.node, weights=cells.area * c, minlength=n)
-                              for c in cells.centroid().T]) / weight[:, None]
-    _, side = polar(centre, at, d)
-    on_face = np.abs(np.abs(theta) - np.pi) < 1e-9
-    theta[on_face] = np.pi * np.sign(side[on_face])
+    r, theta = sided_polar(model.nodes, at, d, node_sides(model))
     with np.errstate(divide="ignore", invalid="ignore"):
         u = williams(r, theta, KI, KII, E, nu, plane)[0]
     u[r == 0.0] = 0.0

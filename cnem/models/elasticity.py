@@ -13,6 +13,7 @@ from skfem.models.elasticity import linear_stress
 from tqdm.auto import tqdm
 
 from ..assembly import BilinearForm, CellBasis, select_nodes
+from ..assembly.quadrature import subdivide
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import SolveError
 from ..geometry.topology import constraint_edges, triangle_neighbors
@@ -56,6 +57,12 @@ class Elasticity:
     plane : {"stress", "strain"}
     gauss : int
         Gauss points per cell-edge piece in the smoothed gradients.
+    enrich : dict(tips=..., radius=..., functions=...) or cnem.fracture.Enrichment, optional
+        Near-tip enrichment of the nodes within ``radius`` of the crack tips
+        nearest to ``tips`` (default all tips): ``functions="sqrt"`` (paper
+        eq. 47) or ``"branch"`` (the four branch functions); two more dofs
+        per function and enriched node, after the nodal ones. The integration
+        cells are then split into fan sub-cells (`cnem.assembly.subdivide`).
 
     Examples
     --------
@@ -70,8 +77,13 @@ class Elasticity:
     True
     """
 
-    def __init__(self, model, materials, *, plane="stress", gauss=2):
+    def __init__(self, model, materials, *, plane="stress", gauss=2, enrich=None):
+        from ..fracture.enrichment import Enrichment
         self.model = model
+        self.enrichment = Enrichment.from_spec(model, enrich)
+        #: the integration cells: the model's, or their fan sub-cells with enrichment (one
+        #: smoothed strain per cell cannot control the extra dofs)
+        self.cells = model.cells if self.enrichment is None else subdivide(model.cells, model.nodes)[0]
         self.materials = parse_materials(materials, len(model.domain.regions))
         lame(1.0, 0.0, plane)                       # validates `plane`
         self.plane = plane
@@ -157,12 +169,15 @@ class Elasticity:
     def basis(self):
         """The vector `CellBasis` (built on first use)."""
         if self._basis is None:
-            self._basis = CellBasis(self.model, vector=True, gauss=self.gauss)
+            extra = (None if self.enrichment is None
+                     else self.enrichment.smoothed_gradient(self.gauss, self.cells))
+            self._basis = CellBasis(self.model, vector=True, gauss=self.gauss, extra=extra,
+                                    cells=self.cells)
         return self._basis
 
     def cell_materials(self):
         """``(m, 2)`` ``(E, nu)`` of every integration cell."""
-        return self.materials[self.model.cells.region]
+        return self.materials[self.cells.region]
 
     def stiffness(self):
         """Global stiffness ``K`` (eq. 33), ``(2 n, 2 n)`` CSR."""
@@ -173,9 +188,10 @@ class Elasticity:
         return self._K
 
     def load(self):
-        """Load vector ``f`` (eq. 21), ``(2 n,)``."""
+        """Load vector ``f`` (eq. 21), ``(2 n,)`` (then the enriched dofs' loads)."""
         n = len(self.model.nodes)
         f = np.zeros((n, 2))
+        enriched = np.zeros((0 if self.enrichment is None else len(self.enrichment), 2))
         g, w = np.polynomial.legendre.leggauss(3)
         s, w = 0.5 * (g + 1.0), 0.5 * w
         x = self.model.nodes
@@ -187,11 +203,14 @@ class Elasticity:
                 tr = _per_point(t(pts, normal) if callable(t) else t, pts, 2, "traction")
                 np.add.at(f, edges[:, 0], (wk * (1.0 - sk) * length)[:, None] * tr)
                 np.add.at(f, edges[:, 1], (wk * sk * length)[:, None] * tr)
-        cells = self.model.cells
+            if self.enrichment is not None:
+                enriched += self.enrichment.edge_loads(edges, normal, t)
+        cells = self.cells
         for b in self._body:
             pts = x[cells.node]
             np.add.at(f, cells.node, cells.area[:, None] * _per_point(b, pts, 2, "body force"))
-        return f.reshape(-1)
+        # (the enrichment functions vanish at the nodes: no nodal body-force share)
+        return np.concatenate([f.reshape(-1), enriched.reshape(-1)])
 
     def _prescribed(self):
         dofs = np.zeros(0, dtype=np.int64)
@@ -199,7 +218,20 @@ class Elasticity:
         for d, v in self._dirichlet:            # later conditions win
             dofs, values = np.concatenate([dofs, d]), np.concatenate([values, v])
         last = len(dofs) - 1 - np.unique(dofs[::-1], return_index=True)[1]
-        return dofs[last], values[last]
+        dofs, values = dofs[last], values[last]
+        if self.enrichment is not None:
+            # enriched dofs of constrained nodes are held at 0, so that every test
+            # function vanishes on the Dirichlet boundary
+            n = len(self.model.nodes)
+            size = self.enrichment.size
+            slot = np.full(n, -1)
+            slot[self.enrichment.nodes] = np.arange(len(self.enrichment.nodes))
+            hit = slot[dofs // 2] >= 0
+            first = n + slot[dofs[hit] // 2] * size               # the node's first function
+            extra = (2 * (first[:, None] + np.arange(size)) + (dofs[hit] % 2)[:, None]).reshape(-1)
+            dofs = np.concatenate([dofs, extra])
+            values = np.concatenate([values, np.zeros(len(extra))])
+        return dofs, values
 
     # -- solve --------------------------------------------------------------------------
     def solve(self, *, method="auto", tol=1e-10, progress=None):
@@ -239,7 +271,8 @@ class Elasticity:
         t2 = time.perf_counter()
         bar.update()
         D, values = self._prescribed()
-        free = free_rigid_motions(K, self.model.nodes, D)
+        n2 = 2 * len(self.model.nodes)
+        free = free_rigid_motions(K[:n2, :n2], self.model.nodes, D[D < n2])
         if free:
             bar.close()
             raise SolveError("the system is singular: the Dirichlet conditions leave free the "
@@ -248,7 +281,9 @@ class Elasticity:
         x = np.zeros(K.shape[0])
         x[D] = values
         A, b, _, interior = condense(K, f, x=x, D=D)
-        modes = rigid_modes(self.model.nodes)[interior]
+        modes = np.zeros((K.shape[0], 3))
+        modes[:n2] = rigid_modes(self.model.nodes)
+        modes = modes[interior]
         x[interior] = solve_spd(A, b, modes=modes, tol=tol, method=method)
         t3 = time.perf_counter()
         bar.update()
@@ -257,4 +292,4 @@ class Elasticity:
         log.info("elasticity: %s", ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
         E, nu = self.cell_materials().T
         C = stiffness_matrix(E, nu, self.plane)
-        return ElasticSolution(self, x.reshape(-1, 2), C, timings)
+        return ElasticSolution(self, x, C, timings)

@@ -33,6 +33,10 @@ class ElasticSolution:
     ----------
     u : (n, 2) ndarray
         Nodal displacements (the displacement at node ``i`` is ``u[i]``).
+    enriched : (e, 2) ndarray
+        Coefficients of the enrichment functions, if any.
+    dofs : (2 n + 2 e,) ndarray
+        All unknowns.
     gradient : (m, 2, 2) ndarray
         Smoothed displacement gradient per cell, ``[k, i, j] = du_i/dx_j``.
     strain : (m, 3) ndarray
@@ -45,18 +49,22 @@ class ElasticSolution:
         Seconds spent in each stage.
     """
 
-    def __init__(self, problem, u, C, timings):
+    def __init__(self, problem, dofs, C, timings):
         self.problem = problem
         self.model = problem.model
+        #: the integration cells of ``stress`` and ``strain`` (``model.cells``, or their
+        #: sub-cells with enrichment)
+        self.cells = problem.cells
         self.plane = problem.plane
-        self.u = u
+        n = len(self.model.nodes)
+        self.dofs = dofs
+        self.u = dofs[:2 * n].reshape(-1, 2)
+        #: (e, 2) coefficients of the enrichment functions (empty without enrichment)
+        self.enriched = dofs[2 * n:].reshape(-1, 2)
         self.C = C
         self.timings = timings
-        grad = problem.basis.grad
-        ux, uy = u[:, 0], u[:, 1]
-        #: (m, 2, 2) smoothed displacement gradient per cell, ``[i, j] = du_i / dx_j``
-        self.gradient = np.stack([np.column_stack([grad.x @ ux, grad.y @ ux]),
-                                  np.column_stack([grad.x @ uy, grad.y @ uy])], axis=1)
+        ops = problem.basis.operators[2:]               # du0/dx, du0/dy, du1/dx, du1/dy
+        self.gradient = np.stack([op @ dofs for op in ops], axis=1).reshape(-1, 2, 2)
         g = self.gradient
         self.strain = np.column_stack([g[:, 0, 0], g[:, 1, 1], g[:, 0, 1] + g[:, 1, 0]])
         self.stress = np.einsum("kij,kj->ki", C, self.strain)
@@ -81,7 +89,12 @@ class ElasticSolution:
         -------
         (p, 2) ndarray
         """
-        return self.model.shape_functions(points) @ self.u
+        phi = self.model.shape_functions(points)
+        out = phi @ self.u
+        enrichment = self.problem.enrichment
+        if enrichment is not None:
+            out += enrichment.values(np.asarray(points, dtype=float), phi) @ self.enriched
+        return out
 
     def energy_error(self, exact_stress, *, order=4):
         """Error in the energy norm against an exact stress field.
@@ -103,9 +116,9 @@ class ElasticSolution:
         -------
         float
         """
-        cell, points, weights = cell_quadrature(self.model.cells, self.model.nodes, order)
+        cell, points, weights = cell_quadrature(self.cells, self.model.nodes, order)
         if _takes_region(exact_stress):
-            exact = exact_stress(points, self.model.cells.region[cell])
+            exact = exact_stress(points, self.cells.region[cell])
         else:
             exact = exact_stress(points)
         exact = np.asarray(exact, dtype=float)
@@ -119,7 +132,7 @@ class ElasticSolution:
 
     def energy(self):
         """Strain energy ``1/2 sum_k A_k σ_k · ε_k``."""
-        return 0.5 * float(self.model.cells.area @ (self.stress * self.strain).sum(axis=1))
+        return 0.5 * float(self.cells.area @ (self.stress * self.strain).sum(axis=1))
 
     def fields(self):
         """Nodal and cell fields for files and pictures.
