@@ -1,0 +1,131 @@
+"""`Body`: peridynamic material points, volumes, horizon and bonds."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..spatial import family_search, remove_crossing
+
+__all__ = ["Body"]
+
+
+def _past_the_mouths(crack, tips, reach):
+    """A crack polyline with each end on the boundary (an edge crack's mouth) pushed
+    ``reach`` further out, so that bonds passing through the mouth are cut too."""
+    crack = np.array(crack, dtype=float)
+    for end, before in ((-1, -2), (0, 1)):
+        if not (np.hypot(*(tips - crack[end]).T) < 1e-12).any() if len(tips) else True:
+            d = crack[end] - crack[before]
+            crack[end] = crack[end] + reach * d / np.hypot(*d)
+    return crack
+
+
+class Body:
+    """Material points with volumes and a horizon; bonds from `cnem.spatial.family_search`.
+
+    Parameters
+    ----------
+    points : (n, d) array_like
+        d = 2 (with a thickness) or 3.
+    volumes : (n,) array_like or float
+        Point volumes (area times thickness in 2-D).
+    horizon : float
+    thickness : float
+        2-D only.
+    period : None or (d,) array_like
+        Periodic cell ``[0, L_1) x ...``: bonds use the minimum image.
+    cracks : sequence of (k, 2) polylines, optional
+        2-D pre-cracks: bonds crossing them are removed.
+
+    Attributes
+    ----------
+    family : cnem.spatial.Family
+    bond_i, bond_j : (b,) int64 ndarray
+        Bond ``b`` goes from point ``bond_i[b]`` to ``bond_j[b]`` (both directions present).
+    xi : (b, d) ndarray
+        Reference bond vectors ``x_j - x_i`` (minimum image).
+    length : (b,) ndarray
+    beta : (b,) ndarray
+        Partial-volume factors of bonds cut by the horizon.
+    """
+
+    def __init__(self, points, volumes, horizon, *, thickness=1.0, period=None, cracks=()):
+        pts = np.ascontiguousarray(points, dtype=float)
+        if pts.ndim != 2 or pts.shape[1] not in (2, 3) or len(pts) == 0:
+            raise ValueError(f"points: expected a non-empty (n, 2) or (n, 3) array, received "
+                             f"shape {pts.shape}")
+        n, d = pts.shape
+        vol = np.broadcast_to(np.asarray(volumes, dtype=float), (n,)).copy()
+        if not (np.isfinite(vol).all() and (vol > 0).all()):
+            raise ValueError("volumes: expected positive finite volumes, one per point")
+        horizon = float(horizon)
+        if not np.isfinite(horizon) or horizon <= 0:
+            raise ValueError(f"horizon: expected a positive number, received {horizon}")
+        self.thickness = float(thickness) if d == 2 else 1.0
+        if self.thickness <= 0:
+            raise ValueError(f"thickness: expected a positive number, received {thickness}")
+        self.points, self.volumes, self.horizon, self.dim = pts, vol, horizon, d
+        fam = family_search(pts, horizon, period=period)
+        crack_segments = [np.column_stack([c[:-1], c[1:]]).reshape(-1, 2, 2)
+                          for c in (np.asarray(c, dtype=float) for c in cracks)]
+        if crack_segments:
+            fam = remove_crossing(fam, self._crossing_points(), np.concatenate(crack_segments))
+        self.family = fam
+        self.period = fam.period
+        self.bond_i = np.repeat(np.arange(n, dtype=np.int64), fam.counts)
+        self.bond_j = fam.indices.astype(np.int64)
+        xi = pts[self.bond_j] - pts[self.bond_i]
+        finite = np.isfinite(self.period)
+        if finite.any():
+            per = self.period[finite]
+            xi[:, finite] -= per * np.round(xi[:, finite] / per)
+        self.xi = xi
+        self.length = np.sqrt((xi * xi).sum(axis=1))
+        spacing = (vol / self.thickness) ** (1.0 / d)
+        dx = 0.5 * (spacing[self.bond_i] + spacing[self.bond_j])
+        self.beta = np.clip((horizon + 0.5 * dx - self.length) / dx, 0.0, 1.0)
+
+    def _crossing_points(self):
+        """Positions used to decide which bonds cross a crack (the points themselves)."""
+        return self.points
+
+    @classmethod
+    def from_cloud(cls, cloud, horizon_factor=3.0, *, thickness=1.0):
+        """The nodes of a C-NEM node cloud, with their integration-cell areas as volumes.
+
+        Points on a crack face become two points, one per face (as in
+        `cnem.discretize`); a bond crossing a crack is removed, and the two
+        copies of a face point are not bonded to the other face.
+
+        Parameters
+        ----------
+        cloud : cnem.NodeCloud
+        horizon_factor : float
+            Horizon in units of the mean node spacing (``sqrt(area / n)``).
+        thickness : float
+        """
+        from ..fracture.williams import node_sides
+        from ..geometry import discretize
+        model = discretize(cloud, progress=False)
+        area = np.bincount(model.cells.node, weights=model.cells.area, minlength=len(model.nodes))
+        h = np.sqrt(model.domain.area / len(np.unique(model.node_of_point)))
+        body = cls.__new__(cls)
+        copies = np.bincount(model.node_of_point)[model.node_of_point] > 1
+        # a crack-face copy is nudged towards its own face for the crossing test only
+        shift = node_sides(model) - model.nodes
+        norm = np.maximum(np.hypot(*shift.T), 1e-300)[:, None]
+        body._nudged = model.nodes + np.where(copies[:, None], 1e-6 * h * shift / norm, 0.0)
+        body._crossing_points = lambda: body._nudged
+        horizon = horizon_factor * h
+        Body.__init__(body, model.nodes, area * thickness, horizon, thickness=thickness,
+                      cracks=[_past_the_mouths(c, model.domain.tips, horizon)
+                              for c in model.domain.cracks])
+        body.model = model
+        return body
+
+    def __len__(self):
+        return len(self.points)
+
+    def __repr__(self):
+        return (f"<Body {len(self.points)} points ({self.dim}-D), horizon {self.horizon:g}, "
+                f"{len(self.bond_i)} bonds>")

@@ -1,0 +1,119 @@
+"""Peridynamic materials: bond-based (PMB) and ordinary state-based (LPS)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["BondBased", "StateBased", "PLANES"]
+
+PLANES = ("stress", "strain")
+
+
+def _positive(name, value):
+    value = float(value)
+    if not np.isfinite(value) or value <= 0:
+        raise ValueError(f"{name}: expected a positive number, received {value}")
+    return value
+
+
+class BondBased:
+    """Prototype microelastic brittle (PMB) material.
+
+    The micromodulus follows from E and the horizon: ``c = 9 E / (pi t delta^3)``
+    in plane stress (Poisson ratio 1/3), ``48 E / (5 pi t delta^3)`` in plane strain
+    and ``12 E / (pi delta^4)`` in 3-D (Poisson ratio 1/4).
+
+    Parameters
+    ----------
+    E : float
+        Young's modulus.
+    critical_stretch : float, optional
+        Bonds break beyond it (dynamics); ``None``: unbreakable.
+    fracture_energy : float, optional
+        ``G0``, giving the critical stretch ``sqrt(5 G0 / (9 K delta))`` (3-D:
+        ``sqrt(5 G0 / (9 K delta))`` with K the bulk modulus; 2-D plane stress:
+        ``sqrt(4 pi G0 / (9 E delta))``) when ``critical_stretch`` is not given.
+    density : float
+        Mass density (dynamics).
+    """
+
+    kind = "bond"
+
+    def __init__(self, E, *, critical_stretch=None, fracture_energy=None, density=1.0):
+        self.E = _positive("E", E)
+        self.critical_stretch = None if critical_stretch is None else _positive(
+            "critical_stretch", critical_stretch)
+        self.fracture_energy = None if fracture_energy is None else _positive(
+            "fracture_energy", fracture_energy)
+        self.density = _positive("density", density)
+
+    def poisson(self, dim, plane):
+        return 1.0 / 3.0 if (dim == 2 and plane == "stress") else 0.25
+
+    def micromodulus(self, dim, plane, horizon, thickness):
+        if dim == 3:
+            return 12.0 * self.E / (np.pi * horizon ** 4)
+        if plane == "stress":
+            return 9.0 * self.E / (np.pi * thickness * horizon ** 3)
+        return 48.0 * self.E / (5.0 * np.pi * thickness * horizon ** 3)
+
+    def stretch_limit(self, dim, plane, horizon):
+        """The critical stretch (given, or from the fracture energy; inf if neither)."""
+        if self.critical_stretch is not None:
+            return self.critical_stretch
+        if self.fracture_energy is None:
+            return np.inf
+        if dim == 2 and plane == "stress":
+            return float(np.sqrt(4.0 * np.pi * self.fracture_energy / (9.0 * self.E * horizon)))
+        K = self.E / (3.0 * (1.0 - 2.0 * self.poisson(dim, plane)))
+        return float(np.sqrt(5.0 * self.fracture_energy / (9.0 * K * horizon)))
+
+    def __repr__(self):
+        return f"<BondBased E={self.E:g}, critical stretch {self.critical_stretch}>"
+
+
+class StateBased:
+    """Ordinary state-based linear peridynamic solid (LPS), any Poisson ratio.
+
+    ``W = k theta^2 / 2 + (alpha / 2) sum_j omega (e^d_j)^2 V_j`` with the 2-D
+    (plane stress / strain) or 3-D bulk modulus ``k`` and
+    ``alpha = mu d (d + 2) / m``; the dilatation ``theta`` is computed from the
+    displacements of the family with the point's moment tensor, so that it
+    is exact for uniform strains even where the horizon is cut by a boundary.
+
+    Parameters
+    ----------
+    E, nu : float
+    critical_stretch : float, optional
+        Bonds break beyond it (dynamics).
+    density : float
+    """
+
+    kind = "state"
+
+    def __init__(self, E, nu, *, critical_stretch=None, density=1.0):
+        self.E = _positive("E", E)
+        nu = float(nu)
+        if not -1.0 < nu < 0.5:
+            raise ValueError(f"nu: expected a Poisson ratio in (-1, 0.5), received {nu}")
+        self.nu = nu
+        self.critical_stretch = None if critical_stretch is None else _positive(
+            "critical_stretch", critical_stretch)
+        self.density = _positive("density", density)
+
+    def moduli(self, dim, plane):
+        """Bulk modulus of the d-dimensional law and the shear modulus."""
+        E, nu = self.E, self.nu
+        mu = E / (2.0 * (1.0 + nu))
+        lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+        if dim == 3:
+            return lam + 2.0 * mu / 3.0, mu
+        if plane == "stress":
+            lam = 2.0 * lam * mu / (lam + 2.0 * mu)
+        return lam + mu, mu
+
+    def stretch_limit(self, dim, plane, horizon):
+        return np.inf if self.critical_stretch is None else self.critical_stretch
+
+    def __repr__(self):
+        return f"<StateBased E={self.E:g}, nu={self.nu:g}>"

@@ -1,0 +1,432 @@
+"""`Problem`: peridynamic statics (sparse tangent, Newton) and explicit dynamics."""
+
+from __future__ import annotations
+
+import logging
+import sys
+import time
+
+import numpy as np
+import scipy.sparse as sp
+from tqdm.auto import tqdm
+
+from ..assembly.basis import select_nodes
+from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
+from ..errors import SolveError
+from . import _kernels as K
+from .materials import PLANES
+
+__all__ = ["Problem", "StaticSolution", "DynamicRun"]
+
+log = logging.getLogger(__name__)
+
+
+def _per_point(value, points, width, what):
+    from ..models.elasticity import _per_point as check
+    return check(value, points, width, what)
+
+
+class StaticSolution:
+    """``u (n, d)``, ``residual_history`` (one list of residual norms per load step)."""
+
+    def __init__(self, problem, u, history):
+        self.problem, self.u, self.residual_history = problem, u, history
+
+    def stress(self):
+        """Stress of every point, ``(n, d, d)`` (see `Problem.stress`)."""
+        return self.problem.stress(self.u)
+
+    def __repr__(self):
+        return (f"<StaticSolution {len(self.u)} points, {len(self.residual_history)} load "
+                f"step(s), max |u| {np.abs(self.u).max():.3e}>")
+
+
+class DynamicRun:
+    """Result of `Problem.run_dynamic`: final ``u``, ``velocity``, ``damage (n,)``,
+    ``times`` of the stored frames, ``frames`` (list of ``(u, damage)``), ``energy``
+    (kinetic + elastic at each stored frame, without breaking), ``broken`` bonds."""
+
+    def __init__(self, **kw):
+        self.__dict__.update(kw)
+
+    def __repr__(self):
+        return (f"<DynamicRun {len(self.u)} points, t = {self.times[-1]:.3e}, "
+                f"max damage {self.damage.max():.3f}>")
+
+
+class Problem:
+    """A peridynamic body with a material, loads and displacement conditions.
+
+    Parameters
+    ----------
+    body : Body
+    material : BondBased or StateBased
+    plane : {"stress", "strain"}
+        2-D only.
+    surface_correction : bool
+        Energy method (Le & Bobaru): every point's bonds are scaled so that
+        uniform test strains store the classical energy density at that point
+        (this also removes the discretisation error of the horizon sums in the
+        bulk).
+    """
+
+    def __init__(self, body, material, *, plane="stress", surface_correction=True):
+        if plane not in PLANES:
+            raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
+        if getattr(material, "kind", None) not in ("bond", "state"):
+            raise ValueError(f"material: expected cnem.pd.BondBased or StateBased, received "
+                             f"{type(material).__name__}")
+        self.body, self.material, self.plane = body, material, plane
+        self.dim = body.dim
+        self.surface_correction = bool(surface_correction)
+        self._dirichlet, self._body = [], []
+        self.alive = np.ones(len(body.bond_i), dtype=np.uint8)
+        self._operators()
+
+    def __repr__(self):
+        return f"<Problem {self.body!r}, {self.material!r}>"
+
+    # -- operators ----------------------------------------------------------------------
+    def _operators(self):
+        b, d, n = self.body, self.dim, len(self.body)
+        nb = len(b.bond_i)
+        self.unit = b.xi / b.length[:, None]
+        rows = np.repeat(np.arange(nb), 2 * d)
+        cols = np.concatenate([d * b.bond_j[:, None] + np.arange(d),
+                               d * b.bond_i[:, None] + np.arange(d)], axis=1).reshape(-1)
+        vals = np.concatenate([self.unit, -self.unit], axis=1).reshape(-1)
+        #: extension operator e = A u, (b, d n)
+        self.A = sp.csr_matrix((vals, (rows, cols)), shape=(nb, d * n))
+        self.weight = b.beta * b.volumes[b.bond_j]            # omega beta V_j, omega = 1
+        if self.material.kind == "bond":
+            c = self.material.micromodulus(d, self.plane, b.horizon, b.thickness)
+            self.bond_stiffness = np.full(nb, c)
+        else:
+            self._state_operators()
+        self.factor = self._correction() if self.surface_correction else np.ones(nb)
+
+    def _state_operators(self):
+        b, d, n = self.body, self.dim, len(self.body)
+        w = self.weight
+        # moment tensors M_i = sum w xi xi^T and theta_i = sum w (u_j - u_i) . M_i^-1 xi
+        M = np.zeros((n, d, d))
+        np.add.at(M, b.bond_i, w[:, None, None] * b.xi[:, :, None] * b.xi[:, None, :])
+        if (np.linalg.det(M) <= 0).any():
+            raise ValueError("a point has too few bonds to span every direction: enlarge the horizon")
+        g = np.einsum("bij,bj->bi", np.linalg.inv(M)[b.bond_i], b.xi) * w[:, None]
+        rows = np.repeat(b.bond_i, 2 * d)
+        cols = np.concatenate([d * b.bond_j[:, None] + np.arange(d),
+                               d * b.bond_i[:, None] + np.arange(d)], axis=1).reshape(-1)
+        vals = np.concatenate([g, -g], axis=1).reshape(-1)
+        #: dilatation operator theta = T u, (n, d n)
+        self.T = sp.csr_matrix((vals, (rows, cols)), shape=(n, d * n))
+        self.m = np.bincount(b.bond_i, weights=w * b.length ** 2, minlength=n)
+        k, mu = self.material.moduli(d, self.plane)
+        self.bulk, self.shear = k, mu
+        self.alpha = mu * d * (d + 2) / self.m
+        # deviatoric extension e^d = E u = A u - (L / d) theta_i
+        S = sp.csr_matrix((b.length / d, (np.arange(len(b.bond_i)), b.bond_i)),
+                          shape=(len(b.bond_i), n))
+        self.Edev = (self.A - S @ self.T).tocsr()
+
+    # -- energies -----------------------------------------------------------------------
+    def energy_density(self, u, factor=None):
+        """Strain energy density of every point, ``(n,)``."""
+        b = self.body
+        factor = self.factor if factor is None else factor
+        x = np.asarray(u, dtype=float).reshape(-1)
+        live = self.alive.astype(bool)
+        if self.material.kind == "bond":
+            e = self.A @ x
+            per = 0.25 * self.bond_stiffness * factor * e * e / b.length * self.weight * live
+            return np.bincount(b.bond_i, weights=per, minlength=len(b))
+        theta = self.T @ x
+        ed = self.Edev @ x
+        per = 0.5 * self.alpha[b.bond_i] * factor * self.weight * ed * ed * live
+        return 0.5 * self.bulk * theta ** 2 + np.bincount(b.bond_i, weights=per, minlength=len(b))
+
+    def _classical_density(self, strain):
+        """``1/2 eps : C : eps`` of the material (d-dimensional law)."""
+        d = self.dim
+        if self.material.kind == "bond":
+            nu = self.material.poisson(d, self.plane)
+            E = self.material.E
+            mu = E / (2 * (1 + nu))
+            lam = E * nu / ((1 + nu) * (1 - 2 * nu))
+            if d == 2 and self.plane == "stress":
+                lam = 2 * lam * mu / (lam + 2 * mu)
+            k = lam + 2 * mu / d
+        else:
+            k, mu = self.bulk, self.shear
+        tr = np.trace(strain)
+        dev = strain - tr / d * np.eye(d)
+        return 0.5 * k * tr * tr + mu * (dev * dev).sum()
+
+    def _test_fields(self):
+        """Uniform test strains and the direction functions of the correction: all unit
+        strains with ``n_a^2`` and ``n_a^2 n_c^2`` of the bond direction (bond-based), the
+        deviatoric shears with ``{1, sum n_a^2 n_b^2}`` (state-based deviatoric part)."""
+        d = self.dim
+        pairs = [(a, c) for a in range(d) for c in range(a, d)]
+        n = self.unit
+        if self.material.kind == "bond":
+            tests = []
+            for a, c in pairs:
+                eps = np.zeros((d, d))
+                eps[a, c] = eps[c, a] = 1e-3
+                tests.append(eps)
+            # even functions of the direction: n_a^2 for the normal tests, n_a^2 n_c^2
+            # for the shear tests
+            return tests, [n[:, a] ** 2 * (n[:, c] ** 2 if a != c else 1.0) for a, c in pairs]
+        tests = []
+        for a, c in pairs:
+            if a != c:
+                eps = np.zeros((d, d))
+                eps[a, c] = eps[c, a] = 1e-3
+                tests.append(eps)
+        eps = np.zeros((d, d))
+        eps[0, 0], eps[1, 1] = 1e-3, -1e-3
+        tests.append(eps)
+        quartic = sum(n[:, a] ** 2 * n[:, c] ** 2 for a, c in pairs if a != c)
+        return tests, [np.ones(len(n)), quartic]
+
+    def _correction(self):
+        """Bond factors of the energy method: at every point, a function of the bond
+        direction fitted so that the uniform test strains store the classical
+        energy density there; a bond takes the mean of its two points' functions."""
+        b = self.body
+        tests, basis = self._test_fields()
+        rows = []
+        for eps in tests:
+            u = b.points @ eps.T
+            dil = 0.0
+            if self.material.kind == "state":
+                dil = 0.5 * self.bulk * (self.T @ u.reshape(-1)) ** 2
+            rows.append([self.energy_density(u, P) - dil for P in basis])
+        Q = np.array(rows).transpose(2, 0, 1)                       # (n, tests, basis)
+        target = np.array([self._classical_density(eps) - (
+            0.5 * self.bulk * np.trace(eps) ** 2 if self.material.kind == "state" else 0.0)
+            for eps in tests])
+        coef = np.array([np.linalg.lstsq(q, target, rcond=None)[0] for q in Q])
+        G = np.array(basis)                                          # (basis, bonds)
+        gi = (coef[b.bond_i].T * G).sum(axis=0)
+        gj = (coef[b.bond_j].T * G).sum(axis=0)
+        return 0.5 * (gi + gj)
+
+    def stiffness(self):
+        """Sparse stiffness ``(d n, d n)``: the Hessian of the total strain energy
+        ``sum_i V_i W_i`` (exact tangent of the linear models), live bonds only."""
+        b = self.body
+        live = self.alive.astype(float)
+        Vi = b.volumes[b.bond_i]
+        if self.material.kind == "bond":
+            w = 0.5 * self.bond_stiffness * self.factor * self.weight * Vi / b.length * live
+            return (self.A.T @ sp.diags(w) @ self.A).tocsr()
+        w = self.alpha[b.bond_i] * self.factor * self.weight * Vi * live
+        dil = self.T.T @ sp.diags(self.bulk * b.volumes) @ self.T
+        return (dil + self.Edev.T @ sp.diags(w) @ self.Edev).tocsr()
+
+    def stress(self, u):
+        """Stress of every point from its bonds, ``(n, d, d)`` (``dW_i / d eps`` for a
+        uniform strain: the classical stress in a uniform field)."""
+        b, d = self.body, self.dim
+        x = np.asarray(u, dtype=float).reshape(-1)
+        nn = self.unit[:, :, None] * self.unit[:, None, :]
+        live = self.alive.astype(bool)
+        if self.material.kind == "bond":
+            e = self.A @ x
+            per = (0.5 * self.bond_stiffness * self.factor * self.weight * e * live)[:, None, None] * nn
+            out = np.zeros((len(b), d, d))
+            np.add.at(out, b.bond_i, per)
+            return out
+        theta = self.T @ x
+        ed = self.Edev @ x
+        L = b.length[:, None, None]
+        per = (self.alpha[b.bond_i] * self.factor * self.weight * ed * live)[:, None, None] * \
+            (L * nn - (L / d) * np.eye(d))
+        out = self.bulk * theta[:, None, None] * np.eye(d)
+        np.add.at(out, b.bond_i, per)
+        return out
+
+    # -- conditions ---------------------------------------------------------------------
+    def add_dirichlet(self, where, component, value=0.0):
+        """Prescribed displacements at points (same meaning as `cnem.Elasticity.add_dirichlet`)."""
+        d = self.dim
+        if component is not None and component not in range(d):
+            raise ValueError(f"component: expected None or 0..{d - 1}, received {component!r}")
+        nodes = select_nodes(self.body.points, where)
+        if nodes.size == 0:
+            raise ValueError("add_dirichlet: `where` selects no point")
+        comps = list(range(d)) if component is None else [component]
+        vals = _per_point(value, self.body.points[nodes], len(comps), "add_dirichlet value")
+        for k, c in enumerate(comps):
+            self._dirichlet.append((d * nodes + c, vals[:, k]))
+
+    def add_body_force(self, b):
+        """Force per unit volume: ``b(x) -> (p, d)`` or a constant."""
+        self._body.append(b)
+
+    def load(self):
+        """External forces ``(d n,)``: body forces times volumes."""
+        f = np.zeros((len(self.body), self.dim))
+        for b in self._body:
+            f += self.body.volumes[:, None] * _per_point(b, self.body.points, self.dim, "body force")
+        return f.reshape(-1)
+
+    def _prescribed(self):
+        dofs = np.zeros(0, dtype=np.int64)
+        values = np.zeros(0)
+        for dd, v in self._dirichlet:
+            dofs, values = np.concatenate([dofs, dd]), np.concatenate([values, v])
+        last = len(dofs) - 1 - np.unique(dofs[::-1], return_index=True)[1]
+        return dofs[last], values[last]
+
+    # -- statics ------------------------------------------------------------------------
+    def solve_static(self, *, tol=1e-10, steps=1, initial=None, max_iterations=20):
+        """Newton-Raphson with the exact tangent, Dirichlet values and loads ramped in
+        ``steps`` equal increments.
+
+        Returns
+        -------
+        StaticSolution
+            ``u (n, d)``, ``residual_history``: residual norms (free dofs, relative to
+            the load or the first residual) per Newton iteration, one list per step.
+
+        Raises
+        ------
+        SolveError
+            Rigid motions not fixed (2-D: named), or a step that does not converge.
+        """
+        d, n = self.dim, len(self.body)
+        Kmat = self.stiffness()
+        D, values = self._prescribed()
+        if d == 2:
+            free = free_rigid_motions(Kmat, self.body.points, D)
+            if free:
+                raise SolveError("the system is singular: the Dirichlet conditions leave free "
+                                 "the " + "; ".join(free) + ". Fix them with add_dirichlet")
+        F = self.load()
+        u = np.zeros(d * n) if initial is None else np.asarray(initial, float).reshape(-1).copy()
+        interior = np.setdiff1d(np.arange(d * n), D)
+        A = Kmat[interior][:, interior].tocsr()
+        modes = rigid_modes(self.body.points)[interior] if d == 2 else None
+        history = []
+        for step in range(1, steps + 1):
+            frac = step / steps
+            u[D] = frac * values
+            scale = max(np.linalg.norm(frac * F[interior]), 1e-300)
+            res = []
+            for _ in range(max_iterations):
+                r = (Kmat @ u - frac * F)[interior]
+                res.append(float(np.linalg.norm(r)))
+                ref = scale if np.linalg.norm(F) > 0 else max(res[0], 1e-300)
+                if res[-1] <= tol * ref or res[-1] == 0.0:
+                    break
+                u[interior] -= solve_spd(A, r, modes=modes, tol=min(tol, 1e-12))
+            else:
+                raise SolveError(f"Newton did not converge in load step {step}: residual "
+                                 f"{res[-1]:.3e} after {max_iterations} iterations")
+            history.append(res)
+        return StaticSolution(self, u.reshape(n, d), history)
+
+    # -- dynamics -----------------------------------------------------------------------
+    def stable_time_step(self, safety=0.8):
+        """Silling & Askari's bound ``sqrt(2 rho / sum_j C_ij V_j)`` (the smallest
+        over points) times ``safety``."""
+        b = self.body
+        Kmat = self.stiffness()
+        diag = np.abs(Kmat).sum(axis=1).A.reshape(-1) / np.repeat(b.volumes, self.dim)
+        return safety * float(np.sqrt(2.0 * self.material.density / diag.max()))
+
+    def damage(self):
+        """``1 - (live bond volume) / (all bond volume)`` per point, ``(n,)``."""
+        b = self.body
+        total = np.bincount(b.bond_i, weights=self.weight, minlength=len(b))
+        live = np.bincount(b.bond_i, weights=self.weight * self.alive, minlength=len(b))
+        return 1.0 - live / np.maximum(total, 1e-300)
+
+    def _internal_force(self, u, limit, state):
+        """Force per unit volume ``(n, d)``, breaking bonds (returns count broken)."""
+        b = self.body
+        if self.material.kind == "bond":
+            out = np.empty_like(u)
+            broken = K.pmb_forces(u, b.xi, b.length, b.family.offsets, b.bond_j, state["stiffness"],
+                                  b.volumes, self.alive, limit, out)
+            return out, broken
+        stretch = np.sqrt(((b.xi + u[b.bond_j] - u[b.bond_i]) ** 2).sum(axis=1)) / b.length - 1
+        broken = int(((stretch > limit) & (self.alive == 1)).sum())
+        if broken:
+            self.alive[stretch > limit] = 0
+            state["K"] = self.stiffness()
+        return -(state["K"] @ u.reshape(-1)).reshape(u.shape) / b.volumes[:, None], broken
+
+    def run_dynamic(self, dt, steps, *, velocity=None, every=None, progress=None):
+        """Explicit velocity Verlet with bond breaking.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (see `stable_time_step`).
+        steps : int
+        velocity : (n, d) array_like or callable ``(n, d) -> (n, d)``, optional
+            Initial velocity.
+        every : int, optional
+            Store a frame (u, damage, energy) every so many steps (default: 10 frames).
+        progress : bool, optional
+
+        Returns
+        -------
+        DynamicRun
+        """
+        b, d, n = self.body, self.dim, len(self.body)
+        dt, steps = float(dt), int(steps)
+        if not dt > 0 or steps < 1:
+            raise ValueError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
+        every = max(1, steps // 10) if every is None else int(every)
+        rho = self.material.density
+        limit = self.material.stretch_limit(d, self.plane, b.horizon)
+        state = {}
+        if self.material.kind == "bond":
+            state["stiffness"] = np.ascontiguousarray(self.bond_stiffness * self.factor * b.beta)
+        else:
+            state["K"] = self.stiffness()
+        D, values = self._prescribed()
+        u = np.zeros((n, d))
+        u.reshape(-1)[D] = values
+        v = np.zeros((n, d))
+        if velocity is not None:
+            v[:] = _per_point(velocity, b.points, d, "velocity")
+        v.reshape(-1)[D] = 0.0
+        fext = self.load().reshape(n, d) / b.volumes[:, None]
+        force, broken = self._internal_force(u, limit, state)
+        acc = (force + fext) / rho
+        times, frames, energy = [0.0], [(u.copy(), self.damage())], [self._energy(u, v)]
+        total_broken = broken
+        show = sys.stderr.isatty() if progress is None else progress
+        for step in tqdm(range(1, steps + 1), desc="PD steps", disable=not show, leave=False):
+            v += 0.5 * dt * acc
+            u += dt * v
+            u.reshape(-1)[D] = values
+            force, broken = self._internal_force(u, limit, state)
+            total_broken += broken
+            acc = (force + fext) / rho
+            v += 0.5 * dt * acc
+            v.reshape(-1)[D] = 0.0
+            if step % every == 0 or step == steps:
+                times.append(step * dt)
+                frames.append((u.copy(), self.damage()))
+                energy.append(self._energy(u, v))
+        return DynamicRun(u=u, velocity=v, damage=self.damage(), times=np.array(times),
+                          frames=frames, energy=np.array(energy), broken=total_broken)
+
+    def _energy(self, u, v):
+        """Kinetic plus elastic energy (the linearised elastic energy)."""
+        b = self.body
+        kinetic = 0.5 * self.material.density * float(b.volumes @ (v * v).sum(axis=1))
+        if self.material.kind == "bond":          # the exact PMB energy of the deformed bonds
+            y = b.xi + u[b.bond_j] - u[b.bond_i]
+            s = np.sqrt((y * y).sum(axis=1)) / b.length - 1
+            per = 0.25 * self.bond_stiffness * self.factor * b.beta * s * s * b.length * \
+                b.volumes[b.bond_j] * self.alive
+            return kinetic + float(b.volumes @ np.bincount(b.bond_i, weights=per, minlength=len(b)))
+        return kinetic + float(b.volumes @ self.energy_density(u))
