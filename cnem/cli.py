@@ -23,6 +23,7 @@ DEMOS = {
     "cylinder": "bimaterial_cylinder",
     "inclined-crack": "inclined_crack",
     "mode1-crack": "mode1_crack",
+    "pd-crack": "pd_vs_cnem_crack",
     "cracked-plate": "cracked_plate_geometry",
 }
 

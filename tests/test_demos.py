@@ -120,3 +120,14 @@ def test_mode1_crack_small(tmp_path):
     assert 0.35 < out["rates"]["fem"] < 0.65, out["rates"]
     finest = [r for r in out["rows"] if r["method"] == "cnem"][-1]
     assert abs(finest["KI"] - 1.0) < 0.05
+
+
+def test_pd_vs_cnem_crack_small(tmp_path):
+    """On the same nodes, C-NEM and state-based PD open the crack like Griffith's
+    ellipse (within the finite-plate excess) and agree with each other."""
+    demo = _load("pd_vs_cnem_crack")
+    out = demo.main((1 / 16, 1 / 32), outdir=tmp_path, plot=True)
+    for row in out["rows"]:
+        assert row["cnem_error"] < 0.15 and row["pd_error"] < 0.15, row
+    assert out["rows"][1]["u_difference"] < out["rows"][0]["u_difference"]
+    assert abs(out["rows"][1]["K_cnem"] / np.sqrt(np.pi * 0.25) - 1.0) < 0.08

@@ -89,7 +89,7 @@ def cell_quadrature(cells, nodes, order=4):
     return np.repeat(owner, len(w)), points.reshape(-1, 2), weights.reshape(-1)
 
 
-def subdivide(cells, nodes):
+def subdivide(cells, nodes, *, whole=None):
     """Split every integration cell into the triangles of a fan (sub-cells).
 
     Used where one smoothed strain per cell is too few (enriched fields:
@@ -100,6 +100,8 @@ def subdivide(cells, nodes):
     ----------
     cells : Cells
     nodes : (n, 2) ndarray
+    whole : (m,) bool array_like, optional
+        Cells to keep whole.
 
     Returns
     -------
@@ -112,7 +114,8 @@ def subdivide(cells, nodes):
     owner, corners = cell_triangles(cells, nodes)
     e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
     twice = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    negative = np.zeros(len(cells.area), dtype=bool)
+    negative = np.zeros(len(cells.area), dtype=bool) if whole is None else \
+        np.array(whole, dtype=bool).copy()
     negative[owner[twice < 0]] = True
     # slivers (collinear polygon vertices) would get an ill-defined smoothed gradient
     keep = ~negative[owner] & (twice > 1e-9 * cells.area[owner])

@@ -207,7 +207,11 @@ class Problem:
         target = np.array([self._classical_density(eps) - (
             0.5 * self.bulk * np.trace(eps) ** 2 if self.material.kind == "state" else 0.0)
             for eps in tests])
-        coef = np.array([np.linalg.lstsq(q, target, rcond=None)[0] for q in Q])
+        rhs = np.broadcast_to(target, Q.shape[:2])[..., None]
+        try:
+            coef = np.linalg.solve(Q, rhs)[..., 0]               # square: tests = functions
+        except np.linalg.LinAlgError:                           # a point with too few bonds
+            coef = np.array([np.linalg.lstsq(q, target, rcond=None)[0] for q in Q])
         G = np.array(basis)                                          # (basis, bonds)
         gi = (coef[b.bond_i].T * G).sum(axis=0)
         gj = (coef[b.bond_j].T * G).sum(axis=0)
