@@ -19,8 +19,8 @@ node counts (`cnem.fem`).
 
 Expected result
 ---------------
-* Plain C-NEM and FEM: rates about 0.5 (measured 0.505 and 0.43 on h = 1/8 ... 1/64).
-* Enriched C-NEM: a lower error at every h (about 30 % lower at h = 1/64), but
+* Plain C-NEM and FEM: rates about 0.5 (measured 0.48 and 0.43 on h = 1/8 ... 1/64).
+* Enriched C-NEM: a lower error at every h (about 20 % lower at h = 1/64), but
   the rate stays about 0.5 (measured 0.54): the SCNI stress is constant per
   (sub-)cell and cannot follow the r^-1/2 field in the cells at the tip, which
   alone bound the energy error by O(sqrt(h)). The rate of 0.9 that the issue

@@ -15,7 +15,7 @@ def _fan(apex, verts, nxt):
     return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
 
 
-def cell_triangles(cells, nodes):
+def cell_triangles(cells, nodes, *, node_apex=None):
     """Triangles covering every cell polygon exactly (signed weights allowed).
 
     A fan from the centroid where the polygon is star-shaped from it (the usual
@@ -28,6 +28,9 @@ def cell_triangles(cells, nodes):
     cells : Cells
     nodes : (n, 2) ndarray
         The model's nodes (``cells.node`` indexes them).
+    node_apex : (m,) bool array_like, optional
+        Cells fanned from their node first (crack-tip cells: a fan from the
+        centroid would run along the crack line through the tip).
 
     Returns
     -------
@@ -42,7 +45,8 @@ def cell_triangles(cells, nodes):
     nxt[offsets[1:] - 1] = offsets[:-1]
     apex = cells.centroid()[cell]
     tol = 1e-12 * cells.area[cell]
-    bad = np.zeros(len(counts), dtype=bool)
+    bad = np.zeros(len(counts), dtype=bool) if node_apex is None else \
+        np.array(node_apex, dtype=bool).copy()
     bad[cell[_fan(apex, verts, nxt) <= tol]] = True
     node_apex = nodes[cells.node][cell]
     use_node = bad[cell]
@@ -89,7 +93,7 @@ def cell_quadrature(cells, nodes, order=4):
     return np.repeat(owner, len(w)), points.reshape(-1, 2), weights.reshape(-1)
 
 
-def subdivide(cells, nodes, *, whole=None):
+def subdivide(cells, nodes, *, whole=None, node_apex=None):
     """Split every integration cell into the triangles of a fan (sub-cells).
 
     Used where one smoothed strain per cell is too few (enriched fields:
@@ -102,6 +106,8 @@ def subdivide(cells, nodes, *, whole=None):
     nodes : (n, 2) ndarray
     whole : (m,) bool array_like, optional
         Cells to keep whole.
+    node_apex : (m,) bool array_like, optional
+        Cells fanned from their node (see `cell_triangles`).
 
     Returns
     -------
@@ -111,7 +117,7 @@ def subdivide(cells, nodes, *, whole=None):
         The cell each sub-cell comes from.
     """
     from ..geometry.model import Cells
-    owner, corners = cell_triangles(cells, nodes)
+    owner, corners = cell_triangles(cells, nodes, node_apex=node_apex)
     e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
     twice = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
     negative = np.zeros(len(cells.area), dtype=bool) if whole is None else \

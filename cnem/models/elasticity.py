@@ -93,7 +93,7 @@ class Elasticity:
         #: the integration cells: the model's, or their fan sub-cells with enrichment (one
         #: smoothed strain per cell cannot control the extra dofs)
         self.cells = (model.cells if self.enrichment is None
-                      else subdivide(model.cells, model.nodes, whole=self._tip_cells())[0])
+                      else subdivide(model.cells, model.nodes, node_apex=self._tip_cells())[0])
         self.materials = parse_materials(materials, len(model.domain.regions))
         lame(1.0, 0.0, plane)                       # validates `plane`
         self.stabilization = float(stabilization)
@@ -203,8 +203,8 @@ class Elasticity:
         return self._K
 
     def _tip_cells(self):
-        """Cells of the crack-tip nodes (kept whole when cells are subdivided: a crack
-        ends inside them)."""
+        """Cells of the crack-tip nodes (fanned from the tip when cells are subdivided:
+        a crack ends inside them)."""
         tips = self.model.domain.tips
         x = self.model.nodes[self.model.cells.node]
         if len(tips) == 0:
@@ -212,9 +212,8 @@ class Elasticity:
         return (np.hypot(*(x[:, None, :] - tips[None]).transpose(2, 0, 1)) < 1e-12).any(axis=1)
 
     def _stabilization_stiffness(self):
-        """``sum_s A_s (B~_s - B~_k)^T C (B~_s - B~_k)`` over the fan sub-cells (the
-        crack-tip cells stay whole)."""
-        sub, parent = subdivide(self.cells, self.model.nodes, whole=self._tip_cells())
+        """``sum_s A_s (B~_s - B~_k)^T C (B~_s - B~_k)`` over the fan sub-cells."""
+        sub, parent = subdivide(self.cells, self.model.nodes, node_apex=self._tip_cells())
         fine = CellBasis(self.model, vector=True, gauss=self.gauss, cells=sub)
         to_sub = sp.csr_matrix((np.ones(len(parent)), (np.arange(len(parent)), parent)),
                                shape=(len(parent), len(self.cells.area)))
