@@ -102,6 +102,7 @@ def test_inclined_crack(tmp_path):
     demo = _load("inclined_crack")
     out = demo.main((0.0, 45.0), outdir=tmp_path, plot=_has_pyvista())
     assert out["max_error"] < 0.02, out["rows"]
+    assert out["max_enriched_error"] < 0.01, out["rows"]
     for row in out["rows"]:
         assert row["nodes"] <= 2000
     ahead = out["ahead"]
