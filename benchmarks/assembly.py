@@ -144,8 +144,9 @@ def symmetry_error(K):
 # --------------------------------------------------------------------------- the two sides
 
 
-#: C-NEM node cloud: "irregular" (default) or "regular" (set by --cloud).
-CLOUD = {"kind": "irregular"}
+#: C-NEM node cloud: "irregular" (default) or "regular" (set by --cloud), and the
+#: weight of the sub-cell stabilisation (--stabilization; 0 = the paper's plain SCNI).
+CLOUD = {"kind": "irregular", "stabilization": 1.0}
 
 
 def lattice_cloud(k):
@@ -171,7 +172,7 @@ def cnem_pipeline(cloud, run):
     model = staged(run, "model", lambda: cnem.discretize(cloud, progress=False))
     model._cache.clear()
     grad = staged(run, "B~", lambda: smoothed_gradient(model))
-    prob = cnem.Elasticity(model, (E, NU), plane=PLANE)
+    prob = cnem.Elasticity(model, (E, NU), plane=PLANE, stabilization=CLOUD["stabilization"])
     K = staged(run, "K", prob.stiffness)
     prob.add_traction(lambda x, nrm: nrm[:, 0] > 0.5, list(TRACTION))
     f, D = prob.load(), clamped_dofs(model.nodes)
@@ -468,8 +469,11 @@ def main(argv=None):
                         help="run every size even when MemAvailable looks too small")
     parser.add_argument("--cloud", choices=("irregular", "regular"), default="irregular",
                         help="C-NEM node cloud (default irregular)")
+    parser.add_argument("--stabilization", type=float, default=1.0,
+                        help="sub-cell stabilisation weight of cnem.Elasticity (0: plain SCNI)")
     args = parser.parse_args(argv)
     CLOUD["kind"] = args.cloud
+    CLOUD["stabilization"] = args.stabilization
 
     if args.sizes:
         sizes = sorted(set(args.sizes))
@@ -482,7 +486,7 @@ def main(argv=None):
     import scipy
     import skfem
     print(f"benchmarks/assembly.py: sizes {[fmt_n(n) for n in sizes]}, repeat {repeat}, "
-          f"C-NEM cloud {args.cloud}; "
+          f"C-NEM cloud {args.cloud}, stabilization {args.stabilization:g}; "
           f"python {sys.version.split()[0]}, numpy {np.__version__}, scipy {scipy.__version__}, "
           f"scikit-fem {skfem.__version__}, {os.cpu_count()} CPUs")
     warm = warm_up()
