@@ -43,3 +43,52 @@ def pmb_forces(u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit,
         if d == 3:
             out[i, 2] = f2
     return broken.sum()
+
+
+@numba.njit(cache=True, parallel=True)
+def bond_geometry(points, offsets, bond_j, period, spacing, horizon, xi, length, beta):
+    """Reference bond vectors (minimum image on periodic axes), lengths and the
+    partial-volume factors ``clip((delta + dx/2 - L) / dx, 0, 1)`` with ``dx`` the
+    mean spacing of the two points."""
+    n, d = points.shape
+    for i in numba.prange(n):
+        for b in range(offsets[i], offsets[i + 1]):
+            j = bond_j[b]
+            s = 0.0
+            for k in range(d):
+                v = points[j, k] - points[i, k]
+                if np.isfinite(period[k]):
+                    v -= period[k] * np.round(v / period[k])
+                xi[b, k] = v
+                s += v * v
+            L = np.sqrt(s)
+            length[b] = L
+            dx = 0.5 * (spacing[i] + spacing[j])
+            f = (horizon + 0.5 * dx - L) / dx
+            beta[b] = 0.0 if f < 0.0 else (1.0 if f > 1.0 else f)
+
+
+@numba.njit(cache=True, parallel=True)
+def pmb_correction_moments(xi, length, weight, offsets, pairs, out):
+    """For the energy-method correction of the PMB: ``out[i, t, k] = sum_j w L
+    (n . eps_t . n)^2 P_k(n)`` over the bonds of ``i``, with the unit test strains
+    ``eps_t`` of the index pairs ``(a, c)`` and ``P_k = n_a^2`` (a == c) or
+    ``n_a^2 n_c^2`` (a != c) for the same pairs."""
+    n = len(offsets) - 1
+    npair = len(pairs)
+    for i in numba.prange(n):
+        for b in range(offsets[i], offsets[i + 1]):
+            L = length[b]
+            for t in range(npair):
+                a, c = pairs[t, 0], pairs[t, 1]
+                na, nc = xi[b, a] / L, xi[b, c] / L
+                proj = na * nc if a == c else 2.0 * na * nc          # n . eps_t . n
+                e2 = proj * proj
+                for k in range(npair):
+                    p, q = pairs[k, 0], pairs[k, 1]
+                    npk = xi[b, p] / L
+                    val = npk * npk
+                    if p != q:
+                        nqk = xi[b, q] / L
+                        val *= nqk * nqk
+                    out[i, t, k] += weight[b] * L * e2 * val

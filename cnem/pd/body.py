@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..spatial import family_search, remove_crossing
+from ._kernels import bond_geometry
 
 __all__ = ["Body"]
 
@@ -74,16 +75,11 @@ class Body:
         self.period = fam.period
         self.bond_i = np.repeat(np.arange(n, dtype=np.int64), fam.counts)
         self.bond_j = fam.indices.astype(np.int64)
-        xi = pts[self.bond_j] - pts[self.bond_i]
-        finite = np.isfinite(self.period)
-        if finite.any():
-            per = self.period[finite]
-            xi[:, finite] -= per * np.round(xi[:, finite] / per)
-        self.xi = xi
-        self.length = np.sqrt((xi * xi).sum(axis=1))
+        nb = len(self.bond_j)
+        self.xi, self.length, self.beta = np.empty((nb, d)), np.empty(nb), np.empty(nb)
         spacing = (vol / self.thickness) ** (1.0 / d)
-        dx = 0.5 * (spacing[self.bond_i] + spacing[self.bond_j])
-        self.beta = np.clip((horizon + 0.5 * dx - self.length) / dx, 0.0, 1.0)
+        bond_geometry(pts, fam.offsets, self.bond_j, np.ascontiguousarray(self.period, dtype=float),
+                      spacing, horizon, self.xi, self.length, self.beta)
 
     def _crossing_points(self):
         """Positions used to decide which bonds cross a crack (the points themselves)."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import logging
 import sys
-import time
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -88,22 +88,30 @@ class Problem:
 
     # -- operators ----------------------------------------------------------------------
     def _operators(self):
+        b = self.body
+        self.weight = b.beta * b.volumes[b.bond_j]            # omega beta V_j, omega = 1
+        if self.material.kind == "bond":
+            c = self.material.micromodulus(self.dim, self.plane, b.horizon, b.thickness)
+            self.bond_stiffness = np.full(len(b.bond_i), c)
+        else:
+            self._state_operators()
+        self.factor = self._correction() if self.surface_correction else np.ones(len(b.bond_i))
+
+    @cached_property
+    def unit(self):
+        """``(b, d)`` unit bond directions."""
+        return self.body.xi / self.body.length[:, None]
+
+    @cached_property
+    def A(self):
+        """Extension operator ``e = A u``, sparse ``(b, d n)``."""
         b, d, n = self.body, self.dim, len(self.body)
         nb = len(b.bond_i)
-        self.unit = b.xi / b.length[:, None]
         rows = np.repeat(np.arange(nb), 2 * d)
         cols = np.concatenate([d * b.bond_j[:, None] + np.arange(d),
                                d * b.bond_i[:, None] + np.arange(d)], axis=1).reshape(-1)
         vals = np.concatenate([self.unit, -self.unit], axis=1).reshape(-1)
-        #: extension operator e = A u, (b, d n)
-        self.A = sp.csr_matrix((vals, (rows, cols)), shape=(nb, d * n))
-        self.weight = b.beta * b.volumes[b.bond_j]            # omega beta V_j, omega = 1
-        if self.material.kind == "bond":
-            c = self.material.micromodulus(d, self.plane, b.horizon, b.thickness)
-            self.bond_stiffness = np.full(nb, c)
-        else:
-            self._state_operators()
-        self.factor = self._correction() if self.surface_correction else np.ones(nb)
+        return sp.csr_matrix((vals, (rows, cols)), shape=(nb, d * n))
 
     def _state_operators(self):
         b, d, n = self.body, self.dim, len(self.body)
@@ -162,6 +170,36 @@ class Problem:
         dev = strain - tr / d * np.eye(d)
         return 0.5 * k * tr * tr + mu * (dev * dev).sum()
 
+    def _pmb_correction(self):
+        """The energy-method factors of the PMB from per-bond sums (numba), without
+        the operators."""
+        b, d = self.body, self.dim
+        pairs = np.array([(a, c) for a in range(d) for c in range(a, d)], dtype=np.int64)
+        Q = np.zeros((len(b), len(pairs), len(pairs)))
+        K.pmb_correction_moments(b.xi, b.length, self.weight, b.family.offsets, pairs, Q)
+        Q *= 0.25 * self.bond_stiffness[0] if len(self.bond_stiffness) else 0.0
+        target = []
+        for a, c in pairs:
+            eps = np.zeros((d, d))
+            eps[a, c] = eps[c, a] = 1.0
+            target.append(self._classical_density(eps))
+        coef = self._fit(Q, np.array(target))
+        n = self.unit
+        factor = np.zeros(len(b.bond_i))
+        for k, (a, c) in enumerate(pairs):
+            P = n[:, a] ** 2 * (n[:, c] ** 2 if a != c else 1.0)
+            factor += 0.5 * (coef[b.bond_i, k] + coef[b.bond_j, k]) * P
+        return factor
+
+    @staticmethod
+    def _fit(Q, target):
+        """Per-point coefficients solving ``Q_i c_i = target`` (least squares where singular)."""
+        rhs = np.broadcast_to(target, Q.shape[:2])[..., None]
+        try:
+            return np.linalg.solve(Q, rhs)[..., 0]
+        except np.linalg.LinAlgError:                           # a point with too few bonds
+            return np.array([np.linalg.lstsq(q, target, rcond=None)[0] for q in Q])
+
     def _test_fields(self):
         """Uniform test strains and the direction functions of the correction: all unit
         strains with ``n_a^2`` and ``n_a^2 n_c^2`` of the bond direction (bond-based), the
@@ -195,6 +233,8 @@ class Problem:
         direction fitted so that the uniform test strains store the classical
         energy density there; a bond takes the mean of its two points' functions."""
         b = self.body
+        if self.material.kind == "bond":
+            return self._pmb_correction()
         tests, basis = self._test_fields()
         rows = []
         for eps in tests:
@@ -207,11 +247,7 @@ class Problem:
         target = np.array([self._classical_density(eps) - (
             0.5 * self.bulk * np.trace(eps) ** 2 if self.material.kind == "state" else 0.0)
             for eps in tests])
-        rhs = np.broadcast_to(target, Q.shape[:2])[..., None]
-        try:
-            coef = np.linalg.solve(Q, rhs)[..., 0]               # square: tests = functions
-        except np.linalg.LinAlgError:                           # a point with too few bonds
-            coef = np.array([np.linalg.lstsq(q, target, rcond=None)[0] for q in Q])
+        coef = self._fit(Q, target)
         G = np.array(basis)                                          # (basis, bonds)
         gi = (coef[b.bond_i].T * G).sum(axis=0)
         gj = (coef[b.bond_j].T * G).sum(axis=0)
@@ -338,8 +374,12 @@ class Problem:
         """Silling & Askari's bound ``sqrt(2 rho / sum_j C_ij V_j)`` (the smallest
         over points) times ``safety``."""
         b = self.body
-        Kmat = self.stiffness()
-        diag = np.abs(Kmat).sum(axis=1).A.reshape(-1) / np.repeat(b.volumes, self.dim)
+        if self.material.kind == "bond":          # sum_j c_ij V_j / L_ij per point
+            per = self.bond_stiffness * self.factor * b.beta * b.volumes[b.bond_j] / b.length
+            diag = np.bincount(b.bond_i, weights=per, minlength=len(b))
+        else:
+            Kmat = self.stiffness()
+            diag = np.abs(Kmat).sum(axis=1).A.reshape(-1) / np.repeat(b.volumes, self.dim)
         return safety * float(np.sqrt(2.0 * self.material.density / diag.max()))
 
     def damage(self):
