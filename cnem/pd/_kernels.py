@@ -92,3 +92,25 @@ def pmb_correction_moments(xi, length, weight, offsets, pairs, out):
                         nqk = xi[b, q] / L
                         val *= nqk * nqk
                     out[i, t, k] += weight[b] * L * e2 * val
+
+
+@numba.njit(cache=True, parallel=True)
+def pmb_bond_factors(xi, length, offsets, bond_j, pairs, coef, out):
+    """``out[b] = (g_i(n_b) + g_j(n_b)) / 2`` with ``g_i(n) = sum_k coef[i, k] P_k(n)``
+    (``P_k`` as in `pmb_correction_moments`)."""
+    n = len(offsets) - 1
+    npair = len(pairs)
+    for i in numba.prange(n):
+        for b in range(offsets[i], offsets[i + 1]):
+            j = bond_j[b]
+            L = length[b]
+            g = 0.0
+            for k in range(npair):
+                p, q = pairs[k, 0], pairs[k, 1]
+                npk = xi[b, p] / L
+                val = npk * npk
+                if p != q:
+                    nqk = xi[b, q] / L
+                    val *= nqk * nqk
+                g += 0.5 * (coef[i, k] + coef[j, k]) * val
+            out[b] = g

@@ -92,7 +92,8 @@ class Problem:
         self.weight = b.beta * b.volumes[b.bond_j]            # omega beta V_j, omega = 1
         if self.material.kind == "bond":
             c = self.material.micromodulus(self.dim, self.plane, b.horizon, b.thickness)
-            self.bond_stiffness = np.full(len(b.bond_i), c)
+            #: the PMB micromodulus (one value for every bond)
+            self.bond_stiffness = float(c)
         else:
             self._state_operators()
         self.factor = self._correction() if self.surface_correction else np.ones(len(b.bond_i))
@@ -177,18 +178,15 @@ class Problem:
         pairs = np.array([(a, c) for a in range(d) for c in range(a, d)], dtype=np.int64)
         Q = np.zeros((len(b), len(pairs), len(pairs)))
         K.pmb_correction_moments(b.xi, b.length, self.weight, b.family.offsets, pairs, Q)
-        Q *= 0.25 * self.bond_stiffness[0] if len(self.bond_stiffness) else 0.0
+        Q *= 0.25 * self.bond_stiffness
         target = []
         for a, c in pairs:
             eps = np.zeros((d, d))
             eps[a, c] = eps[c, a] = 1.0
             target.append(self._classical_density(eps))
-        coef = self._fit(Q, np.array(target))
-        n = self.unit
-        factor = np.zeros(len(b.bond_i))
-        for k, (a, c) in enumerate(pairs):
-            P = n[:, a] ** 2 * (n[:, c] ** 2 if a != c else 1.0)
-            factor += 0.5 * (coef[b.bond_i, k] + coef[b.bond_j, k]) * P
+        coef = np.ascontiguousarray(self._fit(Q, np.array(target)))
+        factor = np.empty(len(b.bond_i))
+        K.pmb_bond_factors(b.xi, b.length, b.family.offsets, b.bond_j, pairs, coef, factor)
         return factor
 
     @staticmethod
