@@ -41,7 +41,7 @@ class Body:
     Attributes
     ----------
     family : cnem.spatial.Family
-    bond_i, bond_j : (b,) int64 ndarray
+    bond_i, bond_j : (b,) int ndarray
         Bond ``b`` goes from point ``bond_i[b]`` to ``bond_j[b]`` (both directions present).
     xi : (b, d) ndarray
         Reference bond vectors ``x_j - x_i`` (minimum image).
@@ -73,8 +73,9 @@ class Body:
             fam = remove_crossing(fam, self._crossing_points(), np.concatenate(crack_segments))
         self.family = fam
         self.period = fam.period
-        self.bond_i = np.repeat(np.arange(n, dtype=np.int64), fam.counts)
-        self.bond_j = fam.indices.astype(np.int64)
+        index = fam.indices.dtype                  # int32 unless the cloud is huge
+        self.bond_i = np.repeat(np.arange(n, dtype=index), fam.counts)
+        self.bond_j = fam.indices
         nb = len(self.bond_j)
         self.xi, self.length, self.beta = np.empty((nb, d)), np.empty(nb), np.empty(nb)
         spacing = (vol / self.thickness) ** (1.0 / d)
