@@ -68,6 +68,17 @@ def bond_geometry(points, offsets, bond_j, period, spacing, horizon, xi, length,
             beta[b] = 0.0 if f < 0.0 else (1.0 if f > 1.0 else f)
 
 
+@numba.njit(cache=True, inline="always")
+def _direction_function(xi, L, b, p, q):
+    """``P(n) = n_p^2`` (p == q) or ``n_p^2 n_q^2`` of bond ``b``'s direction."""
+    np_ = xi[b, p] / L
+    val = np_ * np_
+    if p != q:
+        nq = xi[b, q] / L
+        val *= nq * nq
+    return val
+
+
 @numba.njit(cache=True, parallel=True)
 def pmb_correction_moments(xi, length, weight, offsets, pairs, out):
     """For the energy-method correction of the PMB: ``out[i, t, k] = sum_j w L
@@ -85,12 +96,7 @@ def pmb_correction_moments(xi, length, weight, offsets, pairs, out):
                 proj = na * nc if a == c else 2.0 * na * nc          # n . eps_t . n
                 e2 = proj * proj
                 for k in range(npair):
-                    p, q = pairs[k, 0], pairs[k, 1]
-                    npk = xi[b, p] / L
-                    val = npk * npk
-                    if p != q:
-                        nqk = xi[b, q] / L
-                        val *= nqk * nqk
+                    val = _direction_function(xi, L, b, pairs[k, 0], pairs[k, 1])
                     out[i, t, k] += weight[b] * L * e2 * val
 
 
@@ -106,11 +112,6 @@ def pmb_bond_factors(xi, length, offsets, bond_j, pairs, coef, out):
             L = length[b]
             g = 0.0
             for k in range(npair):
-                p, q = pairs[k, 0], pairs[k, 1]
-                npk = xi[b, p] / L
-                val = npk * npk
-                if p != q:
-                    nqk = xi[b, q] / L
-                    val *= nqk * nqk
+                val = _direction_function(xi, L, b, pairs[k, 0], pairs[k, 1])
                 g += 0.5 * (coef[i, k] + coef[j, k]) * val
             out[b] = g
