@@ -38,7 +38,7 @@ from .geometry.cracks import split_cracks
 from .geometry.pslg import BOUNDARY, CRACK
 from .models.elasticity import _per_point
 from .models.material import lame, parse_materials, stiffness_matrix
-from .models.solution import _takes_region, von_mises
+from .models.solution import energy_error_density, von_mises
 
 __all__ = ["P1Elasticity", "P1Solution", "mesh_domain"]
 
@@ -492,17 +492,9 @@ class P1Solution:
         x = np.asarray(quad.global_coordinates())             # (2, t, q)
         nq = x.shape[2]
         points = x.reshape(2, -1).T
-        if _takes_region(exact_stress):
-            exact = exact_stress(points, np.repeat(self.region, nq))
-        else:
-            exact = exact_stress(points)
-        exact = np.asarray(exact, dtype=float)
-        if exact.shape != (len(points), 3):
-            raise ValueError(f"exact_stress must return ({len(points)}, 3) values "
-                             f"[sxx, syy, sxy], received shape {exact.shape}")
-        diff = np.repeat(self.stress, nq, axis=0) - exact
-        compliance = np.repeat(np.linalg.inv(self.C), nq, axis=0)
-        density = np.einsum("qi,qij,qj->q", diff, compliance, diff)
+        owner = np.repeat(np.arange(len(self.stress)), nq)
+        density = energy_error_density(owner, points, self.region, self.stress, self.C,
+                                       exact_stress)
         return float(np.sqrt(quad.dx.reshape(-1) @ density))
 
     def energy(self):

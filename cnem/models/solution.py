@@ -8,13 +8,43 @@ import numpy as np
 
 from ..assembly.quadrature import cell_quadrature
 
-__all__ = ["ElasticSolution", "von_mises"]
+__all__ = ["ElasticSolution", "von_mises", "energy_error_density"]
 
 
 def von_mises(stress):
     """Plane von Mises stress of ``(..., 3)`` ``[sxx, syy, sxy]`` (in-plane components)."""
     sxx, syy, sxy = stress[..., 0], stress[..., 1], stress[..., 2]
     return np.sqrt(sxx ** 2 - sxx * syy + syy ** 2 + 3.0 * sxy ** 2)
+
+
+def energy_error_density(owner, points, region, stress, C, exact_stress):
+    """``(σh - σ)ᵀ C⁻¹ (σh - σ)`` at quadrature points of piecewise-constant stresses.
+
+    Parameters
+    ----------
+    owner : (q,) int ndarray
+        The cell (or element) of each point.
+    points : (q, 2) ndarray
+    region : (m,) int ndarray
+        Region of every cell.
+    stress : (m, 3) ndarray
+    C : (m, 3, 3) ndarray
+    exact_stress : callable ``(q, 2) -> (q, 3)`` or ``(q, 2), (q,) -> (q, 3)``
+
+    Returns
+    -------
+    (q,) ndarray
+    """
+    if _takes_region(exact_stress):
+        exact = exact_stress(points, region[owner])
+    else:
+        exact = exact_stress(points)
+    exact = np.asarray(exact, dtype=float)
+    if exact.shape != (len(points), 3):
+        raise ValueError(f"exact_stress must return ({len(points)}, 3) values "
+                         f"[sxx, syy, sxy], received shape {exact.shape}")
+    diff = stress[owner] - exact
+    return np.einsum("qi,qij,qj->q", diff, np.linalg.inv(C)[owner], diff)
 
 
 def _takes_region(func):
@@ -117,17 +147,8 @@ class ElasticSolution:
         float
         """
         cell, points, weights = cell_quadrature(self.cells, self.model.nodes, order)
-        if _takes_region(exact_stress):
-            exact = exact_stress(points, self.cells.region[cell])
-        else:
-            exact = exact_stress(points)
-        exact = np.asarray(exact, dtype=float)
-        if exact.shape != (len(points), 3):
-            raise ValueError(f"exact_stress must return ({len(points)}, 3) values "
-                             f"[sxx, syy, sxy], received shape {exact.shape}")
-        diff = self.stress[cell] - exact
-        compliance = np.linalg.inv(self.C)[cell]
-        density = np.einsum("qi,qij,qj->q", diff, compliance, diff)
+        density = energy_error_density(cell, points, self.cells.region, self.stress, self.C,
+                                       exact_stress)
         return float(np.sqrt(weights @ density))
 
     def energy(self):
