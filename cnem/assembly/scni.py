@@ -224,16 +224,26 @@ class BoundaryQuadrature:
     def __init__(self, points, hint, wx, wy, to_cells):
         self.points, self.hint, self.wx, self.wy, self.to_cells = points, hint, wx, wy, to_cells
 
-    def cell_integrals(self, values):
+    def cell_integrals(self, values, rows=None):
         """``(1 / A_k) ∮_{Γ_k} f n dΓ`` for ``values = f(points)``, ``(q, ...)`` array or
-        sparse ``(q, c)``; returns the x and y parts, ``(m, ...)``."""
-        return self.to_cells @ (self.wx @ values), self.to_cells @ (self.wy @ values)
+        sparse ``(q, c)``; returns the x and y parts, ``(m, ...)``. ``rows``: the
+        point of each row of ``values`` when they come in another order."""
+        wx, wy = self.wx, self.wy
+        if rows is not None:                   # relabel the columns: point rows[r] -> r
+            where = np.empty(len(rows), dtype=np.int64)
+            where[rows] = np.arange(len(rows))
+            wx, wy = (sp.csr_matrix((w.data, where[w.indices], w.indptr), shape=w.shape)
+                      for w in (wx, wy))
+        return self.to_cells @ (wx @ values), self.to_cells @ (wy @ values)
 
     def shape_functions(self, model, select=None):
-        """The shape functions at the points (or at ``points[select]``), sides respected."""
+        """The shape functions at the points (or at ``points[select]``), sides
+        respected, rows in any order: returns ``(Phi, order)``, row ``r`` of ``Phi``
+        at ``points[order[r]]`` (indices into the selection)."""
         if select is None:
-            return model.shape_functions(self.points, triangles=self.hint)
-        return model.shape_functions(self.points[select], triangles=self.hint[select])
+            return model.shape_functions(self.points, triangles=self.hint, in_order=False)
+        return model.shape_functions(self.points[select], triangles=self.hint[select],
+                                     in_order=False)
 
 
 def boundary_quadrature(model, *, gauss=2, cells=None):
@@ -307,7 +317,8 @@ def smoothed_gradient(model, *, gauss=2, cells=None):
     if cells is None and key in model._cache:
         return model._cache[key]
     quad = boundary_quadrature(model, gauss=gauss, cells=cells)
-    bx, by = quad.cell_integrals(quad.shape_functions(model))
+    phi, order = quad.shape_functions(model)
+    bx, by = quad.cell_integrals(phi, rows=order)
     grad = SmoothedGradient(bx.tocsr(), by.tocsr(), len(quad.points))
     if cells is None:
         model._cache[key] = grad

@@ -176,7 +176,9 @@ class Enrichment:
         sides = points.copy()                     # on a crack face: its triangle's side
         on_face = hint >= 0
         sides[on_face] = self.model.nodes[self.model.triangles[hint[on_face]]].mean(axis=1)
-        psi = self.values(points, quad.shape_functions(self.model, select), sides).tocoo()
+        phi, order = quad.shape_functions(self.model, select)
+        psi = self.values(points[order], phi, sides[order]).tocoo()
+        select = select[order]
         full = sp.csr_matrix((psi.data, (select[psi.row], psi.col)),
                              shape=(len(quad.points), len(self)))
         gx, gy = quad.cell_integrals(full)

@@ -115,7 +115,8 @@ class Model:
         """Domain: the body this model discretises."""
         return self.cloud.domain
 
-    def shape_functions(self, points, *, kind="sibson", triangles=None, gradient=False):
+    def shape_functions(self, points, *, kind="sibson", triangles=None, gradient=False,
+                        in_order=True):
         """Constrained natural-neighbour coordinates, see `cnem.shape.shape_functions`.
 
         Returns
@@ -124,7 +125,8 @@ class Model:
             Or ``(Phi, dPhi_dx, dPhi_dy)`` with ``gradient=True``.
         """
         from ..shape import shape_functions
-        return shape_functions(self, points, kind=kind, triangles=triangles, gradient=gradient)
+        return shape_functions(self, points, kind=kind, triangles=triangles, gradient=gradient,
+                               in_order=in_order)
 
     def __repr__(self):
         dom = self.domain

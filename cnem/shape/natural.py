@@ -53,7 +53,8 @@ def _locate_sorted(model, spts, tol):
     return tri_of
 
 
-def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=False):
+def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=False,
+                    in_order=True):
     """Constrained natural-neighbour coordinates of points.
 
     Parameters
@@ -130,12 +131,14 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
     offsets, cols, vals, gx, gy, kinds = K.natural(
         model.nodes, model.triangles, nb, spts, tri_of, visit, tol, tol, work_chunks(),
         kind == "laplace", gradient)
-    offsets, cols, vals, gx, gy = K.permute_rows(offsets, cols, vals, gx, gy, order)
     failed = np.sort(order[kinds == K.FAILED])            # kinds are in path order
     if failed.size:
         raise CNEMError(
             f"the natural-neighbour cavity of {failed.size} points was inconsistent (round-off "
             f"on a circumcircle), first {pts[failed[:3]].tolist()}; please report this case")
+    if not in_order and not gradient:
+        return sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n)), order
+    offsets, cols, vals, gx, gy = K.permute_rows(offsets, cols, vals, gx, gy, order)
     phi = sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n))
     if not gradient:
         return phi
