@@ -31,12 +31,11 @@ from skfem import Basis, ElementTriP1, ElementVector, FacetBasis, LinearForm, Me
 from skfem.helpers import dot, sym_grad
 from skfem.models.elasticity import linear_elasticity
 
-from .assembly import select_nodes
 from .assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from .errors import GeometryError, SolveError
 from .geometry.cracks import split_cracks
 from .geometry.pslg import BOUNDARY, CRACK
-from .models.elasticity import _per_point
+from .assembly.conditions import dirichlet_dofs, per_point
 from .models.material import lame, parse_materials, stiffness_matrix
 from .models.solution import energy_error_density, von_mises
 
@@ -275,15 +274,8 @@ class P1Elasticity:
             ``None`` prescribes both.
         value : float, or callable ``(p, 2) -> (p,)`` (``(p, 2)`` for both components)
         """
-        if component not in (0, 1, None):
-            raise ValueError(f"component: expected 0, 1 or None, received {component!r}")
-        picked = select_nodes(self.nodes, where)
-        if picked.size == 0:
-            raise ValueError("add_dirichlet: `where` selects no node; check the predicate "
-                             "against prob.nodes (boundary nodes lie exactly on the boundary)")
-        comps = [0, 1] if component is None else [component]
-        vals = _per_point(value, self.nodes[picked], len(comps), "add_dirichlet value")
-        dofs = 2 * picked[:, None] + np.asarray(comps)[None, :]
+        dofs, vals = dirichlet_dofs(self.nodes, where, component, value,
+                                    where_to_look="prob.nodes")
         self._values[dofs] = vals
 
     def boundary_facets(self):
@@ -402,9 +394,9 @@ def _vector_load(value, what, *, normal):
         x = w.x.reshape(2, -1).T
         if callable(value):
             args = (x, w.n.reshape(2, -1).T) if normal else (x,)
-            vals = _per_point(value(*args), x, 2, what)
+            vals = per_point(value(*args), x, 2, what)
         else:
-            vals = _per_point(value, x, 2, what)
+            vals = per_point(value, x, 2, what)
         return dot(vals.T.reshape(shape), v)
 
     return form

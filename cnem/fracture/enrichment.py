@@ -194,7 +194,7 @@ class Enrichment:
         -------
         (len(self), 2) ndarray
         """
-        from ..models.elasticity import _per_point
+        from ..assembly.conditions import per_point
         x = self.model.nodes
         slot = np.full(len(x), -1)
         slot[self.nodes] = np.arange(len(self.nodes))
@@ -213,7 +213,7 @@ class Enrichment:
                 pts = a + sk * (b - a)
                 sides = pts - 1e-6 * length[:, None] * nrm        # just inside the body
                 phi = sk if end == 1 else 1.0 - sk
-                tr = _per_point(t(pts, nrm) if callable(t) else t, pts, 2, what)
+                tr = per_point(t(pts, nrm) if callable(t) else t, pts, 2, what)
                 F = np.zeros((len(pts), self.size))
                 for tip in range(len(self.tips)):
                     mine = self.tip_of[j] == tip

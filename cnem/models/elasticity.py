@@ -13,7 +13,8 @@ from skfem.helpers import ddot, sym_grad
 from skfem.models.elasticity import linear_stress
 from tqdm.auto import tqdm
 
-from ..assembly import BilinearForm, CellBasis, select_nodes
+from ..assembly import BilinearForm, CellBasis
+from ..assembly.conditions import dirichlet_dofs, per_point
 from ..assembly.quadrature import subdivide
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import SolveError
@@ -30,21 +31,6 @@ log = logging.getLogger(__name__)
 def elasticity_form(u, v, w):
     """``sigma(u) : eps(v)`` with per-cell Lamé parameters ``w.lam``, ``w.mu``."""
     return ddot(linear_stress(w.lam, w.mu)(sym_grad(u)), sym_grad(v))
-
-
-def _per_point(value, points, width, what):
-    """A constant or a callable evaluated at points, as a ``(p, width)`` array."""
-    arr = np.asarray(value(points) if callable(value) else value, dtype=float)
-    if width == 1 and arr.shape == (len(points),):
-        arr = arr[:, None]
-    try:
-        arr = np.broadcast_to(arr, (len(points), width))
-    except ValueError:
-        raise ValueError(f"{what}: expected a number or one value per point, shape "
-                         f"({len(points)}, {width}), received shape {arr.shape}") from None
-    if not np.isfinite(arr).all():
-        raise ValueError(f"{what}: values must be finite, received NaN or inf")
-    return arr
 
 
 class Elasticity:
@@ -123,16 +109,8 @@ class Elasticity:
             ``None`` prescribes both.
         value : float, or callable ``(p, 2) -> (p,)`` (``(p, 2)`` for both components)
         """
-        if component not in (0, 1, None):
-            raise ValueError(f"component: expected 0, 1 or None, received {component!r}")
-        nodes = select_nodes(self.model.nodes, where)
-        if nodes.size == 0:
-            raise ValueError("add_dirichlet: `where` selects no node; check the predicate "
-                             "against model.nodes (boundary nodes lie exactly on the boundary)")
-        comps = [0, 1] if component is None else [component]
-        vals = _per_point(value, self.model.nodes[nodes], len(comps), "add_dirichlet value")
-        for k, c in enumerate(comps):
-            self._dirichlet.append((2 * nodes + c, vals[:, k]))
+        self._dirichlet.append(dirichlet_dofs(self.model.nodes, where, component, value,
+                                              where_to_look="model.nodes"))
 
     def boundary_edges(self):
         """Edges of the outer boundary, holes and crack faces.
@@ -235,7 +213,7 @@ class Elasticity:
             length = np.linalg.norm(b - a, axis=1)
             for sk, wk in zip(s, w):
                 pts = a + sk * (b - a)
-                tr = _per_point(t(pts, normal) if callable(t) else t, pts, 2, "traction")
+                tr = per_point(t(pts, normal) if callable(t) else t, pts, 2, "traction")
                 np.add.at(f, edges[:, 0], (wk * (1.0 - sk) * length)[:, None] * tr)
                 np.add.at(f, edges[:, 1], (wk * sk * length)[:, None] * tr)
             if self.enrichment is not None:
@@ -243,7 +221,7 @@ class Elasticity:
         cells = self.cells
         for b in self._body:
             pts = x[cells.node]
-            np.add.at(f, cells.node, cells.area[:, None] * _per_point(b, pts, 2, "body force"))
+            np.add.at(f, cells.node, cells.area[:, None] * per_point(b, pts, 2, "body force"))
         # (the enrichment functions vanish at the nodes: no nodal body-force share)
         return np.concatenate([f.reshape(-1), enriched.reshape(-1)])
 

@@ -37,6 +37,9 @@ class Body:
         Periodic cell ``[0, L_1) x ...``: bonds use the minimum image.
     cracks : sequence of (k, 2) polylines, optional
         2-D pre-cracks: bonds crossing them are removed.
+    crossing_points : (n, 2) array_like, optional
+        Positions used for that crossing test only (default the points): points
+        lying on a crack line can be moved a little to the side they belong to.
 
     Attributes
     ----------
@@ -50,7 +53,8 @@ class Body:
         Partial-volume factors of bonds cut by the horizon.
     """
 
-    def __init__(self, points, volumes, horizon, *, thickness=1.0, period=None, cracks=()):
+    def __init__(self, points, volumes, horizon, *, thickness=1.0, period=None, cracks=(),
+                 crossing_points=None):
         pts = np.ascontiguousarray(points, dtype=float)
         if pts.ndim != 2 or pts.shape[1] not in (2, 3) or len(pts) == 0:
             raise ValueError(f"points: expected a non-empty (n, 2) or (n, 3) array, received "
@@ -70,7 +74,8 @@ class Body:
         crack_segments = [np.column_stack([c[:-1], c[1:]]).reshape(-1, 2, 2)
                           for c in (np.asarray(c, dtype=float) for c in cracks)]
         if crack_segments:
-            fam = remove_crossing(fam, self._crossing_points(), np.concatenate(crack_segments))
+            test = pts if crossing_points is None else np.asarray(crossing_points, dtype=float)
+            fam = remove_crossing(fam, test, np.concatenate(crack_segments))
         self.family = fam
         self.period = fam.period
         index = fam.indices.dtype                  # int32 unless the cloud is huge
@@ -81,10 +86,6 @@ class Body:
         spacing = (vol / self.thickness) ** (1.0 / d)
         bond_geometry(pts, fam.offsets, self.bond_j, np.ascontiguousarray(self.period, dtype=float),
                       spacing, horizon, self.xi, self.length, self.beta)
-
-    def _crossing_points(self):
-        """Positions used to decide which bonds cross a crack (the points themselves)."""
-        return self.points
 
     @classmethod
     def from_cloud(cls, cloud, horizon_factor=3.0, *, thickness=1.0):
@@ -106,17 +107,15 @@ class Body:
         model = discretize(cloud, progress=False)
         area = np.bincount(model.cells.node, weights=model.cells.area, minlength=len(model.nodes))
         h = np.sqrt(model.domain.area / len(np.unique(model.node_of_point)))
-        body = cls.__new__(cls)
         copies = np.bincount(model.node_of_point)[model.node_of_point] > 1
         # a crack-face copy is nudged towards its own face for the crossing test only
         shift = node_sides(model) - model.nodes
         norm = np.maximum(np.hypot(*shift.T), 1e-300)[:, None]
-        body._nudged = model.nodes + np.where(copies[:, None], 1e-6 * h * shift / norm, 0.0)
-        body._crossing_points = lambda: body._nudged
+        nudged = model.nodes + np.where(copies[:, None], 1e-6 * h * shift / norm, 0.0)
         horizon = horizon_factor * h
-        Body.__init__(body, model.nodes, area * thickness, horizon, thickness=thickness,
-                      cracks=[_past_the_mouths(c, model.domain.tips, horizon)
-                              for c in model.domain.cracks])
+        body = cls(model.nodes, area * thickness, horizon, thickness=thickness,
+                   cracks=[_past_the_mouths(c, model.domain.tips, horizon)
+                           for c in model.domain.cracks], crossing_points=nudged)
         body.model = model
         return body
 

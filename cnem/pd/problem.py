@@ -10,7 +10,7 @@ import numpy as np
 import scipy.sparse as sp
 from tqdm.auto import tqdm
 
-from ..assembly.basis import select_nodes
+from ..assembly.conditions import dirichlet_dofs, per_point
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import SolveError
 from . import _kernels as K
@@ -19,11 +19,6 @@ from .materials import PLANES
 __all__ = ["Problem", "StaticSolution", "DynamicRun"]
 
 log = logging.getLogger(__name__)
-
-
-def _per_point(value, points, width, what):
-    from ..models.elasticity import _per_point as check
-    return check(value, points, width, what)
 
 
 class StaticSolution:
@@ -289,16 +284,8 @@ class Problem:
     # -- conditions ---------------------------------------------------------------------
     def add_dirichlet(self, where, component, value=0.0):
         """Prescribed displacements at points (same meaning as `cnem.Elasticity.add_dirichlet`)."""
-        d = self.dim
-        if component is not None and component not in range(d):
-            raise ValueError(f"component: expected None or 0..{d - 1}, received {component!r}")
-        nodes = select_nodes(self.body.points, where)
-        if nodes.size == 0:
-            raise ValueError("add_dirichlet: `where` selects no point")
-        comps = list(range(d)) if component is None else [component]
-        vals = _per_point(value, self.body.points[nodes], len(comps), "add_dirichlet value")
-        for k, c in enumerate(comps):
-            self._dirichlet.append((d * nodes + c, vals[:, k]))
+        self._dirichlet.append(dirichlet_dofs(self.body.points, where, component, value,
+                                              where_to_look="body.points"))
 
     def add_body_force(self, b):
         """Force per unit volume: ``b(x) -> (p, d)`` or a constant."""
@@ -308,7 +295,7 @@ class Problem:
         """External forces ``(d n,)``: body forces times volumes."""
         f = np.zeros((len(self.body), self.dim))
         for b in self._body:
-            f += self.body.volumes[:, None] * _per_point(b, self.body.points, self.dim, "body force")
+            f += self.body.volumes[:, None] * per_point(b, self.body.points, self.dim, "body force")
         return f.reshape(-1)
 
     def _prescribed(self):
@@ -437,7 +424,7 @@ class Problem:
         u.reshape(-1)[D] = values
         v = np.zeros((n, d))
         if velocity is not None:
-            v[:] = _per_point(velocity, b.points, d, "velocity")
+            v[:] = per_point(velocity, b.points, d, "velocity")
         v.reshape(-1)[D] = 0.0
         fext = self.load().reshape(n, d) / b.volumes[:, None]
         force, broken = self._internal_force(u, limit, state)
