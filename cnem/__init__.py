@@ -7,7 +7,8 @@
 1.0
 """
 
-from . import assembly, exact, fracture, geometry, io, models, nodes, plot, shape, spatial
+from . import (assembly, exact, fracture, geometry, hyperdual, io, models, nodes, plot, shape,
+               spatial)
 from .errors import CNEMError, GeometryError, SolveError
 from .geometry import Domain, Model, NodeCloud, discretize
 from .models import ElasticSolution, Elasticity
@@ -16,5 +17,5 @@ __version__ = "0.1.0"
 
 __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
            "nodes", "geometry", "assembly", "models", "exact", "fracture", "io", "plot", "shape",
-           "spatial",
+           "spatial", "hyperdual",
            "CNEMError", "GeometryError", "SolveError", "__version__"]

@@ -1,0 +1,410 @@
+"""Vectorised hyper-dual numbers: exact first and second derivatives (paper §3, eq. 22-31).
+
+A hyper-dual number is ``a + b eps1 + c eps2 + d eps1eps2`` with ``eps1**2 = eps2**2 = 0`` and
+``eps1eps2 != 0``; here ``a, b, c, d`` are NumPy arrays of one shape. A smooth function obeys
+``g(x) = g(a) + g'(a) b eps1 + g'(a) c eps2 + (g'(a) d + g''(a) b c) eps1eps2``, so an energy
+written once with the operators and functions of this module returns its exact first and
+second derivatives, free of the truncation and cancellation errors of finite differences.
+
+>>> import numpy as np
+>>> from cnem import hyperdual as hd
+>>> x = hd.HyperDual([1.0, 2.0], e1=1.0, e2=1.0)      # seed d/dx in both directions
+>>> y = x ** 3 + hd.sin(x)
+>>> np.allclose(y.e1, 3 * x.re ** 2 + np.cos(x.re)), np.allclose(y.e12, 6 * x.re - np.sin(x.re))
+(True, True)
+>>> value, grad, hess = hd.derivatives(hd.norm, np.array([[3.0, 4.0]]))   # |y|, y = (3, 4)
+>>> value, grad, hess * 125
+(array([5.]), array([[0.6, 0.8]]), array([[[ 16., -12.],
+        [-12.,   9.]]]))
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .errors import CNEMError
+
+__all__ = ["HyperDual", "HyperDualError", "sqrt", "exp", "log", "sin", "cos", "tan", "arcsin",
+           "arccos", "arctan", "sinh", "cosh", "tanh", "power", "dot", "cross", "norm", "stack",
+           "concatenate", "derivatives", "derivative"]
+
+_PARTS = ("re", "e1", "e2", "e12")
+_CHUNK = 2 ** 21     # real numbers per part handed to f in one call of `derivatives`
+
+
+class HyperDualError(CNEMError, ValueError):
+    """Invalid hyper-dual input: shapes that do not broadcast, wrong vector lengths or outputs."""
+
+
+def _broadcast(shapes, what):
+    """Common broadcast shape of ``shapes``, or a HyperDualError naming ``what``."""
+    try:
+        return np.broadcast_shapes(*shapes)
+    except ValueError:
+        raise HyperDualError(
+            f"{what}: expected operands whose shapes broadcast, got shapes "
+            f"{', '.join(map(str, shapes))}; add axes (e.g. a[:, None]) or reshape so that NumPy "
+            f"broadcasting applies") from None
+
+
+class HyperDual:
+    """Array of hyper-dual numbers ``re + e1 eps1 + e2 eps2 + e12 eps1eps2``.
+
+    Parameters
+    ----------
+    re, e1, e2, e12 : array_like
+        Real part and the three non-real parts; they are converted to float64 and broadcast
+        to one shape (read-only views where broadcasting repeats data).
+
+    Notes
+    -----
+    Arithmetic (``+ - * / **``, unary ``-``, ``abs``) mixes freely with Python scalars and
+    ndarrays on either side and broadcasts like NumPy. Comparisons compare the real parts and
+    return bool arrays. Objects are immutable: operations return new ones.
+    """
+
+    __slots__ = _PARTS
+    __array_ufunc__ = None        # ndarray <op> HyperDual defers to the reflected method here
+    __hash__ = None
+
+    def __init__(self, re, e1=0.0, e2=0.0, e12=0.0):
+        parts = [np.asarray(p, dtype=np.float64) for p in (re, e1, e2, e12)]
+        shape = _broadcast([p.shape for p in parts], "HyperDual(re, e1, e2, e12)")
+        for name, p in zip(_PARTS, parts):
+            object.__setattr__(self, name, p if p.shape == shape else np.broadcast_to(p, shape))
+
+    def __setattr__(self, name, value):
+        raise AttributeError("HyperDual is immutable; build a new one with HyperDual(re, e1, ...)")
+
+    @property
+    def shape(self):
+        """tuple : Shape of every part."""
+        return self.re.shape
+
+    @property
+    def ndim(self):
+        """int : Number of dimensions."""
+        return self.re.ndim
+
+    def __len__(self):
+        return len(self.re)
+
+    def __getitem__(self, index):
+        return HyperDual(*(getattr(self, p)[index] for p in _PARTS))
+
+    def __repr__(self):
+        return "HyperDual(" + ", ".join(f"{p}={getattr(self, p)!r}" for p in _PARTS) + ")"
+
+    def sum(self, axis=None):
+        """Sum over ``axis`` (all axes when None), each part separately."""
+        return HyperDual(*(getattr(self, p).sum(axis=axis) for p in _PARTS))
+
+    def reshape(self, *shape):
+        """Same numbers in a new shape (as ``ndarray.reshape``)."""
+        return HyperDual(*(getattr(self, p).reshape(*shape) for p in _PARTS))
+
+    def _chain(self, g0, g1, g2):
+        """g(self) from g(re), g'(re), g''(re)."""
+        return HyperDual(g0, g1 * self.e1, g1 * self.e2, g1 * self.e12 + g2 * self.e1 * self.e2)
+
+    def _operand(self, other, op):
+        """``other`` as a HyperDual (or float ndarray) after checking the shapes broadcast."""
+        if not isinstance(other, HyperDual):
+            other = np.asarray(other, dtype=np.float64)
+        _broadcast([self.shape, other.shape], f"HyperDual {op}")
+        return other
+
+    def __add__(self, other):
+        o = self._operand(other, "+")
+        if isinstance(o, HyperDual):
+            return HyperDual(*(getattr(self, p) + getattr(o, p) for p in _PARTS))
+        return HyperDual(self.re + o, self.e1, self.e2, self.e12)
+
+    __radd__ = __add__
+
+    def __neg__(self):
+        return HyperDual(-self.re, -self.e1, -self.e2, -self.e12)
+
+    def __sub__(self, other):
+        return self + (-self._operand(other, "-"))
+
+    def __rsub__(self, other):
+        return (-self) + other
+
+    def __mul__(self, o):
+        o = self._operand(o, "*")
+        if not isinstance(o, HyperDual):
+            return HyperDual(*(getattr(self, p) * o for p in _PARTS))
+        return HyperDual(self.re * o.re, self.re * o.e1 + self.e1 * o.re,
+                         self.re * o.e2 + self.e2 * o.re,
+                         self.re * o.e12 + self.e1 * o.e2 + self.e2 * o.e1 + self.e12 * o.re)
+
+    __rmul__ = __mul__
+
+    def _reciprocal(self):
+        r = 1.0 / self.re
+        return self._chain(r, -r * r, 2.0 * r * r * r)
+
+    def __truediv__(self, other):
+        o = self._operand(other, "/")
+        return self * (o._reciprocal() if isinstance(o, HyperDual) else 1.0 / o)
+
+    def __rtruediv__(self, other):
+        return self._reciprocal() * self._operand(other, "/")
+
+    def __pow__(self, p):
+        p = self._operand(p, "**")
+        if isinstance(p, HyperDual):
+            return exp(p * log(self))
+        a = self.re
+        with np.errstate(divide="ignore", invalid="ignore"):   # 0 ** negative -> inf, as NumPy
+            g1 = np.where(p == 0, 0.0, p * a ** (p - 1))
+            g2 = np.where(p * (p - 1) == 0, 0.0, p * (p - 1) * a ** (p - 2))
+        return self._chain(a ** p, g1, g2)
+
+    def __rpow__(self, base):
+        return exp(self * log(self._operand(base, "**")))
+
+    def __abs__(self):
+        return self._chain(np.abs(self.re), np.sign(self.re), np.zeros(self.shape))
+
+    def _compare(self, other, op):
+        o = other.re if isinstance(other, HyperDual) else self._operand(other, "comparison")
+        return np.asarray(op(self.re, o))
+
+    def __lt__(self, other):
+        return self._compare(other, np.less)
+
+    def __le__(self, other):
+        return self._compare(other, np.less_equal)
+
+    def __gt__(self, other):
+        return self._compare(other, np.greater)
+
+    def __ge__(self, other):
+        return self._compare(other, np.greater_equal)
+
+    def __eq__(self, other):
+        return self._compare(other, np.equal)
+
+    def __ne__(self, other):
+        return self._compare(other, np.not_equal)
+
+
+def _elementwise(name, real, rule):
+    """A function of one argument: ``real`` on plain input, chain rule ``rule(a)`` on HyperDual."""
+    def func(x):
+        if isinstance(x, HyperDual):
+            return x._chain(*rule(x.re))
+        return real(np.asarray(x, dtype=np.float64))
+    func.__name__ = func.__qualname__ = name
+    func.__doc__ = (f"Elementwise ``{name}``: of a HyperDual (exact derivatives) or of real input "
+                    f"(then a plain NumPy result, as ``numpy.{name}``).")
+    return func
+
+
+def _sqrt_rule(a):
+    s = np.sqrt(a)
+    return s, 0.5 / s, -0.25 / (s * a)
+
+
+def _exp_rule(a):
+    e = np.exp(a)
+    return e, e, e
+
+
+def _tan_rule(a):
+    t = np.tan(a)
+    return t, 1 + t * t, 2 * t * (1 + t * t)
+
+
+def _tanh_rule(a):
+    t = np.tanh(a)
+    return t, 1 - t * t, -2 * t * (1 - t * t)
+
+
+def _arcsin_rule(a):
+    w = 1 - a * a
+    return np.arcsin(a), 1 / np.sqrt(w), a / w ** 1.5
+
+
+def _arccos_rule(a):
+    w = 1 - a * a
+    return np.arccos(a), -1 / np.sqrt(w), -a / w ** 1.5
+
+
+sqrt = _elementwise("sqrt", np.sqrt, _sqrt_rule)
+exp = _elementwise("exp", np.exp, _exp_rule)
+log = _elementwise("log", np.log, lambda a: (np.log(a), 1 / a, -1 / (a * a)))
+sin = _elementwise("sin", np.sin, lambda a: (np.sin(a), np.cos(a), -np.sin(a)))
+cos = _elementwise("cos", np.cos, lambda a: (np.cos(a), -np.sin(a), -np.cos(a)))
+tan = _elementwise("tan", np.tan, _tan_rule)
+arcsin = _elementwise("arcsin", np.arcsin, _arcsin_rule)
+arccos = _elementwise("arccos", np.arccos, _arccos_rule)
+arctan = _elementwise("arctan", np.arctan,
+                      lambda a: (np.arctan(a), 1 / (1 + a * a), -2 * a / (1 + a * a) ** 2))
+sinh = _elementwise("sinh", np.sinh, lambda a: (np.sinh(a), np.cosh(a), np.sinh(a)))
+cosh = _elementwise("cosh", np.cosh, lambda a: (np.cosh(a), np.sinh(a), np.cosh(a)))
+tanh = _elementwise("tanh", np.tanh, _tanh_rule)
+
+
+def power(x, p):
+    """``x ** p`` for HyperDual or real ``x`` and real or HyperDual ``p`` (HyperDual: x > 0)."""
+    if isinstance(x, HyperDual):
+        return x ** p
+    x = np.asarray(x, dtype=np.float64)
+    return p.__rpow__(x) if isinstance(p, HyperDual) else x ** p
+
+
+def _vectors(a, b, what):
+    """Check two vector arrays (last axis = components) of equal length; return them."""
+    a, b = (v if isinstance(v, HyperDual) else np.asarray(v, dtype=np.float64) for v in (a, b))
+    if a.ndim == 0 or b.ndim == 0 or a.shape[-1] != b.shape[-1]:
+        raise HyperDualError(
+            f"{what}: expected two arrays of vectors with the components on the last axis and the "
+            f"same number of components, got shapes {a.shape} and {b.shape}; put the components "
+            f"last (shape (..., d)) in both")
+    _broadcast([a.shape[:-1], b.shape[:-1]], what)
+    return a, b
+
+
+def _stack_any(items):
+    if any(isinstance(v, HyperDual) for v in items):
+        return stack(items, axis=-1)
+    return np.stack(np.broadcast_arrays(*items), axis=-1)
+
+
+def dot(a, b):
+    """Dot product over the last axis: ``(..., d), (..., d) -> (...)``; either may be real."""
+    a, b = _vectors(a, b, "hd.dot")
+    return (a * b).sum(axis=-1)
+
+
+def norm(a):
+    """Euclidean norm over the last axis: ``(..., d) -> (...)``."""
+    return sqrt(dot(a, a))
+
+
+def cross(a, b):
+    """Cross product over the last axis.
+
+    Parameters
+    ----------
+    a, b : (..., 2) or (..., 3) HyperDual or ndarray
+
+    Returns
+    -------
+    (...) for 2-D vectors (``a0 b1 - a1 b0``), (..., 3) for 3-D vectors.
+    """
+    a, b = _vectors(a, b, "hd.cross")
+    d = a.shape[-1]
+    if d == 2:
+        return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    if d == 3:
+        return _stack_any([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                           a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                           a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]])
+    raise HyperDualError(f"hd.cross: expected vectors of 2 or 3 components on the last axis, got "
+                         f"{d} (shapes {a.shape} and {b.shape}); pass 2-D or 3-D vectors")
+
+
+def stack(items, axis=-1):
+    """Stack HyperDuals (or reals) of broadcast-compatible shapes along a new ``axis``."""
+    items = [v if isinstance(v, HyperDual) else HyperDual(v) for v in items]
+    shape = _broadcast([v.shape for v in items], "hd.stack")
+    return HyperDual(*(np.stack([np.broadcast_to(getattr(v, p), shape) for v in items], axis)
+                       for p in _PARTS))
+
+
+def concatenate(items, axis=-1):
+    """Join HyperDuals (or reals) along the existing ``axis`` (default the last, components)."""
+    items = [v if isinstance(v, HyperDual) else HyperDual(v) for v in items]
+    try:
+        return HyperDual(*(np.concatenate([getattr(v, p) for v in items], axis)
+                           for p in _PARTS))
+    except ValueError as exc:      # includes numpy AxisError
+        raise HyperDualError(f"hd.concatenate along axis {axis}: expected shapes equal except on "
+                             f"that axis, got {[v.shape for v in items]} ({exc})") from None
+
+
+def _check_output(out, shape, what, hint=""):
+    if not isinstance(out, HyperDual) or out.shape != shape:
+        got = f"shape {out.shape}" if isinstance(out, HyperDual) else type(out).__name__
+        raise HyperDualError(
+            f"{what}: f must return a HyperDual of shape {shape}, got {got}; write f with the "
+            f"hd functions (not numpy's, which drop the derivative parts), act row by row and "
+            f"index components as y[..., j]{hint}")
+
+
+def derivatives(f, x, *, batch=True):
+    """Value, gradient and Hessian of a scalar function of ``k`` variables at ``m`` points.
+
+    Seeds ``eps1`` along variable p and ``eps2`` along q for every pair p <= q (eq. 30):
+    ``k (k + 1) / 2`` evaluations of ``f``, vectorised over the points and the pairs.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(y) -> HyperDual`` for ``y`` a HyperDual of shape ``(..., m, k)``, returning shape
+        ``(..., m)``: the function of each row, written with this module's functions.
+        With ``batch=True`` the pairs are batched on a leading axis (``y`` has shape
+        ``(n, m, k)``), so f must index components as ``y[..., j]`` and per-point data of
+        shape ``(m,)`` or ``(m, d)`` broadcasts. With ``batch=False`` f is called with exactly
+        ``(m, k)`` once per pair.
+    x : (m, k) array_like
+        Real points.
+
+    Returns
+    -------
+    value : (m,) ndarray
+    gradient : (m, k) ndarray
+    hessian : (m, k, k) ndarray, symmetric
+    """
+    if isinstance(x, HyperDual) or np.ndim(x) != 2 or np.shape(x)[1] == 0:
+        raise HyperDualError(
+            f"hd.derivatives: expected real x of shape (m, k) (m points, k >= 1 variables), got "
+            f"{'a HyperDual' if isinstance(x, HyperDual) else 'shape'} {np.shape(x)}; pass "
+            f"x[:, None] for one variable or x.reshape(m, -1) for several")
+    x = np.asarray(x, dtype=np.float64)
+    m, k = x.shape
+    first, second = np.triu_indices(k)
+    eye = np.eye(k)
+    value, grad, hess = np.empty(m), np.empty((m, k)), np.empty((m, k, k))
+    step = max(1, _CHUNK // max(m * k, 1)) if batch else 1
+    for start in range(0, len(first), step):
+        p, q = first[start:start + step], second[start:start + step]
+        if batch:
+            shape = (len(p), m, k)
+            out = f(HyperDual(np.broadcast_to(x, shape), eye[p][:, None], eye[q][:, None]))
+            _check_output(out, shape[:2], "hd.derivatives", "; with batch=True f receives y of "
+                          f"shape {shape} (pairs, points, variables), batch=False calls f with "
+                          f"exactly {(m, k)} once per pair")
+        else:
+            out = f(HyperDual(x, eye[p[0]], eye[q[0]]))
+            _check_output(out, (m,), "hd.derivatives")
+            out = out.reshape(1, m)
+        hess[:, p, q] = hess[:, q, p] = out.e12.T
+        diag = p == q
+        grad[:, p[diag]] = out.e1[diag].T
+        value[:] = out.re[0]
+    return value, grad, hess
+
+
+def derivative(f, x):
+    """Value, first and second derivative of an elementwise scalar function (eq. 27).
+
+    Parameters
+    ----------
+    f : callable
+        ``f(y) -> HyperDual`` of the same shape as ``y``, applied elementwise.
+    x : (m,) array_like
+        Real arguments (any shape).
+
+    Returns
+    -------
+    value, first, second : (m,) ndarrays
+    """
+    x = np.asarray(x, dtype=np.float64)
+    out = f(HyperDual(x, 1.0, 1.0))
+    _check_output(out, x.shape, "hd.derivative")
+    return np.array(out.re), np.array(out.e1), np.array(out.e12)
