@@ -485,8 +485,8 @@ class P1Solution:
         nq = x.shape[2]
         points = x.reshape(2, -1).T
         owner = np.repeat(np.arange(len(self.stress)), nq)
-        density = energy_error_density(owner, points, self.region, self.stress, self.C,
-                                       exact_stress)
+        density = energy_error_density(points, self.region[owner], self.stress[owner],
+                                       self.C[owner], exact_stress)
         return float(np.sqrt(quad.dx.reshape(-1) @ density))
 
     def energy(self):

@@ -161,6 +161,46 @@ def test_patch_test_with_enrichment(name, functions):
                                atol=1e-8)
 
 
+@pytest.mark.parametrize("functions", ["sqrt", "branch"])
+def test_enrichment_gradients_match_finite_differences(functions):
+    """The gradients of the enrichment functions psi_jk (and so of an enriched
+    displacement field) equal central differences of their values at random
+    points (generic points: off the circumcircles where Sibson gradients jump)."""
+    model = _model(30.0, 0.2, True)
+    enr = cnem.fracture.Enrichment(model, [(0.0, 0.0)], 0.5, functions=functions)
+    rng = np.random.default_rng(3)
+    pts = rng.uniform(-0.6, 0.6, (40, 2))
+    pts = pts[np.hypot(*pts.T) > 0.05]
+    phi, dx, dy = model.shape_functions(pts, gradient=True)
+    psi, gx, gy = enr.values(pts, phi, gradient=(dx, dy))
+    step = 1e-7
+    for axis, grad in enumerate((gx, gy)):
+        e = np.zeros(2)
+        e[axis] = step
+        plus = enr.values(pts + e, model.shape_functions(pts + e)).toarray()
+        minus = enr.values(pts - e, model.shape_functions(pts - e)).toarray()
+        np.testing.assert_allclose(grad.toarray(), (plus - minus) / (2 * step), atol=2e-5)
+    assert abs(psi).max() > 0 and abs(gx).max() > 0
+
+
+def test_pointwise_energy_error_of_an_enriched_solution_vanishes_on_a_linear_field():
+    """The displacement gradient at points (Sibson + enrichment gradients) is exact
+    for a linear field: the pointwise energy error vanishes to round-off."""
+    import cases
+    _, _, model = cases.model("edge_crack_regular")
+    prob = cnem.Elasticity(model, (E, NU), enrich=dict(radius=0.2, functions="branch"))
+    field = lambda p: np.column_stack([1e-3 * (1 + 2 * p[:, 0] - p[:, 1]), 1e-3 * (0.5 * p[:, 0] + p[:, 1])])
+    boundary = np.unique(model.segments[model.segment_kind != 1])
+    prob.add_dirichlet(boundary, None, field)
+    sol = prob.solve(progress=False)
+    D = E / (1 - NU ** 2) * np.array([[1, NU, 0], [NU, 1, 0], [0, 0, (1 - NU) / 2]])
+    sigma = D @ (1e-3 * np.array([2.0, 1.0, -0.5]))
+    exact = lambda x: np.tile(sigma, (len(x), 1))
+    assert sol.energy_error(exact, strain="pointwise") < 1e-7 * np.linalg.norm(sigma)
+    with pytest.raises(ValueError, match="pointwise"):
+        sol.energy_error(exact, strain="nodal")
+
+
 def test_enrichment_improves_an_imposed_singular_field():
     """The mode-I Williams field imposed on the boundary: the enriched solution is
     closer to it (energy norm) than plain C-NEM on the same nodes."""

@@ -107,17 +107,29 @@ class Enrichment:
         return (f"<Enrichment {self.functions}, {len(self.nodes)} nodes within {self.radius:g} "
                 f"of {len(self.tips)} tip(s)>")
 
-    def evaluate(self, points, tip, sides):
+    def evaluate(self, points, tip, sides, *, gradient=False):
         """The functions ``F_k`` about one tip, ``(p, size)``; ``sides`` are points on
-        the side wanted for points on the crack faces."""
+        the side wanted for points on the crack faces. With ``gradient=True`` also
+        their gradients ``(p, size, 2)`` (points off the tip)."""
         r, theta = sided_polar(points, self.tips[tip], self.directions[tip], sides)
         root = np.sqrt(r)
         if self.functions == "sqrt":
-            return root[:, None]
-        s, c, st = np.sin(theta / 2), np.cos(theta / 2), np.sin(theta)
-        return np.column_stack([root * s, root * c, root * s * st, root * c * st])
+            angular, slope = np.ones((len(r), 1)), np.zeros((len(r), 1))
+        else:
+            s, c, st, ct = np.sin(theta / 2), np.cos(theta / 2), np.sin(theta), np.cos(theta)
+            angular = np.column_stack([s, c, s * st, c * st])
+            slope = np.column_stack([c / 2, -s / 2, c / 2 * st + s * ct, -s / 2 * st + c * ct])
+        F = root[:, None] * angular
+        if not gradient:
+            return F
+        # F = sqrt(r) g(theta): grad F = g / (2 sqrt(r)) e_r + g'(theta) / sqrt(r) e_theta
+        e_r = (points - self.tips[tip]) / r[:, None]
+        e_theta = np.column_stack([-e_r[:, 1], e_r[:, 0]])
+        dF = (angular[:, :, None] * e_r[:, None, :] / 2 + slope[:, :, None] * e_theta[:, None, :]) \
+            / root[:, None, None]
+        return F, dF
 
-    def values(self, points, phi, sides=None):
+    def values(self, points, phi, sides=None, *, gradient=None):
         """The functions ``psi_jk`` at points from the shape functions there.
 
         Parameters
@@ -128,22 +140,47 @@ class Enrichment:
         sides : (p, 2) ndarray, optional
             For points on a crack face, a point on the side wanted (default
             the points themselves).
+        gradient : (dphi_dx, dphi_dy), sparse (p, n) with phi's pattern, optional
+            The shape-function gradients: then the gradients of ``psi_jk``
+            are returned too (points inside cells, off the tips).
 
         Returns
         -------
         scipy.sparse.csr_matrix, shape (p, len(self))
+            Or ``(psi, dpsi_dx, dpsi_dy)`` with ``gradient``.
         """
         sides = points if sides is None else sides
-        sub = phi.tocsc()[:, self.nodes].tocoo()
+        columns = phi.tocsc()[:, self.nodes]
+        sub = columns.tocoo()
         F = np.zeros((len(sub.row), self.size))
+        dF = np.zeros((len(sub.row), self.size, 2))
         for t in range(len(self.tips)):
             mine = self.tip_of[sub.col] == t
-            F[mine] = self.evaluate(points[sub.row[mine]], t, sides[sub.row[mine]])
-        data = sub.data[:, None] * (F - self._at_nodes[sub.col])
-        cols = sub.col[:, None] * self.size + np.arange(self.size)
+            got = self.evaluate(points[sub.row[mine]], t, sides[sub.row[mine]],
+                                gradient=gradient is not None)
+            if gradient is None:
+                F[mine] = got
+            else:
+                F[mine], dF[mine] = got
+        shifted = F - self._at_nodes[sub.col]
+        cols = (sub.col[:, None] * self.size + np.arange(self.size)).reshape(-1)
         rows = np.repeat(sub.row, self.size)
-        return sp.csr_matrix((data.reshape(-1), (rows, cols.reshape(-1))),
-                             shape=(len(points), len(self)))
+
+        def matrix(data):
+            return sp.csr_matrix((data.reshape(-1), (rows, cols)), shape=(len(points), len(self)))
+
+        psi = matrix(sub.data[:, None] * shifted)
+        if gradient is None:
+            return psi
+        out = [psi]
+        for axis, dphi in enumerate(gradient):
+            # dphi has phi's pattern: its entries line up with sub's
+            d = dphi.tocsc()[:, self.nodes].tocoo()
+            if not (np.array_equal(d.row, sub.row) and np.array_equal(d.col, sub.col)):
+                raise ValueError("gradient: expected shape-function gradients with the "
+                                 "sparsity pattern of phi (from one shape_functions call)")
+            out.append(matrix(d.data[:, None] * shifted + sub.data[:, None] * dF[:, :, axis]))
+        return tuple(out)
 
     def support_radius(self):
         """Per tip, a radius about it holding the supports of its enriched functions

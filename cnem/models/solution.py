@@ -17,18 +17,18 @@ def von_mises(stress):
     return np.sqrt(sxx ** 2 - sxx * syy + syy ** 2 + 3.0 * sxy ** 2)
 
 
-def energy_error_density(owner, points, region, stress, C, exact_stress):
-    """``(σh - σ)ᵀ C⁻¹ (σh - σ)`` at quadrature points of piecewise-constant stresses.
+def energy_error_density(points, region, stress, C, exact_stress):
+    """``(σh - σ)ᵀ C⁻¹ (σh - σ)`` at quadrature points.
 
     Parameters
     ----------
-    owner : (q,) int ndarray
-        The cell (or element) of each point.
     points : (q, 2) ndarray
-    region : (m,) int ndarray
-        Region of every cell.
-    stress : (m, 3) ndarray
-    C : (m, 3, 3) ndarray
+    region : (q,) int ndarray
+        Region of the cell (or element) holding each point.
+    stress : (q, 3) ndarray
+        The approximate stress ``σh`` at the points.
+    C : (q, 3, 3) ndarray
+        The elastic matrix at the points.
     exact_stress : callable ``(q, 2) -> (q, 3)`` or ``(q, 2), (q,) -> (q, 3)``
 
     Returns
@@ -36,15 +36,15 @@ def energy_error_density(owner, points, region, stress, C, exact_stress):
     (q,) ndarray
     """
     if _takes_region(exact_stress):
-        exact = exact_stress(points, region[owner])
+        exact = exact_stress(points, region)
     else:
         exact = exact_stress(points)
     exact = np.asarray(exact, dtype=float)
     if exact.shape != (len(points), 3):
         raise ValueError(f"exact_stress must return ({len(points)}, 3) values "
                          f"[sxx, syy, sxy], received shape {exact.shape}")
-    diff = stress[owner] - exact
-    return np.einsum("qi,qij,qj->q", diff, np.linalg.inv(C)[owner], diff)
+    diff = stress - exact
+    return np.einsum("qi,qij,qj->q", diff, np.linalg.inv(C), diff)
 
 
 def _takes_region(func):
@@ -126,11 +126,39 @@ class ElasticSolution:
             out += enrichment.values(np.asarray(points, dtype=float), phi) @ self.enriched
         return out
 
-    def energy_error(self, exact_stress, *, order=4):
+    def displacement_gradient(self, points):
+        """The gradient of the displacement field itself (not smoothed) at points
+        inside the cells: Sibson gradients, plus the enrichment's.
+
+        Parameters
+        ----------
+        points : (p, 2) array_like
+            Off the nodes' cell boundaries where the gradients jump, and off the
+            crack tips.
+
+        Returns
+        -------
+        (p, 2, 2) ndarray
+            ``[q, i, j] = du_i/dx_j``.
+        """
+        pts = np.asarray(points, dtype=float)
+        phi, dx, dy = self.model.shape_functions(pts, gradient=True)
+        out = np.stack([dx @ self.u, dy @ self.u], axis=2)
+        enrichment = self.problem.enrichment
+        if enrichment is not None:
+            _, ex, ey = enrichment.values(pts, phi, gradient=(dx, dy))
+            out += np.stack([ex @ self.enriched, ey @ self.enriched], axis=2)
+        return out
+
+    def energy_error(self, exact_stress, *, order=4, strain="smoothed"):
         """Error in the energy norm against an exact stress field.
 
-        ``sqrt(sum_k ∫_{cell k} (σh - σ)ᵀ C⁻¹ (σh - σ) dΩ)`` with the constant
-        SCNI stress ``σh`` of each cell and a quadrature on each cell polygon.
+        ``sqrt(sum_k ∫_{cell k} (σh - σ)ᵀ C⁻¹ (σh - σ) dΩ)`` by a quadrature on
+        each cell polygon, with either the constant SCNI stress ``σh`` of each
+        cell (``strain="smoothed"``, the stress the method computes) or the
+        stress of the displacement field's own gradient at every quadrature
+        point (``strain="pointwise"``: the energy norm of ``u - u_h`` itself;
+        with enrichment it sees the singular part the enrichment adds).
 
         Parameters
         ----------
@@ -141,13 +169,22 @@ class ElasticSolution:
             of the model need not be the exact one).
         order : int
             Degree of the triangle rule on the triangles of each cell.
+        strain : {"smoothed", "pointwise"}
 
         Returns
         -------
         float
         """
+        if strain not in ("smoothed", "pointwise"):
+            raise ValueError(f"strain: expected 'smoothed' or 'pointwise', received {strain!r}")
         cell, points, weights = cell_quadrature(self.cells, self.model.nodes, order)
-        density = energy_error_density(cell, points, self.cells.region, self.stress, self.C,
+        if strain == "smoothed":
+            stress = self.stress[cell]
+        else:
+            g = self.displacement_gradient(points)
+            eps = np.column_stack([g[:, 0, 0], g[:, 1, 1], g[:, 0, 1] + g[:, 1, 0]])
+            stress = np.einsum("qij,qj->qi", self.C[cell], eps)
+        density = energy_error_density(points, self.cells.region[cell], stress, self.C[cell],
                                        exact_stress)
         return float(np.sqrt(weights @ density))
 
