@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 from functools import cached_property
 
 import numpy as np
@@ -10,10 +11,10 @@ from skfem.element import DiscreteField
 
 from .scni import smoothed_gradient
 
-__all__ = ["CellBasis"]
+__all__ = ["CellBasis", "spread_component"]
 
 
-def _spread(op, component, ncomp):
+def spread_component(op, component, ncomp):
     """Move the columns of a node operator ``(m, n)`` to the dofs of one
     component of an interleaved vector field ``(m, ncomp * n)``."""
     op = op.tocsr()
@@ -93,8 +94,18 @@ class CellBasis:
         value, gx, gy = self._node_ops
         if not self.vector:
             return [op.tocsr() for op in (value, gx, gy)]
-        values = [_spread(value, c, 2) for c in range(2)]
-        return values + [_spread(g, c, 2) for c in range(2) for g in (gx, gy)]
+        values = [spread_component(value, c, 2) for c in range(2)]
+        return values + [spread_component(g, c, 2) for c in range(2) for g in (gx, gy)]
+
+    def at_points(self, operators, weights, points):
+        """The same dofs seen at other integration points: a shallow copy with
+        ``operators`` (``(q, N)`` each, in the order of `operators`), quadrature
+        ``weights`` ``(q,)`` and ``points`` ``(q, 2)`` (``w.x``), for forms
+        integrated by a point quadrature instead of over the cells."""
+        out = copy.copy(self)
+        out.__dict__["operators"] = [op.tocsr() for op in operators]
+        out.dx, out.x = np.asarray(weights, dtype=float), np.asarray(points, dtype=float).T
+        return out
 
     @staticmethod
     def _field(flat, vector):
