@@ -3,6 +3,9 @@
     cnem demo list                                   # the demos
     cnem demo cylinder --nodes 687 --irregular --out results/
     cnem demo cracked-plate --gamma 45 --out results/
+    cnem pd list                                     # the peridynamics demos
+    cnem pd crack --n 16 32 --out results/           # PD and C-NEM on one cloud
+    cnem pd branching --help                         # dynamic crack branching
     cnem info                                        # versions, threads
 
 Each demo keeps its own options (``cnem demo cylinder --help``); the demos
@@ -16,7 +19,7 @@ import importlib.util
 import pathlib
 import sys
 
-__all__ = ["main", "DEMOS"]
+__all__ = ["main", "DEMOS", "PD_DEMOS"]
 
 #: Command-line name -> script in ``demos/``.
 DEMOS = {
@@ -26,6 +29,15 @@ DEMOS = {
     "pd-crack": "pd_vs_cnem_crack",
     "cracked-plate": "cracked_plate_geometry",
 }
+
+#: ``cnem pd <name>`` -> script in ``demos/`` (add a CPD demo here).
+PD_DEMOS = {
+    "crack": "pd_vs_cnem_crack",
+    "branching": "pd_crack_branching",
+}
+
+#: Subcommand -> its table of demos.
+_TABLES = {"demo": DEMOS, "pd": PD_DEMOS}
 
 
 def demos_folder():
@@ -37,15 +49,33 @@ def demos_folder():
     return folder
 
 
-def load_demo(name):
-    """The demo module for a command-line name (see `DEMOS`)."""
-    if name not in DEMOS:
-        raise SystemExit(f"cnem: unknown demo {name!r}; choose one of {', '.join(DEMOS)}")
-    path = demos_folder() / f"{DEMOS[name]}.py"
-    spec = importlib.util.spec_from_file_location(DEMOS[name], path)
+def load_demo(name, command="demo"):
+    """The demo module for a command-line name of ``cnem demo`` (see `DEMOS`) or of
+    ``cnem pd`` (``command="pd"``, see `PD_DEMOS`)."""
+    table = _TABLES[command]
+    kind = "demo" if command == "demo" else f"{command} demo"
+    if name not in table:
+        raise SystemExit(f"cnem: unknown {kind} {name!r}; choose one of {', '.join(table)} "
+                         f"(cnem {command} list)")
+    path = demos_folder() / f"{table[name]}.py"
+    if not path.is_file():
+        raise SystemExit(f"cnem: the {kind} {name!r} runs demos/{path.name}, which is not in "
+                         f"{path.parent}; update the source tree (git pull)")
+    spec = importlib.util.spec_from_file_location(table[name], path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def _list(command):
+    """Print each demo of ``cnem <command>`` with its script and its first docstring line."""
+    table = _TABLES[command]
+    for name, script in table.items():
+        if (demos_folder() / f"{script}.py").is_file():
+            doc = (load_demo(name, command).__doc__ or "").strip().split("\n")[0]
+        else:
+            doc = "(not in this source tree yet)"
+        print(f"{name:15s} demos/{script}.py  {doc}")
 
 
 def _info():
@@ -70,6 +100,8 @@ def main(argv=None):
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="run a demo (cnem demo list)", add_help=False)
     demo.add_argument("name", help="demo name, or 'list'")
+    pd = sub.add_parser("pd", help="run a peridynamics demo (cnem pd list)", add_help=False)
+    pd.add_argument("name", help="pd demo name, or 'list'")
     sub.add_parser("info", help="versions and threads")
     args, rest = parser.parse_known_args(argv)
     if args.command == "info":
@@ -78,11 +110,9 @@ def main(argv=None):
         _info()
         return 0
     if args.name == "list":
-        for name, script in DEMOS.items():
-            doc = (load_demo(name).__doc__ or "").strip().split("\n")[0]
-            print(f"{name:15s} demos/{script}.py  {doc}")
+        _list(args.command)
         return 0
-    load_demo(args.name).cli(rest)
+    load_demo(args.name, args.command).cli(rest)
     return 0
 
 

@@ -31,6 +31,34 @@ def test_unknown_demo_is_named():
         cli.main(["demo", "cylindre"])
 
 
+def test_pd_list_names_every_pd_demo(capsys, monkeypatch):
+    monkeypatch.setitem(cli.PD_DEMOS, "cpd-later", "no_such_demo")
+    assert cli.main(["pd", "list"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split()[:2] for line in lines] == [
+        [name, f"demos/{script}.py"] for name, script in cli.PD_DEMOS.items()]
+    assert lines[0].endswith("A central crack under remote tension, solved on one node cloud "
+                             "by C-NEM and by state-based PD.")
+    assert lines[-1].endswith("(not in this source tree yet)")
+
+
+def test_pd_crack_help_exits_cleanly(capsys):
+    with pytest.raises(SystemExit) as done:
+        cli.main(["pd", "crack", "--help"])
+    assert done.value.code == 0
+    assert "--n N [N ...]" in capsys.readouterr().out
+
+
+def test_unknown_or_missing_pd_demo_is_named(monkeypatch):
+    with pytest.raises(SystemExit, match=r"unknown pd demo 'brnaching'; choose one of crack, "
+                                         r"branching.*cnem pd list"):
+        cli.main(["pd", "brnaching"])
+    monkeypatch.setitem(cli.PD_DEMOS, "cpd-later", "no_such_demo")
+    with pytest.raises(SystemExit, match=r"pd demo 'cpd-later' runs demos/no_such_demo.py, "
+                                         r"which is not in .*demos"):
+        cli.main(["pd", "cpd-later"])
+
+
 def test_python_dash_m_runs():
     done = subprocess.run([sys.executable, "-m", "cnem", "info"], capture_output=True, text=True,
                           check=True)

@@ -132,3 +132,53 @@ def test_pd_vs_cnem_crack_small(tmp_path):
         assert row["cnem_error"] < 0.15 and row["pd_error"] < 0.15, row
     assert out["rows"][1]["u_difference"] < out["rows"][0]["u_difference"]
     assert abs(out["rows"][1]["K_cnem"] / np.sqrt(np.pi * 0.25) - 1.0) < 0.08
+
+
+def test_pd_crack_branching_quick(tmp_path):
+    """Dynamic fracture of the pre-notched glass plate (quick size): the crack runs right
+    from the notch tip, slower than Rayleigh waves, only along its path, and branches;
+    the branch measurement recovers a drawn Y-shaped crack."""
+    demo = _load("pd_crack_branching")
+
+    # the measurement alone: a stem to x = 60 mm, then two straight arms at +-20 degrees
+    h, horizon = 0.25e-3, 1e-3
+    points, shape = demo.plate(h)
+    X, Y = (points[:, k].reshape(shape) for k in (0, 1))
+    stem = (X > 0.05) & (X <= 0.06) & (np.abs(Y) < h)
+    arms = (X > 0.06) & (X < 0.08) & (np.abs(np.abs(Y) - np.tan(np.radians(20.0)) * (X - 0.06)) < h)
+    drawn = demo.branching(stem | arms, h, horizon)
+    assert abs(drawn["x"] - 0.06) < h and abs(drawn["y"]) < h
+    assert abs(drawn["half_angle"] - 20.0) < 0.5
+    assert demo.branching(stem, h, horizon) is None
+
+    out = demo.main(**demo.QUICK, outdir=tmp_path, plot=True, progress=False)
+    mat, nu = demo.MATERIALS["soda-lime"], 1.0 / 3.0
+    # Rayleigh speed, Viktorov's approximation with the plane-stress ratio nu / (1 + nu)
+    nu_ps = nu / (1.0 + nu)
+    c_s = np.sqrt(mat["E"] / (2.0 * (1.0 + nu)) / mat["density"])
+    c_r = c_s * (0.862 + 1.14 * nu_ps) / (1.0 + nu_ps)
+    assert abs(out["rayleigh"] / c_r - 1.0) < 0.01
+
+    tip, notch = out["tip"], 0.05
+    assert (np.diff(tip) >= 0).all()
+    assert tip[0] == notch and tip[-1] - notch > 0.015            # the crack ran to the right
+    assert 0.0 < out["t_init"] < 15e-6
+    assert 0.0 < out["speed"] < c_r and out["speed"] <= out["max_speed"] < c_r
+
+    damage, x, y = out["damage"], out["points"][:, 0], out["points"][:, 1]
+    assert damage.min() >= 0.0 and damage.max() <= 1.0 and damage.max() > 0.35
+    # no damage behind the notch tip (left corners, notch flanks) nor at the loaded edges
+    near_path = (x > notch - 2 * 2e-3) & (np.abs(y) < 0.015)
+    assert (damage[~near_path] == 0).all()
+
+    # the crack branches ahead of the notch, the branches diverging
+    assert notch < out["branch_x"] < 0.085
+    assert out["t_init"] < out["branch_time"] < 30e-6
+    assert 10.0 < out["half_angle"] < 45.0
+
+    # energy: balanced while no bond is broken; bond breaking dissipates at least about
+    # the Griffith energy G0 of the crack path
+    assert out["energy_error"] < 0.02
+    assert 0.9 < out["dissipated"] / out["griffith"] < 3.0
+    for f in out["files"]:
+        assert pathlib.Path(f).stat().st_size > 1000

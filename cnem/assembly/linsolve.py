@@ -24,44 +24,99 @@ DIRECT_NNZ = 2_500_000
 
 
 def rigid_modes(points):
-    """Rigid motions of a 2-D body, interleaved dofs: translations x, y and the
-    rotation about the centroid.
+    """Rigid motions of a 2-D or 3-D body, interleaved dofs.
 
-    Returns
-    -------
-    (2 n, 3) ndarray
-    """
-    n = len(points)
-    rel = points - points.mean(axis=0)
-    modes = np.zeros((2 * n, 3))
-    modes[0::2, 0] = 1.0
-    modes[1::2, 1] = 1.0
-    modes[0::2, 2] = -rel[:, 1]
-    modes[1::2, 2] = rel[:, 0]
-    return modes
-
-
-def _describe(mode, centre):
-    tx, ty, rot = mode
-    scale = max(abs(tx), abs(ty), abs(rot), 1e-300)
-    if abs(rot) < 1e-8 * scale:
-        if abs(ty) < 1e-8 * scale:
-            return "translation in x"
-        if abs(tx) < 1e-8 * scale:
-            return "translation in y"
-        return f"translation along ({tx / scale:.3g}, {ty / scale:.3g})"
-    pivot = centre + np.array([-ty, tx]) / rot
-    return f"rotation about ({pivot[0]:.6g}, {pivot[1]:.6g})"
-
-
-def free_rigid_motions(K, points, fixed):
-    """Rigid motions of each connected part of a 2-D body left free by fixed dofs.
+    2-D: translations in x, y and the rotation about the centroid; 3-D:
+    translations in x, y, z and the rotations about the x, y and z axes
+    through the centroid (``u = w x (p - centroid)``).
 
     Parameters
     ----------
-    K : sparse (2 n, 2 n)
+    points : (n, d) ndarray
+        d = 2 or 3.
+
+    Returns
+    -------
+    (2 n, 3) or (3 n, 6) ndarray
+    """
+    n, d = np.shape(points)
+    if d not in (2, 3):
+        raise ValueError(f"points: expected an (n, 2) or (n, 3) array, received shape "
+                         f"{np.shape(points)}")
+    rel = points - points.mean(axis=0)
+    if d == 2:
+        rel = np.column_stack([rel, np.zeros(n)])
+    nrot = 1 if d == 2 else 3
+    modes = np.zeros((n, d, d + nrot))
+    modes[:, :, :d] = np.eye(d)
+    for k, axis in enumerate(range(3 - nrot, 3)):            # 2-D: the z axis only
+        modes[:, :, d + k] = np.cross(np.eye(3)[axis], rel)[:, :d]
+    return modes.reshape(d * n, d + nrot)
+
+
+def _rref(rows, tol):
+    """Reduced row echelon form of a small matrix (partial pivoting, entries below
+    ``tol`` taken as zero)."""
+    rows = np.array(rows, dtype=float)
+    top = 0
+    for col in range(rows.shape[1]):
+        if top == len(rows):
+            break
+        pivot = top + np.argmax(np.abs(rows[top:, col]))
+        if abs(rows[pivot, col]) <= tol:
+            rows[top:, col] = 0.0
+            continue
+        rows[[top, pivot]] = rows[[pivot, top]]
+        rows[top] /= rows[top, col]
+        others = np.arange(len(rows)) != top
+        rows[others] -= rows[others, col][:, None] * rows[top]
+        top += 1
+    rows[np.abs(rows) <= tol] = 0.0
+    return rows[:top]
+
+
+def _direction(v):
+    """``x``, ``y``, ``z`` for a coordinate axis, else the unit vector in brackets."""
+    v = v / np.abs(v).max()
+    if np.count_nonzero(v) == 1:
+        return "xyz"[np.flatnonzero(v)[0]]
+    return "(" + ", ".join(f"{c:.3g}" for c in v) + ")"
+
+
+def _describe(t, w, centre, size):
+    """Name the rigid motion ``u(p) = t + w x (p - centre)`` (``w`` a scalar in 2-D) of a
+    part of extent ``size``."""
+    if not np.any(w):
+        name = _direction(t)
+        return f"translation {'in' if len(name) == 1 else 'along'} {name}"
+    d = len(t)
+    w3 = np.array([0.0, 0.0, w[0]]) if d == 2 else w
+    # the point of the axis nearest the centre, and the slip along the axis (a screw)
+    pivot = centre + np.cross(w3, np.append(t, 0.0) if d == 2 else t)[:d] / (w3 @ w3)
+    pivot = np.where(np.abs(pivot) < 1e-12 * size, 0.0, pivot) + 0.0      # no -0, no 1e-17
+    where = "(" + ", ".join(f"{c:.6g}" for c in pivot) + ")"
+    if d == 2:
+        return f"rotation about {where}"
+    slip = " with a slip along the axis" if abs(t @ w) > 1e-8 * np.abs(t).max() * \
+        np.linalg.norm(w) else ""
+    return f"rotation about {_direction(w)} through {where}{slip}"
+
+
+def free_rigid_motions(K, points, fixed):
+    """Rigid motions of each connected part of a 2-D or 3-D body left free by fixed dofs.
+
+    Each part's free motions are named in a canonical basis: the free
+    translations first (``translation in x``, ``translation along (...)``), then
+    the rotations, each about an axis through the point nearest the part's
+    centroid (2-D: ``rotation about (x, y)``; 3-D: ``rotation about z through
+    (x, y, z)``).
+
+    Parameters
+    ----------
+    K : sparse (d n, d n)
         Stiffness (its pattern tells which nodes hang together).
-    points : (n, 2) ndarray
+    points : (n, d) ndarray
+        d = 2 or 3.
     fixed : (k,) int array
         Dofs with prescribed values.
 
@@ -70,11 +125,12 @@ def free_rigid_motions(K, points, fixed):
     list of str
         One description per free motion (empty when the system is regular).
     """
-    n = len(points)
-    node_graph = sp.csr_matrix((np.ones(K.nnz), (K.tocoo().row // 2, K.tocoo().col // 2)),
-                               shape=(n, n))
+    n, d = np.shape(points)
+    nrot = 1 if d == 2 else 3
+    coo = K.tocoo()
+    node_graph = sp.csr_matrix((np.ones(coo.nnz), (coo.row // d, coo.col // d)), shape=(n, n))
     ncomp, label = csgraph.connected_components(node_graph, directed=False)
-    is_fixed = np.zeros(2 * n, dtype=bool)
+    is_fixed = np.zeros(d * n, dtype=bool)
     is_fixed[fixed] = True
     free = []
     for part in range(ncomp):
@@ -82,14 +138,18 @@ def free_rigid_motions(K, points, fixed):
         pts = points[nodes]
         size = max(np.ptp(pts, axis=0).max(), 1e-300)
         modes = rigid_modes(pts / size)
-        dofs = np.column_stack([2 * nodes, 2 * nodes + 1]).reshape(-1)
+        dofs = (d * nodes[:, None] + np.arange(d)).reshape(-1)
         rows = modes[is_fixed[dofs]]
-        _, s, vt = np.linalg.svd(rows) if len(rows) else (None, np.zeros(0), np.eye(3))
-        s = np.concatenate([s, np.zeros(3 - len(s))])
+        _, s, vt = np.linalg.svd(rows) if len(rows) else (None, np.zeros(0), np.eye(d + nrot))
+        s = np.concatenate([s, np.zeros(d + nrot - len(s))])
+        null = vt[s <= 1e-9 * max(s.max(initial=0.0), 1.0)]
+        # rotations first in the echelon form: the rows left without a rotation are the
+        # free translations, which are then taken out of the rotations
+        basis = _rref(np.roll(null, nrot, axis=1), 1e-8)
         where = "" if ncomp == 1 else f" of the part holding node {nodes[0]} ({len(nodes)} nodes)"
-        for k in np.flatnonzero(s <= 1e-9 * max(s.max(initial=0.0), 1.0)):
-            mode = vt[k] * np.array([1.0, 1.0, 1.0 / size])
-            free.append(_describe(mode, pts.mean(axis=0)) + where)
+        motions = [(row[nrot:], row[:nrot] / size) for row in basis]
+        motions.sort(key=lambda m: bool(np.any(m[1])))
+        free += [_describe(t, w, pts.mean(axis=0), size) + where for t, w in motions]
     return free
 
 
