@@ -3,6 +3,7 @@
 import resource
 import statistics
 import sys
+import time
 
 
 def peak_rss_bytes():
@@ -48,6 +49,17 @@ def median(xs):
     """Median of a sequence, NaN when empty."""
     xs = list(xs)
     return statistics.median(xs) if xs else float("nan")
+
+
+def warm_median(fn, repeat):
+    """One warm-up call, then the median of ``repeat`` timed calls, and the last result."""
+    out = fn()
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return median(times), out
 
 
 def fmt_n(n):

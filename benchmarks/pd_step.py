@@ -68,7 +68,7 @@ import time
 
 import numpy as np
 
-from _harness import median, mem_available_bytes, peak_rss_bytes, reset_peak_rss
+from _harness import median, mem_available_bytes, peak_rss_bytes, reset_peak_rss, warm_median
 
 HORIZON_FACTOR = 3.015                  # horizon / h (delta = 3h)
 DISPLACEMENT = 1e-4                     # |u| ~ DISPLACEMENT * h
@@ -167,13 +167,8 @@ class Stage:
 def timed_calls(fn, repeat):
     """One warm-up call, then ``repeat`` timed calls: (median seconds, last result, growth)."""
     with Stage() as st:
-        out = fn()
-        times = []
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            out = fn()
-            times.append(time.perf_counter() - t0)
-    return median(times), out, st.growth
+        seconds, out = warm_median(fn, repeat)
+    return seconds, out, st.growth
 
 
 def setup(points, volumes, horizon, problem_class, with_problem):

@@ -1,5 +1,6 @@
 """Peridynamics on the shared spatial index: bodies, bond- and state-based materials,
-static (sparse tangent) and explicit dynamic solvers.
+continuum-kinematics-inspired PD (`CPD`, nonlinear, hyper-dual derivatives), static
+(Newton, sparse tangent) and explicit dynamic solvers.
 
 >>> import numpy as np, cnem.pd as pd
 >>> h = 0.05
@@ -15,7 +16,8 @@ True
 """
 
 from .body import Body
+from .cpd import CPD
 from .materials import BondBased, StateBased
 from .problem import DynamicRun, Problem, StaticSolution
 
-__all__ = ["Body", "BondBased", "StateBased", "Problem", "StaticSolution", "DynamicRun"]
+__all__ = ["Body", "BondBased", "StateBased", "CPD", "Problem", "StaticSolution", "DynamicRun"]

@@ -14,7 +14,9 @@ from ..assembly.conditions import dirichlet_dofs, per_point
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import SolveError
 from . import _kernels as K
+from .frames import FrameWriter
 from .materials import PLANES
+from .relaxation import relax
 
 __all__ = ["Problem", "StaticSolution", "DynamicRun"]
 
@@ -28,7 +30,7 @@ class StaticSolution:
         self.problem, self.u, self.residual_history = problem, u, history
 
     def stress(self):
-        """Stress of every point, ``(n, d, d)`` (see `Problem.stress`)."""
+        """Stress of every point, ``(n, d, d)`` (see `Problem.stress`; not for CPD)."""
         return self.problem.stress(self.u)
 
     def __repr__(self):
@@ -39,7 +41,8 @@ class StaticSolution:
 class DynamicRun:
     """Result of `Problem.run_dynamic`: final ``u``, ``velocity``, ``damage (n,)``,
     ``times`` of the stored frames, ``frames`` (list of ``(u, damage)``), ``energy``
-    (kinetic + elastic at each stored frame, without breaking), ``broken`` bonds."""
+    (kinetic + elastic at each stored frame, without breaking), ``broken`` bonds,
+    ``files`` (the VTU file of each frame; empty without ``output``)."""
 
     def __init__(self, **kw):
         self.__dict__.update(kw)
@@ -55,25 +58,33 @@ class Problem:
     Parameters
     ----------
     body : Body
-    material : BondBased or StateBased
+    material : BondBased, StateBased or CPD
+        CPD (nonlinear) supports `solve_static` only; its 2-D energies are defined on
+        the plane directly (``plane`` is not used).
     plane : {"stress", "strain"}
         2-D only.
-    surface_correction : bool
+    surface_correction : bool, optional
         Energy method (Le & Bobaru): every point's bonds are scaled so that
         uniform test strains store the classical energy density at that point
         (this also removes the discretisation error of the horizon sums in the
-        bulk).
+        bulk). Default on for BondBased and StateBased; it does not apply to CPD,
+        which uses the plain volumes.
     """
 
-    def __init__(self, body, material, *, plane="stress", surface_correction=True):
+    def __init__(self, body, material, *, plane="stress", surface_correction=None):
         if plane not in PLANES:
             raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
-        if getattr(material, "kind", None) not in ("bond", "state"):
-            raise ValueError(f"material: expected cnem.pd.BondBased or StateBased, received "
-                             f"{type(material).__name__}")
+        kind = getattr(material, "kind", None)
+        if kind not in ("bond", "state", "cpd"):
+            raise ValueError(f"material: expected cnem.pd.BondBased, StateBased or CPD, "
+                             f"received {type(material).__name__}")
+        if kind == "cpd" and surface_correction:
+            raise ValueError("surface_correction=True: the surface correction does not apply "
+                             "to CPD (its energies use the plain volumes); leave it unset")
         self.body, self.material, self.plane = body, material, plane
         self.dim = body.dim
-        self.surface_correction = bool(surface_correction)
+        self.surface_correction = kind != "cpd" if surface_correction is None else \
+            bool(surface_correction)
         self._dirichlet, self._body = [], []
         self.alive = np.ones(len(body.bond_i), dtype=np.uint8)
         self._operators()
@@ -85,6 +96,11 @@ class Problem:
     def _operators(self):
         b = self.body
         self.weight = b.beta * b.volumes[b.bond_j]            # omega beta V_j, omega = 1
+        if self.material.kind == "cpd":
+            #: the CPD interactions of the body (`cnem.pd.cpd.Interactions`)
+            self.interactions = self.material.interactions(b)
+            self.factor = np.ones(len(b.bond_i))
+            return
         if self.material.kind == "bond":
             c = self.material.micromodulus(self.dim, self.plane, b.horizon, b.thickness)
             #: the PMB micromodulus (one value for every bond)
@@ -133,9 +149,18 @@ class Problem:
                           shape=(len(b.bond_i), n))
         self.Edev = (self.A - S @ self.T).tocsr()
 
+    def _linear_only(self, what):
+        """Refuse CPD in the methods of the linear (bond- and state-based) models."""
+        if self.material.kind == "cpd":
+            raise NotImplementedError(
+                f"{what} is available for BondBased and StateBased materials, not for CPD "
+                "(nonlinear, nonlocal measures): use solve_static, its displacements u, or "
+                "Problem.interactions.evaluate(u) for energy, forces and tangent")
+
     # -- energies -----------------------------------------------------------------------
     def energy_density(self, u, factor=None):
         """Strain energy density of every point, ``(n,)``."""
+        self._linear_only("energy_density")
         b = self.body
         factor = self.factor if factor is None else factor
         x = np.asarray(u, dtype=float).reshape(-1)
@@ -249,6 +274,7 @@ class Problem:
     def stiffness(self):
         """Sparse stiffness ``(d n, d n)``: the Hessian of the total strain energy
         ``sum_i V_i W_i`` (exact tangent of the linear models), live bonds only."""
+        self._linear_only("stiffness")
         b = self.body
         live = self.alive.astype(float)
         Vi = b.volumes[b.bond_i]
@@ -262,6 +288,7 @@ class Problem:
     def stress(self, u):
         """Stress of every point from its bonds, ``(n, d, d)`` (``dW_i / d eps`` for a
         uniform strain: the classical stress in a uniform field)."""
+        self._linear_only("stress")
         b, d = self.body, self.dim
         x = np.asarray(u, dtype=float).reshape(-1)
         nn = self.unit[:, :, None] * self.unit[:, None, :]
@@ -307,57 +334,130 @@ class Problem:
         return dofs[last], values[last]
 
     # -- statics ------------------------------------------------------------------------
-    def solve_static(self, *, tol=1e-10, steps=1, initial=None, max_iterations=20):
+    #: Most step halvings of the backtracking line search of `solve_static`.
+    LINE_SEARCH_HALVINGS = 10
+
+    def _static_system(self):
+        """``evaluate(u, tangent) -> (f_int (d n,), K or None)`` and the tangent's pattern:
+        ``K u`` with the constant stiffness of the linear materials, the CPD energy's
+        gradient and Hessian otherwise."""
+        if self.material.kind == "cpd":
+            inter = self.interactions
+            return lambda u, tangent: inter.evaluate(u, tangent=tangent)[1:], inter.pattern()
+        Kmat = self.stiffness()
+        return lambda u, tangent: (Kmat @ u, Kmat), Kmat
+
+    def solve_static(self, *, tol=1e-10, steps=1, initial=None, max_iterations=20,
+                     line_search=False):
         """Newton-Raphson with the exact tangent, Dirichlet values and loads ramped in
         ``steps`` equal increments.
+
+        The residual is ``R(u) = f_int(u) - f_ext`` on the free dofs (``K u - f_ext`` for
+        BondBased and StateBased, solved by the first correction). Each load step starts
+        with a tangent predictor: the increments of the Dirichlet values and loads,
+        spread over the free dofs by a solve with the last tangent; its linearised
+        residual is the step's first entry. A step has converged when ``|R| <= tol``
+        times the norm of its load (of that first entry when there is no load).
+        Nonlinear materials (CPD) solve each correction to a relative tolerance
+        ``min(1e-3, |R| / reference)`` (inexact Newton, still quadratic).
+
+        Parameters
+        ----------
+        tol : float
+        steps : int
+            Load steps.
+        initial : (n, d) array_like, optional
+            Starting displacements (the Dirichlet values replace theirs).
+        max_iterations : int
+            Newton corrections allowed per load step.
+        line_search : bool
+            Backtrack along each correction (halving the step up to
+            ``LINE_SEARCH_HALVINGS`` times) until the residual norm decreases.
 
         Returns
         -------
         StaticSolution
-            ``u (n, d)``, ``residual_history``: residual norms (free dofs, relative to
-            the load or the first residual) per Newton iteration, one list per step.
+            ``u (n, d)``, ``residual_history``: the residual norms of the free dofs at
+            each Newton iterate, one list per load step.
 
         Raises
         ------
         SolveError
-            Rigid motions not fixed (2-D: named), or a step that does not converge.
+            Rigid motions not fixed (named), or a load step that does not converge
+            (named, with its last residual).
         """
         d, n = self.dim, len(self.body)
-        Kmat = self.stiffness()
+        steps, max_iterations = int(steps), int(max_iterations)
+        if steps < 1 or max_iterations < 1:
+            raise ValueError(f"expected steps >= 1 and max_iterations >= 1, received "
+                             f"steps={steps}, max_iterations={max_iterations}")
+        evaluate, pattern = self._static_system()
         D, values = self._prescribed()
-        if d == 2:
-            free = free_rigid_motions(Kmat, self.body.points, D)
-            if free:
-                raise SolveError("the system is singular: the Dirichlet conditions leave free "
-                                 "the " + "; ".join(free) + ". Fix them with add_dirichlet")
+        free = free_rigid_motions(pattern, self.body.points, D)
+        if free:
+            raise SolveError("the system is singular: the Dirichlet conditions leave free "
+                             "the " + "; ".join(free) + ". Fix them with add_dirichlet")
         F = self.load()
         u = np.zeros(d * n) if initial is None else np.asarray(initial, float).reshape(-1).copy()
         interior = np.setdiff1d(np.arange(d * n), D)
-        A = Kmat[interior][:, interior].tocsr()
-        modes = rigid_modes(self.body.points)[interior] if d == 2 else None
+        modes = rigid_modes(self.body.points)[interior]
+        linear = self.material.kind != "cpd"
+        cache = {}
+
+        def blocks(Kt):
+            """The tangent's free-free and free-prescribed parts (kept while it is unchanged)."""
+            if cache.get("K") is not Kt:
+                rows = Kt[interior]
+                cache.update(K=Kt, A=rows[:, interior].tocsr(), B=rows[:, D].tocsr())
+            return cache["A"], cache["B"]
+
+        f, Kt = evaluate(u, True)
         history = []
         for step in range(1, steps + 1):
-            frac = step / steps
-            u[D] = frac * values
-            scale = max(np.linalg.norm(frac * F[interior]), 1e-300)
-            res = []
-            for _ in range(max_iterations):
-                r = (Kmat @ u - frac * F)[interior]
+            load, target = step / steps * F, step / steps * values
+            r = (f - load)[interior] + blocks(Kt)[1] @ (target - u[D])   # linearised
+            u[D] = target
+            res = [float(np.linalg.norm(r))]
+            ref = np.linalg.norm(load[interior]) or res[0]
+            while not (res[-1] <= tol * ref or res[-1] == 0.0):
+                if len(res) > max_iterations or not np.isfinite(res[-1]):
+                    raise SolveError(
+                        f"Newton did not converge in load step {step} of {steps}: residual "
+                        f"{res[-1]:.3e} (wanted {tol * ref:.3e}) after {len(res) - 1} "
+                        f"iteration(s); try more load steps, line_search=True or a larger "
+                        f"max_iterations")
+                rtol = min(tol, 1e-12) if linear else min(1e-3, max(res[-1] / ref, 1e-12))
+                try:
+                    du = solve_spd(blocks(Kt)[0], r, modes=modes, tol=rtol)
+                except SolveError as exc:
+                    raise SolveError(f"load step {step} of {steps}, Newton iteration "
+                                     f"{len(res)}: {exc}") from exc
+                u = self._newton_update(u, du, interior, load, evaluate, res[-1],
+                                        self.LINE_SEARCH_HALVINGS if line_search else 0)
+                f, Kt = evaluate(u, True)
+                r = (f - load)[interior]
                 res.append(float(np.linalg.norm(r)))
-                ref = scale if np.linalg.norm(F) > 0 else max(res[0], 1e-300)
-                if res[-1] <= tol * ref or res[-1] == 0.0:
-                    break
-                u[interior] -= solve_spd(A, r, modes=modes, tol=min(tol, 1e-12))
-            else:
-                raise SolveError(f"Newton did not converge in load step {step}: residual "
-                                 f"{res[-1]:.3e} after {max_iterations} iterations")
             history.append(res)
         return StaticSolution(self, u.reshape(n, d), history)
+
+    @staticmethod
+    def _newton_update(u, du, interior, load, evaluate, current, halvings):
+        """``u - du`` on the free dofs or, with ``halvings > 0``, the first of
+        ``u - du / 2^k`` (k <= halvings) whose residual norm is below ``current`` (the
+        last one tried if none is)."""
+        for k in range(halvings + 1):
+            trial = u.copy()
+            trial[interior] -= du / 2 ** k
+            if not halvings or np.linalg.norm(
+                    (evaluate(trial, False)[0] - load)[interior]) < current:
+                break
+        return trial
 
     # -- dynamics -----------------------------------------------------------------------
     def stable_time_step(self, safety=0.8):
         """Silling & Askari's bound ``sqrt(2 rho / sum_j C_ij V_j)`` (the smallest
         over points) times ``safety``."""
+        self._linear_only("stable_time_step")
         b = self.body
         if self.material.kind == "bond":          # sum_j c_ij V_j / L_ij per point
             per = self.bond_stiffness * self.factor * b.beta * b.volumes[b.bond_j] / b.length
@@ -374,6 +474,14 @@ class Problem:
         live = np.bincount(b.bond_i, weights=self.weight * self.alive, minlength=len(b))
         return 1.0 - live / np.maximum(total, 1e-300)
 
+    def _force_state(self):
+        """What `_internal_force` keeps between calls: the PMB bond stiffnesses, or the
+        stiffness matrix of the live bonds (state-based)."""
+        if self.material.kind == "bond":
+            return {"stiffness": np.ascontiguousarray(self.bond_stiffness * self.factor *
+                                                      self.body.beta)}
+        return {"K": self.stiffness()}
+
     def _internal_force(self, u, limit, state):
         """Force per unit volume ``(n, d)``, breaking bonds (returns count broken)."""
         b = self.body
@@ -389,7 +497,7 @@ class Problem:
             state["K"] = self.stiffness()
         return -(state["K"] @ u.reshape(-1)).reshape(u.shape) / b.volumes[:, None], broken
 
-    def run_dynamic(self, dt, steps, *, velocity=None, every=None, progress=None):
+    def run_dynamic(self, dt, steps, *, velocity=None, every=None, output=None, progress=None):
         """Explicit velocity Verlet with bond breaking.
 
         Parameters
@@ -400,13 +508,19 @@ class Problem:
         velocity : (n, d) array_like or callable ``(n, d) -> (n, d)``, optional
             Initial velocity.
         every : int, optional
-            Store a frame (u, damage, energy) every so many steps (default: 10 frames).
+            Store a frame (u, damage, energy) every so many steps (default: 10 frames),
+            and at the first and last steps.
+        output : str or os.PathLike, optional
+            A folder or a path stem: every frame is also written to a VTU file
+            (``<stem>_<step>.vtu``, see `cnem.pd.frames.FrameWriter`) with the point
+            data ``u (n, d)``, ``damage (n,)`` and ``velocity (n, d)``.
         progress : bool, optional
 
         Returns
         -------
         DynamicRun
         """
+        self._linear_only("run_dynamic")
         b, d, n = self.body, self.dim, len(self.body)
         dt, steps = float(dt), int(steps)
         if not dt > 0 or steps < 1:
@@ -414,11 +528,7 @@ class Problem:
         every = max(1, steps // 10) if every is None else int(every)
         rho = self.material.density
         limit = self.material.stretch_limit(d, self.plane, b.horizon)
-        state = {}
-        if self.material.kind == "bond":
-            state["stiffness"] = np.ascontiguousarray(self.bond_stiffness * self.factor * b.beta)
-        else:
-            state["K"] = self.stiffness()
+        state = self._force_state()
         D, values = self._prescribed()
         u = np.zeros((n, d))
         u.reshape(-1)[D] = values
@@ -429,7 +539,17 @@ class Problem:
         fext = self.load().reshape(n, d) / b.volumes[:, None]
         force, broken = self._internal_force(u, limit, state)
         acc = (force + fext) / rho
-        times, frames, energy = [0.0], [(u.copy(), self.damage())], [self._energy(u, v)]
+        writer = None if output is None else FrameWriter(output, b.points, steps)
+        times, frames, energy, files = [], [], [], []
+
+        def store(step):
+            times.append(step * dt)
+            frames.append((u.copy(), self.damage()))
+            energy.append(self._energy(u, v))
+            if writer is not None:
+                files.append(writer.write(step, u=u, damage=frames[-1][1], velocity=v))
+
+        store(0)
         total_broken = broken
         show = sys.stderr.isatty() if progress is None else progress
         for step in tqdm(range(1, steps + 1), desc="PD steps", disable=not show, leave=False):
@@ -442,11 +562,23 @@ class Problem:
             v += 0.5 * dt * acc
             v.reshape(-1)[D] = 0.0
             if step % every == 0 or step == steps:
-                times.append(step * dt)
-                frames.append((u.copy(), self.damage()))
-                energy.append(self._energy(u, v))
+                store(step)
         return DynamicRun(u=u, velocity=v, damage=self.damage(), times=np.array(times),
-                          frames=frames, energy=np.array(energy), broken=total_broken)
+                          frames=frames, energy=np.array(energy), broken=total_broken,
+                          files=files)
+
+    def relax(self, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress=None):
+        """Quasi-static equilibrium by adaptive dynamic relaxation (Kilic & Madenci 2010),
+        with bond breaking: see `cnem.pd.relaxation.relax` for the parameters.
+
+        Returns
+        -------
+        cnem.pd.relaxation.Relaxation
+            ``u (n, d)``, ``damage (n,)``, ``residual_history``, ``iterations``.
+        """
+        self._linear_only("relax")
+        return relax(self, tol=tol, max_steps=max_steps, steps=steps, every=every,
+                     progress=progress)
 
     def _energy(self, u, v):
         """Kinetic plus elastic energy (the linearised elastic energy)."""
