@@ -6,6 +6,7 @@
     cnem pd list                                     # the peridynamics demos
     cnem pd crack --n 16 32 --out results/           # PD and C-NEM on one cloud
     cnem pd branching --help                         # dynamic crack branching
+    cnem pd cpd --example tension2d --out results/   # CPD examples (Javili et al. §6)
     cnem info                                        # versions, threads
 
 Each demo keeps its own options (``cnem demo cylinder --help``); the demos
@@ -34,6 +35,7 @@ DEMOS = {
 PD_DEMOS = {
     "crack": "pd_vs_cnem_crack",
     "branching": "pd_crack_branching",
+    "cpd": "cpd_examples",
 }
 
 #: Subcommand -> its table of demos.

@@ -357,7 +357,8 @@ class Problem:
         with a tangent predictor: the increments of the Dirichlet values and loads,
         spread over the free dofs by a solve with the last tangent; its linearised
         residual is the step's first entry. A step has converged when ``|R| <= tol``
-        times the norm of its load (of that first entry when there is no load).
+        times the largest of the norms of its load, of the reactions at the prescribed
+        dofs and of that first entry.
         Nonlinear materials (CPD) solve each correction to a relative tolerance
         ``min(1e-3, |R| / reference)`` (inexact Newton, still quadratic).
 
@@ -418,9 +419,15 @@ class Problem:
             r = (f - load)[interior] + blocks(Kt)[1] @ (target - u[D])   # linearised
             u[D] = target
             res = [float(np.linalg.norm(r))]
-            ref = np.linalg.norm(load[interior]) or res[0]
-            while not (res[-1] <= tol * ref or res[-1] == 0.0):
-                if len(res) > max_iterations or not np.isfinite(res[-1]):
+            while not (res[-1] <= tol * (ref := self._reference(load[interior], f[D], res))
+                       or res[-1] == 0.0):
+                if not np.isfinite(res[-1]):
+                    raise SolveError(
+                        f"load step {step} of {steps}, Newton iteration {len(res) - 1}: the "
+                        f"internal forces are not finite (an interaction inverted or collapsed "
+                        f"where its energy is undefined); try more load steps or "
+                        f"line_search=True")
+                if len(res) > max_iterations:
                     raise SolveError(
                         f"Newton did not converge in load step {step} of {steps}: residual "
                         f"{res[-1]:.3e} (wanted {tol * ref:.3e}) after {len(res) - 1} "
@@ -439,6 +446,13 @@ class Problem:
                 res.append(float(np.linalg.norm(r)))
             history.append(res)
         return StaticSolution(self, u.reshape(n, d), history)
+
+    @staticmethod
+    def _reference(load, reactions, res):
+        """What a load step's residual is measured against: the largest of its load, the
+        reactions at the prescribed dofs (round-off in the residual scales with the
+        internal forces) and its first residual."""
+        return max(float(np.linalg.norm(load)), float(np.linalg.norm(reactions)), res[0])
 
     @staticmethod
     def _newton_update(u, du, interior, load, evaluate, current, halvings):
