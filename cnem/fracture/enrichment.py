@@ -196,6 +196,15 @@ class Enrichment:
                 out[t] = (np.hypot(*(centre[mine] - self.tips[t]).T) + reach[mine]).max()
         return out
 
+    def in_support(self, points):
+        """``(p,)`` bool: points within `support_radius` of a tip (where enrichment
+        functions may be non-zero)."""
+        reach = self.support_radius()
+        near = np.zeros(len(points), dtype=bool)
+        for t, tip in enumerate(self.tips):
+            near |= np.hypot(*(points - tip).T) <= reach[t] * (1 + 1e-9)
+        return near
+
     def smoothed_gradient(self, gauss=2, cells=None):
         """SCNI smoothed gradients of the enrichment functions.
 
@@ -204,11 +213,7 @@ class Enrichment:
         gx, gy : scipy.sparse.csr_matrix, shape (m, len(self))
         """
         quad = boundary_quadrature(self.model, gauss=gauss, cells=cells)
-        reach = self.support_radius()
-        near = np.zeros(len(quad.points), dtype=bool)
-        for t, tip in enumerate(self.tips):
-            near |= np.hypot(*(quad.points - tip).T) <= reach[t] * (1 + 1e-9)
-        select = np.flatnonzero(near)
+        select = np.flatnonzero(self.in_support(quad.points))
         points, hint = quad.points[select], quad.hint[select]
         sides = points.copy()                     # on a crack face: its triangle's side
         on_face = hint >= 0

@@ -214,10 +214,8 @@ class Elasticity:
         stiffness plus this term would be the Galerkin stiffness on these cells."""
         basis, cells, enrichment = self.basis, self.cells, self.enrichment
         owner, points, weights = cell_quadrature(cells, self.model.nodes, order)
-        reach = enrichment.support_radius()
         near = np.zeros(len(cells.area), dtype=bool)
-        for t, tip in enumerate(enrichment.tips):
-            near[owner[np.hypot(*(points - tip).T) <= reach[t] * (1 + 1e-9)]] = True
+        near[owner[enrichment.in_support(points)]] = True        # whole cells
         keep = np.flatnonzero(near[owner])
         owner, points = owner[keep], points[keep]
         phi, dx, dy = self.model.shape_functions(points, gradient=True)

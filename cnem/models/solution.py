@@ -17,6 +17,12 @@ def von_mises(stress):
     return np.sqrt(sxx ** 2 - sxx * syy + syy ** 2 + 3.0 * sxy ** 2)
 
 
+def engineering_strain(gradient):
+    """``[exx, eyy, 2 exy]`` from displacement gradients ``(..., 2, 2)``, ``(..., 3)``."""
+    g = gradient
+    return np.stack([g[..., 0, 0], g[..., 1, 1], g[..., 0, 1] + g[..., 1, 0]], axis=-1)
+
+
 def energy_error_density(points, region, stress, C, exact_stress):
     """``(σh - σ)ᵀ C⁻¹ (σh - σ)`` at quadrature points.
 
@@ -95,8 +101,7 @@ class ElasticSolution:
         self.timings = timings
         ops = problem.basis.operators[2:]               # du0/dx, du0/dy, du1/dx, du1/dy
         self.gradient = np.stack([op @ dofs for op in ops], axis=1).reshape(-1, 2, 2)
-        g = self.gradient
-        self.strain = np.column_stack([g[:, 0, 0], g[:, 1, 1], g[:, 0, 1] + g[:, 1, 0]])
+        self.strain = engineering_strain(self.gradient)
         self.stress = np.einsum("kij,kj->ki", C, self.strain)
 
     def __repr__(self):
@@ -181,8 +186,7 @@ class ElasticSolution:
         if strain == "smoothed":
             stress = self.stress[cell]
         else:
-            g = self.displacement_gradient(points)
-            eps = np.column_stack([g[:, 0, 0], g[:, 1, 1], g[:, 0, 1] + g[:, 1, 0]])
+            eps = engineering_strain(self.displacement_gradient(points))
             stress = np.einsum("qij,qj->qi", self.C[cell], eps)
         density = energy_error_density(points, self.cells.region[cell], stress, self.C[cell],
                                        exact_stress)
