@@ -6,7 +6,7 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
-__all__ = ["cell_triangles", "cell_quadrature", "subdivide"]
+__all__ = ["cell_triangles", "triangle_quadrature", "cell_quadrature", "subdivide"]
 
 
 def _fan(apex, verts, nxt):
@@ -62,7 +62,116 @@ def cell_triangles(cells, nodes, *, node_apex=None):
     return cell[keep], corners
 
 
-def cell_quadrature(cells, nodes, order=4):
+def _triangle_rule(corners, order):
+    """Gauss points and signed weights of a triangle rule of degree ``order``."""
+    ref, w = get_quadrature(RefTri, order)          # reference triangle, area 1/2
+    e1 = corners[:, 1] - corners[:, 0]
+    e2 = corners[:, 2] - corners[:, 0]
+    jac = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    points = (corners[:, None, 0] + ref[0][None, :, None] * e1[:, None]
+              + ref[1][None, :, None] * e2[:, None])
+    return points, jac[:, None] * w[None, :]        # signed: negative fan triangles subtract
+
+
+def _collapsed_rule(apex, b, c, order):
+    """A rule for integrands like ``1/r`` about ``apex`` on triangles ``(apex, b, c)``.
+
+    The unit square is mapped onto the triangle with its side ``u = 0`` collapsed
+    onto the apex (Duffy): ``x = apex + u ((1 - v) (b - apex) + v (c - apex))``,
+    Jacobian ``u * 2 * area``. The factor ``u`` cancels a ``1/r`` singularity, so a
+    tensor Gauss rule converges fast; it is exact for polynomials of degree ``order``.
+
+    Returns
+    -------
+    points : (t, g, 2) ndarray
+    weights : (t, g) ndarray
+        Signed like the triangle.
+    """
+    g, w = np.polynomial.legendre.leggauss(order // 2 + 2)
+    g, w = 0.5 * (g + 1.0), 0.5 * w
+    u, v = (a.reshape(-1) for a in np.meshgrid(g, g, indexing="ij"))
+    wu = np.outer(w, w).reshape(-1) * u
+    pb, pc = b - apex, c - apex
+    jac = pb[:, 0] * pc[:, 1] - pb[:, 1] * pc[:, 0]
+    ray = (1.0 - v)[None, :, None] * pb[:, None] + v[None, :, None] * pc[:, None]
+    return apex[:, None] + u[None, :, None] * ray, jac[:, None] * wu[None, :]
+
+
+def _split_at_singular(corners, singular, rel_tol=1e-9):
+    """Triangles holding a singular point (closed: a point closer than ``rel_tol``
+    times an edge's length to its line counts as on it), split at the point into
+    triangles with it as apex; their signed areas add up to the triangle's.
+
+    Returns
+    -------
+    hit : (t,) bool ndarray
+        Triangles that hold a singular point.
+    source : (s,) int64 ndarray
+        The triangle each piece comes from.
+    apex, b, c : (s, 2) ndarray
+        The pieces ``(apex, b, c)`` (pieces of zero area left out).
+    """
+    hit = np.zeros(len(corners), dtype=bool)
+    edge2 = ((corners[:, [1, 2, 0]] - corners) ** 2).sum(axis=2)          # (t, 3)
+    pieces = []
+    for p in singular:
+        rel = corners - p                                                # (t, 3, 2)
+        nxt = rel[:, [1, 2, 0]]
+        cross = rel[:, :, 0] * nxt[:, :, 1] - rel[:, :, 1] * nxt[:, :, 0]   # 2 x piece areas
+        sign = np.sign(cross.sum(axis=1))[:, None]                       # the triangle's
+        on_line = np.abs(cross) <= rel_tol * edge2
+        inside = ~hit & (sign[:, 0] != 0) & ((sign * cross > 0) | on_line).all(axis=1)
+        hit |= inside
+        for k in range(3):
+            idx = np.flatnonzero(inside & ~on_line[:, k])
+            pieces.append((idx, np.broadcast_to(p, (len(idx), 2)), corners[idx, k],
+                           corners[idx, (k + 1) % 3]))
+    if not pieces:
+        empty = np.zeros((0, 2))
+        return hit, np.zeros(0, np.int64), empty, empty, empty
+    source, apex, b, c = (np.concatenate(x) for x in zip(*pieces))
+    return hit, source, apex, b, c
+
+
+def triangle_quadrature(corners, order=4, *, singular=None):
+    """Quadrature points and weights on triangles, collapsed at singular points.
+
+    Parameters
+    ----------
+    corners : (t, 3, 2) ndarray
+        Triangles (clockwise ones get negative weights).
+    order : int
+        Polynomial degree integrated exactly on each triangle.
+    singular : (s, 2) array_like, optional
+        Points where the integrand may grow like ``1/r`` (crack tips: squared
+        ``r^-1/2`` stresses). The triangles holding one are split at it and
+        integrated by a collapsed (Duffy) rule, which removes the singularity;
+        a plain Gauss rule there has an error that does not shrink with the
+        triangle's size.
+
+    Returns
+    -------
+    triangle : (q,) int64 ndarray
+        The triangle of each point.
+    points : (q, 2) ndarray
+    weights : (q,) ndarray
+        Summing to each triangle's signed area.
+    """
+    singular = np.zeros((0, 2)) if singular is None else np.asarray(singular, float).reshape(-1, 2)
+    hit, source, apex, b, c = _split_at_singular(corners, singular)
+    regular = np.flatnonzero(~hit)
+    points, weights = _triangle_rule(corners[regular], order)
+    owners = [np.repeat(regular, weights.shape[1])]
+    points, weights = [points.reshape(-1, 2)], [weights.reshape(-1)]
+    if len(source):
+        p, w = _collapsed_rule(apex, b, c, order)
+        owners.append(np.repeat(source, w.shape[1]))
+        points.append(p.reshape(-1, 2))
+        weights.append(w.reshape(-1))
+    return np.concatenate(owners), np.concatenate(points), np.concatenate(weights)
+
+
+def cell_quadrature(cells, nodes, order=4, *, singular=None):
     """Quadrature points and weights on every cell polygon.
 
     Parameters
@@ -73,6 +182,8 @@ def cell_quadrature(cells, nodes, order=4):
         The model's nodes.
     order : int
         Polynomial degree integrated exactly on each triangle of the cells.
+    singular : (s, 2) array_like, optional
+        Crack tips: collapsed rules about them (see `triangle_quadrature`).
 
     Returns
     -------
@@ -83,14 +194,8 @@ def cell_quadrature(cells, nodes, order=4):
         ``sum(weights[cell == k]) == cells.area[k]``.
     """
     owner, corners = cell_triangles(cells, nodes)
-    ref, w = get_quadrature(RefTri, order)          # reference triangle, area 1/2
-    e1 = corners[:, 1] - corners[:, 0]
-    e2 = corners[:, 2] - corners[:, 0]
-    jac = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    points = (corners[:, None, 0] + ref[0][None, :, None] * e1[:, None]
-              + ref[1][None, :, None] * e2[:, None])
-    weights = jac[:, None] * w[None, :]            # signed: negative fan triangles subtract
-    return np.repeat(owner, len(w)), points.reshape(-1, 2), weights.reshape(-1)
+    triangle, points, weights = triangle_quadrature(corners, order, singular=singular)
+    return owner[triangle], points, weights
 
 
 def subdivide(cells, nodes, *, whole=None, node_apex=None):

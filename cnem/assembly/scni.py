@@ -246,11 +246,24 @@ class BoundaryQuadrature:
                                      in_order=False)
 
 
-def boundary_quadrature(model, *, gauss=2, cells=None):
+def _graded_rule(s, w, start, end):
+    """Gauss points ``s`` and weights ``w`` on ``[0, 1]`` per piece, graded towards
+    the ends flagged in ``start`` / ``end`` by ``t = s^2`` (``1 - (1 - s)^2``): a
+    ``sqrt(t)`` behaviour at that end becomes smooth. Returns ``(q, g)`` arrays."""
+    S = np.broadcast_to(s, (len(start), len(s))).copy()
+    W = np.broadcast_to(w, (len(start), len(s))).copy()
+    S[start], W[start] = s ** 2, 2.0 * s * w
+    S[end], W[end] = 1.0 - (1.0 - s) ** 2, 2.0 * (1.0 - s) * w
+    return S, W
+
+
+def boundary_quadrature(model, *, gauss=2, cells=None, singular=None):
     """Gauss points on every cell boundary: each edge cut at circumcircle crossings,
     ``gauss`` points per piece, crack faces seen from their side, slits in tip cells.
 
     ``cells``: integration cells other than ``model.cells`` (sub-cells, say).
+    ``singular``: ``(s, 2)`` points (crack tips) where the integrand behaves like
+    ``sqrt(r)`` (enrichment functions); the pieces ending at one are graded.
 
     Returns
     -------
@@ -278,10 +291,16 @@ def boundary_quadrature(model, *, gauss=2, cells=None):
     s, w = np.polynomial.legendre.leggauss(gauss)
     s, w = 0.5 * (s + 1.0), 0.5 * w
     d = b - a
-    t = t0[:, None] + (t1 - t0)[:, None] * s
+    start, end = np.zeros(len(edge), dtype=bool), np.zeros(len(edge), dtype=bool)
+    tol = config.SNAP_TOL * model.domain.diameter
+    for p in np.zeros((0, 2)) if singular is None else np.asarray(singular, float).reshape(-1, 2):
+        start |= np.hypot(*(a[edge] + t0[:, None] * d[edge] - p).T) <= tol
+        end |= np.hypot(*(a[edge] + t1[:, None] * d[edge] - p).T) <= tol
+    S, W = _graded_rule(s, w, start, end)
+    t = t0[:, None] + (t1 - t0)[:, None] * S
     points = (a[edge][:, None, :] + t[:, :, None] * d[edge][:, None, :]).reshape(-1, 2)
     # weights times the outward normal of the canonical direction times length: (dy, -dx)
-    weight = ((t1 - t0)[:, None] * w).reshape(-1)
+    weight = ((t1 - t0)[:, None] * W).reshape(-1)
     rows = np.repeat(edge, gauss)
     cols = np.arange(len(points))
     shape = (len(a), len(points))

@@ -30,6 +30,10 @@ __all__ = ["Enrichment", "FUNCTIONS"]
 #: Enrichment function sets and their sizes.
 FUNCTIONS = {"sqrt": 1, "branch": 4}
 
+#: Fewest Gauss points per cell-edge piece in the smoothing of the enrichment
+#: functions (they vary like sqrt(r) about the tip, not like a rational function).
+MIN_GAUSS = 4
+
 
 class Enrichment:
     """Near-tip enrichment of the nodes close to some crack tips.
@@ -206,13 +210,15 @@ class Enrichment:
         return near
 
     def smoothed_gradient(self, gauss=2, cells=None):
-        """SCNI smoothed gradients of the enrichment functions.
+        """SCNI smoothed gradients of the enrichment functions, with at least
+        `MIN_GAUSS` points per piece of cell edge, graded towards the tips.
 
         Returns
         -------
         gx, gy : scipy.sparse.csr_matrix, shape (m, len(self))
         """
-        quad = boundary_quadrature(self.model, gauss=gauss, cells=cells)
+        quad = boundary_quadrature(self.model, gauss=max(gauss, MIN_GAUSS), cells=cells,
+                                   singular=self.tips)
         select = np.flatnonzero(self.in_support(quad.points))
         points, hint = quad.points[select], quad.hint[select]
         sides = points.copy()                     # on a crack face: its triangle's side

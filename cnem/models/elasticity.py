@@ -213,7 +213,8 @@ class Elasticity:
         fields (the patch test holds). With exact integration the smoothed
         stiffness plus this term would be the Galerkin stiffness on these cells."""
         basis, cells, enrichment = self.basis, self.cells, self.enrichment
-        owner, points, weights = cell_quadrature(cells, self.model.nodes, order)
+        owner, points, weights = cell_quadrature(cells, self.model.nodes, order,
+                                                 singular=enrichment.tips)
         near = np.zeros(len(cells.area), dtype=bool)
         near[owner[enrichment.in_support(points)]] = True        # whole cells
         keep = np.flatnonzero(near[owner])

@@ -182,7 +182,8 @@ class ElasticSolution:
         """
         if strain not in ("smoothed", "pointwise"):
             raise ValueError(f"strain: expected 'smoothed' or 'pointwise', received {strain!r}")
-        cell, points, weights = cell_quadrature(self.cells, self.model.nodes, order)
+        cell, points, weights = cell_quadrature(self.cells, self.model.nodes, order,
+                                                singular=self.model.domain.tips)
         if strain == "smoothed":
             stress = self.stress[cell]
         else:
