@@ -17,6 +17,9 @@ import numpy as np
 import scipy.sparse as sp
 from skfem.assembly.form.form import FormExtraParams
 
+from ..spatial.rtree import work_chunks
+from . import _sparse_kernels as SK
+
 __all__ = ["BilinearForm", "LinearForm", "Functional", "asm"]
 
 
@@ -86,13 +89,15 @@ class BilinearForm(_Form):
             return sp.csr_matrix((basis.N, basis.N))
         used = sorted({a for a, _ in active} | {b for _, b in active})
         slot = {d: i for i, d in enumerate(used)}
-        cells = np.arange(m)
-        rows = np.concatenate([slot[b] * m + cells for a, b in active])
-        cols = np.concatenate([slot[a] * m + cells for a, b in active])
-        vals = np.concatenate([basis.dx * coeff[a][b] for a, b in active])
-        weights = sp.csr_matrix((vals, (rows, cols)), shape=(len(used) * m,) * 2)
+        weights = np.zeros((m, len(used), len(used)))
+        for a, b in active:
+            weights[:, slot[a], slot[b]] = basis.dx * coeff[a][b]
         stack = sp.vstack([ops[d] for d in used], format="csr")
-        return (stack.T @ (weights @ stack)).tocsr()
+        t = stack.T.tocsr()
+        indptr, indices, data = SK.weighted_gram(stack.indptr, stack.indices, stack.data,
+                                                 t.indptr, t.indices, t.data, weights, m,
+                                                 basis.N, work_chunks())
+        return sp.csr_matrix((data, indices, indptr), shape=(basis.N, basis.N))
 
 
 class LinearForm(_Form):

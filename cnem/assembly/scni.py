@@ -23,7 +23,9 @@ import shapely
 from .. import config
 from ..geometry.topology import circumcenters, constraint_edges, triangle_neighbors
 from ..spatial.rtree import RTree
+from ..spatial.rtree import work_chunks
 from . import _kernels as K
+from . import _sparse_kernels as SK
 
 __all__ = ["SmoothedGradient", "smoothed_gradient", "BoundaryQuadrature", "boundary_quadrature",
            "cell_edges"]
@@ -226,15 +228,22 @@ class BoundaryQuadrature:
 
     def cell_integrals(self, values, rows=None):
         """``(1 / A_k) ∮_{Γ_k} f n dΓ`` for ``values = f(points)``, ``(q, ...)`` array or
-        sparse ``(q, c)``; returns the x and y parts, ``(m, ...)``. ``rows``: the
-        point of each row of ``values`` when they come in another order."""
-        wx, wy = self.wx, self.wy
-        if rows is not None:                   # relabel the columns: point rows[r] -> r
-            where = np.empty(len(rows), dtype=np.int64)
+        sparse ``(q, c)`` (then CSR results); returns the x and y parts, ``(m, ...)``.
+        ``rows``: the point of each row of ``values`` when they come in another order."""
+        where = np.arange(len(self.points))
+        if rows is not None:                   # point rows[r] is row r of values
             where[rows] = np.arange(len(rows))
-            wx, wy = (sp.csr_matrix((w.data, where[w.indices], w.indptr), shape=w.shape)
-                      for w in (wx, wy))
-        return self.to_cells @ (wx @ values), self.to_cells @ (wy @ values)
+        if not sp.issparse(values):
+            values = np.asarray(values)[where]
+            return self.to_cells @ (self.wx @ values), self.to_cells @ (self.wy @ values)
+        phi = values.tocsr()
+        c, w = self.to_cells, self.wx
+        indptr, indices, x, y = SK.boundary_sums(
+            c.indptr, c.indices, c.data, w.indptr, w.indices, w.data, self.wy.data,
+            phi.indptr, phi.indices, phi.data, where, phi.shape[1], work_chunks())
+        shape = (c.shape[0], phi.shape[1])
+        return sp.csr_matrix((x, indices, indptr), shape=shape), \
+            sp.csr_matrix((y, indices, indptr), shape=shape)
 
     def shape_functions(self, model, select=None):
         """The shape functions at the points (or at ``points[select]``), sides
@@ -301,11 +310,14 @@ def boundary_quadrature(model, *, gauss=2, cells=None, singular=None):
     points = (a[edge][:, None, :] + t[:, :, None] * d[edge][:, None, :]).reshape(-1, 2)
     # weights times the outward normal of the canonical direction times length: (dy, -dx)
     weight = ((t1 - t0)[:, None] * W).reshape(-1)
-    rows = np.repeat(edge, gauss)
-    cols = np.arange(len(points))
+    rows = np.repeat(edge, gauss)                     # sorted: the pieces come edge by edge
+    indptr = np.zeros(len(a) + 1, dtype=np.int64)
+    np.cumsum(np.bincount(rows, minlength=len(a)), out=indptr[1:])
+    cols = np.arange(len(points), dtype=np.int32)
     shape = (len(a), len(points))
-    wx = sp.csr_matrix((weight * d[rows, 1], (rows, cols)), shape=shape)
-    wy = sp.csr_matrix((-weight * d[rows, 0], (rows, cols)), shape=shape)
+    # one pattern for both (explicit zeros kept): cell_integrals relies on it
+    wx = sp.csr_matrix((weight * d[rows, 1], cols, indptr), shape=shape)
+    wy = sp.csr_matrix((-weight * d[rows, 0], cols, indptr), shape=shape)
     to_cells = sp.csr_matrix((sign / cells.area[cell], (cell, occurrence.reshape(-1))),
                              shape=(len(cells.area), len(a)))
     log.info("SCNI quadrature: %d cells, %d edges, %d pieces, %d points", len(cells.area),

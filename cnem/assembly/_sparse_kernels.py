@@ -1,0 +1,183 @@
+"""Numba kernels for the sparse products of SCNI assembly (row by row, Gustavson).
+
+scipy's general sparse-times-sparse products are single-threaded and build
+every intermediate product; these kernels compute each output row at once
+with a dense accumulator per thread (two passes: count, then fill).
+"""
+
+import numba
+import numpy as np
+
+
+@numba.njit(cache=True, inline="always")
+def _chunk(ch, nch, n):
+    return ch * n // nch, (ch + 1) * n // nch
+
+
+@numba.njit(cache=True, parallel=True)
+def boundary_sums(cell_ptr, cell_edge, cell_sign, edge_ptr, edge_point, wx, wy,
+                  phi_ptr, phi_idx, phi_val, point_row, ncol, nch):
+    """``B~x = to_cells @ Wx @ Phi`` and ``B~y`` alike, as two CSR matrices with
+    one pattern.
+
+    Parameters
+    ----------
+    cell_ptr, cell_edge, cell_sign : CSR (m, e)
+        The edges of every cell and ``±1 / A_k``.
+    edge_ptr, edge_point, wx, wy : CSR (e, q)
+        The quadrature points of every edge and their weights times the normal.
+    phi_ptr, phi_idx, phi_val : CSR (q, ncol)
+        Values at the points, row ``point_row[p]`` for point ``p``.
+    ncol : int
+    nch : int
+        Work chunks shared between threads.
+
+    Returns
+    -------
+    indptr : (m + 1,) int64
+    indices : (nnz,) int32
+    x, y : (nnz,) float64
+    """
+    m = len(cell_ptr) - 1
+    counts = np.zeros(m, dtype=np.int64)
+    for ch in numba.prange(nch):
+        mark = np.full(ncol, -1, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, m)
+        for c in range(lo, hi):
+            count = 0
+            for ce in range(cell_ptr[c], cell_ptr[c + 1]):
+                e = cell_edge[ce]
+                for ep in range(edge_ptr[e], edge_ptr[e + 1]):
+                    r = point_row[edge_point[ep]]
+                    for k in range(phi_ptr[r], phi_ptr[r + 1]):
+                        j = phi_idx[k]
+                        if mark[j] != c:
+                            mark[j] = c
+                            count += 1
+            counts[c] = count
+    indptr = np.zeros(m + 1, dtype=np.int64)
+    for c in range(m):
+        indptr[c + 1] = indptr[c] + counts[c]
+    indices = np.empty(indptr[m], dtype=np.int32)
+    x = np.empty(indptr[m])
+    y = np.empty(indptr[m])
+    for ch in numba.prange(nch):
+        slot = np.full(ncol, -1, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, m)
+        for c in range(lo, hi):
+            start = indptr[c]
+            end = start
+            for ce in range(cell_ptr[c], cell_ptr[c + 1]):
+                e = cell_edge[ce]
+                s = cell_sign[ce]
+                for ep in range(edge_ptr[e], edge_ptr[e + 1]):
+                    r = point_row[edge_point[ep]]
+                    sx, sy = s * wx[ep], s * wy[ep]
+                    for k in range(phi_ptr[r], phi_ptr[r + 1]):
+                        j = phi_idx[k]
+                        at = slot[j]
+                        if at < start:                  # first time in this row
+                            at = end
+                            slot[j] = at
+                            indices[at] = j
+                            x[at] = 0.0
+                            y[at] = 0.0
+                            end += 1
+                        x[at] += sx * phi_val[k]
+                        y[at] += sy * phi_val[k]
+            _sort_row(indices, x, y, start, end)
+    return indptr, indices, x, y
+
+
+@numba.njit(cache=True)
+def _sort_row(indices, x, y, start, end):
+    """Sort one CSR row by column (insertion sort: rows are short)."""
+    for i in range(start + 1, end):
+        j, a, b = indices[i], x[i], y[i]
+        k = i - 1
+        while k >= start and indices[k] > j:
+            indices[k + 1], x[k + 1], y[k + 1] = indices[k], x[k], y[k]
+            k -= 1
+        indices[k + 1], x[k + 1], y[k + 1] = j, a, b
+
+
+@numba.njit(cache=True, parallel=True)
+def weighted_gram(q_ptr, q_idx, q_val, t_ptr, t_row, t_val, coeff, m, ncol, nch):
+    """``K = Q^T W Q`` for stacked descriptor operators ``Q`` (``c m`` rows: row
+    ``a m + k`` is descriptor ``a`` at cell ``k``) and per-cell couplings
+    ``W[b m + k, a m + k] = coeff[k, a, b]``, row by row.
+
+    Parameters
+    ----------
+    q_ptr, q_idx, q_val : CSR (c m, ncol)
+    t_ptr, t_row, t_val : CSR of ``Q^T`` (ncol, c m)
+    coeff : (m, c, c) float64
+        ``coeff[k, a, b]``: weight of the pair (trial descriptor ``a``, test ``b``).
+    m, ncol, nch : int
+
+    Returns
+    -------
+    indptr : (ncol + 1,) int64
+    indices : (nnz,) int32
+    data : (nnz,) float64
+        ``K[i, j] = sum_k sum_ab Q[b m + k, i] coeff[k, a, b] Q[a m + k, j]``.
+    """
+    c = coeff.shape[1]
+    counts = np.zeros(ncol, dtype=np.int64)
+    for ch in numba.prange(nch):
+        mark = np.full(ncol, -1, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            count = 0
+            for t in range(t_ptr[i], t_ptr[i + 1]):
+                b = t_row[t] // m
+                k = t_row[t] % m
+                for a in range(c):
+                    if coeff[k, a, b] * t_val[t] == 0.0:
+                        continue
+                    row = a * m + k
+                    for p in range(q_ptr[row], q_ptr[row + 1]):
+                        j = q_idx[p]
+                        if mark[j] != i:
+                            mark[j] = i
+                            count += 1
+            counts[i] = count
+    indptr = np.zeros(ncol + 1, dtype=np.int64)
+    for i in range(ncol):
+        indptr[i + 1] = indptr[i] + counts[i]
+    indices = np.empty(indptr[ncol], dtype=np.int32)
+    data = np.zeros(indptr[ncol])
+    for ch in numba.prange(nch):
+        slot = np.full(ncol, -1, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            start = indptr[i]
+            end = start
+            for t in range(t_ptr[i], t_ptr[i + 1]):         # the row's columns ...
+                b = t_row[t] // m
+                k = t_row[t] % m
+                for a in range(c):
+                    if coeff[k, a, b] * t_val[t] == 0.0:
+                        continue
+                    row = a * m + k
+                    for p in range(q_ptr[row], q_ptr[row + 1]):
+                        j = q_idx[p]
+                        if slot[j] < start:
+                            slot[j] = start
+                            indices[end] = j
+                            end += 1
+            indices[start:end].sort()                       # ... in order
+            for p in range(start, end):
+                slot[indices[p]] = p
+            for t in range(t_ptr[i], t_ptr[i + 1]):         # then their values
+                b = t_row[t] // m
+                k = t_row[t] % m
+                qi = t_val[t]
+                for a in range(c):
+                    w = coeff[k, a, b] * qi
+                    if w == 0.0:
+                        continue
+                    row = a * m + k
+                    for p in range(q_ptr[row], q_ptr[row + 1]):
+                        data[slot[q_idx[p]]] += w * q_val[p]
+    return indptr, indices, data

@@ -1,0 +1,62 @@
+"""The numba sparse products of SCNI assembly against scipy's general products."""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import pytest
+
+from cnem.assembly import _sparse_kernels as SK
+
+
+def _random_csr(rng, shape, density):
+    A = sp.random(*shape, density=density, random_state=rng, format="csr")
+    A.data = rng.uniform(-1, 1, A.nnz)
+    return A
+
+
+@pytest.mark.parametrize("nch", [1, 3, 16])
+@pytest.mark.parametrize("c", [1, 3])
+def test_weighted_gram_matches_scipy(c, nch):
+    rng = np.random.default_rng(c + nch)
+    m, ncol = 40, 25
+    Q = _random_csr(rng, (c * m, ncol), 0.15)
+    coeff = rng.uniform(-1, 1, (m, c, c))
+    coeff[:, 0, -1] = 0.0                                  # some couplings absent
+    W = sp.lil_matrix((c * m, c * m))
+    for k in range(m):
+        for a in range(c):
+            for b in range(c):
+                W[b * m + k, a * m + k] = coeff[k, a, b]
+    expected = (Q.T @ W.tocsr() @ Q).toarray()
+    T = Q.T.tocsr()
+    indptr, indices, data = SK.weighted_gram(Q.indptr, Q.indices, Q.data, T.indptr, T.indices,
+                                             T.data, coeff, m, ncol, nch)
+    K = sp.csr_matrix((data, indices, indptr), shape=(ncol, ncol))
+    np.testing.assert_allclose(K.toarray(), expected, atol=1e-13)
+    for i in range(ncol):                                  # sorted, no duplicates
+        row = indices[indptr[i]:indptr[i + 1]]
+        assert np.all(np.diff(row) > 0)
+
+
+@pytest.mark.parametrize("nch", [1, 5])
+def test_boundary_sums_match_scipy(nch):
+    rng = np.random.default_rng(nch)
+    m, e, q, n = 12, 30, 90, 20
+    to_cells = _random_csr(rng, (m, e), 0.2)
+    pattern = _random_csr(rng, (e, q), 0.1)
+    wx = pattern.copy()
+    wy = sp.csr_matrix((rng.uniform(-1, 1, pattern.nnz), pattern.indices, pattern.indptr),
+                       shape=pattern.shape)
+    phi = _random_csr(rng, (q, n), 0.2)
+    order = rng.permutation(q)                     # point p is row where[p] of the values
+    where = np.empty(q, dtype=np.int64)
+    where[order] = np.arange(q)
+    values = phi[order]
+    indptr, indices, x, y = SK.boundary_sums(to_cells.indptr, to_cells.indices, to_cells.data,
+                                             wx.indptr, wx.indices, wx.data, wy.data,
+                                             values.indptr, values.indices, values.data, where,
+                                             n, nch)
+    for got, w in ((x, wx), (y, wy)):
+        B = sp.csr_matrix((got, indices, indptr), shape=(m, n))
+        np.testing.assert_allclose(B.toarray(), (to_cells @ w @ phi).toarray(), atol=1e-13)
