@@ -242,8 +242,9 @@ class BoundaryQuadrature:
             c.indptr, c.indices, c.data, w.indptr, w.indices, w.data, self.wy.data,
             phi.indptr, phi.indices, phi.data, where, phi.shape[1], work_chunks())
         shape = (c.shape[0], phi.shape[1])
+        # own index arrays: scipy may sort one matrix's indices in place
         return sp.csr_matrix((x, indices, indptr), shape=shape), \
-            sp.csr_matrix((y, indices, indptr), shape=shape)
+            sp.csr_matrix((y, indices.copy(), indptr.copy()), shape=shape)
 
     def shape_functions(self, model, select=None):
         """The shape functions at the points (or at ``points[select]``), sides

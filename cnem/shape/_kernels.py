@@ -257,9 +257,14 @@ def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, s
 
 
 @numba.njit(cache=True, parallel=True)
-def natural(nodes, tri, nb, points, tri_of, order, node_tol, edge_tol, nch, laplace,
-            gradient):
-    """Sibson (or Laplace) coordinates of many points as CSR.
+def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace, gradient,
+            slots):
+    """Sibson (or Laplace) coordinates of many points, one pass, rows in visit order.
+
+    Each chunk of points writes its rows one after the other into its own
+    region of the output, ``slots`` entries per point (the rows are moved to
+    their final places by `permute_rows`); a chunk whose rows do not fit
+    stops and is reported (call again with more slots).
 
     Parameters
     ----------
@@ -272,8 +277,6 @@ def natural(nodes, tri, nb, points, tri_of, order, node_tol, edge_tol, nch, lapl
         after the other keep the triangulation in cache).
     tri_of : (p,) int64
         A triangle containing each point (same order).
-    order : (p,) int64
-        Row of the output of each point: point ``s`` fills row ``order[s]``.
     node_tol, edge_tol : float
         Distances under which a point is at a node / on a constraint edge.
     nch : int
@@ -283,49 +286,51 @@ def natural(nodes, tri, nb, points, tri_of, order, node_tol, edge_tol, nch, lapl
     gradient : bool
         Also return the Sibson gradients (rows at nodes and on constraint
         edges, where they are not defined, stay zero).
+    slots : int
+        Room per point in the chunks' regions.
 
     Returns
     -------
-    offsets : (p + 1,) int64
-    cols : (k,) int64
-    vals, gx, gy : (k,) float64
+    start, size : (p,) int64
+        Row ``s`` is ``cols[start[s]:start[s] + size[s]]`` (same for the values).
+    cols : (p * slots,) int64
+    vals, gx, gy : (p * slots,) float64
         Values and gradients (``gx, gy`` empty unless ``gradient``).
     kinds : (p,) int8
         ``CAVITY``, ``AT_NODE``, ``ON_EDGE`` or ``FAILED`` (an inconsistent
         cavity; the row is empty).
+    full : bool
+        Some chunk ran out of room (the result is incomplete).
     """
     p = points.shape[0]
-    counts = np.zeros(p, dtype=np.int64)
+    start = np.zeros(p, dtype=np.int64)
+    size = np.zeros(p, dtype=np.int64)
     kinds = np.zeros(p, dtype=np.int8)
     nch = max(1, min(p, nch))
-    for ch in numba.prange(nch):
-        cav = np.empty(MAX_CAVITY, dtype=np.int64)
-        for s in range(ch * p // nch, (ch + 1) * p // nch):
-            q = order[s]
-            counts[q] = _row_size(nodes, tri, nb, tri_of[s], points[s, 0], points[s, 1],
-                                  node_tol, edge_tol, cav)
-    offsets = np.zeros(p + 1, dtype=np.int64)
-    for q in range(p):
-        offsets[q + 1] = offsets[q] + counts[q]
-    out_cols = np.empty(offsets[p], dtype=np.int64)
-    out_vals = np.empty(offsets[p])
-    out_gx = np.zeros(offsets[p] if gradient else 0)
-    out_gy = np.zeros(offsets[p] if gradient else 0)
+    out_cols = np.empty(p * slots, dtype=np.int64)
+    out_vals = np.empty(p * slots)
+    out_gx = np.zeros(p * slots if gradient else 0)
+    out_gy = np.zeros(p * slots if gradient else 0)
+    full = np.zeros(nch, dtype=np.bool_)
     for ch in numba.prange(nch):
         cav = np.empty(MAX_CAVITY, dtype=np.int64)
         cols = np.empty(MAX_CAVITY, dtype=np.int64)
         vals, gx, gy = np.empty(MAX_CAVITY), np.empty(MAX_CAVITY), np.empty(MAX_CAVITY)
         scratch = np.empty((MAX_CAVITY, 8))
-        for s in range(ch * p // nch, (ch + 1) * p // nch):
-            q = order[s]
+        lo, hi = ch * p // nch, (ch + 1) * p // nch
+        a, end = lo * slots, hi * slots
+        for s in range(lo, hi):
             kind, c = _row(nodes, tri, nb, tri_of[s], points[s, 0], points[s, 1], node_tol,
                            edge_tol, cav, cols, vals, gx, gy, scratch, laplace,
                            laplace or gradient)
-            kinds[q] = kind
-            if kind == FAILED or c != counts[q]:
-                kinds[q] = FAILED
+            kinds[s] = kind
+            start[s] = a
+            if kind == FAILED:
                 continue
-            a = offsets[q]
+            if a + c > end:
+                full[ch] = True
+                break
+            size[s] = c
             for e in range(c):           # element-wise: slices would cost atomic
                 out_cols[a + e] = cols[e]    # reference counts in a parallel loop
                 out_vals[a + e] = vals[e]
@@ -333,7 +338,8 @@ def natural(nodes, tri, nb, points, tri_of, order, node_tol, edge_tol, nch, lapl
                 for e in range(c):
                     out_gx[a + e] = gx[e]
                     out_gy[a + e] = gy[e]
-    return offsets, out_cols, out_vals, out_gx, out_gy, kinds
+            a += c
+    return start, size, out_cols, out_vals, out_gx, out_gy, kinds, full.any()
 
 
 @numba.njit(cache=True, parallel=True)
@@ -406,31 +412,36 @@ def locate_walk(nodes, tri, nb, points, seeds, nch):
 
 
 @numba.njit(cache=True, parallel=True)
-def permute_rows(offsets, cols, vals, gx, gy, order):
-    """CSR rows ``s`` moved to rows ``order[s]``.
+def permute_rows(start, size, cols, vals, gx, gy, order):
+    """Rows ``s`` (``cols[start[s]:start[s] + size[s]]``) moved to CSR rows ``order[s]``.
 
     Filling rows in the order the points were visited and moving them
     afterwards (sequential writes, random reads) is much cheaper than
     writing every row straight to its final, random, place.
+
+    Returns
+    -------
+    offsets : (p + 1,) int64
+    cols : (k,) int32
+    vals, gx, gy : (k,) float64
     """
     p = order.shape[0]
-    counts = np.empty(p, dtype=np.int64)
-    for s in numba.prange(p):
-        counts[order[s]] = offsets[s + 1] - offsets[s]
-    new = np.zeros(p + 1, dtype=np.int64)
-    for q in range(p):
-        new[q + 1] = new[q] + counts[q]
     inv = np.empty(p, dtype=np.int64)
+    moved = np.empty(p, dtype=np.int64)
     for s in numba.prange(p):
         inv[order[s]] = s
-    out_cols = np.empty_like(cols)
-    out_vals = np.empty_like(vals)
-    out_gx = np.empty_like(gx)
-    out_gy = np.empty_like(gy)
+        moved[order[s]] = size[s]
+    new = np.zeros(p + 1, dtype=np.int64)
+    for q in range(p):                    # sequential reads only in the serial loop
+        new[q + 1] = new[q] + moved[q]
+    out_cols = np.empty(new[p], dtype=np.int32)
+    out_vals = np.empty(new[p])
     grad = gx.shape[0] > 0
+    out_gx = np.empty(new[p] if grad else 0)
+    out_gy = np.empty(new[p] if grad else 0)
     for q in numba.prange(p):
-        a, b = offsets[inv[q]], new[q]
-        for e in range(counts[q]):
+        a, b = start[inv[q]], new[q]
+        for e in range(new[q + 1] - b):
             out_cols[b + e] = cols[a + e]
             out_vals[b + e] = vals[a + e]
             if grad:

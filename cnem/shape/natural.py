@@ -15,6 +15,10 @@ __all__ = ["shape_functions", "KINDS"]
 
 KINDS = ("sibson", "laplace")
 
+#: Room per point for the rows written chunk by chunk (doubled when a chunk overflows;
+#: points have about 5-6 natural neighbours on average).
+ROW_SLOTS = 8
+
 
 def _topology(model):
     """Neighbours cut across constraints, all neighbours (for walking) and an R-tree
@@ -127,18 +131,23 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
         raise GeometryError(
             f"{outside.size} of {len(pts)} points lie outside {where}, first (index: point) "
             + ", ".join(f"{i}: {pts[i].tolist()}" for i in outside[:5]))
-    visit = np.arange(len(pts), dtype=np.int64)   # rows filled in path order, then moved
-    offsets, cols, vals, gx, gy, kinds = K.natural(
-        model.nodes, model.triangles, nb, spts, tri_of, visit, tol, tol, work_chunks(),
-        kind == "laplace", gradient)
+    slots = ROW_SLOTS
+    while True:                                # rows in path order, chunk by chunk
+        start, size, cols, vals, gx, gy, kinds, full = K.natural(
+            model.nodes, model.triangles, nb, spts, tri_of, tol, tol, work_chunks(),
+            kind == "laplace", gradient, slots)
+        if not full:
+            break
+        slots *= 2
     failed = np.sort(order[kinds == K.FAILED])            # kinds are in path order
     if failed.size:
         raise CNEMError(
             f"the natural-neighbour cavity of {failed.size} points was inconsistent (round-off "
             f"on a circumcircle), first {pts[failed[:3]].tolist()}; please report this case")
+    rows = np.arange(len(pts), dtype=np.int64) if not in_order and not gradient else order
+    offsets, cols, vals, gx, gy = K.permute_rows(start, size, cols, vals, gx, gy, rows)
     if not in_order and not gradient:
         return sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n)), order
-    offsets, cols, vals, gx, gy = K.permute_rows(offsets, cols, vals, gx, gy, order)
     phi = sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n))
     if not gradient:
         return phi
@@ -148,5 +157,6 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
             f"{singular.size} points lie at a node or on a boundary, interface or crack "
             f"segment, where the gradients are not defined, first {pts[singular[:3]].tolist()}; "
             "evaluate gradients inside the cells")
-    return (phi, sp.csr_matrix((gx, cols, offsets), shape=phi.shape),
-            sp.csr_matrix((gy, cols, offsets), shape=phi.shape))
+    # own index arrays: scipy may sort one matrix's indices in place
+    return (phi, sp.csr_matrix((gx, cols.copy(), offsets.copy()), shape=phi.shape),
+            sp.csr_matrix((gy, cols.copy(), offsets.copy()), shape=phi.shape))
