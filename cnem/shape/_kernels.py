@@ -416,8 +416,8 @@ def permute_rows(start, size, cols, vals, gx, gy, order):
     """Rows ``s`` (``cols[start[s]:start[s] + size[s]]``) moved to CSR rows ``order[s]``.
 
     Filling rows in the order the points were visited and moving them
-    afterwards (sequential writes, random reads) is much cheaper than
-    writing every row straight to its final, random, place.
+    afterwards (reads in that order, each row written to its place) is much
+    cheaper than computing them in the order of the rows.
 
     Returns
     -------
@@ -426,10 +426,8 @@ def permute_rows(start, size, cols, vals, gx, gy, order):
     vals, gx, gy : (k,) float64
     """
     p = order.shape[0]
-    inv = np.empty(p, dtype=np.int64)
     moved = np.empty(p, dtype=np.int64)
     for s in numba.prange(p):
-        inv[order[s]] = s
         moved[order[s]] = size[s]
     new = np.zeros(p + 1, dtype=np.int64)
     for q in range(p):                    # sequential reads only in the serial loop
@@ -439,9 +437,9 @@ def permute_rows(start, size, cols, vals, gx, gy, order):
     grad = gx.shape[0] > 0
     out_gx = np.empty(new[p] if grad else 0)
     out_gy = np.empty(new[p] if grad else 0)
-    for q in numba.prange(p):
-        a, b = start[inv[q]], new[q]
-        for e in range(new[q + 1] - b):
+    for s in numba.prange(p):
+        a, b = start[s], new[order[s]]
+        for e in range(size[s]):
             out_cols[b + e] = cols[a + e]
             out_vals[b + e] = vals[a + e]
             if grad:
