@@ -22,8 +22,7 @@ import shapely
 
 from .. import config
 from ..geometry.topology import circumcenters, constraint_edges, triangle_neighbors
-from ..spatial.rtree import RTree
-from ..spatial.rtree import work_chunks
+from ..spatial.rtree import RTree, work_chunks
 from . import _kernels as K
 from . import _sparse_kernels as SK
 
@@ -302,10 +301,12 @@ def boundary_quadrature(model, *, gauss=2, cells=None, singular=None):
     s, w = 0.5 * (s + 1.0), 0.5 * w
     d = b - a
     start, end = np.zeros(len(edge), dtype=bool), np.zeros(len(edge), dtype=bool)
-    tol = config.SNAP_TOL * model.domain.diameter
-    for p in np.zeros((0, 2)) if singular is None else np.asarray(singular, float).reshape(-1, 2):
-        start |= np.hypot(*(a[edge] + t0[:, None] * d[edge] - p).T) <= tol
-        end |= np.hypot(*(a[edge] + t1[:, None] * d[edge] - p).T) <= tol
+    if singular is not None:                  # pieces that begin or end at a singular point
+        tol = config.SNAP_TOL * model.domain.diameter
+        first, last = a[edge] + t0[:, None] * d[edge], a[edge] + t1[:, None] * d[edge]
+        for p in np.asarray(singular, float).reshape(-1, 2):
+            start |= np.hypot(*(first - p).T) <= tol
+            end |= np.hypot(*(last - p).T) <= tol
     S, W = _graded_rule(s, w, start, end)
     t = t0[:, None] + (t1 - t0)[:, None] * S
     points = (a[edge][:, None, :] + t[:, :, None] * d[edge][:, None, :]).reshape(-1, 2)
