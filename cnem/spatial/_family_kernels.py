@@ -24,6 +24,22 @@ def _dist2(a, i, b, j, period):
     return s
 
 
+@numba.njit(cache=True, inline="always")
+def _shifted_dist2(pts, q, x0, x1, x2, s0, s1, s2):
+    """Squared distance from ``(x0, x1, x2)`` to ``pts[q]`` shifted by ``(s0, s1, s2)``.
+
+    ``(x_q - x_i) + shift`` is exactly the minimum-image difference that
+    ``_wrap`` computes when the shift is the right periodic image, so all
+    methods agree to the last bit.
+    """
+    d = (pts[q, 0] - x0) + s0
+    d2 = d * d
+    d = (pts[q, 1] - x1) + s1
+    d2 += d * d
+    d = (pts[q, 2] - x2) + s2
+    return d2 + d * d
+
+
 @numba.njit(cache=True)
 def _cell_axis(x, origin, size, nc):
     """Cell of a coordinate (clamped: periodic coordinates already lie in [0, L))."""
@@ -144,8 +160,6 @@ def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, dest, pos, cap, 
                 if g1 + g2 * g2 >= h2:
                     continue
                 cell = base + buf[2, c]
-                # x_q - x_i + shift is exactly the minimum-image difference
-                # that _wrap computes, so all methods agree to the last bit
                 s0_, s1_, s2_ = shift[0, a], shift[1, b], shift[2, c]
                 if np.isnan(s0_) or np.isnan(s1_) or np.isnan(s2_):
                     for q in range(start[cell], start[cell + 1]):
@@ -155,12 +169,7 @@ def _scan(s0, spts, hs2, start, perm, origin, size, nc, period, dest, pos, cap, 
                         hits += (d2 < h2) & (d2 > 0.0)
                 else:
                     for q in range(start[cell], start[cell + 1]):
-                        d = (spts[q, 0] - x0) + s0_
-                        d2 = d * d
-                        d = (spts[q, 1] - x1) + s1_
-                        d2 += d * d
-                        d = (spts[q, 2] - x2) + s2_
-                        d2 += d * d
+                        d2 = _shifted_dist2(spts, q, x0, x1, x2, s0_, s1_, s2_)
                         if hits < room:
                             dest[pos + hits] = perm[q]
                         hits += (d2 < h2) & (d2 > 0.0)

@@ -17,10 +17,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
 from . import _family_kernels as K
+from . import _pair_kernels as P
 from .rtree import RTree, as_points, check_period, work_chunks
 
 __all__ = ["Family", "family_search", "METHODS", "BRUTE_LIMIT"]
@@ -30,8 +32,11 @@ METHODS = ("auto", "rtree", "cells", "kdtree", "brute")
 #: Largest cloud the brute-force method accepts.
 BRUTE_LIMIT = 20_000
 
-#: Cells per horizon along each axis in the cell list.
+#: Cells per horizon along each axis in the cell list (horizons per point).
 CELLS_PER_HORIZON = 2
+
+#: Columns per horizon along the two binned axes (one horizon for all points).
+COLUMNS_PER_HORIZON = 3
 
 
 @dataclass(frozen=True, repr=False)
@@ -81,11 +86,12 @@ def _index_dtype(n):
     return np.int32 if n < 2**31 - 1 else np.int64
 
 
-def _grid(pts3, hmax, period3, dim):
-    """Cell list grid: origin, cell sizes and counts, at most ~4 cells per point."""
+def _grid(pts3, hmax, period3, dim, per_horizon=CELLS_PER_HORIZON):
+    """Grid of cells over the first ``dim`` axes: origin, cell sizes and counts,
+    ``per_horizon`` cells per horizon and at most ~4 cells per point."""
     n = len(pts3)
     span = np.where(np.isfinite(period3), period3, np.ptp(pts3, axis=0) if n else 0.0)
-    size = np.full(3, hmax / CELLS_PER_HORIZON)
+    size = np.full(3, hmax / per_horizon)
     active = span[:dim] > 0
     volume = np.prod(span[:dim][active]) if active.any() else 0.0
     if volume > 0:                       # sparse clouds: larger cells, memory stays O(n)
@@ -104,8 +110,16 @@ def _grid(pts3, hmax, period3, dim):
 
 
 def _cells(pts3, horizon, period3, dim):
-    origin, size, nc = _grid(pts3, float(horizon.max()), period3, dim)
     sample = np.empty(0, dtype=_index_dtype(len(pts3)))
+    if horizon.min() == horizon.max():
+        # one horizon: each pair tested once, columns along two axes swept
+        # along the third, which must be a real one: 2-D points go (0, x, y)
+        axes = [2, 0, 1] if dim == 2 else [0, 1, 2]
+        pts_c, per_c = np.ascontiguousarray(pts3[:, axes]), period3[axes]
+        origin, size, nc = _grid(pts_c, float(horizon[0]), per_c, 2, COLUMNS_PER_HORIZON)
+        return P.uniform_family(pts_c, float(horizon[0]), origin, size, nc, per_c, sample,
+                                numba.get_num_threads())
+    origin, size, nc = _grid(pts3, float(horizon.max()), period3, dim)
     return K.cell_family(pts3, horizon, origin, size, nc, period3, sample, 2 * work_chunks())
 
 

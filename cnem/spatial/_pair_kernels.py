@@ -1,0 +1,349 @@
+"""Numba kernels of family search with one horizon for all points.
+
+With a common horizon the relation is symmetric, so every pair is tested once.
+Points are binned into columns along the first two axes and sorted by the
+third inside each column. The points of a column are visited in that order;
+for every neighbouring column that follows it in the sorted order (and for
+the column itself, points after the visited one), a window of heights
+``(z - reach, z + reach)`` slides up the neighbour as ``z`` grows, with
+``reach`` set by the gap between the two columns. Each candidate in the
+window is tested once; a member ``q`` of ``s`` goes to the row of ``s`` and
+``s`` to the row of ``q``.
+
+On a periodic third axis the neighbour column is seen as three copies
+(shifted by ``-L``, ``0``, ``+L``) laid end to end, so the window still
+slides monotonically; when the horizon reaches half the period, whole
+columns are tested with wrapped distances instead.
+
+Rows written by different work chunks are kept apart: each chunk counts, and
+later writes, the entries it adds to each row in a window of rows of its own
+(``lo[c] <= row < hi[c]``: partners follow a point in the sorted order by at
+most the columns its horizon reaches), and a row takes the chunks'
+contributions one after the other.
+
+Membership uses the same arithmetic as the other methods (squared
+minimum-image distance ``0 < s < h ** 2``; ``x_q - x_s`` is exactly the
+negative of ``x_s - x_q``, also after a periodic shift), so the sets are
+identical to theirs.
+"""
+
+import numba
+import numpy as np
+
+from ._family_kernels import _dist2, _shifted_dist2, bin_points
+
+
+@numba.njit(cache=True, parallel=True)
+def _sort_heights(pts, perm, start):
+    """Sort every column of ``perm`` by the third coordinate, in place."""
+    for c in numba.prange(start.shape[0] - 1):
+        seg = perm[start[c]:start[c + 1]]
+        seg[:] = seg[np.argsort(pts[seg, 2], kind="mergesort")]
+
+
+@numba.njit(cache=True)
+def _axis_columns(c, r, nc, size, period, tol, col, shift, gap):
+    """Columns within ``r`` of column ``c`` along one axis.
+
+    Writes each column, the periodic shift of its points (0, +L, -L; NaN when
+    ``r`` spans the period: distances are then wrapped one by one) and the gap
+    between the two columns along the axis, less ``tol``. Returns their number.
+    """
+    if np.isfinite(period) and 2 * r + 1 >= nc:
+        for k in range(nc):
+            col[k], shift[k], gap[k] = k, np.nan, 0.0
+        return nc
+    m = 0
+    for o in range(-r, r + 1):
+        k = c + o
+        s = 0.0
+        if np.isfinite(period):
+            if k < 0:
+                s = -period
+            elif k >= nc:
+                s = period
+            k %= nc
+        elif k < 0 or k >= nc:
+            continue
+        col[m], shift[m], gap[m] = k, s, max((abs(o) - 1) * size - tol, 0.0)
+        m += 1
+    return m
+
+
+@numba.njit(cache=True)
+def _neighbours(c, start, nc, size, period, h2, tol, cols, sx, sy, reach):
+    """Columns that may hold partners of column ``c`` and follow it in sorted order.
+
+    Fills ``cols``, their shifts ``sx``, ``sy`` and height ``reach``; the own
+    column comes first. Returns their number.
+    """
+    h = np.sqrt(h2)
+    r0 = int(np.ceil(h / size[0]))
+    r1 = int(np.ceil(h / size[1]))
+    w = max(nc[0], nc[1], 2 * max(r0, r1) + 1)
+    ca, sa, ga = np.empty(w, np.int64), np.empty(w), np.empty(w)
+    cb, sb, gb = np.empty(w, np.int64), np.empty(w), np.empty(w)
+    na = _axis_columns(c // nc[1], r0, nc[0], size[0], period[0], tol, ca, sa, ga)
+    nb = _axis_columns(c % nc[1], r1, nc[1], size[1], period[1], tol, cb, sb, gb)
+    cols[0], sx[0], sy[0], reach[0] = c, 0.0, 0.0, np.sqrt(h2)
+    m = 1
+    for a in range(na):
+        for b in range(nb):
+            k = ca[a] * nc[1] + cb[b]
+            g = ga[a] * ga[a] + gb[b] * gb[b]
+            if k == c:
+                sx[0], sy[0] = sa[a], sb[b]     # NaN when the period is spanned
+            elif k > c and g < h2 and start[k + 1] > start[k]:
+                cols[m], sx[m], sy[m], reach[m] = k, sa[a], sb[b], np.sqrt(h2 - g)
+                m += 1
+    return m
+
+
+@numba.njit(cache=True, inline="always")
+def _height(spts, base, m, v, period):
+    """Height of point ``v`` of the three copies of a column (``m`` points each)
+    shifted by ``-period``, 0 and ``+period``."""
+    if v < m:
+        return spts[base + v, 2] - period
+    if v < 2 * m:
+        return spts[base + v - m, 2]
+    return spts[base + v - 2 * m, 2] + period
+
+
+@numba.njit(cache=True)
+def _column_pass(col, spts, h2, tol, start, perm, nc, size, period, wrap_z, write, rows, lo,
+                 out, cols, sx, sy, reach, wlo, whi):
+    """Count (``write`` False) or write the pairs of the points of column ``col``.
+
+    Counting adds 1 to ``rows[x - lo]`` for both points of every pair;
+    writing uses ``rows`` as cursors into ``out``. ``tol`` bounds the rounding
+    of coordinates (gaps are shrunk and windows widened by it).
+    """
+    m = _neighbours(col, start, nc, size, period, h2, tol, cols, sx, sy, reach)
+    periodic_z = np.isfinite(period[2]) and not wrap_z
+    for k in range(m):
+        wlo[k] = 0
+        whi[k] = 0
+    for s in range(start[col], start[col + 1]):
+        x0, x1, x2 = spts[s, 0], spts[s, 1], spts[s, 2]
+        own = perm[s]
+        mine = rows[s - lo]
+        for k in range(m):
+            base = start[cols[k]]
+            size_k = start[cols[k] + 1] - base
+            exact = wrap_z or np.isnan(sx[k]) or np.isnan(sy[k])
+            # in the own column (k = 0) only the points after s: each pair is
+            # found from its first point
+            after = s + 1 if k == 0 else base
+            if wrap_z:
+                mine = _run(max(base, after), base + size_k, 0.0, True, s, spts, h2, sx[k],
+                            sy[k], period, write, rows, lo, out, perm, mine)
+                continue
+            zlo, zhi = x2 - reach[k] - tol, x2 + reach[k] + tol
+            if periodic_z:
+                # the window slides over three copies of the column (shifted
+                # by -L, 0, +L) laid end to end; offset: where the unshifted starts
+                offset, end = size_k, 3 * size_k
+                va = wlo[k]
+                while va < end and _height(spts, base, size_k, va, period[2]) <= zlo:
+                    va += 1
+                vb = max(whi[k], va)
+                while vb < end and _height(spts, base, size_k, vb, period[2]) < zhi:
+                    vb += 1
+            else:
+                offset, end = 0, size_k
+                va = wlo[k]
+                while va < end and spts[base + va, 2] <= zlo:
+                    va += 1
+                vb = max(whi[k], va)
+                while vb < end and spts[base + vb, 2] < zhi:
+                    vb += 1
+            wlo[k], whi[k] = va, vb
+            if va < offset or vb > offset + size_k:
+                for copy in range(3):      # the window wraps around the period
+                    qa = base + max(va - copy * size_k, 0)
+                    qb = base + min(vb - copy * size_k, size_k)
+                    mine = _run(max(qa, after), qb, (copy - 1) * period[2], exact, s, spts,
+                                h2, sx[k], sy[k], period, write, rows, lo, out, perm, mine)
+                continue
+            qa, qb = max(base + va - offset, after), base + vb - offset
+            if exact:
+                mine = _run(qa, qb, 0.0, True, s, spts, h2, sx[k], sy[k], period, write, rows,
+                            lo, out, perm, mine)
+                continue
+            sa, sb = sx[k], sy[k]
+            for q in range(qa, qb):        # the common case: one straight run
+                d2 = _shifted_dist2(spts, q, x0, x1, x2, sa, sb, 0.0)
+                mine = _record(d2, h2, write, rows, lo, out, q, own, perm, mine)
+        rows[s - lo] = mine
+
+
+@numba.njit(cache=True, inline="always")
+def _run(qa, qb, sz, exact, s, spts, h2, sx, sy, period, write, rows, lo, out, perm, mine):
+    """Test the candidates ``qa <= q < qb`` of point ``s``, shifted by
+    ``(sx, sy, sz)`` (or wrapped one by one when ``exact``). Returns the new ``mine``."""
+    own = perm[s]
+    x0, x1, x2 = spts[s, 0], spts[s, 1], spts[s, 2]
+    for q in range(qa, qb):
+        if exact:
+            d2 = _dist2(spts, s, spts, q, period)
+        else:
+            d2 = _shifted_dist2(spts, q, x0, x1, x2, sx, sy, sz)
+        mine = _record(d2, h2, write, rows, lo, out, q, own, perm, mine)
+    return mine
+
+
+@numba.njit(cache=True, inline="always")
+def _record(d2, h2, write, rows, lo, out, q, own, perm, mine):
+    """Candidate ``q`` at squared distance ``d2`` from the point ``own``: when a
+    member, count it in the row of ``q`` and in ``mine`` (the count, or the
+    write cursor, of the row of ``own``), or write both entries.
+    Returns the new ``mine``."""
+    if not write:                    # branch-free: about half the candidates are members
+        hit = (d2 < h2) & (d2 > 0.0)
+        rows[q - lo] += hit
+        return mine + hit
+    if d2 < h2 and d2 > 0.0:
+        i = rows[q - lo]
+        out[i] = own
+        rows[q - lo] = i + 1
+        out[mine] = perm[q]
+        return mine + 1
+    return mine
+
+
+@numba.njit(cache=True, parallel=True)
+def _scan_all(spts, h2, tol, start, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
+              write, rows, out):
+    """One counting (``write`` False) or filling pass, a chunk of columns per thread."""
+    nch = lo.shape[0]
+    h = np.sqrt(h2)
+    most = (2 * int(np.ceil(h / size[0])) + 1) * (2 * int(np.ceil(h / size[1])) + 1)
+    most = min(most, nc[0] * nc[1]) + 1
+    for c in numba.prange(nch):
+        cols = np.empty(most, dtype=np.int64)
+        sx, sy, reach = np.empty(most), np.empty(most), np.empty(most)
+        wlo, whi = np.empty(most, dtype=np.int64), np.empty(most, dtype=np.int64)
+        window = rows[woff[c]:woff[c + 1]]
+        for col in range(chunk_cols[c], chunk_cols[c + 1]):
+            _column_pass(col, spts, h2, tol, start, perm, nc, size, period, wrap_z, write,
+                         window, lo[c], out, cols, sx, sy, reach, wlo, whi)
+
+
+@numba.njit(cache=True)
+def _chunks(start, nc, size, h, period, nch):
+    """Columns of each chunk (balanced by points) and the rows it may write.
+
+    Returns
+    -------
+    chunk_cols : (nch + 1,) int64, chunk ``c`` visits columns
+        ``chunk_cols[c] <= col < chunk_cols[c + 1]``
+    lo, hi : (nch,) int64, it writes rows ``lo[c] <= row < hi[c]`` (sorted order)
+    """
+    ncol = start.shape[0] - 1
+    n = start[ncol]
+    chunk_cols = np.empty(nch + 1, dtype=np.int64)
+    chunk_cols[0] = 0
+    chunk_cols[nch] = ncol
+    col = 0
+    for c in range(1, nch):
+        while col < ncol and start[col] < c * n // nch:
+            col += 1
+        chunk_cols[c] = col
+    ahead = (int(np.ceil(h / size[0])) * nc[1] + int(np.ceil(h / size[1]))) + 1
+    periodic = np.isfinite(period[0]) or np.isfinite(period[1])
+    lo = np.empty(nch, dtype=np.int64)
+    hi = np.empty(nch, dtype=np.int64)
+    for c in range(nch):
+        lo[c] = start[chunk_cols[c]]
+        hi[c] = n if periodic else start[min(chunk_cols[c + 1] - 1 + ahead, ncol)]
+        hi[c] = max(hi[c], start[chunk_cols[c + 1]])
+    return chunk_cols, lo, hi
+
+
+@numba.njit(cache=True, parallel=True)
+def uniform_family(pts, h, origin, size, nc, period, index_dtype_sample, nch):
+    """Family of every point for one horizon ``h``, each pair tested once.
+
+    Parameters
+    ----------
+    pts : (n, 3) float64
+        Points (2-D points padded with a zero coordinate; the third axis is the
+        one swept, so it should be a real one).
+    h : float
+    origin, size : (3,) float64
+        Origin and widths of the columns.
+    nc : (3,) int64
+        Columns along the first two axes; ``nc[2]`` must be 1.
+    period : (3,) float64
+        ``inf`` on open axes.
+    index_dtype_sample : (0,) array
+        Its dtype (int32 or int64) is the dtype of the returned indices.
+    nch : int
+        Work chunks (about one per thread: each holds a window of row counters).
+
+    Returns
+    -------
+    offsets : (n + 1,) int64
+    indices : (offsets[-1],) index_dtype_sample.dtype
+    """
+    n = pts.shape[0]
+    perm, start = bin_points(pts, origin, size, nc, period)     # nc[2] = 1: columns
+    _sort_heights(pts, perm, start)
+    spts = np.empty_like(pts)
+    for s in numba.prange(n):
+        for k in range(3):
+            spts[s, k] = pts[perm[s], k]
+    h2 = h * h
+    tol = 1e-9 * h + 1e-12 * (np.abs(pts).max() + h)
+    wrap_z = np.isfinite(period[2]) and 2.0 * h * (1.0 + 1e-9) >= period[2]
+    nch = max(1, min(nch, nc[0] * nc[1]))
+    chunk_cols, lo, hi = _chunks(start, nc, size, h, period, nch)
+    woff = np.zeros(nch + 1, dtype=np.int64)
+    for c in range(nch):
+        woff[c + 1] = woff[c] + hi[c] - lo[c]
+    rows = np.zeros(woff[nch], dtype=np.int64)
+    dummy = np.empty(0, dtype=index_dtype_sample.dtype)
+    _scan_all(spts, h2, tol, start, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
+              False, rows, dummy)
+    offsets, out = _cursors(rows, woff, lo, hi, perm, index_dtype_sample)
+    _scan_all(spts, h2, tol, start, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
+              True, rows, out)
+    return offsets, out
+
+
+@numba.njit(cache=True)
+def _chunk_range(x, lo, hi):
+    """Chunks whose row windows hold sorted row ``x``: ``first <= c < stop``."""
+    stop = np.searchsorted(lo, x, side="right")
+    first = stop - 1
+    while first > 0 and hi[first - 1] > x:
+        first -= 1
+    return first, stop
+
+
+@numba.njit(cache=True, parallel=True)
+def _cursors(rows, woff, lo, hi, perm, index_dtype_sample):
+    """Row offsets; the per-chunk row counts turned into write cursors, in place;
+    the output allocated."""
+    n = perm.shape[0]
+    counts = np.empty(n, dtype=np.int64)
+    for x in numba.prange(n):
+        first, stop = _chunk_range(x, lo, hi)
+        t = 0
+        for c in range(first, stop):
+            t += rows[woff[c] + x - lo[c]]
+        counts[perm[x]] = t
+    offsets = np.empty(n + 1, dtype=np.int64)
+    offsets[0] = 0
+    for i in range(n):
+        offsets[i + 1] = offsets[i] + counts[i]
+    for x in numba.prange(n):
+        first, stop = _chunk_range(x, lo, hi)
+        t = offsets[perm[x]]
+        for c in range(first, stop):
+            k = woff[c] + x - lo[c]
+            v = rows[k]
+            rows[k] = t
+            t += v
+    return offsets, np.empty(offsets[n], dtype=index_dtype_sample.dtype)
