@@ -198,7 +198,7 @@ def cell_quadrature(cells, nodes, order=4, *, singular=None):
     return owner[triangle], points, weights
 
 
-def subdivide(cells, nodes, *, whole=None, node_apex=None):
+def subdivide(cells, nodes, *, whole=None, node_apex=None, mark_spokes=False):
     """Split every integration cell into the triangles of a fan (sub-cells).
 
     Used where one smoothed strain per cell is too few (enriched fields:
@@ -213,6 +213,11 @@ def subdivide(cells, nodes, *, whole=None, node_apex=None):
         Cells to keep whole.
     node_apex : (m,) bool array_like, optional
         Cells fanned from their node (see `cell_triangles`).
+    mark_spokes : bool
+        Mark the triangles' edges from their apex (``sub.spokes``): the
+        boundary quadrature then integrates them whole, fewer points where
+        the sub-cells only serve the stabilisation, whose spoke integrals
+        cancel between neighbouring triangles.
 
     Returns
     -------
@@ -242,5 +247,10 @@ def subdivide(cells, nodes, *, whole=None, node_apex=None):
         else np.arange(len(verts)).reshape(-1, 3)[order].reshape(-1)
     offsets = np.concatenate([[0], np.cumsum(counts[order])])
     parent = parent[order]
-    sub = Cells(cells.node[parent], cells.region[parent], offsets, np.ascontiguousarray(verts[index]))
+    spokes = None
+    if mark_spokes:         # triangles run apex, v_i, v_i+1: edges 0 and 2 are spokes
+        spokes = np.concatenate([np.tile([True, False, True], keep.sum()),
+                                 np.zeros(counts[keep.sum():].sum(), dtype=bool)])[index]
+    sub = Cells(cells.node[parent], cells.region[parent], offsets,
+                np.ascontiguousarray(verts[index]), spokes)
     return sub, parent

@@ -78,8 +78,9 @@ def _row_keys(a, b, hint):
     return rows.view(np.dtype((np.void, rows.dtype.itemsize * rows.shape[1]))).reshape(-1)
 
 
-def _pieces(model, a, b):
-    """Pieces of the edges between circumcircle crossings.
+def _pieces(model, a, b, whole=None):
+    """Pieces of the edges between circumcircle crossings (``whole``: (e,) bool,
+    edges left in one piece).
 
     Returns
     -------
@@ -90,14 +91,16 @@ def _pieces(model, a, b):
     centre = circumcenters(model.nodes, model.triangles)
     radius2 = ((model.nodes[model.triangles[:, 0]] - centre) ** 2).sum(axis=1)
     radius = np.sqrt(radius2)[:, None]
+    ne = len(a)
+    cut = np.arange(ne) if whole is None else np.flatnonzero(~np.asarray(whole, dtype=bool))
+    a, b = a[cut], b[cut]
     off, idx = RTree(centre - radius, centre + radius).query(np.minimum(a, b), np.maximum(a, b))
     counts = np.zeros(len(a) + 1, dtype=np.int64)
     K.circle_crossings(a, b, centre, radius2, off, idx, counts, np.zeros(0), False)
     offsets = np.cumsum(counts)
     t = np.empty(offsets[-1])
     K.circle_crossings(a, b, centre, radius2, off, idx, offsets, t, True)
-    ne = len(a)
-    edge = np.concatenate([np.repeat(np.arange(ne), np.diff(offsets)), np.arange(ne), np.arange(ne)])
+    edge = np.concatenate([np.repeat(cut, np.diff(offsets)), np.arange(ne), np.arange(ne)])
     t = np.concatenate([t, np.zeros(ne), np.ones(ne)])
     order = np.lexsort((t, edge))
     edge, t = edge[order], t[order]
@@ -270,7 +273,8 @@ def boundary_quadrature(model, *, gauss=2, cells=None, singular=None):
     """Gauss points on every cell boundary: each edge cut at circumcircle crossings,
     ``gauss`` points per piece, crack faces seen from their side, slits in tip cells.
 
-    ``cells``: integration cells other than ``model.cells`` (sub-cells, say).
+    ``cells``: integration cells other than ``model.cells`` (sub-cells, say);
+    their spokes (``cells.spokes``), if marked, are not cut.
     ``singular``: ``(s, 2)`` points (crack tips) where the integrand behaves like
     ``sqrt(r)`` (enrichment functions); the pieces ending at one are graded.
 
@@ -296,7 +300,11 @@ def boundary_quadrature(model, *, gauss=2, cells=None, singular=None):
     sign = np.where(flip, -1.0, 1.0)
     _, first, occurrence = np.unique(_row_keys(a, b, hint), return_index=True, return_inverse=True)
     a, b, hint = a[first], b[first], hint[first]
-    edge, t0, t1 = _pieces(model, a, b)
+    whole = np.zeros(len(first), dtype=bool)
+    if cells.spokes is not None:              # the slit edges (after the cells' own) are cut
+        inner = first < len(cells.spokes)
+        whole[inner] = cells.spokes[first[inner]]
+    edge, t0, t1 = _pieces(model, a, b, whole)
     s, w = np.polynomial.legendre.leggauss(gauss)
     s, w = 0.5 * (s + 1.0), 0.5 * w
     d = b - a

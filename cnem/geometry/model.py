@@ -33,12 +33,17 @@ class Cells:
     vertices : (k, 2) ndarray
         Cell ``c`` is ``vertices[offsets[c]:offsets[c + 1]]`` (counter-clockwise).
     area : (m,) ndarray
+    spokes : (k,) bool ndarray or None
+        Fan sub-cells only (`cnem.assembly.subdivide`): the edge from vertex
+        ``i`` to the next is a spoke, inside a model cell (integrated whole,
+        without cuts at circumcircle crossings, by `boundary_quadrature`).
     """
 
     node: np.ndarray
     region: np.ndarray
     offsets: np.ndarray
     vertices: np.ndarray
+    spokes: np.ndarray | None = None
     area: np.ndarray = field(init=False)
 
     def __post_init__(self):

@@ -176,11 +176,18 @@ class Elasticity:
         if self._K is None:
             E, nu = self.cell_materials().T
             lam, mu = lame(E, nu, self.plane)
-            self._K = elasticity_form.assemble(self.basis, lam=lam, mu=mu)
-            if self.stabilization > 0:
-                self._K = self._K + self.stabilization * (
-                    self._stabilization_stiffness() if self.enrichment is None
-                    else self._pointwise_stabilization_stiffness())
+            a = self.stabilization
+            if self.enrichment is not None:
+                self._K = elasticity_form.assemble(self.basis, lam=lam, mu=mu)
+                if a > 0:
+                    self._K = self._K + a * self._pointwise_stabilization_stiffness()
+            elif a == 0:
+                self._K = elasticity_form.assemble(self.basis, lam=lam, mu=mu)
+            elif a == 1:
+                self._K = self._sub_cell_stiffness()
+            else:
+                self._K = ((1 - a) * elasticity_form.assemble(self.basis, lam=lam, mu=mu)
+                           + a * self._sub_cell_stiffness())
         return self._K
 
     def _tip_cells(self):
@@ -192,13 +199,18 @@ class Elasticity:
             return np.zeros(len(x), dtype=bool)
         return (np.hypot(*(x[:, None, :] - tips[None]).transpose(2, 0, 1)) < 1e-12).any(axis=1)
 
-    def _stabilization_stiffness(self):
-        """``sum_s A_s (B~_s - B~_k)^T C (B~_s - B~_k)`` over the fan sub-cells."""
-        sub, parent = subdivide(self.cells, self.model.nodes, node_apex=self._tip_cells())
+    def _sub_cell_stiffness(self):
+        """``sum_s A_s B~_s^T C B~_s`` over the fan sub-cells ``s``.
+
+        The sub-cells of a cell ``k`` share its boundary integrals and their
+        spokes cancel, so ``sum_s A_s B~_s = A_k B~_k`` and the stabilised
+        stiffness ``K_k + a sum_s A_s (B~_s - B~_k)^T C (B~_s - B~_k)`` equals
+        ``(1 - a) K_k + a sum_s A_s B~_s^T C B~_s``: no difference operators
+        (whose rows would carry both patterns) are formed.
+        """
+        sub, _ = subdivide(self.cells, self.model.nodes, node_apex=self._tip_cells(),
+                           mark_spokes=True)
         fine = CellBasis(self.model, vector=True, gauss=self.gauss, cells=sub)
-        to_sub = sp.csr_matrix((np.ones(len(parent)), (np.arange(len(parent)), parent)),
-                               shape=(len(parent), len(self.cells.area)))
-        fine.operators = [f - to_sub @ c for f, c in zip(fine.operators, self.basis.operators)]
         E, nu = self.materials[sub.region].T
         lam, mu = lame(E, nu, self.plane)
         return elasticity_form.assemble(fine, lam=lam, mu=mu)
