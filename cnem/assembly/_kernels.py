@@ -35,3 +35,86 @@ def circle_crossings(a, b, centre, radius2, cand_off, cand_idx, out_off, out_t, 
                     count += 1
         if not fill:
             out_off[k + 1] = count
+
+
+@numba.njit(cache=True, parallel=True)
+def edge_pieces(offsets, t):
+    """Pieces of every edge between its crossings, in order along the edge.
+
+    Edge ``k`` is crossed at ``t[offsets[k]:offsets[k + 1]]`` (any order; sorted
+    in place); its pieces are ``[0, t_1], [t_1, t_2], ..., [t_c, 1]``.
+
+    Returns
+    -------
+    edge : (offsets[-1] + e,) int64, sorted
+    t0, t1 : (offsets[-1] + e,) float64
+        Piece ``i`` is ``t0[i] <= t <= t1[i]`` along edge ``edge[i]``.
+    """
+    ne = offsets.shape[0] - 1
+    total = offsets[ne] + ne
+    edge = np.empty(total, dtype=np.int64)
+    t0 = np.empty(total)
+    t1 = np.empty(total)
+    for k in numba.prange(ne):
+        lo, hi = offsets[k], offsets[k + 1]
+        for i in range(lo + 1, hi):          # insertion sort: a few crossings per edge
+            v = t[i]
+            j = i - 1
+            while j >= lo and t[j] > v:
+                t[j + 1] = t[j]
+                j -= 1
+            t[j + 1] = v
+        p = lo + k
+        prev = 0.0
+        for i in range(lo, hi):
+            edge[p], t0[p], t1[p] = k, prev, t[i]
+            prev = t[i]
+            p += 1
+        edge[p], t0[p], t1[p] = k, prev, 1.0
+    return edge, t0, t1
+
+
+@numba.njit(cache=True)
+def unique_rows(bits):
+    """Distinct rows of a ``(e, w)`` uint64 array (rows equal bit for bit), by hashing.
+
+    Returns
+    -------
+    first : (u,) int64
+        The first row of each distinct row, in order of first appearance.
+    occurrence : (e,) int64
+        ``bits[i]`` equals ``bits[first[occurrence[i]]]``.
+    """
+    e, w = bits.shape
+    size = 1
+    while size < 2 * e + 2:
+        size *= 2
+    table = np.full(size, -1, dtype=np.int64)       # index into first
+    first = np.empty(e, dtype=np.int64)
+    occurrence = np.empty(e, dtype=np.int64)
+    u = 0
+    for i in range(e):
+        h = np.uint64(14695981039346656037)
+        for c in range(w):
+            h = (h ^ bits[i, c]) * np.uint64(1099511628211)
+            h ^= h >> np.uint64(29)
+        slot = np.int64(h & np.uint64(size - 1))
+        while True:
+            f = table[slot]
+            if f < 0:
+                table[slot] = u
+                first[u] = i
+                occurrence[i] = u
+                u += 1
+                break
+            r = first[f]
+            same = True
+            for c in range(w):
+                if bits[r, c] != bits[i, c]:
+                    same = False
+                    break
+            if same:
+                occurrence[i] = f
+                break
+            slot = (slot + 1) & (size - 1)
+    return first[:u].copy(), occurrence

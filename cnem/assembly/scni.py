@@ -72,10 +72,11 @@ def cell_edges(cells):
     return cell, cells.vertices, cells.vertices[nxt]
 
 
-def _row_keys(a, b, hint):
-    """One hashable key per edge: its end coordinates (bit for bit) and side hint."""
+def _row_bits(a, b, hint):
+    """One row of bits per edge: its end coordinates and side hint, ``(e, 5)`` uint64
+    (equal rows are the same edge, bit for bit)."""
     rows = np.ascontiguousarray(np.column_stack([a, b, hint.astype(np.float64)]))
-    return rows.view(np.dtype((np.void, rows.dtype.itemsize * rows.shape[1]))).reshape(-1)
+    return rows.view(np.uint64)
 
 
 def _pieces(model, a, b, whole=None):
@@ -93,19 +94,16 @@ def _pieces(model, a, b, whole=None):
     radius = np.sqrt(radius2)[:, None]
     ne = len(a)
     cut = np.arange(ne) if whole is None else np.flatnonzero(~np.asarray(whole, dtype=bool))
-    a, b = a[cut], b[cut]
-    off, idx = RTree(centre - radius, centre + radius).query(np.minimum(a, b), np.maximum(a, b))
-    counts = np.zeros(len(a) + 1, dtype=np.int64)
-    K.circle_crossings(a, b, centre, radius2, off, idx, counts, np.zeros(0), False)
-    offsets = np.cumsum(counts)
+    ca, cb = a[cut], b[cut]
+    off, idx = RTree(centre - radius, centre + radius).query(np.minimum(ca, cb), np.maximum(ca, cb))
+    counts = np.zeros(len(cut) + 1, dtype=np.int64)
+    K.circle_crossings(ca, cb, centre, radius2, off, idx, counts, np.zeros(0), False)
+    offsets = np.zeros(ne + 1, dtype=np.int64)
+    offsets[cut + 1] = counts[1:]
+    np.cumsum(offsets, out=offsets)
     t = np.empty(offsets[-1])
-    K.circle_crossings(a, b, centre, radius2, off, idx, offsets, t, True)
-    edge = np.concatenate([np.repeat(cut, np.diff(offsets)), np.arange(ne), np.arange(ne)])
-    t = np.concatenate([t, np.zeros(ne), np.ones(ne)])
-    order = np.lexsort((t, edge))
-    edge, t = edge[order], t[order]
-    same = edge[1:] == edge[:-1]
-    return edge[:-1][same], t[:-1][same], t[1:][same]
+    K.circle_crossings(ca, cb, centre, radius2, off, idx, offsets[cut], t, True)
+    return K.edge_pieces(offsets, t)
 
 
 def _crack_faces(model):
@@ -298,7 +296,7 @@ def boundary_quadrature(model, *, gauss=2, cells=None, singular=None):
     flip = (a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1]))
     a, b = np.where(flip[:, None], b, a), np.where(flip[:, None], a, b)
     sign = np.where(flip, -1.0, 1.0)
-    _, first, occurrence = np.unique(_row_keys(a, b, hint), return_index=True, return_inverse=True)
+    first, occurrence = K.unique_rows(_row_bits(a, b, hint))
     a, b, hint = a[first], b[first], hint[first]
     whole = np.zeros(len(first), dtype=bool)
     if cells.spokes is not None:              # the slit edges (after the cells' own) are cut
