@@ -60,3 +60,27 @@ def test_boundary_sums_match_scipy(nch):
     for got, w in ((x, wx), (y, wy)):
         B = sp.csr_matrix((got, indices, indptr), shape=(m, n))
         np.testing.assert_allclose(B.toarray(), (to_cells @ w @ phi).toarray(), atol=1e-13)
+
+
+@pytest.mark.parametrize("nch", [1, 3, 16])
+def test_gradient_block_gram_matches_scipy(nch):
+    """Vector operators spread from scalar gradients: K = Q^T W Q by 2 x 2 blocks."""
+    rng = np.random.default_rng(nch)
+    m, n = 40, 25
+    G = _random_csr(rng, (m, n), 0.2)
+    gy = rng.uniform(-1, 1, G.nnz)
+    coeff = rng.uniform(-1, 1, (m, 4, 4))
+    coeff[:, 1, 2] = 0.0
+    # descriptor a = 2 c + d: component c, direction d, on dofs 2 j + c
+    ops = []
+    for c in range(2):
+        for values in (G.data, gy):
+            ops.append(sp.csr_matrix((values, G.indices * 2 + c, G.indptr), shape=(m, 2 * n)))
+    expected = sum((ops[b].T @ sp.diags(coeff[:, a, b]) @ ops[a]).toarray()
+                   for a in range(4) for b in range(4))
+    indptr, indices, blocks = SK.gradient_block_gram(G.indptr, G.indices, G.data, gy, coeff,
+                                                     n, nch)
+    K = sp.bsr_matrix((blocks, indices, indptr), shape=(2 * n, 2 * n))
+    np.testing.assert_allclose(K.toarray(), expected, atol=1e-13)
+    for i in range(n):                                     # sorted, no duplicates
+        assert np.all(np.diff(indices[indptr[i]:indptr[i + 1]]) > 0)

@@ -14,6 +14,33 @@ def _chunk(ch, nch, n):
     return ch * n // nch, (ch + 1) * n // nch
 
 
+@numba.njit(cache=True)
+def _offsets(counts):
+    """CSR row pointers ``(n + 1,)`` from row counts ``(n,)``."""
+    indptr = np.zeros(counts.shape[0] + 1, dtype=np.int64)
+    indptr[1:] = np.cumsum(counts)
+    return indptr
+
+
+@numba.njit(cache=True, inline="always")
+def _add_column(j, start, end, slot, indices):
+    """Append column ``j`` to the row being built at ``indices[start:end]`` unless
+    it is there (``slot[j] >= start``); returns the new ``end``."""
+    if slot[j] < start:
+        slot[j] = start
+        indices[end] = j
+        end += 1
+    return end
+
+
+@numba.njit(cache=True, inline="always")
+def _sort_slots(indices, start, end, slot):
+    """Sort the row's columns and point ``slot`` at their positions."""
+    indices[start:end].sort()
+    for p in range(start, end):
+        slot[indices[p]] = p
+
+
 @numba.njit(cache=True, parallel=True)
 def boundary_sums(cell_ptr, cell_edge, cell_sign, edge_ptr, edge_point, wx, wy,
                   phi_ptr, phi_idx, phi_val, point_row, ncol, nch):
@@ -55,9 +82,7 @@ def boundary_sums(cell_ptr, cell_edge, cell_sign, edge_ptr, edge_point, wx, wy,
                             mark[j] = c
                             count += 1
             counts[c] = count
-    indptr = np.zeros(m + 1, dtype=np.int64)
-    for c in range(m):
-        indptr[c + 1] = indptr[c] + counts[c]
+    indptr = _offsets(counts)
     indices = np.empty(indptr[m], dtype=np.int32)
     x = np.empty(indptr[m])
     y = np.empty(indptr[m])
@@ -142,9 +167,7 @@ def weighted_gram(q_ptr, q_idx, q_val, t_ptr, t_row, t_val, coeff, m, ncol, nch)
                             mark[j] = i
                             count += 1
             counts[i] = count
-    indptr = np.zeros(ncol + 1, dtype=np.int64)
-    for i in range(ncol):
-        indptr[i + 1] = indptr[i] + counts[i]
+    indptr = _offsets(counts)
     indices = np.empty(indptr[ncol], dtype=np.int32)
     data = np.zeros(indptr[ncol])
     for ch in numba.prange(nch):
@@ -161,14 +184,8 @@ def weighted_gram(q_ptr, q_idx, q_val, t_ptr, t_row, t_val, coeff, m, ncol, nch)
                         continue
                     row = a * m + k
                     for p in range(q_ptr[row], q_ptr[row + 1]):
-                        j = q_idx[p]
-                        if slot[j] < start:
-                            slot[j] = start
-                            indices[end] = j
-                            end += 1
-            indices[start:end].sort()                       # ... in order
-            for p in range(start, end):
-                slot[indices[p]] = p
+                        end = _add_column(q_idx[p], start, end, slot, indices)
+            _sort_slots(indices, start, end, slot)          # ... in order
             for t in range(t_ptr[i], t_ptr[i + 1]):         # then their values
                 b = t_row[t] // m
                 k = t_row[t] % m
@@ -181,3 +198,93 @@ def weighted_gram(q_ptr, q_idx, q_val, t_ptr, t_row, t_val, coeff, m, ncol, nch)
                     for p in range(q_ptr[row], q_ptr[row + 1]):
                         data[slot[q_idx[p]]] += w * q_val[p]
     return indptr, indices, data
+
+
+@numba.njit(cache=True)
+def _transpose_pattern(ptr, idx, ncol):
+    """Columns of a CSR pattern: for column ``j``, the rows holding it and the
+    positions of those entries, ``(t_ptr, t_row, t_pos)``."""
+    m = ptr.shape[0] - 1
+    t_ptr = np.zeros(ncol + 1, dtype=np.int64)
+    for p in range(ptr[m]):
+        t_ptr[idx[p] + 1] += 1
+    for j in range(ncol):
+        t_ptr[j + 1] += t_ptr[j]
+    fill = t_ptr[:-1].copy()
+    t_row = np.empty(ptr[m], dtype=np.int64)
+    t_pos = np.empty(ptr[m], dtype=np.int64)
+    for k in range(m):
+        for p in range(ptr[k], ptr[k + 1]):
+            j = idx[p]
+            t_row[fill[j]] = k
+            t_pos[fill[j]] = p
+            fill[j] += 1
+    return t_ptr, t_row, t_pos
+
+
+@numba.njit(cache=True, parallel=True)
+def gradient_block_gram(ptr, idx, gx, gy, coeff, ncol, nch):
+    """``K`` of a vector form that sees only gradients, by 2 x 2 node blocks.
+
+    The gradients of the two components are the scalar operators ``gx``,
+    ``gy`` (one CSR pattern ``ptr, idx``, ``(m, ncol)``) on interleaved dofs.
+
+    Parameters
+    ----------
+    ptr, idx : CSR pattern (m, ncol)
+    gx, gy : (nnz,) float64
+        Values of the x and y derivatives.
+    coeff : (m, 4, 4) float64
+        ``coeff[k, a, b]`` for trial descriptor ``a = 2 c + d`` (component ``c``,
+        direction ``d``) and test descriptor ``b``.
+    ncol, nch : int
+
+    Returns
+    -------
+    indptr : (ncol + 1,) int64
+    indices : (nnzb,) int32
+    blocks : (nnzb, 2, 2) float64
+        Block ``(I, J)``, entry ``[r, s]`` is ``K[2 I + r, 2 J + s]``.
+    """
+    t_ptr, t_row, t_pos = _transpose_pattern(ptr, idx, ncol)
+    counts = np.zeros(ncol, dtype=np.int64)
+    for ch in numba.prange(nch):
+        mark = np.full(ncol, -1, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            count = 0
+            for t in range(t_ptr[i], t_ptr[i + 1]):
+                k = t_row[t]
+                for p in range(ptr[k], ptr[k + 1]):
+                    if mark[idx[p]] != i:
+                        mark[idx[p]] = i
+                        count += 1
+            counts[i] = count
+    indptr = _offsets(counts)
+    indices = np.empty(indptr[ncol], dtype=np.int32)
+    blocks = np.zeros((indptr[ncol], 2, 2))
+    for ch in numba.prange(nch):
+        slot = np.full(ncol, -1, dtype=np.int64)
+        v = np.empty((2, 4))
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            start = indptr[i]
+            end = start
+            for t in range(t_ptr[i], t_ptr[i + 1]):         # the row's columns ...
+                k = t_row[t]
+                for p in range(ptr[k], ptr[k + 1]):
+                    end = _add_column(idx[p], start, end, slot, indices)
+            _sort_slots(indices, start, end, slot)          # ... in order
+            for t in range(t_ptr[i], t_ptr[i + 1]):         # then their values
+                k = t_row[t]
+                gi0, gi1 = gx[t_pos[t]], gy[t_pos[t]]
+                for r in range(2):                          # test component r
+                    for a in range(4):
+                        v[r, a] = gi0 * coeff[k, a, 2 * r] + gi1 * coeff[k, a, 2 * r + 1]
+                for p in range(ptr[k], ptr[k + 1]):
+                    gj0, gj1 = gx[p], gy[p]
+                    q = slot[idx[p]]
+                    for r in range(2):
+                        blocks[q, r, 0] += v[r, 0] * gj0 + v[r, 1] * gj1
+                        blocks[q, r, 1] += v[r, 2] * gj0 + v[r, 3] * gj1
+    return indptr, indices, blocks
