@@ -31,6 +31,9 @@ __all__ = ["SmoothedGradient", "smoothed_gradient", "BoundaryQuadrature", "bound
 
 log = logging.getLogger(__name__)
 
+#: Cells whose boundary quadrature is built and evaluated in one pass of `smoothed_gradient`.
+CELLS_PER_PASS = 200_000
+
 
 class SmoothedGradient:
     """The operator ``B~`` of eq. 30: smoothed derivatives of every shape function.
@@ -355,10 +358,18 @@ def smoothed_gradient(model, *, gauss=2, cells=None):
     key = ("scni", int(gauss))
     if cells is None and key in model._cache:
         return model._cache[key]
-    quad = boundary_quadrature(model, gauss=gauss, cells=cells)
-    phi, order = quad.shape_functions(model)
-    bx, by = quad.cell_integrals(phi, rows=order)
-    grad = SmoothedGradient(bx.tocsr(), by.tocsr(), len(quad.points))
+    every = model.cells if cells is None else cells
+    parts, points = [], 0
+    for lo in range(0, max(len(every), 1), CELLS_PER_PASS):
+        # a pass per run of cells bounds the memory of the quadrature points and
+        # their shape functions; edges between runs are integrated in both
+        quad = boundary_quadrature(model, gauss=gauss,
+                                   cells=every.take(lo, min(lo + CELLS_PER_PASS, len(every))))
+        phi, order = quad.shape_functions(model)
+        parts.append(quad.cell_integrals(phi, rows=order))
+        points += len(quad.points)
+    grad = SmoothedGradient(*(sp.vstack([part[c] for part in parts], format="csr")
+                              for c in range(2)), points)
     if cells is None:
         model._cache[key] = grad
     return grad

@@ -69,6 +69,13 @@ class Cells:
     def __len__(self):
         return len(self.node)
 
+    def take(self, lo, hi):
+        """The cells ``lo <= c < hi`` as a `Cells` of their own."""
+        first, last = self.offsets[lo], self.offsets[hi]
+        return Cells(self.node[lo:hi], self.region[lo:hi], self.offsets[lo:hi + 1] - first,
+                     self.vertices[first:last],
+                     None if self.spokes is None else self.spokes[first:last])
+
     def polygon(self, i):
         """Vertices of cell ``i``, ``(k, 2)``, counter-clockwise."""
         return self.vertices[self.offsets[i]:self.offsets[i + 1]]
