@@ -82,6 +82,17 @@ def _row_bits(a, b, hint):
     return rows.view(np.uint64)
 
 
+def _circumcircles(model):
+    """Circumcentres ``(t, 2)``, squared radii ``(t,)`` and an R-tree of the
+    circumcircles' boxes of the model's triangles (cached on the model)."""
+    if "circumcircles" not in model._cache:
+        centre = circumcenters(model.nodes, model.triangles)
+        radius2 = ((model.nodes[model.triangles[:, 0]] - centre) ** 2).sum(axis=1)
+        radius = np.sqrt(radius2)[:, None]
+        model._cache["circumcircles"] = centre, radius2, RTree(centre - radius, centre + radius)
+    return model._cache["circumcircles"]
+
+
 def _pieces(model, a, b, whole=None):
     """Pieces of the edges between circumcircle crossings (``whole``: (e,) bool,
     edges left in one piece).
@@ -92,13 +103,11 @@ def _pieces(model, a, b, whole=None):
     t0, t1 : (q,) ndarray
         Piece ``i`` is ``t0[i] <= t <= t1[i]`` along edge ``edge[i]``.
     """
-    centre = circumcenters(model.nodes, model.triangles)
-    radius2 = ((model.nodes[model.triangles[:, 0]] - centre) ** 2).sum(axis=1)
-    radius = np.sqrt(radius2)[:, None]
+    centre, radius2, tree = _circumcircles(model)
     ne = len(a)
     cut = np.arange(ne) if whole is None else np.flatnonzero(~np.asarray(whole, dtype=bool))
     ca, cb = a[cut], b[cut]
-    off, idx = RTree(centre - radius, centre + radius).query(np.minimum(ca, cb), np.maximum(ca, cb))
+    off, idx = tree.query(np.minimum(ca, cb), np.maximum(ca, cb))
     counts = np.zeros(len(cut) + 1, dtype=np.int64)
     K.circle_crossings(ca, cb, centre, radius2, off, idx, counts, np.zeros(0), False)
     offsets = np.zeros(ne + 1, dtype=np.int64)
