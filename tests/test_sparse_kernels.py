@@ -78,9 +78,9 @@ def test_gradient_block_gram_matches_scipy(nch):
             ops.append(sp.csr_matrix((values, G.indices * 2 + c, G.indptr), shape=(m, 2 * n)))
     expected = sum((ops[b].T @ sp.diags(coeff[:, a, b]) @ ops[a]).toarray()
                    for a in range(4) for b in range(4))
-    indptr, indices, blocks = SK.gradient_block_gram(G.indptr, G.indices, G.data, gy, coeff,
-                                                     n, nch)
-    K = sp.bsr_matrix((blocks, indices, indptr), shape=(2 * n, 2 * n))
+    indptr, indices, data = SK.gradient_block_gram(G.indptr, G.indices, G.data, gy, coeff,
+                                                   n, nch)
+    K = sp.csr_matrix((data, indices, indptr), shape=(2 * n, 2 * n))
     np.testing.assert_allclose(K.toarray(), expected, atol=1e-13)
-    for i in range(n):                                     # sorted, no duplicates
+    for i in range(2 * n):                                 # sorted, no duplicates
         assert np.all(np.diff(indices[indptr[i]:indptr[i + 1]]) > 0)

@@ -241,10 +241,10 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, ncol, nch):
 
     Returns
     -------
-    indptr : (ncol + 1,) int64
-    indices : (nnzb,) int32
-    blocks : (nnzb, 2, 2) float64
-        Block ``(I, J)``, entry ``[r, s]`` is ``K[2 I + r, 2 J + s]``.
+    indptr : (2 ncol + 1,) int64
+    indices : (nnz,) int32
+    data : (nnz,) float64
+        ``K`` in CSR over the interleaved dofs, ``(2 ncol, 2 ncol)``.
     """
     t_ptr, t_row, t_pos = _transpose_pattern(ptr, idx, ncol)
     counts = np.zeros(ncol, dtype=np.int64)
@@ -287,4 +287,27 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, ncol, nch):
                     for r in range(2):
                         blocks[q, r, 0] += v[r, 0] * gj0 + v[r, 1] * gj1
                         blocks[q, r, 1] += v[r, 2] * gj0 + v[r, 3] * gj1
-    return indptr, indices, blocks
+    return _blocks_to_csr(indptr, indices, blocks)
+
+
+@numba.njit(cache=True, parallel=True)
+def _blocks_to_csr(indptr, indices, blocks):
+    """CSR over interleaved dofs from 2 x 2 node blocks in block-CSR form."""
+    n = indptr.shape[0] - 1
+    out_ptr = np.empty(2 * n + 1, dtype=np.int64)
+    out_ptr[0] = 0
+    for i in range(n):
+        width = 2 * (indptr[i + 1] - indptr[i])
+        out_ptr[2 * i + 1] = 4 * indptr[i] + width
+        out_ptr[2 * i + 2] = 4 * indptr[i + 1]
+    out_idx = np.empty(4 * indptr[n], dtype=np.int32)
+    data = np.empty(4 * indptr[n])
+    for i in numba.prange(n):
+        for r in range(2):
+            w = out_ptr[2 * i + r]
+            for q in range(indptr[i], indptr[i + 1]):
+                for s in range(2):
+                    out_idx[w] = 2 * indices[q] + s
+                    data[w] = blocks[q, r, s]
+                    w += 1
+    return out_ptr, out_idx, data

@@ -94,9 +94,9 @@ class BilinearForm(_Form):
             for a, b in active:
                 weights[:, a - 2, b - 2] = basis.dx * coeff[a][b]
             ptr, idx, gx, gy = grads
-            indptr, indices, blocks = SK.gradient_block_gram(ptr, idx, gx, gy, weights,
-                                                             basis.N // 2, work_chunks())
-            return sp.bsr_matrix((blocks, indices, indptr), shape=(basis.N, basis.N)).tocsr()
+            indptr, indices, data = SK.gradient_block_gram(ptr, idx, gx, gy, weights,
+                                                           basis.N // 2, work_chunks())
+            return sp.csr_matrix((data, indices, indptr), shape=(basis.N, basis.N))
         used = sorted({a for a, _ in active} | {b for _, b in active})
         slot = {d: i for i, d in enumerate(used)}
         weights = np.zeros((m, len(used), len(used)))
