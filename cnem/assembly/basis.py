@@ -76,6 +76,7 @@ class CellBasis:
         self.nfun = value.shape[1]
         self.N = self.ncomp * self.nfun
         self._node_ops = (value, gx, gy)
+        self._built = None                  # the operators as built from _node_ops
 
     def __repr__(self):
         kind = "vector" if self.vector else "scalar"
@@ -93,9 +94,24 @@ class CellBasis:
         """
         value, gx, gy = self._node_ops
         if not self.vector:
-            return [op.tocsr() for op in (value, gx, gy)]
-        values = [spread_component(value, c, 2) for c in range(2)]
-        return values + [spread_component(g, c, 2) for c in range(2) for g in (gx, gy)]
+            self._built = [op.tocsr() for op in (value, gx, gy)]
+        else:
+            values = [spread_component(value, c, 2) for c in range(2)]
+            self._built = values + [spread_component(g, c, 2) for c in range(2) for g in (gx, gy)]
+        return self._built
+
+    def component_gradients(self):
+        """The scalar x and y derivatives ``(m, nfun)`` CSR behind the gradient
+        operators of a vector basis, when both have one pattern (then forms that
+        see only gradients are assembled by 2 x 2 node blocks); None for a scalar
+        basis or operators set otherwise (`at_points`, assignment)."""
+        given = self.__dict__.get("operators", self._built)
+        if not self.vector or given is not self._built:
+            return None
+        gx, gy = (g.tocsr() for g in self._node_ops[1:])
+        if not (np.array_equal(gx.indptr, gy.indptr) and np.array_equal(gx.indices, gy.indices)):
+            return None
+        return gx, gy
 
     def at_points(self, operators, weights, points):
         """The same dofs seen at other integration points: a shallow copy with

@@ -82,21 +82,22 @@ class BilinearForm(_Form):
     def assemble(self, basis, **kwargs):
         """Sparse matrix ``(N, N)`` (CSR)."""
         coeff = self.coefficients(basis, **kwargs)
-        ops = basis.operators
-        m, c = len(basis.dx), len(ops)
+        m, c = len(basis.dx), len(coeff)
         active = [(a, b) for a in range(c) for b in range(c) if np.any(coeff[a][b] != 0.0)]
         if not active:
             return sp.csr_matrix((basis.N, basis.N))
         only_gradients = basis.vector and min(min(ab) for ab in active) >= 2
-        grads = _component_gradients(ops) if only_gradients else None
+        grads = basis.component_gradients() if only_gradients else None
         if grads is not None:          # 2 x 2 node blocks from the scalar gradients
             weights = np.zeros((m, 4, 4))
             for a, b in active:
                 weights[:, a - 2, b - 2] = basis.dx * coeff[a][b]
-            ptr, idx, gx, gy = grads
-            indptr, indices, data = SK.gradient_block_gram(ptr, idx, gx, gy, weights,
-                                                           basis.N // 2, work_chunks())
+            gx, gy = grads
+            indptr, indices, data = SK.gradient_block_gram(gx.indptr, gx.indices, gx.data,
+                                                           gy.data, weights, basis.N // 2,
+                                                           work_chunks())
             return sp.csr_matrix((data, indices, indptr), shape=(basis.N, basis.N))
+        ops = basis.operators
         used = sorted({a for a, _ in active} | {b for _, b in active})
         slot = {d: i for i, d in enumerate(used)}
         weights = np.zeros((m, len(used), len(used)))
@@ -108,24 +109,6 @@ class BilinearForm(_Form):
                                                  t.indptr, t.indices, t.data, weights, m,
                                                  basis.N, work_chunks())
         return sp.csr_matrix((data, indices, indptr), shape=(basis.N, basis.N))
-
-
-def _component_gradients(ops):
-    """The scalar x and y derivatives behind the gradient operators of a 2-component
-    vector basis (``ops[2:6]``: ``du0/dx, du0/dy, du1/dx, du1/dy`` on interleaved
-    dofs), when they share one pattern: ``(indptr, node indices, gx, gy)``, else None."""
-    d = [ops[k].tocsr() for k in range(2, 6)]
-    first = d[0]
-    for o in d[1:]:
-        if o.nnz != first.nnz or not np.array_equal(o.indptr, first.indptr):
-            return None
-    if (first.indices % 2 != 0).any() or not np.array_equal(d[1].indices, first.indices):
-        return None
-    if not (np.array_equal(d[2].indices, first.indices + 1)
-            and np.array_equal(d[3].indices, d[2].indices)
-            and np.array_equal(d[2].data, first.data) and np.array_equal(d[3].data, d[1].data)):
-        return None
-    return first.indptr, first.indices // 2, first.data, d[1].data
 
 
 class LinearForm(_Form):
