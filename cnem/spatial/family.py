@@ -90,7 +90,10 @@ def _grid(pts3, hmax, period3, dim, per_horizon=CELLS_PER_HORIZON):
     """Grid of cells over the first ``dim`` axes: origin, cell sizes and counts,
     ``per_horizon`` cells per horizon and at most ~4 cells per point."""
     n = len(pts3)
-    span = np.where(np.isfinite(period3), period3, np.ptp(pts3, axis=0) if n else 0.0)
+    # column by column: reductions along axis 0 of an (n, 3) array are ~15x slower
+    lo = np.array([pts3[:, k].min() if n else 0.0 for k in range(3)])
+    hi = np.array([pts3[:, k].max() if n else 0.0 for k in range(3)])
+    span = np.where(np.isfinite(period3), period3, hi - lo)
     size = np.full(3, hmax / per_horizon)
     active = span[:dim] > 0
     volume = np.prod(span[:dim][active]) if active.any() else 0.0
@@ -103,7 +106,7 @@ def _grid(pts3, hmax, period3, dim, per_horizon=CELLS_PER_HORIZON):
             nc[k] = max(1, int(np.floor(period3[k] / size[k])))
             size[k] = period3[k] / nc[k]
         else:
-            origin[k] = pts3[:, k].min()
+            origin[k] = lo[k]
             nc[k] = int(np.floor(span[k] / size[k])) + 1
     size[dim:] = 1.0
     return origin, size, nc
@@ -114,8 +117,10 @@ def _cells(pts3, horizon, period3, dim):
     if horizon.min() == horizon.max():
         # one horizon: each pair tested once, columns along two axes swept
         # along the third, which must be a real one: 2-D points go (0, x, y)
-        axes = [2, 0, 1] if dim == 2 else [0, 1, 2]
-        pts_c, per_c = np.ascontiguousarray(pts3[:, axes]), period3[axes]
+        pts_c, per_c = pts3, period3
+        if dim == 2:
+            axes = [2, 0, 1]
+            pts_c, per_c = np.ascontiguousarray(pts3[:, axes]), period3[axes]
         origin, size, nc = _grid(pts_c, float(horizon[0]), per_c, 2, COLUMNS_PER_HORIZON)
         return P.uniform_family(pts_c, float(horizon[0]), origin, size, nc, per_c, sample,
                                 numba.get_num_threads())
