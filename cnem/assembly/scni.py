@@ -345,6 +345,18 @@ def boundary_quadrature(model, *, gauss=2, cells=None, singular=None):
     return BoundaryQuadrature(points, np.repeat(hint[edge], gauss), wx, wy, to_cells)
 
 
+def _stack_rows(mats):
+    """CSR matrices with the same columns, one under the other (their arrays
+    concatenated; scipy's vstack is several times slower on large ones)."""
+    if len(mats) == 1:
+        return mats[0]
+    shifts = np.cumsum([0] + [a.nnz for a in mats[:-1]])
+    indptr = np.concatenate([[0]] + [a.indptr[1:] + shift for a, shift in zip(mats, shifts)])
+    return sp.csr_matrix((np.concatenate([a.data for a in mats]),
+                          np.concatenate([a.indices for a in mats]), indptr),
+                         shape=(sum(a.shape[0] for a in mats), mats[0].shape[1]))
+
+
 def smoothed_gradient(model, *, gauss=2, cells=None):
     """The smoothed gradient operator ``B~`` of a model (cached on the model).
 
@@ -377,8 +389,7 @@ def smoothed_gradient(model, *, gauss=2, cells=None):
         phi, order = quad.shape_functions(model)
         parts.append(quad.cell_integrals(phi, rows=order))
         points += len(quad.points)
-    grad = SmoothedGradient(*(sp.vstack([part[c] for part in parts], format="csr")
-                              for c in range(2)), points)
+    grad = SmoothedGradient(*(_stack_rows([part[c] for part in parts]) for c in range(2)), points)
     if cells is None:
         model._cache[key] = grad
     return grad

@@ -245,3 +245,41 @@ def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg):
         c = _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly)
         out[poly_offsets[i]:poly_offsets[i] + c] = poly[:c]
     return status, poly_offsets, out, region_tri
+
+
+@numba.njit(cache=True, parallel=True)
+def polygon_moments(offsets, vertices):
+    """Areas and centroids of polygons by the shoelace formula, each relative to
+    its first vertex (no cancellation far from the origin).
+
+    Parameters
+    ----------
+    offsets : (m + 1,) int64
+        Polygon ``c`` is ``vertices[offsets[c]:offsets[c + 1]]``.
+    vertices : (k, 2) float64
+
+    Returns
+    -------
+    area : (m,) float64
+        Signed (positive counter-clockwise).
+    centroid : (m, 2) float64
+    """
+    m = offsets.shape[0] - 1
+    area = np.empty(m)
+    centroid = np.empty((m, 2))
+    for c in numba.prange(m):
+        lo, hi = offsets[c], offsets[c + 1]
+        x0, y0 = vertices[lo, 0], vertices[lo, 1]
+        a = cx = cy = 0.0
+        for i in range(lo, hi):
+            j = i + 1 if i + 1 < hi else lo
+            x, y = vertices[i, 0] - x0, vertices[i, 1] - y0
+            xn, yn = vertices[j, 0] - x0, vertices[j, 1] - y0
+            cross = x * yn - xn * y
+            a += cross
+            cx += (x + xn) * cross
+            cy += (y + yn) * cross
+        area[c] = 0.5 * a
+        centroid[c, 0] = cx / (3.0 * a) + x0
+        centroid[c, 1] = cy / (3.0 * a) + y0
+    return area, centroid

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import GeometryError
+from ._kernels import polygon_moments
 from .cells import voronoi_cells
 from .cloud import NodeCloud
 from .cracks import split_cracks
@@ -54,17 +55,8 @@ class Cells:
         vertex (no cancellation far from the origin)."""
         if len(self.vertices) == 0:
             return np.zeros(0), np.zeros((0, 2))
-        first = np.repeat(self.offsets[:-1], np.diff(self.offsets))
-        rel = self.vertices - self.vertices[first]
-        nxt = np.arange(len(rel)) + 1
-        nxt[self.offsets[1:] - 1] = self.offsets[:-1]
-        x, y = rel[:, 0], rel[:, 1]
-        cross = x * y[nxt] - x[nxt] * y
-        area = 0.5 * np.add.reduceat(cross, self.offsets[:-1])
-        cx = np.add.reduceat((x + x[nxt]) * cross, self.offsets[:-1])
-        cy = np.add.reduceat((y + y[nxt]) * cross, self.offsets[:-1])
-        centroid = np.column_stack([cx, cy]) / (6.0 * area[:, None])
-        return area, centroid + self.vertices[self.offsets[:-1]]
+        return polygon_moments(np.asarray(self.offsets, dtype=np.int64),
+                               np.ascontiguousarray(self.vertices, dtype=np.float64))
 
     def __len__(self):
         return len(self.node)
