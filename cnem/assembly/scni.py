@@ -380,12 +380,14 @@ def smoothed_gradient(model, *, gauss=2, cells=None):
     if cells is None and key in model._cache:
         return model._cache[key]
     every = model.cells if cells is None else cells
+    # a pass per run of cells bounds the memory of the quadrature points and their
+    # shape functions; edges between runs are integrated in both
+    runs = [every] if len(every) <= CELLS_PER_PASS else \
+        [every.take(lo, min(lo + CELLS_PER_PASS, len(every)))
+         for lo in range(0, len(every), CELLS_PER_PASS)]
     parts, points = [], 0
-    for lo in range(0, max(len(every), 1), CELLS_PER_PASS):
-        # a pass per run of cells bounds the memory of the quadrature points and
-        # their shape functions; edges between runs are integrated in both
-        quad = boundary_quadrature(model, gauss=gauss,
-                                   cells=every.take(lo, min(lo + CELLS_PER_PASS, len(every))))
+    for run in runs:
+        quad = boundary_quadrature(model, gauss=gauss, cells=run)
         phi, order = quad.shape_functions(model)
         parts.append(quad.cell_integrals(phi, rows=order))
         points += len(quad.points)

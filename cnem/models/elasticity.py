@@ -174,20 +174,20 @@ class Elasticity:
     def stiffness(self):
         """Global stiffness ``K`` (eq. 33), ``(2 n, 2 n)`` CSR."""
         if self._K is None:
-            E, nu = self.cell_materials().T
-            lam, mu = lame(E, nu, self.plane)
             a = self.stabilization
-            if self.enrichment is not None:
-                self._K = elasticity_form.assemble(self.basis, lam=lam, mu=mu)
-                if a > 0:
-                    self._K = self._K + a * self._pointwise_stabilization_stiffness()
-            elif a == 0:
-                self._K = elasticity_form.assemble(self.basis, lam=lam, mu=mu)
-            elif a == 1:
-                self._K = self._sub_cell_stiffness()
-            else:
-                self._K = ((1 - a) * elasticity_form.assemble(self.basis, lam=lam, mu=mu)
-                           + a * self._sub_cell_stiffness())
+            sub_cells = self.enrichment is None and a > 0
+            # with sub-cells K = (1 - a) K_cells + a K_sub (see _sub_cell_stiffness)
+            weight = 1.0 - a if sub_cells else 1.0
+            K = None
+            if weight != 0.0:
+                E, nu = self.cell_materials().T
+                lam, mu = lame(E, nu, self.plane)
+                K = weight * elasticity_form.assemble(self.basis, lam=lam, mu=mu)
+            if a > 0:
+                extra = a * (self._sub_cell_stiffness() if sub_cells
+                             else self._pointwise_stabilization_stiffness())
+                K = extra if K is None else K + extra
+            self._K = K
         return self._K
 
     def _tip_cells(self):

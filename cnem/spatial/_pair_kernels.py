@@ -172,7 +172,9 @@ def _column_pass(col, spts, h2, tol, start, perm, nc, size, period, wrap_z, writ
                             lo, out, perm, mine)
                 continue
             sa, sb = sx[k], sy[k]
-            for q in range(qa, qb):        # the common case: one straight run
+            # the common case, one straight run; written out here: through _run
+            # (inlined by numba) this loop measured 1.4x slower
+            for q in range(qa, qb):
                 d2 = _shifted_dist2(spts, q, x0, x1, x2, sa, sb, 0.0)
                 mine = _record(d2, h2, write, rows, lo, out, q, own, perm, mine)
         rows[s - lo] = mine
