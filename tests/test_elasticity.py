@@ -73,7 +73,7 @@ def test_stabilised_stiffness_is_the_difference_form(name, weight):
     built here term by term from the fan sub-cells (slow reference); the sub-cells'
     spokes integrated whole or cut, their integrals cancel between neighbours."""
     import scipy.sparse as sp
-    from cnem.assembly.quadrature import subdivide
+    from cnem.assembly.quadrature import subdivide, tip_cells
     from cnem.models.elasticity import elasticity_form, lame
     _, _, model = cases.model(name)
     nreg = len(model.domain.regions)
@@ -83,7 +83,7 @@ def test_stabilised_stiffness_is_the_difference_form(name, weight):
     coarse = prob.basis
     lam, mu = lame(*prob.cell_materials().T, "stress")
     reference = elasticity_form.assemble(coarse, lam=lam, mu=mu).toarray()
-    sub, parent = subdivide(prob.cells, model.nodes, node_apex=prob._tip_cells(),
+    sub, parent = subdivide(prob.cells, model.nodes, node_apex=tip_cells(model),
                             mark_spokes=True)
     fine = CellBasis(model, vector=True, cells=sub)
     to_sub = sp.csr_matrix((np.ones(len(parent)), (np.arange(len(parent)), parent)),

@@ -40,6 +40,8 @@ class CellBasis:
         Gauss points per edge piece for ``b~`` (see `smoothed_gradient`).
     cells : Cells, optional
         Integration cells (default ``model.cells``; sub-cells for enrichment).
+    gradient : SmoothedGradient, optional
+        ``b~`` on ``cells`` when already computed (`cnem.assembly.scni.fan_gradient`).
     extra : (gx, gy) sparse (m, e), optional
         Smoothed gradients of ``e`` more functions that vanish at every node
         (enrichment); their dofs follow the nodes' (function ``n + i``).
@@ -56,12 +58,13 @@ class CellBasis:
         The node of each cell.
     """
 
-    def __init__(self, model, *, vector=False, gauss=2, extra=None, cells=None):
+    def __init__(self, model, *, vector=False, gauss=2, extra=None, cells=None, gradient=None):
         self.model = model
         self.vector = bool(vector)
         self.ncomp = 2 if vector else 1
         self.cells = cells = model.cells if cells is None else cells
-        self.grad = smoothed_gradient(model, gauss=gauss, cells=None if cells is model.cells else cells)
+        self.grad = gradient if gradient is not None else \
+            smoothed_gradient(model, gauss=gauss, cells=None if cells is model.cells else cells)
         m, n = len(cells.area), len(model.nodes)
         self.dx = cells.area
         self.x = cells.centroid().T

@@ -6,7 +6,7 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
-__all__ = ["cell_triangles", "triangle_quadrature", "cell_quadrature", "subdivide"]
+__all__ = ["cell_triangles", "triangle_quadrature", "cell_quadrature", "subdivide", "tip_cells"]
 
 
 def _fan(apex, verts, nxt):
@@ -254,3 +254,13 @@ def subdivide(cells, nodes, *, whole=None, node_apex=None, mark_spokes=False):
     sub = Cells(cells.node[parent], cells.region[parent], offsets,
                 np.ascontiguousarray(verts[index]), spokes)
     return sub, parent
+
+
+def tip_cells(model):
+    """Cells of the crack-tip nodes, ``(m,)`` bool: a crack ends inside them, so
+    their fans run from the node (see `cell_triangles`)."""
+    tips = model.domain.tips
+    x = model.nodes[model.cells.node]
+    if len(tips) == 0:
+        return np.zeros(len(x), dtype=bool)
+    return (np.hypot(*(x[:, None, :] - tips[None]).transpose(2, 0, 1)) < 1e-12).any(axis=1)

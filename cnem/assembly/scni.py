@@ -26,8 +26,8 @@ from ..spatial.rtree import RTree, work_chunks
 from . import _kernels as K
 from . import _sparse_kernels as SK
 
-__all__ = ["SmoothedGradient", "smoothed_gradient", "BoundaryQuadrature", "boundary_quadrature",
-           "cell_edges"]
+__all__ = ["SmoothedGradient", "smoothed_gradient", "fan_gradient", "BoundaryQuadrature",
+           "boundary_quadrature", "boundary_quadratures", "cell_edges"]
 
 log = logging.getLogger(__name__)
 
@@ -292,28 +292,69 @@ def boundary_quadrature(model, *, gauss=2, cells=None, singular=None):
     -------
     BoundaryQuadrature
     """
-    gauss = int(gauss)
-    if gauss < 1:
-        raise ValueError(f"gauss: expected a positive number of Gauss points, received {gauss}")
     cells = model.cells if cells is None else cells
+    return boundary_quadratures(model, [cells], gauss=gauss, singular=singular)[0]
+
+
+def _set_edges(model, cells, faces):
+    """The directed edges of one set of cells, with slits and crack-face hints.
+
+    Returns
+    -------
+    cell : (e,) int64 ndarray
+    a, b : (e, 2) ndarray
+    hint : (e,) int64 ndarray
+        Triangle of the crack face the edge lies on (its side), -1 elsewhere.
+    spoke : (e,) bool ndarray
+        Spokes of fan sub-cells (left whole).
+    """
     cell, a, b = cell_edges(cells)
     hint = np.full(len(a), -1, dtype=np.int64)
-    if (model.segment_kind == 2).any():
-        faces = _crack_faces(model)
+    spoke = np.zeros(len(a), dtype=bool) if cells.spokes is None else np.asarray(cells.spokes)
+    if faces is not None:
         hint = _face_triangles(model, a, b, faces)
         slit = _slit_edges(model, faces, cells)
         cell, a, b, hint = (np.concatenate([x, y]) for x, y in zip((cell, a, b, hint), slit))
+        spoke = np.concatenate([spoke, np.zeros(len(slit[0]), dtype=bool)])
+    return cell, a, b, hint, spoke
+
+
+def boundary_quadratures(model, cell_sets, *, gauss=2, singular=None):
+    """`boundary_quadrature` of several sets of cells with one set of points.
+
+    An edge that several sets share (the same ends bit for bit, the same side of
+    a crack face) gets its points once: fan sub-cells (`subdivide`) share every
+    edge but their spokes with their parent cells, so the shape functions at
+    those points serve both smoothed gradients. Where a shared edge is a spoke
+    in one set only, it is cut like the other's.
+
+    Parameters
+    ----------
+    model : Model
+    cell_sets : sequence of Cells
+    gauss : int
+    singular : (s, 2) array_like, optional
+
+    Returns
+    -------
+    list of BoundaryQuadrature
+        One per set, all with the same ``points``, ``hint``, ``wx`` and ``wy``.
+    """
+    gauss = int(gauss)
+    if gauss < 1:
+        raise ValueError(f"gauss: expected a positive number of Gauss points, received {gauss}")
+    faces = _crack_faces(model) if (model.segment_kind == 2).any() else None
+    edges = [_set_edges(model, cells, faces) for cells in cell_sets]
+    cell, a, b, hint, spoke = (np.concatenate(x) for x in zip(*edges))
     # each edge is integrated once, from its lexicographically smaller end: the two
     # cells sharing it get the same integral with opposite signs (they cancel exactly)
     flip = (a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1]))
     a, b = np.where(flip[:, None], b, a), np.where(flip[:, None], a, b)
     sign = np.where(flip, -1.0, 1.0)
     first, occurrence = K.unique_rows(_row_bits(a, b, hint))
+    occurrence = occurrence.reshape(-1)
     a, b, hint = a[first], b[first], hint[first]
-    whole = np.zeros(len(first), dtype=bool)
-    if cells.spokes is not None:              # the slit edges (after the cells' own) are cut
-        inner = first < len(cells.spokes)
-        whole[inner] = cells.spokes[first[inner]]
+    whole = _all_spokes(spoke, occurrence, len(first))
     edge, t0, t1 = _pieces(model, a, b, whole)
     s, w = np.polynomial.legendre.leggauss(gauss)
     s, w = 0.5 * (s + 1.0), 0.5 * w
@@ -338,11 +379,24 @@ def boundary_quadrature(model, *, gauss=2, cells=None, singular=None):
     # one pattern for both (explicit zeros kept): cell_integrals relies on it
     wx = sp.csr_matrix((weight * d[rows, 1], cols, indptr), shape=shape)
     wy = sp.csr_matrix((-weight * d[rows, 0], cols, indptr), shape=shape)
-    to_cells = sp.csr_matrix((sign / cells.area[cell], (cell, occurrence.reshape(-1))),
-                             shape=(len(cells.area), len(a)))
-    log.info("SCNI quadrature: %d cells, %d edges, %d pieces, %d points", len(cells.area),
-             len(a), len(edge), len(points))
-    return BoundaryQuadrature(points, np.repeat(hint[edge], gauss), wx, wy, to_cells)
+    hint = np.repeat(hint[edge], gauss)
+    out, lo = [], 0
+    for cells, (set_cell, *_) in zip(cell_sets, edges):
+        hi = lo + len(set_cell)
+        to_cells = sp.csr_matrix((sign[lo:hi] / cells.area[set_cell], (set_cell, occurrence[lo:hi])),
+                                 shape=(len(cells.area), len(a)))
+        out.append(BoundaryQuadrature(points, hint, wx, wy, to_cells))
+        lo = hi
+    log.info("SCNI quadrature: %s cells, %d edges, %d pieces, %d points",
+             "+".join(str(len(c.area)) for c in cell_sets), len(a), len(edge), len(points))
+    return out
+
+
+def _all_spokes(spoke, occurrence, count):
+    """Per distinct edge: True if every occurrence of it is a spoke."""
+    cut = np.zeros(count, dtype=bool)
+    cut[occurrence[~spoke]] = True
+    return ~cut
 
 
 def _stack_rows(mats):
@@ -382,16 +436,82 @@ def smoothed_gradient(model, *, gauss=2, cells=None):
     every = model.cells if cells is None else cells
     # a pass per run of cells bounds the memory of the quadrature points and their
     # shape functions; edges between runs are integrated in both
-    runs = [every] if len(every) <= CELLS_PER_PASS else \
-        [every.take(lo, min(lo + CELLS_PER_PASS, len(every)))
-         for lo in range(0, len(every), CELLS_PER_PASS)]
-    parts, points = [], 0
-    for run in runs:
-        quad = boundary_quadrature(model, gauss=gauss, cells=run)
-        phi, order = quad.shape_functions(model)
-        parts.append(quad.cell_integrals(phi, rows=order))
-        points += len(quad.points)
-    grad = SmoothedGradient(*(_stack_rows([part[c] for part in parts]) for c in range(2)), points)
+    runs = [[_part(every, lo, hi)] for lo, hi in _runs(len(every))]
+    grad, = _gradients(model, gauss, runs)
     if cells is None:
         model._cache[key] = grad
     return grad
+
+
+def fan_gradient(model, *, gauss=2):
+    """Smoothed gradients on the fan sub-cells of the model's cells (cached).
+
+    The sub-cells (`cnem.assembly.subdivide`, spokes marked; crack-tip cells
+    fanned from their node) share every edge but their spokes with their
+    cells, so ``B~`` of the cells (`smoothed_gradient`, cached too when not yet
+    there) comes from the same shape-function values: only the spokes add
+    points.
+
+    Parameters
+    ----------
+    model : Model
+    gauss : int
+        As in `smoothed_gradient`.
+
+    Returns
+    -------
+    sub : Cells
+        ``s`` fan sub-cells.
+    grad : SmoothedGradient
+        ``x, y`` sparse ``(s, n)``.
+    """
+    from .quadrature import subdivide, tip_cells
+    key = ("scni-fan", int(gauss))
+    if key in model._cache:
+        return model._cache[key]
+    cells = model.cells
+    sub, parent = subdivide(cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
+    have_cells = ("scni", int(gauss)) in model._cache
+    runs = []
+    for lo, hi in _runs(len(cells)):
+        a, b = np.searchsorted(parent, [lo, hi])         # parent is sorted
+        runs.append(([] if have_cells else [_part(cells, lo, hi)]) + [_part(sub, a, b)])
+    grads = _gradients(model, gauss, runs)
+    if not have_cells:
+        model._cache[("scni", int(gauss))] = grads[0]
+    model._cache[key] = sub, grads[-1]
+    return model._cache[key]
+
+
+def _runs(m):
+    """``(lo, hi)`` ranges of at most `CELLS_PER_PASS` cells covering ``m``."""
+    return [(lo, min(lo + CELLS_PER_PASS, m)) for lo in range(0, max(m, 1), CELLS_PER_PASS)]
+
+
+def _part(cells, lo, hi):
+    """``cells.take(lo, hi)``, or the cells themselves when that is all of them."""
+    return cells if (lo, hi) == (0, len(cells)) else cells.take(lo, hi)
+
+
+def _gradients(model, gauss, runs):
+    """Smoothed gradients of several sets of cells, pass by pass.
+
+    Parameters
+    ----------
+    runs : list of lists of Cells
+        For each pass, one run of cells of every set (the same number of sets).
+
+    Returns
+    -------
+    list of SmoothedGradient
+        One per set, the runs' rows one under the other.
+    """
+    parts, points = [[] for _ in runs[0]], 0
+    for run in runs:
+        quads = boundary_quadratures(model, run, gauss=gauss)
+        phi, order = quads[0].shape_functions(model)
+        for part, quad in zip(parts, quads):
+            part.append(quad.cell_integrals(phi, rows=order))
+        points += len(quads[0].points)
+    return [SmoothedGradient(*(_stack_rows([p[c] for p in part]) for c in range(2)), points)
+            for part in parts]

@@ -16,7 +16,8 @@ from tqdm.auto import tqdm
 from ..assembly import BilinearForm, CellBasis
 from ..assembly.conditions import dirichlet_dofs, per_point
 from ..assembly.basis import spread_component
-from ..assembly.quadrature import cell_quadrature, subdivide
+from ..assembly.quadrature import cell_quadrature, subdivide, tip_cells
+from ..assembly.scni import fan_gradient
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import SolveError
 from ..geometry.topology import constraint_edges, triangle_neighbors
@@ -80,7 +81,7 @@ class Elasticity:
         #: the integration cells: the model's, or their fan sub-cells with enrichment (one
         #: smoothed strain per cell cannot control the extra dofs)
         self.cells = (model.cells if self.enrichment is None
-                      else subdivide(model.cells, model.nodes, node_apex=self._tip_cells())[0])
+                      else subdivide(model.cells, model.nodes, node_apex=tip_cells(model))[0])
         self.materials = parse_materials(materials, len(model.domain.regions))
         lame(1.0, 0.0, plane)                       # validates `plane`
         self.stabilization = float(stabilization)
@@ -161,6 +162,8 @@ class Elasticity:
     def basis(self):
         """The vector `CellBasis` (built on first use)."""
         if self._basis is None:
+            if self._sub_cells():
+                fan_gradient(self.model, gauss=self.gauss)    # B~ of the cells comes with it
             extra = (None if self.enrichment is None
                      else self.enrichment.smoothed_gradient(self.gauss, self.cells))
             self._basis = CellBasis(self.model, vector=True, gauss=self.gauss, extra=extra,
@@ -175,7 +178,7 @@ class Elasticity:
         """Global stiffness ``K`` (eq. 33), ``(2 n, 2 n)`` CSR."""
         if self._K is None:
             a = self.stabilization
-            sub_cells = self.enrichment is None and a > 0
+            sub_cells = self._sub_cells()
             # with sub-cells K = (1 - a) K_cells + a K_sub (see _sub_cell_stiffness)
             weight = 1.0 - a if sub_cells else 1.0
             K = None
@@ -190,14 +193,10 @@ class Elasticity:
             self._K = K
         return self._K
 
-    def _tip_cells(self):
-        """Cells of the crack-tip nodes (fanned from the tip when cells are subdivided:
-        a crack ends inside them)."""
-        tips = self.model.domain.tips
-        x = self.model.nodes[self.model.cells.node]
-        if len(tips) == 0:
-            return np.zeros(len(x), dtype=bool)
-        return (np.hypot(*(x[:, None, :] - tips[None]).transpose(2, 0, 1)) < 1e-12).any(axis=1)
+    def _sub_cells(self):
+        """Whether the stabilisation uses the fan sub-cells of the model's cells
+        (stabilised, not enriched)."""
+        return self.enrichment is None and self.stabilization > 0
 
     def _sub_cell_stiffness(self):
         """``sum_s A_s B~_s^T C B~_s`` over the fan sub-cells ``s``.
@@ -208,9 +207,8 @@ class Elasticity:
         ``(1 - a) K_k + a sum_s A_s B~_s^T C B~_s``: no difference operators
         (whose rows would carry both patterns) are formed.
         """
-        sub, _ = subdivide(self.cells, self.model.nodes, node_apex=self._tip_cells(),
-                           mark_spokes=True)
-        fine = CellBasis(self.model, vector=True, gauss=self.gauss, cells=sub)
+        sub, grad = fan_gradient(self.model, gauss=self.gauss)
+        fine = CellBasis(self.model, vector=True, cells=sub, gradient=grad)
         E, nu = self.materials[sub.region].T
         lam, mu = lame(E, nu, self.plane)
         return elasticity_form.assemble(fine, lam=lam, mu=mu)
