@@ -32,7 +32,9 @@ nothing), so nothing cached by one run serves the next:
   ``asm(linear_elasticity(...), basis)``;
 * ``solve`` (both sides, the very same function): ``skfem.condense`` of the clamped dofs, the
   rigid-body modes of the free dofs, and ``cnem.assembly.linsolve.solve_spd`` (direct up to
-  2.5M non-zeros, pyamg smoothed aggregation + CG above, tol 1e-10).  This is what
+  2.5M non-zeros, pyamg smoothed aggregation + CG above, tol 1e-10; on the C-NEM side the
+  hierarchy is built on the P1 stiffness of the same nodes on the model's triangles,
+  ``Elasticity.preconditioner_matrix``, whose assembly is timed in the stage).  This is what
   ``Elasticity.solve`` does after K and the load, minus its rigid-motion check
   (``free_rigid_motions``), which is timed apart and printed in the details;
 * ``total``: the sum of a run's stages (load vectors and dof selection are not timed).
@@ -111,15 +113,18 @@ def clamped_dofs(points):
     return np.column_stack([2 * nodes, 2 * nodes + 1]).reshape(-1)
 
 
-def condensed_solve(K, f, points, D):
-    """What both sides time as ``solve``: condense, rigid modes of the free dofs, solve_spd."""
+def condensed_solve(K, f, points, D, preconditioner=None):
+    """What both sides time as ``solve``: condense, rigid modes of the free dofs, solve_spd
+    (C-NEM: with ``preconditioner(free dofs)``, the P1 matrix its smoothed aggregation is
+    built on, as in ``Elasticity.solve``)."""
     from skfem import condense
 
     from cnem.assembly.linsolve import rigid_modes, solve_spd
 
     x = np.zeros(K.shape[0])
     A, b, _, interior = condense(K, f, x=x, D=D)
-    x[interior] = solve_spd(A, b, modes=rigid_modes(points)[interior])
+    lazy = None if preconditioner is None else (lambda: preconditioner(interior))
+    x[interior] = solve_spd(A, b, modes=rigid_modes(points)[interior], preconditioner=lazy)
     return x
 
 
@@ -187,7 +192,8 @@ def cnem_pipeline(cloud, run):
     t0 = time.perf_counter()
     free = free_rigid_motions(K, model.nodes, D)
     run["check"] = time.perf_counter() - t0
-    x = staged(run, "solve", lambda: condensed_solve(K, f, model.nodes, D))
+    x = staged(run, "solve", lambda: condensed_solve(K, f, model.nodes, D,
+                                                     prob.preconditioner_matrix))
     return dict(nodes=len(model.nodes), cells=len(model.cells), quad=points,
                 grad_nnz=int(grad.x.nnz), K_nnz=int(K.nnz), dofs=K.shape[0], free=free,
                 sym=symmetry_error(K), tip=tip_displacement(model.nodes, x))
@@ -376,7 +382,8 @@ def report(results, warm):
     print(f"C-NEM elasticity vs scikit-fem P1 on the unit square, plane {PLANE}, E = {E:g}, "
           f"nu = {NU:g}, clamped on x = 0, traction {TRACTION} on x = 1; median wall times in s")
     print("solve (both sides) = skfem.condense + rigid modes + cnem.assembly.linsolve.solve_spd "
-          "(direct <= 2.5M non-zeros, pyamg + CG above): Elasticity.solve's path without its "
+          "(direct <= 2.5M non-zeros, pyamg + CG above; C-NEM: hierarchy on the P1 matrix of its "
+          "triangles, built in the stage): Elasticity.solve's path without its "
           "rigid-motion check (timed in the details)")
     print("B~ = the smoothed gradients on an empty model cache (includes the shape-function "
           "setup): fan_gradient (cells and their fan sub-cells, one set of points) with the "

@@ -59,27 +59,58 @@ class CellBasis:
     """
 
     def __init__(self, model, *, vector=False, gauss=2, extra=None, cells=None, gradient=None):
-        self.model = model
-        self.vector = bool(vector)
-        self.ncomp = 2 if vector else 1
-        self.cells = cells = model.cells if cells is None else cells
+        cells = model.cells if cells is None else cells
+        self.cells = cells
         self.grad = gradient if gradient is not None else \
             smoothed_gradient(model, gauss=gauss, cells=None if cells is model.cells else cells)
         m, n = len(cells.area), len(model.nodes)
-        self.dx = cells.area
-        self.x = cells.centroid().T
-        self.nodes = model.nodes[cells.node].T
         value = sp.csr_matrix((np.ones(m), (np.arange(m), cells.node)), shape=(m, n))
         gx, gy = self.grad.x, self.grad.y
         if extra is not None:           # functions that vanish at the nodes (enrichment)
             ex, ey = extra
             value = sp.hstack([value, sp.csr_matrix(ex.shape)], format="csr")
             gx, gy = sp.hstack([gx, ex], format="csr"), sp.hstack([gy, ey], format="csr")
+        self._setup(model, vector, (value, gx, gy), cells.area, cells.centroid().T,
+                    model.nodes[cells.node].T)
+
+    def _setup(self, model, vector, node_ops, dx, x, nodes):
+        self.model = model
+        self.vector = bool(vector)
+        self.ncomp = 2 if vector else 1
+        self.dx, self.x, self.nodes = dx, x, nodes
         #: number of functions: the nodes' shape functions, then the extra ones
-        self.nfun = value.shape[1]
+        self.nfun = node_ops[0].shape[1]
         self.N = self.ncomp * self.nfun
-        self._node_ops = (value, gx, gy)
+        self._node_ops = node_ops
         self._built = None                  # the operators as built from _node_ops
+
+    @classmethod
+    def from_operators(cls, model, value, gx, gy, weights, points, *, vector=False):
+        """A basis over other integration points, from the scalar operators of the
+        functions there (linear triangles, say: `cnem.assembly.triangles`).
+
+        Parameters
+        ----------
+        model : Model
+        value, gx, gy : sparse (q, nfun)
+            Values and x, y derivatives of the functions at the points.
+        weights : (q,) ndarray
+            Quadrature weights (``dx``).
+        points : (q, 2) ndarray
+            The points (``w.x``).
+        vector : bool
+
+        Returns
+        -------
+        CellBasis
+            Without cells (``cells``, ``grad`` and ``nodes`` are None).
+        """
+        out = cls.__new__(cls)
+        out.cells = out.grad = None
+        x = np.asarray(points, dtype=float).T
+        out._setup(model, vector, tuple(op.tocsr() for op in (value, gx, gy)),
+                   np.asarray(weights, dtype=float), x, None)
+        return out
 
     def __repr__(self):
         kind = "vector" if self.vector else "scalar"

@@ -70,39 +70,58 @@ class BilinearForm(_Form):
 
     def coefficients(self, basis, **kwargs):
         """``D[a][b]``: the form at unit descriptors ``u = e_a``, ``v = e_b``, per cell."""
+        c = 3 * basis.ncomp
+        out = [[np.zeros(len(basis.dx)) for _ in range(c)] for _ in range(c)]
+        for a, b, value in self._nonzero_coefficients(basis, kwargs):
+            out[a][b] = value
+        return out
+
+    def _nonzero_coefficients(self, basis, kwargs):
+        """``(a, b, D_ab)`` for the descriptor pairs where the form is not zero in
+        every cell, one at a time (a large basis holds only one of them)."""
         w = _extras(basis, kwargs)
         m = len(basis.dx)
         units = basis.unit_fields()
         zero = basis.zero_field()
         if np.any(np.asarray(self.form(zero, zero, w)) != 0.0):
             raise ValueError(f"form {self.__name__} is not bilinear: it is non-zero for u = v = 0")
-        return [[_coefficients(self.form(ua, vb, w), m, f"form {self.__name__}")
-                 for vb in units] for ua in units]
+        for a, ua in enumerate(units):
+            for b, vb in enumerate(units):
+                value = _coefficients(self.form(ua, vb, w), m, f"form {self.__name__}")
+                if np.any(value != 0.0):
+                    yield a, b, value
 
     def assemble(self, basis, **kwargs):
         """Sparse matrix ``(N, N)`` (CSR)."""
-        coeff = self.coefficients(basis, **kwargs)
-        m, c = len(basis.dx), len(coeff)
-        active = [(a, b) for a in range(c) for b in range(c) if np.any(coeff[a][b] != 0.0)]
+        m, g = len(basis.dx), basis.ncomp             # descriptors g, g + 1, ...: gradients
+        # A_k D_ab(k), filled one descriptor pair at a time: gradient pairs in one array
+        grad_weights = np.zeros((m, 2 * g, 2 * g))
+        other = {}
+        for a, b, value in self._nonzero_coefficients(basis, kwargs):
+            if a >= g and b >= g:
+                np.multiply(basis.dx, value, out=grad_weights[:, a - g, b - g])
+            else:
+                other[a, b] = basis.dx * value
+        active = {(a, b) for a in range(g, 3 * g) for b in range(g, 3 * g)
+                  if grad_weights[:, a - g, b - g].any()} | set(other)
         if not active:
             return sp.csr_matrix((basis.N, basis.N))
-        only_gradients = basis.vector and min(min(ab) for ab in active) >= 2
-        grads = basis.component_gradients() if only_gradients else None
+        grads = basis.component_gradients() if basis.vector and not other else None
         if grads is not None:          # 2 x 2 node blocks from the scalar gradients
-            weights = np.zeros((m, 4, 4))
-            for a, b in active:
-                weights[:, a - 2, b - 2] = basis.dx * coeff[a][b]
             gx, gy = grads
             indptr, indices, data = SK.gradient_block_gram(gx.indptr, gx.indices, gx.data,
-                                                           gy.data, weights, basis.N // 2,
+                                                           gy.data, grad_weights, basis.N // 2,
                                                            work_chunks())
             return sp.csr_matrix((data, indices, indptr), shape=(basis.N, basis.N))
         ops = basis.operators
         used = sorted({a for a, _ in active} | {b for _, b in active})
-        slot = {d: i for i, d in enumerate(used)}
         weights = np.zeros((m, len(used), len(used)))
-        for a, b in active:
-            weights[:, slot[a], slot[b]] = basis.dx * coeff[a][b]
+        for i, a in enumerate(used):
+            for j, b in enumerate(used):
+                if (a, b) in other:
+                    weights[:, i, j] = other[a, b]
+                elif a >= g and b >= g:
+                    weights[:, i, j] = grad_weights[:, a - g, b - g]
         stack = sp.vstack([ops[d] for d in used], format="csr")
         t = stack.T.tocsr()
         indptr, indices, data = SK.weighted_gram(stack.indptr, stack.indices, stack.data,

@@ -153,7 +153,7 @@ def free_rigid_motions(K, points, fixed):
     return free
 
 
-def solve_spd(A, b, *, modes=None, tol=1e-10, method="auto"):
+def solve_spd(A, b, *, modes=None, tol=1e-10, method="auto", preconditioner=None):
     """Solve a symmetric positive definite system.
 
     Parameters
@@ -166,6 +166,12 @@ def solve_spd(A, b, *, modes=None, tol=1e-10, method="auto"):
         Relative residual for the iterative solver.
     method : {"auto", "direct", "amg"}
         ``"auto"``: direct up to `DIRECT_NNZ` non-zeros, pyamg + CG above.
+    preconditioner : sparse (N, N) or callable returning one, optional
+        A sparser SPD matrix spectrally close to ``A`` (the P1 stiffness of the
+        same nodes, `cnem.assembly.triangles`): the smoothed-aggregation
+        hierarchy is built on it and preconditions CG on ``A``. Should CG not
+        reach ``tol`` so, the hierarchy is built on ``A`` itself. A callable is
+        called only when the iterative path is taken.
 
     Returns
     -------
@@ -177,13 +183,48 @@ def solve_spd(A, b, *, modes=None, tol=1e-10, method="auto"):
         return spla.spsolve(A.tocsc(), b)
     if method != "amg":
         raise ValueError(f"method: expected 'auto', 'direct' or 'amg', received {method!r}")
-    import pyamg
-    ml = pyamg.smoothed_aggregation_solver(A.tocsr(), B=modes, symmetry="symmetric")
-    residuals = []
-    x = ml.solve(b, tol=tol, accel="cg", maxiter=2000, residuals=residuals)
-    rel = residuals[-1] / max(residuals[0], 1e-300)
-    log.info("pyamg CG: %d iterations, relative residual %.2e", len(residuals) - 1, rel)
+    if callable(preconditioner):
+        preconditioner = preconditioner()
+    if preconditioner is not None:
+        if preconditioner.shape != A.shape:
+            raise ValueError(f"preconditioner: expected shape {A.shape} like the matrix, "
+                             f"received {preconditioner.shape}")
+        x, rel, its = _amg_cg(A, b, preconditioner, modes, tol)
+        if rel <= 10 * tol:
+            return x
+        log.warning("pyamg on the preconditioner matrix: CG stopped at relative residual "
+                    "%.2e after %d iterations; building the hierarchy on the matrix itself",
+                    rel, its)
+    x, rel, its = _amg_cg(A, b, A, modes, tol)
     if not rel <= 10 * tol:
         raise SolveError(f"pyamg + CG stopped at relative residual {rel:.2e} after "
-                         f"{len(residuals) - 1} iterations (wanted {tol:.0e})")
+                         f"{its} iterations (wanted {tol:.0e})")
     return x
+
+
+def _amg_cg(A, b, P, modes, tol, maxiter=2000):
+    """CG on ``A x = b`` preconditioned by a smoothed-aggregation V-cycle built on ``P``.
+
+    Returns
+    -------
+    x : (N,) ndarray
+    rel : float
+        Final relative residual ``|b - A x| / |b|``.
+    its : int
+        Iterations.
+    """
+    import pyamg
+    ml = pyamg.smoothed_aggregation_solver(P.tocsr(), B=modes, symmetry="symmetric")
+    A = A.tocsr()
+    its = [0]
+
+    def count(_):
+        its[0] += 1
+
+    x, _ = spla.cg(A, b, rtol=tol, atol=0.0, maxiter=maxiter, M=ml.aspreconditioner(),
+                   callback=count)
+    norm = np.linalg.norm(b)
+    rel = np.linalg.norm(b - A @ x) / norm if norm > 0 else 0.0
+    log.info("pyamg (hierarchy on %s) + CG: %d iterations, relative residual %.2e",
+             "the matrix" if P is A else "the preconditioner matrix", its[0], rel)
+    return x, rel, its[0]

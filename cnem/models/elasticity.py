@@ -18,6 +18,7 @@ from ..assembly.conditions import dirichlet_dofs, per_point
 from ..assembly.basis import spread_component
 from ..assembly.quadrature import cell_quadrature, subdivide, tip_cells
 from ..assembly.scni import fan_gradient
+from ..assembly.triangles import triangle_basis
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import SolveError
 from ..geometry.topology import constraint_edges, triangle_neighbors
@@ -289,6 +290,28 @@ class Elasticity:
             values = np.concatenate([values, np.zeros(len(extra))])
         return dofs, values
 
+    def preconditioner_matrix(self, dofs=None):
+        """The P1 stiffness of the nodes on the model's triangles (same materials):
+        where smoothed aggregation is built for large solves (see
+        `cnem.assembly.triangles`).
+
+        Parameters
+        ----------
+        dofs : (k,) int array_like, optional
+            Keep these rows and columns only (the free dofs).
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix, shape (2 n, 2 n) or (k, k); None with enrichment
+            (P1 has no enriched dofs).
+        """
+        if self.enrichment is not None:
+            return None
+        E, nu = self.materials[self.model.triangle_region].T
+        lam, mu = lame(E, nu, self.plane)
+        P = elasticity_form.assemble(triangle_basis(self.model, vector=True), lam=lam, mu=mu)
+        return P if dofs is None else P[dofs][:, dofs]
+
     # -- solve --------------------------------------------------------------------------
     def solve(self, *, method="auto", tol=1e-10, progress=None):
         """Solve ``K d = f`` with the Dirichlet values imposed.
@@ -297,7 +320,8 @@ class Elasticity:
         ----------
         method : {"auto", "direct", "amg"}
             ``"auto"``: sparse direct up to 2.5M non-zeros in K (~20k nodes), pyamg smoothed
-            aggregation (rigid-body modes) + CG above.
+            aggregation (rigid-body modes) + CG above, the hierarchy built on the P1
+            stiffness of the same nodes on the model's triangles (without enrichment).
         tol : float
             Relative residual of the iterative solver.
         progress : bool, optional
@@ -340,7 +364,8 @@ class Elasticity:
         modes = np.zeros((K.shape[0], 3))
         modes[:n2] = rigid_modes(self.model.nodes)
         modes = modes[interior]
-        x[interior] = solve_spd(A, b, modes=modes, tol=tol, method=method)
+        x[interior] = solve_spd(A, b, modes=modes, tol=tol, method=method,
+                                preconditioner=lambda: self.preconditioner_matrix(interior))
         t3 = time.perf_counter()
         bar.update()
         bar.close()

@@ -1,0 +1,102 @@
+"""Large-system solves: the P1 basis on a model's triangles (`cnem.assembly.triangles`)
+and CG preconditioned by smoothed aggregation built on its stiffness.
+
+Checked against scikit-fem's own P1 assembly on the same triangles, and the
+iterative solutions against the direct ones on the same systems.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from skfem import Basis, ElementTriP1, ElementVector, MeshTri, asm
+from skfem.helpers import dot, grad
+from skfem.models.elasticity import linear_elasticity
+from skfem.models.poisson import laplace
+
+import cases
+import cnem
+from cnem.assembly import BilinearForm, linsolve
+from cnem.assembly.triangles import triangle_basis
+from cnem.models.elasticity import elasticity_form
+from cnem.models.material import lame
+
+E, NU = 1000.0, 0.3
+
+
+@pytest.mark.parametrize("name", ["plate_hole_irregular", "kinked_crack_irregular",
+                                  "three_rectangles_irregular"])
+def test_triangle_basis_gives_the_p1_stiffness(name):
+    """Elasticity (per-triangle materials) and Laplace forms on the triangle basis are
+    scikit-fem's P1 matrices on the same triangles; the crack faces stay apart."""
+    _, _, model = cases.model(name)
+    mesh = MeshTri(model.nodes.T.copy(), model.triangles.T.copy())
+    lam, mu = lame(E * (1.0 + model.triangle_region), NU, "strain")
+    ours = elasticity_form.assemble(triangle_basis(model, vector=True), lam=lam, mu=mu)
+    ref = asm(linear_elasticity(lam[:, None], mu[:, None]), Basis(mesh, ElementVector(ElementTriP1())))
+    assert abs(ours - ref).max() <= 1e-12 * abs(ref).max()
+    scalar = BilinearForm(lambda u, v, w: dot(grad(u), grad(v))).assemble(triangle_basis(model))
+    ref = asm(laplace, Basis(mesh, ElementTriP1()))
+    assert abs(scalar - ref).max() <= 1e-12 * abs(ref).max()
+
+
+@pytest.mark.parametrize("name, enrich", [("three_rectangles_irregular", None),
+                                          ("kinked_crack_irregular", None),
+                                          ("edge_crack_regular", dict(radius=0.2))])
+def test_amg_solution_is_the_direct_one(name, enrich, caplog):
+    """pyamg + CG (hierarchy on the P1 stiffness; on K itself with enrichment, whose
+    extra dofs P1 does not have) gives the direct solution."""
+    _, _, model = cases.model(name)
+    nreg = len(model.domain.regions)
+    mats = [(E * (1 + r), NU - 0.1 * r) for r in range(nreg)]
+    lo = model.nodes.min(axis=0)
+
+    def solve(method):
+        prob = cnem.Elasticity(model, mats, enrich=enrich)
+        prob.add_dirichlet(lambda p: p[:, 0] < lo[0] + 1e-9, None)
+        prob.add_traction(lambda x, nrm: nrm[:, 0] > 0.5, [3.0, 1.0])
+        prob.add_body_force([0.5, -2.0])
+        return prob.solve(method=method, tol=1e-12, progress=False)
+
+    direct = solve("direct")
+    with caplog.at_level("INFO", logger="cnem.assembly.linsolve"):
+        amg = solve("amg")
+    where = "the matrix" if enrich else "the preconditioner matrix"
+    assert f"pyamg (hierarchy on {where})" in caplog.text
+    assert "building the hierarchy on the matrix itself" not in caplog.text
+    scale = np.abs(direct.u).max()
+    np.testing.assert_allclose(amg.u, direct.u, atol=1e-9 * scale)
+
+
+def _laplacian(n):
+    """A 1-D Dirichlet Laplacian ``(n, n)`` (SPD)."""
+    return sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1], format="csr")
+
+
+def test_falls_back_to_the_matrix_when_the_preconditioner_fails(monkeypatch, caplog):
+    A, b = _laplacian(300), np.linspace(1.0, 2.0, 300)
+    built_on = []
+    real = linsolve._amg_cg
+
+    def failing_first(A_, b_, P, modes, tol):
+        built_on.append(P)
+        x, rel, its = real(A_, b_, P, modes, tol)
+        return (x, 1.0, its) if len(built_on) == 1 else (x, rel, its)
+
+    monkeypatch.setattr(linsolve, "_amg_cg", failing_first)
+    P = 2.0 * sp.identity(300, format="csr")
+    x = linsolve.solve_spd(A, b, method="amg", preconditioner=lambda: P)
+    assert built_on[0] is P and built_on[1] is A
+    assert "building the hierarchy on the matrix itself" in caplog.text
+    np.testing.assert_allclose(A @ x, b, atol=1e-8 * np.abs(b).max())
+
+
+def test_preconditioner_is_built_only_for_the_iterative_path():
+    A, b = _laplacian(50), np.ones(50)
+    called = []
+    x = linsolve.solve_spd(A, b, method="direct", preconditioner=lambda: called.append(1))
+    assert not called
+    np.testing.assert_allclose(A @ x, b, atol=1e-12)
+    with pytest.raises(ValueError, match=r"preconditioner: expected shape \(50, 50\)"):
+        linsolve.solve_spd(A, b, method="amg", preconditioner=sp.identity(49))
