@@ -159,9 +159,9 @@ CLOUD = {"kind": "irregular", "stabilization": 1.0}
 def lattice_cloud(k):
     """The C-NEM node cloud: the k x k lattice of the unit square (``--cloud regular``),
     or an irregular cloud of the same spacing (``cnem.nodes.irregular``, seed 0; about
-    k^2 nodes). On the exact lattice every Delaunay circle holds four nodes and the
-    SCNI stiffness is much harder for smoothed aggregation (about 5x the CG
-    iterations at 40k nodes), so the irregular cloud is the representative case."""
+    k^2 nodes). On the exact lattice every Delaunay circle holds four nodes (a degenerate
+    case for natural neighbours, with sparser SCNI rows), so the irregular cloud is the
+    representative case."""
     import cnem
 
     dom = cnem.geometry.rectangle(1.0, 1.0)

@@ -166,3 +166,8 @@ def test_fan_gradient_shares_the_cells_points(name, per_pass, monkeypatch):
         np.testing.assert_allclose(a.toarray(), b.toarray(), atol=1e-12 * abs(a).max())
     # the spokes add points; the edges shared with the cells do not
     assert alone.points < fan.points < alone.points + sub_alone.points
+    # its last user takes it out of the cache
+    assert scni.fan_gradient(model, release=True)[1] is fan
+    again = scni.fan_gradient(model, release=True)[1]
+    assert again is not fan and ("scni-fan", 2) not in model._cache
+    np.testing.assert_allclose(again.x.toarray(), fan.x.toarray(), atol=1e-12 * abs(fan.x).max())

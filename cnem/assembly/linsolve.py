@@ -102,6 +102,26 @@ def _describe(t, w, centre, size):
     return f"rotation about {_direction(w)} through {where}{slip}"
 
 
+def _node_components(K, n, d):
+    """Connected parts of the nodes of a stiffness on interleaved dofs: the parts of the
+    dof graph (K's own pattern, no copy), joined where one node's dofs fall in several.
+
+    Returns
+    -------
+    ncomp : int
+    label : (n,) int ndarray
+    """
+    _, dof_label = csgraph.connected_components(K.tocsr(), directed=False)
+    labels = dof_label[:d * n].reshape(n, d)
+    m = dof_label.max() + 1
+    # join the parts of each node's dofs (a small graph over the parts)
+    join = sp.csr_matrix((np.ones(n * (d - 1)), (np.repeat(labels[:, 0], d - 1),
+                                                 labels[:, 1:].reshape(-1))), shape=(m, m))
+    _, part = csgraph.connected_components(join, directed=False)
+    kinds, label = np.unique(part[labels[:, 0]], return_inverse=True)
+    return len(kinds), label
+
+
 def free_rigid_motions(K, points, fixed):
     """Rigid motions of each connected part of a 2-D or 3-D body left free by fixed dofs.
 
@@ -127,9 +147,7 @@ def free_rigid_motions(K, points, fixed):
     """
     n, d = np.shape(points)
     nrot = 1 if d == 2 else 3
-    coo = K.tocoo()
-    node_graph = sp.csr_matrix((np.ones(coo.nnz), (coo.row // d, coo.col // d)), shape=(n, n))
-    ncomp, label = csgraph.connected_components(node_graph, directed=False)
+    ncomp, label = _node_components(K, n, d)
     is_fixed = np.zeros(d * n, dtype=bool)
     is_fixed[fixed] = True
     free = []

@@ -447,7 +447,7 @@ def smoothed_gradient(model, *, gauss=2, cells=None):
     return grad
 
 
-def fan_gradient(model, *, gauss=2):
+def fan_gradient(model, *, gauss=2, release=False):
     """Smoothed gradients on the fan sub-cells of the model's cells (cached).
 
     The sub-cells (`cnem.assembly.subdivide`, spokes marked; crack-tip cells
@@ -461,6 +461,9 @@ def fan_gradient(model, *, gauss=2):
     model : Model
     gauss : int
         As in `smoothed_gradient`.
+    release : bool
+        Drop the result from the model's cache (its last user: about as large
+        as ``B~`` six times over, so a large model does not keep it).
 
     Returns
     -------
@@ -472,7 +475,7 @@ def fan_gradient(model, *, gauss=2):
     from .quadrature import subdivide, tip_cells
     key = ("scni-fan", int(gauss))
     if key in model._cache:
-        return model._cache[key]
+        return model._cache.pop(key) if release else model._cache[key]
     cells = model.cells
     sub, parent = subdivide(cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
     have_cells = ("scni", int(gauss)) in model._cache
@@ -483,8 +486,9 @@ def fan_gradient(model, *, gauss=2):
     grads = _gradients(model, gauss, runs)
     if not have_cells:
         model._cache[("scni", int(gauss))] = grads[0]
-    model._cache[key] = sub, grads[-1]
-    return model._cache[key]
+    if not release:
+        model._cache[key] = sub, grads[-1]
+    return sub, grads[-1]
 
 
 def _runs(m):

@@ -208,7 +208,7 @@ class Elasticity:
         ``(1 - a) K_k + a sum_s A_s B~_s^T C B~_s``: no difference operators
         (whose rows would carry both patterns) are formed.
         """
-        sub, grad = fan_gradient(self.model, gauss=self.gauss)
+        sub, grad = fan_gradient(self.model, gauss=self.gauss, release=True)
         fine = CellBasis(self.model, vector=True, cells=sub, gradient=grad)
         E, nu = self.materials[sub.region].T
         lam, mu = lame(E, nu, self.plane)

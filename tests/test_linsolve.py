@@ -1,8 +1,10 @@
-"""Large-system solves: the P1 basis on a model's triangles (`cnem.assembly.triangles`)
-and CG preconditioned by smoothed aggregation built on its stiffness.
+"""Linear solves: the P1 basis on a model's triangles (`cnem.assembly.triangles`), CG
+preconditioned by smoothed aggregation built on its stiffness, and the rigid motions
+a stiffness leaves free part by part.
 
-Checked against scikit-fem's own P1 assembly on the same triangles, and the
-iterative solutions against the direct ones on the same systems.
+Checked against scikit-fem's own P1 assembly on the same triangles, the iterative
+solutions against the direct ones on the same systems, and the free motions of
+bodies whose parts are known by construction.
 """
 
 from __future__ import annotations
@@ -100,3 +102,16 @@ def test_preconditioner_is_built_only_for_the_iterative_path():
     np.testing.assert_allclose(A @ x, b, atol=1e-12)
     with pytest.raises(ValueError, match=r"preconditioner: expected shape \(50, 50\)"):
         linsolve.solve_spd(A, b, method="amg", preconditioner=sp.identity(49))
+
+
+def test_parts_whose_dofs_do_not_couple_across_components():
+    """Two chains of springs acting on each component apart (the x and y dofs of a
+    node never couple): the dof graph has four parts, the body two; fixing the first
+    chain leaves the second one's three rigid motions, named for its part."""
+    chain = sp.diags([-np.ones(4), np.r_[1, 2 * np.ones(3), 1], -np.ones(4)], [-1, 0, 1])
+    K = sp.kron(sp.block_diag([chain, chain]), sp.identity(2), format="csr")
+    points = np.column_stack([np.tile(np.arange(5.0), 2), np.repeat([0.0, 1.0], 5)])
+    free = linsolve.free_rigid_motions(K, points, np.arange(10))
+    assert free == [f"{m} of the part holding node 5 (5 nodes)" for m in
+                    ("translation in x", "translation in y", "rotation about (2, 1)")]
+    assert linsolve.free_rigid_motions(K, points, np.arange(20)) == []
