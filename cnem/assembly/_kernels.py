@@ -167,3 +167,28 @@ def piece_points(a, b, edge, t0, t1, S, W, single):
             piece[p] = i
             p += 1
     return points, wx, wy, indptr, piece
+
+
+@numba.njit(cache=True, parallel=True)
+def canonical_rows(a, b, hint):
+    """Every edge from its lexicographically smaller end, as one row of numbers.
+
+    Returns
+    -------
+    rows : (e, 5) float64
+        ``[x0, y0, x1, y1, hint]``: equal rows (bit for bit, as uint64) are the
+        same edge seen from the same side.
+    sign : (e,) float64
+        -1 where the edge was turned round, else 1.
+    """
+    e = a.shape[0]
+    rows = np.empty((e, 5))
+    sign = np.empty(e)
+    for i in numba.prange(e):
+        flip = a[i, 0] > b[i, 0] or (a[i, 0] == b[i, 0] and a[i, 1] > b[i, 1])
+        p, q = (b, a) if flip else (a, b)
+        rows[i, 0], rows[i, 1] = p[i, 0], p[i, 1]
+        rows[i, 2], rows[i, 3] = q[i, 0], q[i, 1]
+        rows[i, 4] = float(hint[i])
+        sign[i] = -1.0 if flip else 1.0
+    return rows, sign

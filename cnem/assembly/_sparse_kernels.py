@@ -311,3 +311,32 @@ def _blocks_to_csr(indptr, indices, blocks):
                     data[w] = blocks[q, r, s]
                     w += 1
     return out_ptr, out_idx, data
+
+
+@numba.njit(cache=True, parallel=True)
+def scatter_rows(indptr, indices, x, y, target):
+    """Row ``r`` of a CSR (values ``x`` and ``y`` on one pattern) moved to row
+    ``target[r]`` (``target`` a permutation).
+
+    Returns
+    -------
+    indptr : (m + 1,) int64
+    indices : (nnz,) int32
+    x, y : (nnz,) float64
+    """
+    m = target.shape[0]
+    new = np.zeros(m + 1, dtype=np.int64)
+    for r in numba.prange(m):
+        new[target[r] + 1] = indptr[r + 1] - indptr[r]
+    for r in range(m):
+        new[r + 1] += new[r]
+    out_idx = np.empty(new[m], dtype=np.int32)
+    out_x = np.empty(new[m])
+    out_y = np.empty(new[m])
+    for r in numba.prange(m):
+        a, b = indptr[r], new[target[r]]
+        for e in range(indptr[r + 1] - a):
+            out_idx[b + e] = indices[a + e]
+            out_x[b + e] = x[a + e]
+            out_y[b + e] = y[a + e]
+    return new, out_idx, out_x, out_y

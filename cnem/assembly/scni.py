@@ -22,6 +22,7 @@ import shapely
 
 from .. import config
 from ..geometry.topology import circumcenters, constraint_edges, triangle_neighbors
+from ..shape.natural import path_order
 from ..spatial.rtree import RTree, work_chunks
 from . import _kernels as K
 from . import _sparse_kernels as SK
@@ -32,7 +33,7 @@ __all__ = ["SmoothedGradient", "smoothed_gradient", "fan_gradient", "BoundaryQua
 log = logging.getLogger(__name__)
 
 #: Cells whose boundary quadrature is built and evaluated in one pass of `smoothed_gradient`.
-CELLS_PER_PASS = 200_000
+CELLS_PER_PASS = 50_000
 
 #: Spokes of fan sub-cells (edges left whole) get their midpoint alone: exact for the
 #: linear fields the shape functions reproduce, so the patch test still holds, and
@@ -78,13 +79,6 @@ def cell_edges(cells):
     nxt = np.arange(len(cells.vertices)) + 1
     nxt[cells.offsets[1:] - 1] = cells.offsets[:-1]
     return cell, cells.vertices, cells.vertices[nxt]
-
-
-def _row_bits(a, b, hint):
-    """One row of bits per edge: its end coordinates and side hint, ``(e, 5)`` uint64
-    (equal rows are the same edge, bit for bit)."""
-    rows = np.ascontiguousarray(np.column_stack([a, b, hint.astype(np.float64)]))
-    return rows.view(np.uint64)
 
 
 def _circumcircles(model):
@@ -353,12 +347,10 @@ def boundary_quadratures(model, cell_sets, *, gauss=2, singular=None):
     cell, a, b, hint, spoke = (np.concatenate(x) for x in zip(*edges))
     # each edge is integrated once, from its lexicographically smaller end: the two
     # cells sharing it get the same integral with opposite signs (they cancel exactly)
-    flip = (a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1]))
-    a, b = np.where(flip[:, None], b, a), np.where(flip[:, None], a, b)
-    sign = np.where(flip, -1.0, 1.0)
-    first, occurrence = K.unique_rows(_row_bits(a, b, hint))
-    occurrence = occurrence.reshape(-1)
-    a, b, hint = a[first], b[first], hint[first]
+    rows, sign = K.canonical_rows(a, b, hint)
+    first, occurrence = K.unique_rows(rows.view(np.uint64))
+    rows, hint = rows[first], hint[first]
+    a, b = np.ascontiguousarray(rows[:, :2]), np.ascontiguousarray(rows[:, 2:4])
     whole = _all_spokes(spoke, occurrence, len(first))
     edge, t0, t1 = _pieces(model, a, b, whole)
     s, w = np.polynomial.legendre.leggauss(gauss)
@@ -438,10 +430,11 @@ def smoothed_gradient(model, *, gauss=2, cells=None):
     if cells is None and key in model._cache:
         return model._cache[key]
     every = model.cells if cells is None else cells
-    # a pass per run of cells bounds the memory of the quadrature points and their
-    # shape functions; edges between runs are integrated in both
-    runs = [[_part(every, lo, hi)] for lo, hi in _runs(len(every))]
-    grad, = _gradients(model, gauss, runs)
+    runs = _cell_runs(model, every)
+    if runs is None:
+        grad, = _gradients(model, gauss, [[every]])
+    else:
+        grad, = _gradients(model, gauss, [[every.subset(run)] for run in runs], [[run] for run in runs])
     if cells is None:
         model._cache[key] = grad
     return grad
@@ -479,11 +472,21 @@ def fan_gradient(model, *, gauss=2, release=False):
     cells = model.cells
     sub, parent = subdivide(cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
     have_cells = ("scni", int(gauss)) in model._cache
-    runs = []
-    for lo, hi in _runs(len(cells)):
-        a, b = np.searchsorted(parent, [lo, hi])         # parent is sorted
-        runs.append(([] if have_cells else [_part(cells, lo, hi)]) + [_part(sub, a, b)])
-    grads = _gradients(model, gauss, runs)
+    runs = _cell_runs(model, cells)
+    if runs is None:
+        grads = _gradients(model, gauss, [([] if have_cells else [cells]) + [sub]])
+    else:                       # the sub-cells go with their cells' runs
+        run_of = np.empty(len(cells), dtype=np.int64)
+        for r, run in enumerate(runs):
+            run_of[run] = r
+        key_of = run_of[parent]
+        sub_order = np.argsort(key_of, kind="stable")
+        cuts = np.searchsorted(key_of[sub_order], np.arange(len(runs) + 1))
+        sub_runs = [sub_order[cuts[r]:cuts[r + 1]] for r in range(len(runs))]
+        sets = [([] if have_cells else [run]) + [sub_run] for run, sub_run in zip(runs, sub_runs)]
+        grads = _gradients(model, gauss,
+                           [([] if have_cells else [cells.subset(run)]) + [sub.subset(sub_run)]
+                            for run, sub_run in zip(runs, sub_runs)], sets)
     if not have_cells:
         model._cache[("scni", int(gauss))] = grads[0]
     if not release:
@@ -491,28 +494,39 @@ def fan_gradient(model, *, gauss=2, release=False):
     return sub, grads[-1]
 
 
-def _runs(m):
-    """``(lo, hi)`` ranges of at most `CELLS_PER_PASS` cells covering ``m``."""
-    return [(lo, min(lo + CELLS_PER_PASS, m)) for lo in range(0, max(m, 1), CELLS_PER_PASS)]
+def _cell_runs(model, cells):
+    """Runs of at most `CELLS_PER_PASS` cells, one pass of `smoothed_gradient` each,
+    as index arrays into ``cells`` (None when one pass takes them all).
+
+    A pass bounds the memory of the quadrature points and their shape functions,
+    and a small one works in cache; the edges between runs are integrated in both.
+    The cells are taken tile by tile along a serpentine path (by their nodes), a
+    run about four tiles, so that every run is a compact block whatever the order
+    of the nodes.
+    """
+    m = len(cells)
+    if m <= CELLS_PER_PASS:
+        return None
+    order = path_order(model.nodes[cells.node], model.domain.bounds,
+                       per_tile=CELLS_PER_PASS / 4)
+    return [order[lo:lo + CELLS_PER_PASS] for lo in range(0, m, CELLS_PER_PASS)]
 
 
-def _part(cells, lo, hi):
-    """``cells.take(lo, hi)``, or the cells themselves when that is all of them."""
-    return cells if (lo, hi) == (0, len(cells)) else cells.take(lo, hi)
-
-
-def _gradients(model, gauss, runs):
+def _gradients(model, gauss, runs, rows=None):
     """Smoothed gradients of several sets of cells, pass by pass.
 
     Parameters
     ----------
     runs : list of lists of Cells
         For each pass, one run of cells of every set (the same number of sets).
+    rows : list of lists of (r,) int arrays, optional
+        For each pass and set, the rows of the result the run's cells take (the
+        runs of a set cover its rows once). By default the runs' rows follow one
+        another.
 
     Returns
     -------
     list of SmoothedGradient
-        One per set, the runs' rows one under the other.
     """
     parts, points = [[] for _ in runs[0]], 0
     for run in runs:
@@ -521,5 +535,14 @@ def _gradients(model, gauss, runs):
         for part, quad in zip(parts, quads):
             part.append(quad.cell_integrals(phi, rows=order))
         points += len(quads[0].points)
-    return [SmoothedGradient(*(_stack_rows([p[c] for p in part]) for c in range(2)), points)
-            for part in parts]
+    out = []
+    for i, part in enumerate(parts):
+        x, y = (_stack_rows([p[c] for p in part]) for c in range(2))
+        if rows is not None:
+            target = np.concatenate([r[i] for r in rows]).astype(np.int64)
+            indptr, indices, vx, vy = SK.scatter_rows(x.indptr, x.indices, x.data, y.data, target)
+            # own index arrays: scipy may sort one matrix's indices in place
+            x = sp.csr_matrix((vx, indices, indptr), shape=x.shape)
+            y = sp.csr_matrix((vy, indices.copy(), indptr.copy()), shape=y.shape)
+        out.append(SmoothedGradient(x, y, points))
+    return out

@@ -61,12 +61,15 @@ class Cells:
     def __len__(self):
         return len(self.node)
 
-    def take(self, lo, hi):
-        """The cells ``lo <= c < hi`` as a `Cells` of their own."""
-        first, last = self.offsets[lo], self.offsets[hi]
-        return Cells(self.node[lo:hi], self.region[lo:hi], self.offsets[lo:hi + 1] - first,
-                     self.vertices[first:last],
-                     None if self.spokes is None else self.spokes[first:last])
+    def subset(self, index):
+        """The cells ``index`` (in that order) as a `Cells` of their own."""
+        index = np.asarray(index, dtype=np.int64)
+        counts = np.diff(self.offsets)[index]
+        offsets = np.zeros(len(index) + 1, dtype=np.int64)
+        np.cumsum(counts, out=offsets[1:])
+        verts = np.repeat(self.offsets[index] - offsets[:-1], counts) + np.arange(offsets[-1])
+        return Cells(self.node[index], self.region[index], offsets, self.vertices[verts],
+                     None if self.spokes is None else self.spokes[verts])
 
     def polygon(self, i):
         """Vertices of cell ``i``, ``(k, 2)``, counter-clockwise."""

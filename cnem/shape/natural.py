@@ -33,9 +33,25 @@ def _topology(model):
     return cache["shape"]
 
 
-def _path_order(pts, bounds):
-    """Order of the points along a serpentine path through a grid (locality for walks)."""
-    k = max(1, int(np.sqrt(len(pts) / 4)))
+def path_order(pts, bounds, per_tile=4):
+    """Order of points along a serpentine path through a square grid of tiles.
+
+    Parameters
+    ----------
+    pts : (p, 2) float64 ndarray
+    bounds : (4,) array_like
+        ``xmin, ymin, xmax, ymax`` of the grid.
+    per_tile : float
+        About how many points a tile holds (4: locality for walks; more: runs
+        of consecutive points that fill compact blocks).
+
+    Returns
+    -------
+    (p,) int64 ndarray
+        Tile by tile, the tiles row by row in alternating directions, the points
+        of a tile in their given order.
+    """
+    k = max(1, int(np.ceil(np.sqrt(len(pts) / per_tile))))
     lo, hi = np.asarray(bounds[:2], dtype=float), np.asarray(bounds[2:], dtype=float)
     scale = k / np.maximum(hi - lo, 1e-300)
     return K.path_order(pts, lo[0], lo[1], scale[0], scale[1], k)
@@ -108,7 +124,7 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
         return (empty, empty.copy(), empty.copy()) if gradient else empty
     nb = _topology(model)[0]
     tol = config.SHAPE_TOL * model.domain.diameter
-    order = _path_order(pts, model.domain.bounds)
+    order = path_order(pts, model.domain.bounds)
     spts = K.gather_rows(pts, order)
     if triangles is None:
         tri_of = _locate_sorted(model, spts, tol)
