@@ -6,6 +6,8 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
+from . import _fan_kernels as FK
+
 __all__ = ["cell_triangles", "triangle_quadrature", "cell_quadrature", "subdivide", "tip_cells"]
 
 
@@ -43,23 +45,22 @@ def cell_triangles(cells, nodes, *, node_apex=None):
     cell = np.repeat(np.arange(len(counts), dtype=np.int64), counts)
     nxt = np.arange(len(verts)) + 1
     nxt[offsets[1:] - 1] = offsets[:-1]
-    apex = cells.centroid()[cell]
-    tol = 1e-12 * cells.area[cell]
-    bad = np.zeros(len(counts), dtype=bool) if node_apex is None else \
-        np.array(node_apex, dtype=bool).copy()
-    bad[cell[_fan(apex, verts, nxt) <= tol]] = True
-    node_apex = nodes[cells.node][cell]
-    use_node = bad[cell]
-    apex[use_node] = node_apex[use_node]
-    signed = _fan(apex, verts, nxt)
-    still = np.zeros(len(counts), dtype=bool)
-    still[cell[use_node & (signed < -tol)]] = True
-    first = verts[offsets[:-1]][cell]
-    apex[still[cell]] = first[still[cell]]
+    apex = _apexes(cells, nodes, node_apex)[cell]
     signed = _fan(apex, verts, nxt)
     keep = np.abs(signed) > 0.0
     corners = np.stack([apex, verts, verts[nxt]], axis=1)[keep]
     return cell[keep], corners
+
+
+def _apexes(cells, nodes, node_apex):
+    """The apex of every cell's fan (see `cell_triangles`), ``(m, 2)``."""
+    first = np.zeros(len(cells.area), dtype=bool) if node_apex is None else \
+        np.asarray(node_apex, dtype=bool)
+    return FK.fan_apexes(np.asarray(cells.offsets, dtype=np.int64),
+                         np.ascontiguousarray(cells.vertices, dtype=np.float64),
+                         np.ascontiguousarray(cells.centroid()),
+                         np.ascontiguousarray(nodes[cells.node], dtype=np.float64), first,
+                         cells.area)
 
 
 def _triangle_rule(corners, order):
@@ -227,32 +228,14 @@ def subdivide(cells, nodes, *, whole=None, node_apex=None, mark_spokes=False):
         The cell each sub-cell comes from.
     """
     from ..geometry.model import Cells
-    owner, corners = cell_triangles(cells, nodes, node_apex=node_apex)
-    e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
-    twice = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
-    negative = np.zeros(len(cells.area), dtype=bool) if whole is None else \
-        np.array(whole, dtype=bool).copy()
-    negative[owner[twice < 0]] = True
-    # slivers (collinear polygon vertices) would get an ill-defined smoothed gradient
-    keep = ~negative[owner] & (twice > 1e-9 * cells.area[owner])
-    whole = np.flatnonzero(negative)
-    parent = np.concatenate([owner[keep], whole])
-    counts = np.concatenate([np.full(keep.sum(), 3), np.diff(cells.offsets)[whole]])
-    verts = np.concatenate([corners[keep].reshape(-1, 2)]
-                           + [cells.polygon(c) for c in whole]) if len(whole) else \
-        corners[keep].reshape(-1, 2)
-    order = np.argsort(parent, kind="stable")
-    starts = np.concatenate([[0], np.cumsum(counts)])
-    index = np.concatenate([np.arange(starts[i], starts[i + 1]) for i in order]) if len(whole) \
-        else np.arange(len(verts)).reshape(-1, 3)[order].reshape(-1)
-    offsets = np.concatenate([[0], np.cumsum(counts[order])])
-    parent = parent[order]
-    spokes = None
-    if mark_spokes:         # triangles run apex, v_i, v_i+1: edges 0 and 2 are spokes
-        spokes = np.concatenate([np.tile([True, False, True], keep.sum()),
-                                 np.zeros(counts[keep.sum():].sum(), dtype=bool)])[index]
-    sub = Cells(cells.node[parent], cells.region[parent], offsets,
-                np.ascontiguousarray(verts[index]), spokes)
+    whole = np.zeros(len(cells.area), dtype=bool) if whole is None else \
+        np.asarray(whole, dtype=bool)
+    parent, offsets, verts, spokes = FK.fan_sub_cells(
+        np.asarray(cells.offsets, dtype=np.int64),
+        np.ascontiguousarray(cells.vertices, dtype=np.float64),
+        _apexes(cells, nodes, node_apex), cells.area, whole)
+    sub = Cells(cells.node[parent], cells.region[parent], offsets, verts,
+                spokes if mark_spokes else None)
     return sub, parent
 
 
