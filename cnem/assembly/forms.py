@@ -96,14 +96,13 @@ class BilinearForm(_Form):
         m, g = len(basis.dx), basis.ncomp             # descriptors g, g + 1, ...: gradients
         # A_k D_ab(k), filled one descriptor pair at a time: gradient pairs in one array
         grad_weights = np.zeros((m, 2 * g, 2 * g))
-        other = {}
+        other, active = {}, set()
         for a, b, value in self._nonzero_coefficients(basis, kwargs):
+            active.add((a, b))
             if a >= g and b >= g:
                 np.multiply(basis.dx, value, out=grad_weights[:, a - g, b - g])
             else:
                 other[a, b] = basis.dx * value
-        active = {(a, b) for a in range(g, 3 * g) for b in range(g, 3 * g)
-                  if grad_weights[:, a - g, b - g].any()} | set(other)
         if not active:
             return sp.csr_matrix((basis.N, basis.N))
         grads = basis.component_gradients() if basis.vector and not other else None

@@ -182,14 +182,15 @@ class Elasticity:
             sub_cells = self._sub_cells()
             # with sub-cells K = (1 - a) K_cells + a K_sub (see _sub_cell_stiffness)
             weight = 1.0 - a if sub_cells else 1.0
+            # the weights scale the Lamé parameters: no pass over the matrices
             K = None
             if weight != 0.0:
                 E, nu = self.cell_materials().T
                 lam, mu = lame(E, nu, self.plane)
-                K = weight * elasticity_form.assemble(self.basis, lam=lam, mu=mu)
+                K = elasticity_form.assemble(self.basis, lam=weight * lam, mu=weight * mu)
             if a > 0:
-                extra = a * (self._sub_cell_stiffness() if sub_cells
-                             else self._pointwise_stabilization_stiffness())
+                extra = (self._sub_cell_stiffness(a) if sub_cells
+                         else self._pointwise_stabilization_stiffness(a))
                 K = extra if K is None else K + extra
             self._K = K
         return self._K
@@ -199,8 +200,8 @@ class Elasticity:
         (stabilised, not enriched)."""
         return self.enrichment is None and self.stabilization > 0
 
-    def _sub_cell_stiffness(self):
-        """``sum_s A_s B~_s^T C B~_s`` over the fan sub-cells ``s``.
+    def _sub_cell_stiffness(self, weight):
+        """``weight sum_s A_s B~_s^T C B~_s`` over the fan sub-cells ``s``.
 
         The sub-cells of a cell ``k`` share its boundary integrals and their
         spokes cancel, so ``sum_s A_s B~_s = A_k B~_k`` and the stabilised
@@ -212,10 +213,10 @@ class Elasticity:
         fine = CellBasis(self.model, vector=True, cells=sub, gradient=grad)
         E, nu = self.materials[sub.region].T
         lam, mu = lame(E, nu, self.plane)
-        return elasticity_form.assemble(fine, lam=lam, mu=mu)
+        return elasticity_form.assemble(fine, lam=weight * lam, mu=weight * mu)
 
-    def _pointwise_stabilization_stiffness(self, order=4):
-        """``sum_q w_q (B(x_q) - B~_k)^T C (B(x_q) - B~_k)`` over quadrature points of
+    def _pointwise_stabilization_stiffness(self, weight, order=4):
+        """``weight sum_q w_q (B(x_q) - B~_k)^T C (B(x_q) - B~_k)`` over quadrature points of
         the cells where enrichment functions live, ``B(x)`` the gradients of the
         displacement field itself (Sibson and enrichment gradients).
 
@@ -242,7 +243,7 @@ class Elasticity:
                                     weights[keep], points)
         E, nu = self.materials[cells.region[owner]].T
         lam, mu = lame(E, nu, self.plane)
-        return elasticity_form.assemble(at_points, lam=lam, mu=mu)
+        return elasticity_form.assemble(at_points, lam=weight * lam, mu=weight * mu)
 
     def load(self):
         """Load vector ``f`` (eq. 21), ``(2 n,)`` (then the enriched dofs' loads)."""
