@@ -293,7 +293,7 @@ def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace, gr
     -------
     start, size : (p,) int64
         Row ``s`` is ``cols[start[s]:start[s] + size[s]]`` (same for the values).
-    cols : (p * slots,) int64
+    cols : (p * slots,) int32
     vals, gx, gy : (p * slots,) float64
         Values and gradients (``gx, gy`` empty unless ``gradient``).
     kinds : (p,) int8
@@ -307,7 +307,7 @@ def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace, gr
     size = np.zeros(p, dtype=np.int64)
     kinds = np.zeros(p, dtype=np.int8)
     nch = max(1, min(p, nch))
-    out_cols = np.empty(p * slots, dtype=np.int64)
+    out_cols = np.empty(p * slots, dtype=np.int32)
     out_vals = np.empty(p * slots)
     out_gx = np.zeros(p * slots if gradient else 0)
     out_gy = np.zeros(p * slots if gradient else 0)
