@@ -260,9 +260,15 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, ncol, nch):
                         mark[idx[p]] = i
                         count += 1
             counts[i] = count
-    indptr = _offsets(counts)
+    indptr = _offsets(counts)                   # of the node blocks
+    out_ptr = np.empty(2 * ncol + 1, dtype=np.int64)     # of the dofs: two rows per node
+    out_ptr[0] = 0
+    for i in range(ncol):
+        out_ptr[2 * i + 1] = 4 * indptr[i] + 2 * counts[i]
+        out_ptr[2 * i + 2] = 4 * indptr[i + 1]
     indices = np.empty(indptr[ncol], dtype=np.int32)
-    blocks = np.zeros((indptr[ncol], 2, 2))
+    out_idx = np.empty(4 * indptr[ncol], dtype=np.int32)
+    data = np.zeros(4 * indptr[ncol])
     for ch in numba.prange(nch):
         slot = np.full(ncol, -1, dtype=np.int64)
         v = np.empty((2, 4))
@@ -275,6 +281,12 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, ncol, nch):
                 for p in range(ptr[k], ptr[k + 1]):
                     end = _add_column(idx[p], start, end, slot, indices)
             _sort_slots(indices, start, end, slot)          # ... in order
+            row0 = out_ptr[2 * i] - 2 * start               # block q -> row0 + 2 q
+            row1 = out_ptr[2 * i + 1] - 2 * start
+            for q in range(start, end):
+                for c in range(2):
+                    out_idx[row0 + 2 * q + c] = 2 * indices[q] + c
+                    out_idx[row1 + 2 * q + c] = 2 * indices[q] + c
             for t in range(t_ptr[i], t_ptr[i + 1]):         # then their values
                 k = t_row[t]
                 gi0, gi1 = gx[t_pos[t]], gy[t_pos[t]]
@@ -283,33 +295,11 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, ncol, nch):
                         v[r, a] = gi0 * coeff[k, a, 2 * r] + gi1 * coeff[k, a, 2 * r + 1]
                 for p in range(ptr[k], ptr[k + 1]):
                     gj0, gj1 = gx[p], gy[p]
-                    q = slot[idx[p]]
-                    for r in range(2):
-                        blocks[q, r, 0] += v[r, 0] * gj0 + v[r, 1] * gj1
-                        blocks[q, r, 1] += v[r, 2] * gj0 + v[r, 3] * gj1
-    return _blocks_to_csr(indptr, indices, blocks)
-
-
-@numba.njit(cache=True, parallel=True)
-def _blocks_to_csr(indptr, indices, blocks):
-    """CSR over interleaved dofs from 2 x 2 node blocks in block-CSR form."""
-    n = indptr.shape[0] - 1
-    out_ptr = np.empty(2 * n + 1, dtype=np.int64)
-    out_ptr[0] = 0
-    for i in range(n):
-        width = 2 * (indptr[i + 1] - indptr[i])
-        out_ptr[2 * i + 1] = 4 * indptr[i] + width
-        out_ptr[2 * i + 2] = 4 * indptr[i + 1]
-    out_idx = np.empty(4 * indptr[n], dtype=np.int32)
-    data = np.empty(4 * indptr[n])
-    for i in numba.prange(n):
-        for r in range(2):
-            w = out_ptr[2 * i + r]
-            for q in range(indptr[i], indptr[i + 1]):
-                for s in range(2):
-                    out_idx[w] = 2 * indices[q] + s
-                    data[w] = blocks[q, r, s]
-                    w += 1
+                    q = 2 * slot[idx[p]]
+                    data[row0 + q] += v[0, 0] * gj0 + v[0, 1] * gj1
+                    data[row0 + q + 1] += v[0, 2] * gj0 + v[0, 3] * gj1
+                    data[row1 + q] += v[1, 0] * gj0 + v[1, 1] * gj1
+                    data[row1 + q + 1] += v[1, 2] * gj0 + v[1, 3] * gj1
     return out_ptr, out_idx, data
 
 
