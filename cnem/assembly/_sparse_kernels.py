@@ -304,29 +304,12 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, ncol, nch):
 
 
 @numba.njit(cache=True, parallel=True)
-def scatter_rows(indptr, indices, x, y, target):
-    """Row ``r`` of a CSR (values ``x`` and ``y`` on one pattern) moved to row
-    ``target[r]`` (``target`` a permutation).
-
-    Returns
-    -------
-    indptr : (m + 1,) int64
-    indices : (nnz,) int32
-    x, y : (nnz,) float64
-    """
-    m = target.shape[0]
-    new = np.zeros(m + 1, dtype=np.int64)
-    for r in numba.prange(m):
-        new[target[r] + 1] = indptr[r + 1] - indptr[r]
-    for r in range(m):
-        new[r + 1] += new[r]
-    out_idx = np.empty(new[m], dtype=np.int32)
-    out_x = np.empty(new[m])
-    out_y = np.empty(new[m])
-    for r in numba.prange(m):
-        a, b = indptr[r], new[target[r]]
+def place_rows(indptr, indices, x, y, target, out_ptr, out_idx, out_x, out_y):
+    """Copy row ``r`` of a CSR (values ``x`` and ``y`` on one pattern) into row
+    ``target[r]`` of another whose row pointers ``out_ptr`` are already set."""
+    for r in numba.prange(target.shape[0]):
+        a, b = indptr[r], out_ptr[target[r]]
         for e in range(indptr[r + 1] - a):
             out_idx[b + e] = indices[a + e]
             out_x[b + e] = x[a + e]
             out_y[b + e] = y[a + e]
-    return new, out_idx, out_x, out_y

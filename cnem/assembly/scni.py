@@ -537,12 +537,27 @@ def _gradients(model, gauss, runs, rows=None):
         points += len(quads[0].points)
     out = []
     for i, part in enumerate(parts):
-        x, y = (_stack_rows([p[c] for p in part]) for c in range(2))
-        if rows is not None:
-            target = np.concatenate([r[i] for r in rows]).astype(np.int64)
-            indptr, indices, vx, vy = SK.scatter_rows(x.indptr, x.indices, x.data, y.data, target)
-            # own index arrays: scipy may sort one matrix's indices in place
-            x = sp.csr_matrix((vx, indices, indptr), shape=x.shape)
-            y = sp.csr_matrix((vy, indices.copy(), indptr.copy()), shape=y.shape)
+        if rows is None:
+            x, y = (_stack_rows([p[c] for p in part]) for c in range(2))
+        else:
+            x, y = _place_runs(part, [r[i] for r in rows])
         out.append(SmoothedGradient(x, y, points))
     return out
+
+
+def _place_runs(part, targets):
+    """The x and y parts of the runs of one set of cells put together, run ``r``'s
+    rows going to rows ``targets[r]``: two CSR with their own index arrays."""
+    m, n = sum(len(t) for t in targets), part[0][0].shape[1]
+    indptr = np.zeros(m + 1, dtype=np.int64)
+    for (x, _), target in zip(part, targets):
+        indptr[np.asarray(target) + 1] = np.diff(x.indptr)
+    np.cumsum(indptr, out=indptr)
+    indices = np.empty(indptr[-1], dtype=np.int32)
+    vx, vy = np.empty(indptr[-1]), np.empty(indptr[-1])
+    for (x, y), target in zip(part, targets):
+        SK.place_rows(x.indptr, x.indices, x.data, y.data, np.asarray(target, dtype=np.int64),
+                      indptr, indices, vx, vy)
+    # own index arrays: scipy may sort one matrix's indices in place
+    return sp.csr_matrix((vx, indices, indptr), shape=(m, n)), \
+        sp.csr_matrix((vy, indices.copy(), indptr.copy()), shape=(m, n))
