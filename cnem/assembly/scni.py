@@ -21,6 +21,7 @@ import scipy.sparse as sp
 import shapely
 
 from .. import config
+from .._memory import release_free_memory
 from ..geometry.topology import circumcenters, constraint_edges, triangle_neighbors
 from ..shape.natural import path_order
 from ..spatial.rtree import RTree, work_chunks
@@ -434,7 +435,8 @@ def smoothed_gradient(model, *, gauss=2, cells=None):
     if runs is None:
         grad, = _gradients(model, gauss, [[every]])
     else:
-        grad, = _gradients(model, gauss, [[every.subset(run)] for run in runs], [[run] for run in runs])
+        grad, = _gradients(model, gauss, ([every.subset(run)] for run in runs),
+                           [[run] for run in runs])
     if cells is None:
         model._cache[key] = grad
     return grad
@@ -485,8 +487,8 @@ def fan_gradient(model, *, gauss=2, release=False):
         sub_runs = [sub_order[cuts[r]:cuts[r + 1]] for r in range(len(runs))]
         sets = [([] if have_cells else [run]) + [sub_run] for run, sub_run in zip(runs, sub_runs)]
         grads = _gradients(model, gauss,
-                           [([] if have_cells else [cells.subset(run)]) + [sub.subset(sub_run)]
-                            for run, sub_run in zip(runs, sub_runs)], sets)
+                           (([] if have_cells else [cells.subset(run)]) + [sub.subset(sub_run)]
+                            for run, sub_run in zip(runs, sub_runs)), sets)
     if not have_cells:
         model._cache[("scni", int(gauss))] = grads[0]
     if not release:
@@ -517,8 +519,9 @@ def _gradients(model, gauss, runs, rows=None):
 
     Parameters
     ----------
-    runs : list of lists of Cells
-        For each pass, one run of cells of every set (the same number of sets).
+    runs : iterable of lists of Cells
+        For each pass, one run of cells of every set (the same number of sets),
+        made when the pass comes (a generator keeps one pass's cells at a time).
     rows : list of lists of (r,) int arrays, optional
         For each pass and set, the rows of the result the run's cells take (the
         runs of a set cover its rows once). By default the runs' rows follow one
@@ -528,21 +531,29 @@ def _gradients(model, gauss, runs, rows=None):
     -------
     list of SmoothedGradient
     """
-    parts, points = [[] for _ in runs[0]], 0
+    parts, points = _passes(model, gauss, runs)
+    out = [SmoothedGradient(*(_stack_rows([p[c] for p in parts[i]]) for c in range(2))
+                            if rows is None else _place_runs(parts[i], [r[i] for r in rows]),
+                            points) for i in range(len(parts))]
+    if len(parts[0]) > 1:    # the passes' arrays are freed, but the C heap keeps them
+        del parts
+        release_free_memory()
+    return out
+
+
+def _passes(model, gauss, runs):
+    """The cell integrals of every run: ``parts[set][run] = (x, y)``, and the number
+    of quadrature points (the runs' cells are dropped pass by pass)."""
+    parts, points = None, 0
     for run in runs:
+        if parts is None:
+            parts = [[] for _ in run]
         quads = boundary_quadratures(model, run, gauss=gauss)
         phi, order = quads[0].shape_functions(model)
         for part, quad in zip(parts, quads):
             part.append(quad.cell_integrals(phi, rows=order))
         points += len(quads[0].points)
-    out = []
-    for i, part in enumerate(parts):
-        if rows is None:
-            x, y = (_stack_rows([p[c] for p in part]) for c in range(2))
-        else:
-            x, y = _place_runs(part, [r[i] for r in rows])
-        out.append(SmoothedGradient(x, y, points))
-    return out
+    return parts, points
 
 
 def _place_runs(part, targets):
