@@ -48,8 +48,9 @@ def test_triangle_basis_gives_the_p1_stiffness(name):
                                                   ("kinked_crack_irregular", None, 0.0),
                                                   ("edge_crack_regular", dict(radius=0.2), 1.0)])
 def test_amg_solution_is_the_direct_one(name, enrich, weight, caplog):
-    """pyamg + CG (hierarchy on the P1 stiffness; on K itself with enrichment, whose
-    extra dofs P1 does not have, and for plain SCNI) gives the direct solution."""
+    """pyamg + CG (hierarchy on the P1 stiffness, finest level smoothed with K for plain
+    SCNI; on K itself with enrichment, whose extra dofs P1 does not have) gives the
+    direct solution."""
     _, _, model = cases.model(name)
     nreg = len(model.domain.regions)
     mats = [(E * (1 + r), NU - 0.1 * r) for r in range(nreg)]
@@ -65,8 +66,9 @@ def test_amg_solution_is_the_direct_one(name, enrich, weight, caplog):
     direct = solve("direct")
     with caplog.at_level("INFO", logger="cnem.assembly.linsolve"):
         amg = solve("amg")
-    where = "the matrix" if enrich or weight == 0 else "the preconditioner matrix"
-    assert f"pyamg (hierarchy on {where})" in caplog.text
+    where = "the matrix" if enrich else "the preconditioner matrix" + \
+        (", smoothing with the matrix" if weight == 0 else "")
+    assert f"pyamg (hierarchy on {where}) + CG" in caplog.text
     assert "building the hierarchy on the matrix itself" not in caplog.text
     scale = np.abs(direct.u).max()
     np.testing.assert_allclose(amg.u, direct.u, atol=1e-9 * scale)
@@ -82,9 +84,9 @@ def test_falls_back_to_the_matrix_when_the_preconditioner_fails(monkeypatch, cap
     built_on = []
     real = linsolve._amg_cg
 
-    def failing_first(A_, b_, P, modes, tol):
+    def failing_first(A_, b_, P, modes, tol, smooth_with_A=False):
         built_on.append(P)
-        x, rel, its = real(A_, b_, P, modes, tol)
+        x, rel, its = real(A_, b_, P, modes, tol, smooth_with_A)
         return (x, 1.0, its) if len(built_on) == 1 else (x, rel, its)
 
     monkeypatch.setattr(linsolve, "_amg_cg", failing_first)

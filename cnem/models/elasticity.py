@@ -304,12 +304,9 @@ class Elasticity:
         Returns
         -------
         scipy.sparse.csr_matrix, shape (2 n, 2 n) or (k, k)
-            None with enrichment (P1 has no enriched dofs) and without
-            stabilisation: plain SCNI's low-energy modes, which P1 does not have,
-            take CG from about 40 to about 250 iterations at 100k nodes, so
-            smoothed aggregation on K itself is faster then.
+            None with enrichment (P1 has no enriched dofs).
         """
-        if self.enrichment is not None or self.stabilization == 0:
+        if self.enrichment is not None:
             return None
         E, nu = self.materials[self.model.triangle_region].T
         lam, mu = lame(E, nu, self.plane)
@@ -325,8 +322,9 @@ class Elasticity:
         method : {"auto", "direct", "amg"}
             ``"auto"``: sparse direct up to 2.5M non-zeros in K (~20k nodes), pyamg smoothed
             aggregation (rigid-body modes) + CG above, the hierarchy built on the P1
-            stiffness of the same nodes on the model's triangles (stabilised, without
-            enrichment: see `preconditioner_matrix`).
+            stiffness of the same nodes on the model's triangles (without enrichment:
+            see `preconditioner_matrix`; for plain SCNI, ``stabilization=0``, the
+            finest level smoothed with K itself).
         tol : float
             Relative residual of the iterative solver.
         progress : bool, optional
@@ -370,7 +368,10 @@ class Elasticity:
         modes[:n2] = rigid_modes(self.model.nodes)
         modes = modes[interior]
         x[interior] = solve_spd(A, b, modes=modes, tol=tol, method=method,
-                                preconditioner=lambda: self.preconditioner_matrix(interior))
+                                preconditioner=lambda: self.preconditioner_matrix(interior),
+                                # plain SCNI's oscillating low-energy modes, which P1
+                                # lacks, need smoothing with K itself
+                                smooth_with_matrix=self.stabilization == 0)
         t3 = time.perf_counter()
         bar.update()
         bar.close()
