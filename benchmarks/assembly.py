@@ -34,7 +34,7 @@ nothing), so nothing cached by one run serves the next:
   rigid-body modes of the free dofs, and ``cnem.assembly.linsolve.solve_spd`` (direct up to
   2.5M non-zeros, pyamg smoothed aggregation + CG above, tol 1e-10; on the C-NEM side the
   hierarchy is built on the P1 stiffness of the same nodes on the model's triangles,
-  ``Elasticity.preconditioner_matrix``, whose assembly is timed in the stage).  This is what
+  ``Elasticity.solver_options``, whose assembly is timed in the stage).  This is what
   ``Elasticity.solve`` does after K and the load, minus its rigid-motion check
   (``free_rigid_motions``), which is timed apart and printed in the details;
 * ``total``: the sum of a run's stages (load vectors and dof selection are not timed).
@@ -113,18 +113,18 @@ def clamped_dofs(points):
     return np.column_stack([2 * nodes, 2 * nodes + 1]).reshape(-1)
 
 
-def condensed_solve(K, f, points, D, preconditioner=None):
+def condensed_solve(K, f, points, D, solver_options=None):
     """What both sides time as ``solve``: condense, rigid modes of the free dofs, solve_spd
-    (C-NEM: with ``preconditioner(free dofs)``, the P1 matrix its smoothed aggregation is
-    built on, as in ``Elasticity.solve``)."""
+    (C-NEM: with ``solver_options(free dofs)``, ``Elasticity.solver_options``: the P1
+    matrix its smoothed aggregation is built on, as in ``Elasticity.solve``)."""
     from skfem import condense
 
     from cnem.assembly.linsolve import rigid_modes, solve_spd
 
     x = np.zeros(K.shape[0])
     A, b, _, interior = condense(K, f, x=x, D=D)
-    lazy = None if preconditioner is None else (lambda: preconditioner(interior))
-    x[interior] = solve_spd(A, b, modes=rigid_modes(points)[interior], preconditioner=lazy)
+    options = {} if solver_options is None else solver_options(interior)
+    x[interior] = solve_spd(A, b, modes=rigid_modes(points)[interior], **options)
     return x
 
 
@@ -193,7 +193,7 @@ def cnem_pipeline(cloud, run):
     free = free_rigid_motions(K, model.nodes, D)
     run["check"] = time.perf_counter() - t0
     x = staged(run, "solve", lambda: condensed_solve(K, f, model.nodes, D,
-                                                     prob.preconditioner_matrix))
+                                                     prob.solver_options))
     return dict(nodes=len(model.nodes), cells=len(model.cells), quad=points,
                 grad_nnz=int(grad.x.nnz), K_nnz=int(K.nnz), dofs=K.shape[0], free=free,
                 sym=symmetry_error(K), tip=tip_displacement(model.nodes, x))

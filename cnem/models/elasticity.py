@@ -291,6 +291,19 @@ class Elasticity:
             values = np.concatenate([values, np.zeros(len(extra))])
         return dofs, values
 
+    def solver_options(self, dofs):
+        """The keywords of `cnem.assembly.linsolve.solve_spd` for the system on ``dofs``
+        (the free ones): the P1 matrix its smoothed aggregation is built on (made only
+        if the iterative path is taken), and for plain SCNI smoothing with K itself
+        (its oscillating low-energy modes, which P1 lacks).
+
+        Returns
+        -------
+        dict
+        """
+        return dict(preconditioner=lambda: self.preconditioner_matrix(dofs),
+                    smooth_with_matrix=self.stabilization == 0)
+
     def preconditioner_matrix(self, dofs=None):
         """The P1 stiffness of the nodes on the model's triangles (same materials):
         where smoothed aggregation is built for large solves (see
@@ -368,10 +381,7 @@ class Elasticity:
         modes[:n2] = rigid_modes(self.model.nodes)
         modes = modes[interior]
         x[interior] = solve_spd(A, b, modes=modes, tol=tol, method=method,
-                                preconditioner=lambda: self.preconditioner_matrix(interior),
-                                # plain SCNI's oscillating low-energy modes, which P1
-                                # lacks, need smoothing with K itself
-                                smooth_with_matrix=self.stabilization == 0)
+                                **self.solver_options(interior))
         t3 = time.perf_counter()
         bar.update()
         bar.close()
