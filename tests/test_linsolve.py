@@ -118,3 +118,32 @@ def test_parts_whose_dofs_do_not_couple_across_components():
     assert free == [f"{m} of the part holding node 5 (5 nodes)" for m in
                     ("translation in x", "translation in y", "rotation about (2, 1)")]
     assert linsolve.free_rigid_motions(K, points, np.arange(20)) == []
+
+
+def test_degenerate_triangles_leave_the_hierarchy_on_k(monkeypatch, caplog):
+    """A triangulation P1 cannot use (degenerate triangles) costs the cheaper
+    preconditioner, not the solve."""
+    from cnem.models import elasticity
+    _, _, model = cases.model("plate_hole_irregular")
+
+    def degenerate(model, *, vector=False):
+        raise ValueError("triangle_basis: 1 of 10 triangles are degenerate or clockwise")
+
+    monkeypatch.setattr(elasticity, "triangle_basis", degenerate)
+    prob = cnem.Elasticity(model, (E, NU))
+    prob.add_dirichlet(lambda p: p[:, 0] < model.nodes[:, 0].min() + 1e-9, None)
+    prob.add_traction(lambda x, nrm: nrm[:, 0] > 0.5, [3.0, 1.0])
+    with caplog.at_level("INFO", logger="cnem"):
+        amg = prob.solve(method="amg", tol=1e-12, progress=False)
+    assert "no P1 preconditioner matrix" in caplog.text
+    assert "pyamg (hierarchy on the matrix) + CG" in caplog.text
+    direct = prob.solve(method="direct", progress=False)
+    np.testing.assert_allclose(amg.u, direct.u, atol=1e-9 * np.abs(direct.u).max())
+
+
+def test_triangle_basis_rejects_degenerate_triangles():
+    from types import SimpleNamespace
+    flat = SimpleNamespace(nodes=np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [0.0, 1.0]]),
+                           triangles=np.array([[0, 1, 3], [0, 1, 2]]))
+    with pytest.raises(ValueError, match="1 of 2 triangles are degenerate or clockwise"):
+        triangle_basis(flat)

@@ -317,13 +317,19 @@ class Elasticity:
         Returns
         -------
         scipy.sparse.csr_matrix, shape (2 n, 2 n) or (k, k)
-            None with enrichment (P1 has no enriched dofs).
+            None with enrichment (P1 has no enriched dofs) or degenerate triangles
+            (the solver then builds its hierarchy on K).
         """
         if self.enrichment is not None:
             return None
+        try:
+            basis = triangle_basis(self.model, vector=True)
+        except ValueError as err:
+            log.warning("no P1 preconditioner matrix (%s): smoothed aggregation on K", err)
+            return None
         E, nu = self.materials[self.model.triangle_region].T
         lam, mu = lame(E, nu, self.plane)
-        P = elasticity_form.assemble(triangle_basis(self.model, vector=True), lam=lam, mu=mu)
+        P = elasticity_form.assemble(basis, lam=lam, mu=mu)
         return P if dofs is None else P[dofs][:, dofs]
 
     # -- solve --------------------------------------------------------------------------
