@@ -241,3 +241,17 @@ def test_block_assembly_equals_the_general_one(name, monkeypatch):
     general = elasticity_form.assemble(prob.basis, lam=lam, mu=mu)
     np.testing.assert_allclose(blocks.toarray(), general.toarray(),
                                atol=1e-13 * abs(general).max())
+
+
+def test_stabilised_solve_keeps_no_sub_cell_gradients():
+    """The fan sub-cells' gradients serve K alone: neither assembling K nor solving
+    afterwards (which needs the cells' B~) leaves them in the model's cache."""
+    dom = cnem.geometry.rectangle(1.0, 1.0)
+    model = cnem.discretize(cnem.nodes.irregular(dom, 0.1, seed=7))
+    prob = cnem.Elasticity(model, (E, NU))
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-12, None)
+    prob.add_traction(lambda x, n: n[:, 0] > 0.5, [1.0, 0.0])
+    prob.stiffness()
+    assert ("scni-fan", 2) not in model._cache and ("scni", 2) in model._cache
+    prob.solve(progress=False)
+    assert ("scni-fan", 2) not in model._cache

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import cases
+import cnem
 from cnem.assembly.quadrature import cell_quadrature, triangle_quadrature
 from cnem.assembly.scni import _graded_rule
 
@@ -123,3 +124,13 @@ def test_graded_rule_integrates_sqrt_ends(gauss):
     assert np.array_equal(S[2], s) and np.array_equal(W[2], w)
     plain = abs(w @ np.sqrt(s) - 2 / 3)
     assert plain > 1e-4
+
+
+@pytest.mark.parametrize("name", ["whole", "node_apex"])
+def test_subdivide_checks_its_per_cell_flags(name):
+    from cnem.assembly.quadrature import subdivide
+    model = cnem.discretize(cnem.nodes.regular(cnem.geometry.rectangle(), 0.25))
+    m = len(model.cells.area)
+    with pytest.raises(ValueError, match=rf"{name}: expected one flag per cell, shape \({m},\), "
+                                         rf"received shape \({m - 1},\)"):
+        subdivide(model.cells, model.nodes, **{name: np.zeros(m - 1, dtype=bool)})

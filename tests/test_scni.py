@@ -146,20 +146,27 @@ def test_passes_over_runs_of_cells_give_the_same_operator(name, monkeypatch):
 @pytest.mark.parametrize("name", ["kinked_crack_irregular", "three_rectangles_irregular",
                                   "plate_hole_irregular", "edge_crack_regular"])
 @pytest.mark.parametrize("per_pass", [None, 5])
-def test_fan_gradient_shares_the_cells_points(name, per_pass, monkeypatch):
+@pytest.mark.parametrize("cells_cached", [False, True])
+def test_fan_gradient_shares_the_cells_points(name, per_pass, cells_cached, monkeypatch):
     """The fan sub-cells' B~ and the cells' B~, computed together from one set of
-    points (in one pass or many), equal each computed alone."""
+    points (in one pass or many), equal each computed alone; with the cells' B~
+    already cached only the sub-cells' is computed."""
     from cnem.assembly import scni
     from cnem.assembly.quadrature import subdivide, tip_cells
     _, _, model = cases.model(name)
     alone = smoothed_gradient(model, cells=model.cells)
     sub, _ = subdivide(model.cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
     sub_alone = smoothed_gradient(model, cells=sub)
+    for key in (("scni", 2), ("scni-fan", 2)):             # a cold cache (restored after)
+        monkeypatch.delitem(model._cache, key, raising=False)
+    if cells_cached:
+        monkeypatch.setitem(model._cache, ("scni", 2), alone)
     if per_pass is not None:
         monkeypatch.setattr(scni, "CELLS_PER_PASS", per_pass)
     fan_sub, fan = scni.fan_gradient(model)
     np.testing.assert_array_equal(fan_sub.vertices, sub.vertices)
-    together = smoothed_gradient(model)                    # cached by fan_gradient
+    together = model._cache[("scni", 2)]
+    assert (together is alone) == cells_cached
     assert scni.fan_gradient(model)[1] is fan
     for a, b in ((alone.x, together.x), (alone.y, together.y),
                  (sub_alone.x, fan.x), (sub_alone.y, fan.y)):

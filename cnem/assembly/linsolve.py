@@ -239,9 +239,11 @@ def _amg_cg(A, b, P, modes, tol, smooth_with_A=False, maxiter=2000):
         Iterations.
     """
     import pyamg
-    ml = pyamg.smoothed_aggregation_solver(P.tocsr(), B=modes, symmetry="symmetric")
+    same = P is A
     A = A.tocsr()
-    if smooth_with_A and P is not A:
+    ml = pyamg.smoothed_aggregation_solver(A if same else P.tocsr(), B=modes,
+                                           symmetry="symmetric")
+    if smooth_with_A and not same:
         ml.levels[0].A = A                  # the smoothers take the level's matrix per call
     its = [0]
 
@@ -253,6 +255,6 @@ def _amg_cg(A, b, P, modes, tol, smooth_with_A=False, maxiter=2000):
     norm = np.linalg.norm(b)
     rel = np.linalg.norm(b - A @ x) / norm if norm > 0 else 0.0
     log.info("pyamg (hierarchy on %s) + CG: %d iterations, relative residual %.2e",
-             "the matrix" if P is A else "the preconditioner matrix"
+             "the matrix" if same else "the preconditioner matrix"
              + (", smoothing with the matrix" if smooth_with_A else ""), its[0], rel)
     return x, rel, its[0]

@@ -52,10 +52,20 @@ def cell_triangles(cells, nodes, *, node_apex=None):
     return cell[keep], corners
 
 
+def _cell_flags(flags, m, name):
+    """A ``(m,)`` bool array from an optional per-cell flag argument (checked)."""
+    if flags is None:
+        return np.zeros(m, dtype=bool)
+    arr = np.asarray(flags, dtype=bool)
+    if arr.shape != (m,):
+        raise ValueError(f"{name}: expected one flag per cell, shape ({m},), "
+                         f"received shape {arr.shape}")
+    return arr
+
+
 def _apexes(cells, nodes, node_apex):
     """The apex of every cell's fan (see `cell_triangles`), ``(m, 2)``."""
-    first = np.zeros(len(cells.area), dtype=bool) if node_apex is None else \
-        np.asarray(node_apex, dtype=bool)
+    first = _cell_flags(node_apex, len(cells.area), "node_apex")
     return FK.fan_apexes(np.asarray(cells.offsets, dtype=np.int64),
                          np.ascontiguousarray(cells.vertices, dtype=np.float64),
                          np.ascontiguousarray(cells.centroid()),
@@ -216,8 +226,8 @@ def subdivide(cells, nodes, *, whole=None, node_apex=None, mark_spokes=False):
         Cells fanned from their node (see `cell_triangles`).
     mark_spokes : bool
         Mark the triangles' edges from their apex (``sub.spokes``): the
-        boundary quadrature then integrates them whole, fewer points where
-        the sub-cells only serve the stabilisation, whose spoke integrals
+        boundary quadrature then gives them their midpoint alone, fewer points
+        where the sub-cells only serve the stabilisation, whose spoke integrals
         cancel between neighbouring triangles.
 
     Returns
@@ -228,8 +238,7 @@ def subdivide(cells, nodes, *, whole=None, node_apex=None, mark_spokes=False):
         The cell each sub-cell comes from.
     """
     from ..geometry.model import Cells
-    whole = np.zeros(len(cells.area), dtype=bool) if whole is None else \
-        np.asarray(whole, dtype=bool)
+    whole = _cell_flags(whole, len(cells.area), "whole")
     parent, offsets, verts, spokes = FK.fan_sub_cells(
         np.asarray(cells.offsets, dtype=np.int64),
         np.ascontiguousarray(cells.vertices, dtype=np.float64),

@@ -36,11 +36,6 @@ log = logging.getLogger(__name__)
 #: Cells whose boundary quadrature is built and evaluated in one pass of `smoothed_gradient`.
 CELLS_PER_PASS = 50_000
 
-#: Spokes of fan sub-cells (edges left whole) get their midpoint alone: exact for the
-#: linear fields the shape functions reproduce, so the patch test still holds, and
-#: their integrals cancel between neighbouring sub-cells (only the stabilisation sees them).
-SPOKE_MIDPOINT = True
-
 
 class SmoothedGradient:
     """The operator ``B~`` of eq. 30: smoothed derivatives of every shape function.
@@ -50,7 +45,9 @@ class SmoothedGradient:
     x, y : scipy.sparse.csr_matrix, shape (m, n)
         ``x[k, j] = b~_xj(cell k)`` and ``y[k, j] = b~_yj(cell k)``.
     points : int
-        Number of quadrature points used on the cell boundaries.
+        Number of quadrature points evaluated for it on the cell boundaries (with
+        the other sets of cells computed in the same passes, `fan_gradient`: their
+        shared count).
     """
 
     def __init__(self, x, y, points):
@@ -284,7 +281,10 @@ def boundary_quadrature(model, *, gauss=2, cells=None, singular=None):
     ``gauss`` points per piece, crack faces seen from their side, slits in tip cells.
 
     ``cells``: integration cells other than ``model.cells`` (sub-cells, say);
-    their spokes (``cells.spokes``), if marked, are not cut.
+    their spokes (``cells.spokes``), if marked, get their midpoint alone: exact
+    for the linear fields the shape functions reproduce, so the patch test still
+    holds, and their integrals cancel between neighbouring sub-cells (only the
+    stabilisation sees them).
     ``singular``: ``(s, 2)`` points (crack tips) where the integrand behaves like
     ``sqrt(r)`` (enrichment functions); the pieces ending at one are graded.
 
@@ -306,7 +306,7 @@ def _set_edges(model, cells, faces):
     hint : (e,) int64 ndarray
         Triangle of the crack face the edge lies on (its side), -1 elsewhere.
     spoke : (e,) bool ndarray
-        Spokes of fan sub-cells (left whole).
+        Spokes of fan sub-cells (one midpoint each).
     """
     cell, a, b = cell_edges(cells)
     hint = np.full(len(a), -1, dtype=np.int64)
@@ -365,8 +365,7 @@ def boundary_quadratures(model, cell_sets, *, gauss=2, singular=None):
             start |= np.hypot(*(first - p).T) <= tol
             end |= np.hypot(*(last - p).T) <= tol
     S, W = _graded_rule(s, w, start, end)
-    single = whole if SPOKE_MIDPOINT else np.zeros(len(a), dtype=bool)
-    points, wx, wy, indptr, piece = K.piece_points(a, b, edge, t0, t1, S, W, single)
+    points, wx, wy, indptr, piece = K.piece_points(a, b, edge, t0, t1, S, W, whole)
     cols = np.arange(len(points), dtype=np.int32)
     shape = (len(a), len(points))
     # one pattern for both (explicit zeros kept): cell_integrals relies on it

@@ -36,8 +36,8 @@ class Cells:
     area : (m,) ndarray
     spokes : (k,) bool ndarray or None
         Fan sub-cells only (`cnem.assembly.subdivide`): the edge from vertex
-        ``i`` to the next is a spoke, inside a model cell (integrated whole,
-        without cuts at circumcircle crossings, by `boundary_quadrature`).
+        ``i`` to the next is a spoke, inside a model cell (integrated by its
+        midpoint alone, by `boundary_quadrature`).
     """
 
     node: np.ndarray

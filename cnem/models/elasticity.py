@@ -163,8 +163,9 @@ class Elasticity:
     def basis(self):
         """The vector `CellBasis` (built on first use)."""
         if self._basis is None:
-            if self._sub_cells():
-                fan_gradient(self.model, gauss=self.gauss)    # B~ of the cells comes with it
+            if self._sub_cells() and self._K is None:
+                # K will need the fan sub-cells' gradients: B~ of the cells comes with them
+                fan_gradient(self.model, gauss=self.gauss)
             extra = (None if self.enrichment is None
                      else self.enrichment.smoothed_gradient(self.gauss, self.cells))
             self._basis = CellBasis(self.model, vector=True, gauss=self.gauss, extra=extra,
