@@ -69,3 +69,34 @@ def test_vector_forms_block_and_general_paths(model, with_mass):
     ref = _reference(basis, pairs)
     got = form.assemble(basis, lam=lam).toarray()
     np.testing.assert_allclose(got, ref, atol=1e-12 * abs(ref).max())
+
+
+def test_groups_evaluate_the_form_once_per_group(model):
+    """Per-material keywords with ``groups`` give the matrix of the per-cell keywords."""
+    basis = CellBasis(model, vector=True)
+    region = model.cells.region
+    lam_r = np.array([1.0, 2.5, 4.0])[:region.max() + 1]
+    mu_r = np.array([0.5, 0.7, 0.9])[:region.max() + 1]
+
+    @BilinearForm
+    def form(u, v, w):
+        return 2.0 * w.mu * ddot(sym_grad(u), sym_grad(v)) + w.lam * grad(u)[0, 0] * grad(v)[1, 1]
+
+    ref = form.assemble(basis, lam=lam_r[region], mu=mu_r[region]).toarray()
+    got = form.assemble(basis, groups=region, lam=lam_r, mu=mu_r).toarray()
+    np.testing.assert_allclose(got, ref, atol=1e-13 * abs(ref).max())
+    scalar = form.assemble(basis, groups=region, lam=lam_r, mu=0.5).toarray()
+    np.testing.assert_allclose(scalar, form.assemble(basis, lam=lam_r[region], mu=0.5).toarray(),
+                               atol=1e-13 * abs(ref).max())
+
+
+def test_groups_are_checked(model):
+    basis = CellBasis(model)
+    m = len(model.cells.area)
+    form = BilinearForm(lambda u, v, w: w.k * dot(grad(u), grad(v)))
+    with pytest.raises(ValueError, match=rf"groups: expected \({m},\) non-negative integers"):
+        form.assemble(basis, groups=np.zeros(m - 1, dtype=int), k=np.ones(1))
+    with pytest.raises(ValueError, match="one value per group"):
+        form.assemble(basis, groups=np.zeros(m, dtype=int), k=np.ones((2, 2)))
+    with pytest.raises(ValueError, match="groups: index 1 but the keywords hold 1 values"):
+        form.assemble(basis, groups=np.arange(m) % 2, k=np.ones(1))

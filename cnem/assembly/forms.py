@@ -29,6 +29,27 @@ def _extras(basis, kwargs):
     return w
 
 
+def _check_groups(groups, m, kwargs):
+    """``groups`` as ``(m,)`` int64 and the number of groups: the length of the
+    keyword arrays (one value per group; scalars allowed), else the largest group
+    index plus one."""
+    groups = np.asarray(groups)
+    if groups.shape != (m,) or not np.issubdtype(groups.dtype, np.integer) or \
+            (m and groups.min() < 0):
+        raise ValueError(f"groups: expected ({m},) non-negative integers, one per cell, "
+                         f"received dtype {groups.dtype} shape {groups.shape}")
+    shapes = {name: np.shape(value) for name, value in kwargs.items()}
+    lengths = {shape[0] for shape in shapes.values() if len(shape) == 1}
+    if any(len(shape) > 1 for shape in shapes.values()) or len(lengths) > 1:
+        raise ValueError(f"with groups, the keywords must hold one value per group (the same "
+                         f"number for all) or a scalar, received shapes {shapes}")
+    count = lengths.pop() if lengths else (int(groups.max()) + 1 if m else 0)
+    if m and groups.max() >= count:
+        raise ValueError(f"groups: index {int(groups.max())} but the keywords hold {count} "
+                         "values, one per group")
+    return groups.astype(np.int64, copy=False), count
+
+
 def _coefficients(values, m, what):
     """Broadcast a form's value to one coefficient per cell."""
     arr = np.asarray(values, dtype=float)
@@ -76,11 +97,15 @@ class BilinearForm(_Form):
             out[a][b] = value
         return out
 
-    def _nonzero_coefficients(self, basis, kwargs):
+    def _nonzero_coefficients(self, basis, kwargs, groups=None):
         """``(a, b, D_ab)`` for the descriptor pairs where the form is not zero in
-        every cell, one at a time (a large basis holds only one of them)."""
-        w = _extras(basis, kwargs)
-        m = len(basis.dx)
+        every cell, one at a time (a large basis holds only one of them); with
+        ``groups``, evaluated once per group (see `assemble`)."""
+        if groups is None:
+            w, m = _extras(basis, kwargs), len(basis.dx)
+        else:
+            groups, m = _check_groups(groups, len(basis.dx), kwargs)
+            w = FormExtraParams(kwargs)
         units = basis.unit_fields()
         zero = basis.zero_field()
         if np.any(np.asarray(self.form(zero, zero, w)) != 0.0):
@@ -89,15 +114,28 @@ class BilinearForm(_Form):
             for b, vb in enumerate(units):
                 value = _coefficients(self.form(ua, vb, w), m, f"form {self.__name__}")
                 if np.any(value != 0.0):
-                    yield a, b, value
+                    yield a, b, value if groups is None else value[groups]
 
-    def assemble(self, basis, **kwargs):
-        """Sparse matrix ``(N, N)`` (CSR)."""
+    def assemble(self, basis, *, groups=None, **kwargs):
+        """Sparse matrix ``(N, N)`` (CSR).
+
+        Parameters
+        ----------
+        basis : CellBasis
+            ``m`` integration cells.
+        groups : (m,) int array_like, optional
+            Cells whose form coefficients are the same (one material each, say):
+            the form is evaluated once per group, ``w`` holding the keywords given
+            per group (arrays ``(G,)`` or scalars) and neither ``w.x`` nor ``w.h``
+            (which differ from cell to cell).
+        **kwargs
+            Extras ``w`` of the form, per cell (or per group).
+        """
         m, g = len(basis.dx), basis.ncomp             # descriptors g, g + 1, ...: gradients
         # A_k D_ab(k), filled one descriptor pair at a time: gradient pairs in one array
         grad_weights = np.zeros((m, 2 * g, 2 * g))
         other, active = {}, set()
-        for a, b, value in self._nonzero_coefficients(basis, kwargs):
+        for a, b, value in self._nonzero_coefficients(basis, kwargs, groups):
             active.add((a, b))
             if a >= g and b >= g:
                 np.multiply(basis.dx, value, out=grad_weights[:, a - g, b - g])

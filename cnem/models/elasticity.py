@@ -186,15 +186,19 @@ class Elasticity:
             # the weights scale the Lamé parameters: no pass over the matrices
             K = None
             if weight != 0.0:
-                E, nu = self.cell_materials().T
-                lam, mu = lame(E, nu, self.plane)
-                K = elasticity_form.assemble(self.basis, lam=weight * lam, mu=weight * mu)
+                lam, mu = self._lame(weight)
+                K = elasticity_form.assemble(self.basis, groups=self.cells.region, lam=lam, mu=mu)
             if a > 0:
                 extra = (self._sub_cell_stiffness(a) if sub_cells
                          else self._pointwise_stabilization_stiffness(a))
                 K = extra if K is None else K + extra
             self._K = K
         return self._K
+
+    def _lame(self, weight=1.0):
+        """Lamé parameters of every material (region), times ``weight``: ``(r,)`` each."""
+        lam, mu = lame(*self.materials.T, self.plane)
+        return weight * lam, weight * mu
 
     def _sub_cells(self):
         """Whether the stabilisation uses the fan sub-cells of the model's cells
@@ -212,9 +216,8 @@ class Elasticity:
         """
         sub, grad = fan_gradient(self.model, gauss=self.gauss, release=True)
         fine = CellBasis(self.model, vector=True, cells=sub, gradient=grad)
-        E, nu = self.materials[sub.region].T
-        lam, mu = lame(E, nu, self.plane)
-        return elasticity_form.assemble(fine, lam=weight * lam, mu=weight * mu)
+        lam, mu = self._lame(weight)
+        return elasticity_form.assemble(fine, groups=sub.region, lam=lam, mu=mu)
 
     def _pointwise_stabilization_stiffness(self, weight, order=4):
         """``weight sum_q w_q (B(x_q) - B~_k)^T C (B(x_q) - B~_k)`` over quadrature points of
@@ -242,9 +245,8 @@ class Elasticity:
         diff = [p - to_cell @ b for p, b in zip(pointwise, ops[2:])]
         at_points = basis.at_points([to_cell @ ops[0], to_cell @ ops[1]] + diff,
                                     weights[keep], points)
-        E, nu = self.materials[cells.region[owner]].T
-        lam, mu = lame(E, nu, self.plane)
-        return elasticity_form.assemble(at_points, lam=weight * lam, mu=weight * mu)
+        lam, mu = self._lame(weight)
+        return elasticity_form.assemble(at_points, groups=cells.region[owner], lam=lam, mu=mu)
 
     def load(self):
         """Load vector ``f`` (eq. 21), ``(2 n,)`` (then the enriched dofs' loads)."""
@@ -328,9 +330,8 @@ class Elasticity:
         except ValueError as err:
             log.warning("no P1 preconditioner matrix (%s): smoothed aggregation on K", err)
             return None
-        E, nu = self.materials[self.model.triangle_region].T
-        lam, mu = lame(E, nu, self.plane)
-        P = elasticity_form.assemble(basis, lam=lam, mu=mu)
+        lam, mu = self._lame()
+        P = elasticity_form.assemble(basis, groups=self.model.triangle_region, lam=lam, mu=mu)
         return P if dofs is None else P[dofs][:, dofs]
 
     # -- solve --------------------------------------------------------------------------
