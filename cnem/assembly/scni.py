@@ -508,9 +508,9 @@ def _cell_runs(model, cells):
     m = len(cells)
     if m <= CELLS_PER_PASS:
         return None
-    order = path_order(model.nodes[cells.node], model.domain.bounds,
-                       per_tile=CELLS_PER_PASS / 4)
-    return [order[lo:lo + CELLS_PER_PASS] for lo in range(0, m, CELLS_PER_PASS)]
+    size = -(-m // -(-m // CELLS_PER_PASS))          # runs of equal size, none tiny
+    order = path_order(model.nodes[cells.node], model.domain.bounds, per_tile=size / 4)
+    return [order[lo:lo + size] for lo in range(0, m, size)]
 
 
 def _gradients(model, gauss, runs, rows=None):
