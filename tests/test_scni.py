@@ -91,6 +91,16 @@ def test_edges_are_cut_at_circumcircles():
                 assert (_in_circles(model.nodes, tri, x2) == inside).all()
 
 
+@pytest.mark.parametrize("name", ["random_points", "kinked_crack_irregular"])
+def test_one_query_per_cell_finds_the_same_pieces(name):
+    """Candidate circles looked up once per cell (the box of its edges) give the
+    pieces of one lookup per edge, exactly."""
+    _, _, model = cases.model(name)
+    cell, a, b = cell_edges(model.cells)
+    for got, ref in zip(_pieces(model, a, b, group=cell), _pieces(model, a, b)):
+        np.testing.assert_array_equal(got, ref)
+
+
 def _cross(u, v):
     return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
 

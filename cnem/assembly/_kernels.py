@@ -5,21 +5,23 @@ import numpy as np
 
 
 @numba.njit(cache=True, parallel=True)
-def circle_crossings(a, b, centre, radius2, cand_off, cand_idx, out_off, out_t, fill):
+def circle_crossings(a, b, centre, radius2, cand_off, cand_idx, group, out_off, out_t, fill):
     """Parameters ``t`` in (0, 1) where segments ``a + t (b - a)`` cross circles.
 
     Two passes: with ``fill=False`` writes the count of crossings of segment
     ``k`` to ``out_off[k + 1]``; with ``fill=True`` writes them to
-    ``out_t[out_off[k]:out_off[k + 1]]`` (unsorted). Candidates are circles
-    ``cand_idx[cand_off[k]:cand_off[k + 1]]``. Crossings closer than 1e-12
-    (relative) to an end are left out: they would make empty pieces.
+    ``out_t[out_off[k]:out_off[k + 1]]`` (unsorted). Candidates of segment ``k``
+    are the circles ``cand_idx[cand_off[g]:cand_off[g + 1]]`` of its group
+    ``g = group[k]``. Crossings closer than 1e-12 (relative) to an end are left
+    out: they would make empty pieces.
     """
     for k in numba.prange(len(a)):
         dx = b[k, 0] - a[k, 0]
         dy = b[k, 1] - a[k, 1]
         length2 = dx * dx + dy * dy
         count = 0
-        for p in range(cand_off[k], cand_off[k + 1]):
+        g = group[k]
+        for p in range(cand_off[g], cand_off[g + 1]):
             c = cand_idx[p]
             fx = a[k, 0] - centre[c, 0]
             fy = a[k, 1] - centre[c, 1]

@@ -90,9 +90,13 @@ def _circumcircles(model):
     return model._cache["circumcircles"]
 
 
-def _pieces(model, a, b, whole=None):
+def _pieces(model, a, b, whole=None, group=None):
     """Pieces of the edges between circumcircle crossings (``whole``: (e,) bool,
     edges left in one piece).
+
+    ``group``: (e,) keys; consecutive edges with the same key (the edges of one
+    cell) look their candidate circles up in one query of the circumcircles'
+    R-tree, with the box of them all.
 
     Returns
     -------
@@ -104,14 +108,21 @@ def _pieces(model, a, b, whole=None):
     ne = len(a)
     cut = np.arange(ne) if whole is None else np.flatnonzero(~np.asarray(whole, dtype=bool))
     ca, cb = a[cut], b[cut]
-    off, idx = tree.query(np.minimum(ca, cb), np.maximum(ca, cb))
+    lo, hi = np.minimum(ca, cb), np.maximum(ca, cb)
+    gid = np.arange(len(cut))
+    if group is not None and len(cut):
+        key = np.asarray(group)[cut]
+        start = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+        gid = np.repeat(np.arange(len(start)), np.diff(np.r_[start, len(cut)]))
+        lo, hi = np.minimum.reduceat(lo, start, axis=0), np.maximum.reduceat(hi, start, axis=0)
+    off, idx = tree.query(lo, hi)
     counts = np.zeros(len(cut) + 1, dtype=np.int64)
-    K.circle_crossings(ca, cb, centre, radius2, off, idx, counts, np.zeros(0), False)
+    K.circle_crossings(ca, cb, centre, radius2, off, idx, gid, counts, np.zeros(0), False)
     offsets = np.zeros(ne + 1, dtype=np.int64)
     offsets[cut + 1] = counts[1:]
     np.cumsum(offsets, out=offsets)
     t = np.empty(offsets[-1])
-    K.circle_crossings(ca, cb, centre, radius2, off, idx, offsets[cut], t, True)
+    K.circle_crossings(ca, cb, centre, radius2, off, idx, gid, offsets[cut], t, True)
     return K.edge_pieces(offsets, t)
 
 
@@ -346,6 +357,9 @@ def boundary_quadratures(model, cell_sets, *, gauss=2, singular=None):
     faces = _crack_faces(model) if (model.segment_kind == 2).any() else None
     edges = [_set_edges(model, cells, faces) for cells in cell_sets]
     cell, a, b, hint, spoke = (np.concatenate(x) for x in zip(*edges))
+    # one key per cell of every set: the edges first seen in one cell share a query
+    shift = np.repeat(np.cumsum([0] + [len(c.area) for c in cell_sets[:-1]]),
+                      [len(e[0]) for e in edges])
     # each edge is integrated once, from its lexicographically smaller end: the two
     # cells sharing it get the same integral with opposite signs (they cancel exactly)
     rows, sign = K.canonical_rows(a, b, hint)
@@ -353,7 +367,7 @@ def boundary_quadratures(model, cell_sets, *, gauss=2, singular=None):
     rows, hint = rows[first], hint[first]
     a, b = np.ascontiguousarray(rows[:, :2]), np.ascontiguousarray(rows[:, 2:4])
     whole = _all_spokes(spoke, occurrence, len(first))
-    edge, t0, t1 = _pieces(model, a, b, whole)
+    edge, t0, t1 = _pieces(model, a, b, whole, group=(cell + shift)[first])
     s, w = np.polynomial.legendre.leggauss(gauss)
     s, w = 0.5 * (s + 1.0), 0.5 * w
     d = b - a
