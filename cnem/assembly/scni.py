@@ -409,18 +409,6 @@ def _all_spokes(spoke, occurrence, count):
     return ~cut
 
 
-def _stack_rows(mats):
-    """CSR matrices with the same columns, one under the other (their arrays
-    concatenated; scipy's vstack is several times slower on large ones)."""
-    if len(mats) == 1:
-        return mats[0]
-    shifts = np.cumsum([0] + [a.nnz for a in mats[:-1]])
-    indptr = np.concatenate([[0]] + [a.indptr[1:] + shift for a, shift in zip(mats, shifts)])
-    return sp.csr_matrix((np.concatenate([a.data for a in mats]),
-                          np.concatenate([a.indices for a in mats]), indptr),
-                         shape=(sum(a.shape[0] for a in mats), mats[0].shape[1]))
-
-
 def smoothed_gradient(model, *, gauss=2, cells=None):
     """The smoothed gradient operator ``B~`` of a model (cached on the model).
 
@@ -445,11 +433,7 @@ def smoothed_gradient(model, *, gauss=2, cells=None):
         return model._cache[key]
     every = model.cells if cells is None else cells
     runs = _cell_runs(model, every)
-    if runs is None:
-        grad, = _gradients(model, gauss, [[every]])
-    else:
-        grad, = _gradients(model, gauss, ([every.subset(run)] for run in runs),
-                           [[run] for run in runs])
+    grad, = _gradients(model, gauss, [every], None if runs is None else [[run] for run in runs])
     if cells is None:
         model._cache[key] = grad
     return grad
@@ -488,9 +472,7 @@ def fan_gradient(model, *, gauss=2, release=False):
     sub, parent = subdivide(cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
     have_cells = ("scni", int(gauss)) in model._cache
     runs = _cell_runs(model, cells)
-    if runs is None:
-        grads = _gradients(model, gauss, [([] if have_cells else [cells]) + [sub]])
-    else:                       # the sub-cells go with their cells' runs
+    if runs is not None:        # the sub-cells go with their cells' runs
         run_of = np.empty(len(cells), dtype=np.int64)
         for r, run in enumerate(runs):
             run_of[run] = r
@@ -498,10 +480,10 @@ def fan_gradient(model, *, gauss=2, release=False):
         sub_order = np.argsort(key_of, kind="stable")
         cuts = np.searchsorted(key_of[sub_order], np.arange(len(runs) + 1))
         sub_runs = [sub_order[cuts[r]:cuts[r + 1]] for r in range(len(runs))]
-        sets = [([] if have_cells else [run]) + [sub_run] for run, sub_run in zip(runs, sub_runs)]
-        grads = _gradients(model, gauss,
-                           (([] if have_cells else [cells.subset(run)]) + [sub.subset(sub_run)]
-                            for run, sub_run in zip(runs, sub_runs)), sets)
+    sets = [sub] if have_cells else [cells, sub]
+    passes = None if runs is None else \
+        [[s] if have_cells else [r, s] for r, s in zip(runs, sub_runs)]
+    grads = _gradients(model, gauss, sets, passes)
     if not have_cells:
         model._cache[("scni", int(gauss))] = grads[0]
     if not release:
@@ -527,30 +509,31 @@ def _cell_runs(model, cells):
     return [order[lo:lo + size] for lo in range(0, m, size)]
 
 
-def _gradients(model, gauss, runs, rows=None):
+def _gradients(model, gauss, sets, runs=None):
     """Smoothed gradients of several sets of cells, pass by pass.
 
     Parameters
     ----------
-    runs : iterable of lists of Cells
-        For each pass, one run of cells of every set (the same number of sets),
-        made when the pass comes (a generator keeps one pass's cells at a time).
-    rows : list of lists of (r,) int arrays, optional
-        For each pass and set, the rows of the result the run's cells take (the
-        runs of a set cover its rows once). By default the runs' rows follow one
-        another.
+    sets : list of Cells
+    runs : list of lists of (r,) int arrays, optional
+        For each pass, the cells of every set it takes (the runs of a set cover
+        it once); by default one pass takes them all.
 
     Returns
     -------
     list of SmoothedGradient
+        One per set.
     """
-    parts, points = _passes(model, gauss, runs)
-    out = [SmoothedGradient(*(_stack_rows([p[c] for p in parts[i]]) for c in range(2))
-                            if rows is None else _place_runs(parts[i], [r[i] for r in rows]),
-                            points) for i in range(len(parts))]
-    if len(parts[0]) > 1:    # the passes' arrays are freed, but the C heap keeps them
-        del parts
-        release_free_memory()
+    if runs is None:
+        parts, points = _passes(model, gauss, [sets])
+        return [SmoothedGradient(*part[0], points) for part in parts]
+    # a generator: one pass's cells alive at a time
+    parts, points = _passes(model, gauss, ([cells.subset(index) for cells, index in zip(sets, run)]
+                                           for run in runs))
+    out = [SmoothedGradient(*_place_runs(parts[i], [run[i] for run in runs]), points)
+           for i in range(len(sets))]
+    del parts                # the passes' arrays are freed, but the C heap keeps them
+    release_free_memory()
     return out
 
 
