@@ -205,3 +205,42 @@ def test_runs_are_compact_blocks_whatever_the_order_of_the_nodes(monkeypatch):
     assert whole.points < runs.points < 1.2 * whole.points
     for a, b in ((whole.x, runs.x), (whole.y, runs.y)):
         np.testing.assert_allclose(a.toarray(), b.toarray(), atol=1e-13 * abs(a).max())
+
+
+def _fan_operators(quads, model):
+    phi, order = quads[0].shape_functions(model)
+    return [quad.cell_integrals(phi, rows=order) for quad in quads]
+
+
+@pytest.mark.parametrize("name", [n for n in NAMES if n not in cases.CRACKED])
+@pytest.mark.parametrize("node_apex", [False, True])
+def test_fan_quadratures_take_the_sub_cells_edges_from_their_cells(name, node_apex):
+    """The sub-cells' edges taken from where they come from (no search) give the
+    points and the operators of the search by coordinates; fans from the cells'
+    nodes put the apex on a vertex for boundary nodes, where a spoke is a cell
+    edge: it is that edge (cut at the circles), not a spoke."""
+    from cnem.assembly.quadrature import subdivide
+    from cnem.assembly.scni import boundary_quadratures, fan_quadratures
+    _, _, model = cases.model(name)
+    cells = model.cells
+    sub, parent = subdivide(cells, model.nodes, node_apex=np.full(len(cells), node_apex),
+                            mark_spokes=True)
+    fast = fan_quadratures(model, cells, sub, parent)
+    slow = boundary_quadratures(model, [cells, sub])
+    assert len(fast[0].points) == len(slow[0].points)
+    for f, s in zip(_fan_operators(fast, model), _fan_operators(slow, model)):
+        for a, b in zip(f, s):
+            np.testing.assert_allclose(a.toarray(), b.toarray(), rtol=0,
+                                       atol=1e-13 * abs(b).max())
+    # no spoke lies on a cell edge
+    _, a, b = cell_edges(sub)
+    spoke = sub.spokes
+    _, ca, cb = cell_edges(cells)
+    key = {tuple(np.r_[p, q]) for p, q in zip(ca, cb)}
+    assert not any(tuple(np.r_[p, q]) in key or tuple(np.r_[q, p]) in key
+                   for p, q in zip(a[spoke], b[spoke]))
+    if node_apex:       # the case arose: apexes on a vertex of their cell
+        apex = sub.vertices[sub.offsets[:-1]]
+        on_vertex = [any((apex[s] == cells.polygon(c)).all(axis=1))
+                     for s, c in enumerate(parent) if sub.spokes[sub.offsets[s]:sub.offsets[s + 1]].any()]
+        assert any(on_vertex)

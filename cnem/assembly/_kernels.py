@@ -127,8 +127,9 @@ def piece_points(a, b, edge, t0, t1, S, W, single):
     """Quadrature points on edge pieces, with their weights times the edge normal.
 
     Piece ``i`` (``t0[i] <= t <= t1[i]`` along edge ``edge[i]``, from ``a`` to
-    ``b``) gets the points ``S[i]`` and weights ``W[i]`` of a rule on [0, 1], or
-    its midpoint alone where ``single[edge[i]]``.
+    ``b``) gets the points ``S[i]`` and weights ``W[i]`` of a rule on [0, 1]
+    (``S[0]``, ``W[0]`` for every piece when they have one row), or its midpoint
+    alone where ``single[edge[i]]``.
 
     Returns
     -------
@@ -139,10 +140,8 @@ def piece_points(a, b, edge, t0, t1, S, W, single):
     indptr : (e + 1,) int64
         The points of edge ``k`` are ``indptr[k]:indptr[k + 1]`` (pieces come
         edge by edge).
-    piece : (q,) int64
-        The piece of each point.
     """
-    npiece, g = S.shape
+    npiece, g = edge.shape[0], S.shape[1]
     ne = a.shape[0]
     indptr = np.zeros(ne + 1, dtype=np.int64)
     for i in range(npiece):
@@ -153,22 +152,21 @@ def piece_points(a, b, edge, t0, t1, S, W, single):
     points = np.empty((q, 2))
     wx = np.empty(q)
     wy = np.empty(q)
-    piece = np.empty(q, dtype=np.int64)
     p = 0
     for i in range(npiece):
         e = edge[i]
+        r = i if S.shape[0] > 1 else 0
         dx, dy = b[e, 0] - a[e, 0], b[e, 1] - a[e, 1]
         span = t1[i] - t0[i]
         for j in range(1 if single[e] else g):
-            s, w = (0.5, 1.0) if single[e] else (S[i, j], W[i, j])
+            s, w = (0.5, 1.0) if single[e] else (S[r, j], W[r, j])
             t = t0[i] + span * s
             points[p, 0] = a[e, 0] + t * dx
             points[p, 1] = a[e, 1] + t * dy
             wx[p] = span * w * dy
             wy[p] = -span * w * dx
-            piece[p] = i
             p += 1
-    return points, wx, wy, indptr, piece
+    return points, wx, wy, indptr
 
 
 @numba.njit(cache=True, parallel=True)

@@ -228,7 +228,8 @@ def subdivide(cells, nodes, *, whole=None, node_apex=None, mark_spokes=False):
         Mark the triangles' edges from their apex (``sub.spokes``): the
         boundary quadrature then gives them their midpoint alone, fewer points
         where the sub-cells only serve the stabilisation, whose spoke integrals
-        cancel between neighbouring triangles.
+        cancel between neighbouring triangles. Also says where every edge
+        comes from in its parent (``sub.edge_source``).
 
     Returns
     -------
@@ -239,12 +240,12 @@ def subdivide(cells, nodes, *, whole=None, node_apex=None, mark_spokes=False):
     """
     from ..geometry.model import Cells
     whole = _cell_flags(whole, len(cells.area), "whole")
-    parent, offsets, verts, spokes = FK.fan_sub_cells(
+    parent, offsets, verts, spokes, source = FK.fan_sub_cells(
         np.asarray(cells.offsets, dtype=np.int64),
         np.ascontiguousarray(cells.vertices, dtype=np.float64),
         _apexes(cells, nodes, node_apex), cells.area, whole)
     sub = Cells(cells.node[parent], cells.region[parent], offsets, verts,
-                spokes if mark_spokes else None)
+                spokes if mark_spokes else None, source if mark_spokes else None)
     return sub, parent
 
 

@@ -25,6 +25,7 @@ from .._memory import release_free_memory
 from ..geometry.topology import circumcenters, constraint_edges, triangle_neighbors
 from ..shape.natural import path_order
 from ..spatial.rtree import RTree, work_chunks
+from . import _fan_kernels as FK
 from . import _kernels as K
 from . import _sparse_kernels as SK
 
@@ -351,55 +352,144 @@ def boundary_quadratures(model, cell_sets, *, gauss=2, singular=None):
     list of BoundaryQuadrature
         One per set, all with the same ``points``, ``hint``, ``wx`` and ``wy``.
     """
-    gauss = int(gauss)
-    if gauss < 1:
-        raise ValueError(f"gauss: expected a positive number of Gauss points, received {gauss}")
+    gauss = _check_gauss(gauss)
     faces = _crack_faces(model) if (model.segment_kind == 2).any() else None
     edges = [_set_edges(model, cells, faces) for cells in cell_sets]
     cell, a, b, hint, spoke = (np.concatenate(x) for x in zip(*edges))
     # one key per cell of every set: the edges first seen in one cell share a query
     shift = np.repeat(np.cumsum([0] + [len(c.area) for c in cell_sets[:-1]]),
                       [len(e[0]) for e in edges])
-    # each edge is integrated once, from its lexicographically smaller end: the two
-    # cells sharing it get the same integral with opposite signs (they cancel exactly)
+    rows, sign, first, occurrence = _distinct_edges(a, b, hint)
+    whole = _all_spokes(spoke, occurrence, len(first))
+    points = _edge_points(model, rows, hint[first], whole, (cell + shift)[first], gauss, singular)
+    out, lo = [], 0
+    for cells, (set_cell, *_) in zip(cell_sets, edges):
+        hi = lo + len(set_cell)
+        to_cells = _to_cells(cells, set_cell, sign[lo:hi], occurrence[lo:hi], len(rows))
+        out.append(BoundaryQuadrature(*points, to_cells))
+        lo = hi
+    log.info("SCNI quadrature: %s cells, %d edges, %d points",
+             "+".join(str(len(c.area)) for c in cell_sets), len(rows), len(points[0]))
+    return out
+
+
+def fan_quadratures(model, cells, sub, parent, *, gauss=2):
+    """`boundary_quadratures` of cells and of their fan sub-cells (`subdivide` with
+    ``mark_spokes``), the sub-cells' edges taken from where they come from.
+
+    The cells' edges are found shared by their coordinates; a sub-cell's edge
+    that lies on its cell's edge (``sub.edge_source``) is that edge, and the
+    spoke to a cell's vertex is one edge for the two triangles beside it: no
+    search. Cracked models (faces and slits to place) take `boundary_quadratures`.
+
+    Parameters
+    ----------
+    model : Model
+    cells : Cells
+        ``m`` cells (of the model, or some of them).
+    sub : Cells
+        Fan sub-cells of ``cells``, with ``spokes`` and ``edge_source``.
+    parent : (s,) int array_like
+        The cell of each sub-cell (indices into ``cells``).
+    gauss : int
+
+    Returns
+    -------
+    cells_quadrature, sub_quadrature : BoundaryQuadrature
+        With the same points.
+    """
+    if (model.segment_kind == 2).any() or sub.edge_source is None:
+        return tuple(boundary_quadratures(model, [cells, sub], gauss=gauss))
+    gauss = _check_gauss(gauss)
+    cell, a, b = cell_edges(cells)
+    rows, sign, first, occurrence = _distinct_edges(a, b, np.full(len(a), -1, dtype=np.int64))
+    # the cell vertex every sub-cell edge comes from
+    counts = np.diff(sub.offsets)
+    vertex = np.repeat(np.asarray(cells.offsets, dtype=np.int64)[np.asarray(parent)], counts) \
+        + sub.edge_source
+    spoke = np.asarray(sub.spokes, dtype=bool)
+    spoke_rows, spoke_index, spoke_sign = FK.fan_spokes(
+        np.asarray(sub.offsets, dtype=np.int64), sub.vertices, spoke, vertex, len(cells.vertices))
+    sub_edge = np.where(spoke, len(rows) + spoke_index, occurrence[vertex])
+    sub_sign = np.where(spoke, spoke_sign, sign[vertex])
+    rows = np.concatenate([rows, spoke_rows])
+    whole = np.arange(len(rows)) >= len(first)
+    group = np.concatenate([cell[first], np.zeros(len(spoke_rows), dtype=np.int64)])
+    points = _edge_points(model, rows, np.full(len(rows), -1, dtype=np.int64), whole, group,
+                          gauss, None)
+    sub_cell = np.repeat(np.arange(len(sub.area), dtype=np.int64), counts)
+    log.info("SCNI quadrature: %d cells + %d sub-cells, %d edges, %d points",
+             len(cells.area), len(sub.area), len(rows), len(points[0]))
+    return (BoundaryQuadrature(*points, _to_cells(cells, cell, sign, occurrence, len(rows))),
+            BoundaryQuadrature(*points, _to_cells(sub, sub_cell, sub_sign, sub_edge, len(rows))))
+
+
+def _check_gauss(gauss):
+    gauss = int(gauss)
+    if gauss < 1:
+        raise ValueError(f"gauss: expected a positive number of Gauss points, received {gauss}")
+    return gauss
+
+
+def _distinct_edges(a, b, hint):
+    """The distinct edges among directed edges ``(e, 2)`` (the same ends bit for bit
+    and the same ``hint``, either way round).
+
+    Each edge is integrated once, from its lexicographically smaller end: the two
+    cells sharing it get the same integral with opposite signs (they cancel exactly).
+
+    Returns
+    -------
+    rows : (u, 5) float64
+        ``[x0, y0, x1, y1, hint]`` of every distinct edge.
+    sign : (e,) float64
+        -1 where an edge runs against its distinct edge.
+    first : (u,) int64
+        An edge of each distinct edge.
+    occurrence : (e,) int64
+        The distinct edge of every edge.
+    """
     rows, sign = K.canonical_rows(a, b, hint)
     first, occurrence = K.unique_rows(rows.view(np.uint64))
-    rows, hint = rows[first], hint[first]
+    return rows[first], sign, first, occurrence
+
+
+def _edge_points(model, rows, hint, whole, group, gauss, singular):
+    """Gauss points on the distinct edges ``rows`` (see `_distinct_edges`), cut at
+    circumcircle crossings unless ``whole`` (then their midpoint alone); ``group``
+    as in `_pieces`. Returns ``points, hint, wx, wy`` of `BoundaryQuadrature`."""
     a, b = np.ascontiguousarray(rows[:, :2]), np.ascontiguousarray(rows[:, 2:4])
-    whole = _all_spokes(spoke, occurrence, len(first))
-    edge, t0, t1 = _pieces(model, a, b, whole, group=(cell + shift)[first])
+    edge, t0, t1 = _pieces(model, a, b, whole, group=group)
     s, w = np.polynomial.legendre.leggauss(gauss)
     s, w = 0.5 * (s + 1.0), 0.5 * w
-    d = b - a
-    start, end = np.zeros(len(edge), dtype=bool), np.zeros(len(edge), dtype=bool)
+    S, W = s[None], w[None]                   # one rule for every piece
     if singular is not None:                  # pieces that begin or end at a singular point
         tol = config.SNAP_TOL * model.domain.diameter
+        d = b - a
         first, last = a[edge] + t0[:, None] * d[edge], a[edge] + t1[:, None] * d[edge]
+        start, end = np.zeros(len(edge), dtype=bool), np.zeros(len(edge), dtype=bool)
         for p in np.asarray(singular, float).reshape(-1, 2):
             start |= np.hypot(*(first - p).T) <= tol
             end |= np.hypot(*(last - p).T) <= tol
-    S, W = _graded_rule(s, w, start, end)
-    points, wx, wy, indptr, piece = K.piece_points(a, b, edge, t0, t1, S, W, whole)
+        S, W = _graded_rule(s, w, start, end)
+    points, wx, wy, indptr = K.piece_points(a, b, edge, t0, t1, S, W, whole)
     cols = np.arange(len(points), dtype=np.int32)
     shape = (len(a), len(points))
     # one pattern for both (explicit zeros kept): cell_integrals relies on it
     wx = sp.csr_matrix((wx, cols, indptr), shape=shape)
     wy = sp.csr_matrix((wy, cols.copy(), indptr.copy()), shape=shape)
-    hint = hint[edge[piece]]
-    out, lo = [], 0
-    for cells, (set_cell, *_) in zip(cell_sets, edges):
-        hi = lo + len(set_cell)
-        data, cols = sign[lo:hi] / cells.area[set_cell], occurrence[lo:hi].astype(np.int32)
-        shape = (len(cells.area), len(a))
-        if len(set_cell) == len(cells.vertices):          # no slits: rows in cell order
-            to_cells = sp.csr_matrix((data, cols, cells.offsets.astype(np.int64)), shape=shape)
-        else:
-            to_cells = sp.csr_matrix((data, (set_cell, cols)), shape=shape)
-        out.append(BoundaryQuadrature(points, hint, wx, wy, to_cells))
-        lo = hi
-    log.info("SCNI quadrature: %s cells, %d edges, %d pieces, %d points",
-             "+".join(str(len(c.area)) for c in cell_sets), len(a), len(edge), len(points))
-    return out
+    return points, np.repeat(hint, np.diff(indptr)), wx, wy
+
+
+def _to_cells(cells, edge_cell, sign, occurrence, count):
+    """``±1 / A_k`` from the cells to the ``count`` distinct edges, ``(m, count)``
+    CSR, for the directed edges of the cells (cell ``edge_cell``, distinct edge
+    ``occurrence``, ``sign`` against it)."""
+    data, cols = sign / cells.area[edge_cell], occurrence.astype(np.int32)
+    shape = (len(cells.area), count)
+    if len(edge_cell) == len(cells.vertices):          # no slits: rows in cell order
+        return sp.csr_matrix((data, cols, np.asarray(cells.offsets, dtype=np.int64)), shape=shape)
+    return sp.csr_matrix((data, (edge_cell, cols)), shape=shape)
 
 
 def _all_spokes(spoke, occurrence, count):
@@ -433,7 +523,8 @@ def smoothed_gradient(model, *, gauss=2, cells=None):
         return model._cache[key]
     every = model.cells if cells is None else cells
     runs = _cell_runs(model, every)
-    grad, = _gradients(model, gauss, [every], None if runs is None else [[run] for run in runs])
+    grad, = _gradients(model, [every], lambda sets, _: boundary_quadratures(model, sets, gauss=gauss),
+                       None if runs is None else [[run] for run in runs])
     if cells is None:
         model._cache[key] = grad
     return grad
@@ -470,8 +561,8 @@ def fan_gradient(model, *, gauss=2, release=False):
         return model._cache.pop(key) if release else model._cache[key]
     cells = model.cells
     sub, parent = subdivide(cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
-    have_cells = ("scni", int(gauss)) in model._cache
     runs = _cell_runs(model, cells)
+    passes = None
     if runs is not None:        # the sub-cells go with their cells' runs
         run_of = np.empty(len(cells), dtype=np.int64)
         for r, run in enumerate(runs):
@@ -479,16 +570,21 @@ def fan_gradient(model, *, gauss=2, release=False):
         key_of = run_of[parent]
         sub_order = np.argsort(key_of, kind="stable")
         cuts = np.searchsorted(key_of[sub_order], np.arange(len(runs) + 1))
-        sub_runs = [sub_order[cuts[r]:cuts[r + 1]] for r in range(len(runs))]
-    sets = [sub] if have_cells else [cells, sub]
-    passes = None if runs is None else \
-        [[s] if have_cells else [r, s] for r, s in zip(runs, sub_runs)]
-    grads = _gradients(model, gauss, sets, passes)
-    if not have_cells:
-        model._cache[("scni", int(gauss))] = grads[0]
+        passes = [[run, sub_order[cuts[r]:cuts[r + 1]]] for r, run in enumerate(runs)]
+
+    def quadratures(sets, index):
+        local = parent
+        if index is not None:               # the parents' places in their run
+            place = np.empty(len(cells), dtype=np.int64)
+            place[index[0]] = np.arange(len(index[0]))
+            local = place[parent[index[1]]]
+        return fan_quadratures(model, *sets, local, gauss=gauss)
+
+    grads = _gradients(model, [cells, sub], quadratures, passes)
+    model._cache.setdefault(("scni", int(gauss)), grads[0])
     if not release:
-        model._cache[key] = sub, grads[-1]
-    return sub, grads[-1]
+        model._cache[key] = sub, grads[1]
+    return sub, grads[1]
 
 
 def _cell_runs(model, cells):
@@ -509,12 +605,16 @@ def _cell_runs(model, cells):
     return [order[lo:lo + size] for lo in range(0, m, size)]
 
 
-def _gradients(model, gauss, sets, runs=None):
+def _gradients(model, sets, quadratures, runs=None):
     """Smoothed gradients of several sets of cells, pass by pass.
 
     Parameters
     ----------
     sets : list of Cells
+    quadratures : callable
+        ``quadratures(subsets, index)``: one `BoundaryQuadrature` per set, with
+        one set of points, for the cells ``subsets`` (``index``: their indices
+        into ``sets``, one array per set; None when they are the sets).
     runs : list of lists of (r,) int arrays, optional
         For each pass, the cells of every set it takes (the runs of a set cover
         it once); by default one pass takes them all.
@@ -525,11 +625,11 @@ def _gradients(model, gauss, sets, runs=None):
         One per set.
     """
     if runs is None:
-        parts, points = _passes(model, gauss, [sets])
+        parts, points = _passes(model, quadratures, [(sets, None)])
         return [SmoothedGradient(*part[0], points) for part in parts]
     # a generator: one pass's cells alive at a time
-    parts, points = _passes(model, gauss, ([cells.subset(index) for cells, index in zip(sets, run)]
-                                           for run in runs))
+    parts, points = _passes(model, quadratures,
+                            (([cells.subset(i) for cells, i in zip(sets, run)], run) for run in runs))
     out = [SmoothedGradient(*_place_runs(parts[i], [run[i] for run in runs]), points)
            for i in range(len(sets))]
     del parts                # the passes' arrays are freed, but the C heap keeps them
@@ -537,14 +637,14 @@ def _gradients(model, gauss, sets, runs=None):
     return out
 
 
-def _passes(model, gauss, runs):
-    """The cell integrals of every run: ``parts[set][run] = (x, y)``, and the number
-    of quadrature points (the runs' cells are dropped pass by pass)."""
+def _passes(model, quadratures, runs):
+    """The cell integrals of every run ``(subsets, index)``: ``parts[set][run] = (x, y)``,
+    and the number of quadrature points (the runs' cells are dropped pass by pass)."""
     parts, points = None, 0
-    for run in runs:
+    for run, index in runs:
         if parts is None:
             parts = [[] for _ in run]
-        quads = boundary_quadratures(model, run, gauss=gauss)
+        quads = quadratures(run, index)
         phi, order = quads[0].shape_functions(model)
         for part, quad in zip(parts, quads):
             part.append(quad.cell_integrals(phi, rows=order))

@@ -38,6 +38,11 @@ class Cells:
         Fan sub-cells only (`cnem.assembly.subdivide`): the edge from vertex
         ``i`` to the next is a spoke, inside a model cell (integrated by its
         midpoint alone, by `boundary_quadrature`).
+    edge_source : (k,) int64 ndarray or None
+        Fan sub-cells only: the edge from vertex ``i`` to the next lies on its
+        parent cell's edge from vertex ``edge_source[i]`` (a position in the
+        parent's polygon) to the next, in the same direction; a spoke joins the
+        apex to the parent's vertex ``edge_source[i]``.
     """
 
     node: np.ndarray
@@ -45,6 +50,7 @@ class Cells:
     offsets: np.ndarray
     vertices: np.ndarray
     spokes: np.ndarray | None = None
+    edge_source: np.ndarray | None = None
     area: np.ndarray = field(init=False)
 
     def __post_init__(self):
@@ -69,7 +75,8 @@ class Cells:
         np.cumsum(counts, out=offsets[1:])
         verts = np.repeat(self.offsets[index] - offsets[:-1], counts) + np.arange(offsets[-1])
         return Cells(self.node[index], self.region[index], offsets, self.vertices[verts],
-                     None if self.spokes is None else self.spokes[verts])
+                     None if self.spokes is None else self.spokes[verts],
+                     None if self.edge_source is None else self.edge_source[verts])
 
     def polygon(self, i):
         """Vertices of cell ``i``, ``(k, 2)``, counter-clockwise."""
