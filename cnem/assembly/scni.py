@@ -35,7 +35,7 @@ __all__ = ["SmoothedGradient", "smoothed_gradient", "fan_gradient", "BoundaryQua
 log = logging.getLogger(__name__)
 
 #: Cells whose boundary quadrature is built and evaluated in one pass of `smoothed_gradient`.
-CELLS_PER_PASS = 50_000
+CELLS_PER_PASS = 10_000
 
 
 class SmoothedGradient:
