@@ -305,3 +305,26 @@ def test_far_from_the_origin():
     assert (model.cells.area > 0).all()
     centroid = model.cells.centroid()
     assert (np.linalg.norm(centroid - model.nodes[model.cells.node], axis=1) < 0.1).all()
+
+
+@all_cases
+def test_neighbors_are_the_triangulation_adjacency(name):
+    """`Model.neighbors` (filled by `discretize`, or computed on a cold cache) is the
+    adjacency of the triangles: neighbours share the edge facing the vertex, in
+    the same region unless asked across regions."""
+    from cnem.geometry.topology import triangle_neighbors
+    _, _, model = cases.model(name)
+    tri, region = model.triangles, model.triangle_region
+    cold = cnem.geometry.model.Model(model.cloud, model.nodes, model.node_of_point, tri, region,
+                                     model.segments, model.segment_kind, model.cells, {})
+    for m in (model, cold):
+        for across in (False, True):
+            nb = m.neighbors(across_regions=across)
+            np.testing.assert_array_equal(nb, triangle_neighbors(tri, None if across else region))
+            t, k = np.nonzero(nb >= 0)
+            edge = np.sort(np.stack([tri[t, (k + 1) % 3], tri[t, (k + 2) % 3]], axis=1), axis=1)
+            other = np.sort(tri[nb[t, k]], axis=1)
+            assert all(set(e) <= set(o) for e, o in zip(edge, other))
+            assert across or (region[nb[t, k]] == region[t]).all()
+    if len(np.unique(region)) > 1:
+        assert (model.neighbors() < 0).sum() > (model.neighbors(across_regions=True) < 0).sum()

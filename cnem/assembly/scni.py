@@ -22,7 +22,7 @@ import shapely
 
 from .. import config
 from .._memory import release_free_memory
-from ..geometry.topology import circumcenters, constraint_edges, triangle_neighbors
+from ..geometry.topology import circumcenters, constraint_edges
 from ..shape.natural import path_order
 from ..spatial.rtree import RTree, work_chunks
 from . import _fan_kernels as FK
@@ -139,8 +139,7 @@ def _crack_faces(model):
     """
     crack = model.segments[model.segment_kind == 2]
     n = len(model.nodes)
-    edges, owner = constraint_edges(model.triangles,
-                                    triangle_neighbors(model.triangles, model.triangle_region))
+    edges, owner = constraint_edges(model.triangles, model.neighbors())
     is_face = np.isin(np.sort(edges, axis=1) @ [n, 1], np.sort(crack, axis=1) @ [n, 1])
     edges, owner = edges[is_face], owner[is_face]
     return model.nodes[edges[:, 0]], model.nodes[edges[:, 1]], owner

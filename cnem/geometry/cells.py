@@ -234,7 +234,7 @@ class _ExactCells:
         return ring
 
 
-def voronoi_cells(nodes, triangles, region, *, progress=None):
+def voronoi_cells(nodes, triangles, region, *, progress=None, neighbors=None):
     """Constrained Voronoi cells of a (crack-split) constrained Delaunay triangulation.
 
     Parameters
@@ -245,6 +245,8 @@ def voronoi_cells(nodes, triangles, region, *, progress=None):
     region : (t,) int64 ndarray
     progress : bool, optional
         Progress bar over the clipped cells (default: when on a terminal).
+    neighbors : (t, 3) int64 ndarray, optional
+        `triangle_neighbors` of the triangles and regions, if already known.
 
     Returns
     -------
@@ -254,7 +256,7 @@ def voronoi_cells(nodes, triangles, region, *, progress=None):
         Cell ``c`` is ``vertices[offsets[c]:offsets[c + 1]]``, counter-clockwise.
     """
     n = len(nodes)
-    nb = triangle_neighbors(triangles, region)
+    nb = triangle_neighbors(triangles, region) if neighbors is None else neighbors
     offsets, star = vertex_triangles(triangles, n)
     cc = circumcenters(nodes, triangles)
     max_deg = int(np.diff(offsets).max())

@@ -13,6 +13,7 @@ from ._kernels import polygon_moments
 from .cells import voronoi_cells
 from .cloud import NodeCloud
 from .cracks import split_cracks
+from .topology import cut_between_regions, triangle_neighbors
 
 from .triangulation import constrained_delaunay
 
@@ -129,6 +130,16 @@ class Model:
         """Domain: the body this model discretises."""
         return self.cloud.domain
 
+    def neighbors(self, *, across_regions=False):
+        """The triangle across each edge, ``(t, 3)`` int64: ``nb[t, k]`` faces vertex
+        ``k``; -1 on the boundary, at crack faces and (unless ``across_regions``)
+        where the neighbour lies in another region. Cached (`discretize` fills it).
+        """
+        if "neighbors" not in self._cache:
+            every = triangle_neighbors(self.triangles)
+            self._cache["neighbors"] = cut_between_regions(every, self.triangle_region), every
+        return self._cache["neighbors"][1 if across_regions else 0]
+
     def shape_functions(self, points, *, kind="sibson", triangles=None, gradient=False,
                         in_order=True):
         """Constrained natural-neighbour coordinates, see `cnem.shape.shape_functions`.
@@ -181,16 +192,21 @@ def discretize(cloud, *, progress=None):
     nodes, node_of_point, tri, segments, kind = split_cracks(
         cloud.points, tri, cloud.segments, cloud.segment_kind)
     t2 = time.perf_counter()
+    every = triangle_neighbors(tri)
+    neighbors = cut_between_regions(every, region), every
     shift = nodes.min(axis=0)        # a local frame keeps the snap grid above round-off
     node, cell_region, offsets, vertices = voronoi_cells(nodes - shift, tri, region,
-                                                         progress=progress)
+                                                         progress=progress,
+                                                         neighbors=neighbors[0])
     vertices += shift
     t3 = time.perf_counter()
     timings.update(triangulation=t1 - t0, splitting=t2 - t1, cells=t3 - t2)
     log.info("discretize: %d nodes, %s", len(nodes),
              ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
     cells = Cells(node, cell_region, offsets, vertices)
-    return Model(cloud, nodes, node_of_point, tri, region, segments, kind, cells, timings)
+    model = Model(cloud, nodes, node_of_point, tri, region, segments, kind, cells, timings)
+    model._cache["neighbors"] = neighbors
+    return model
 
 
 

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["triangle_neighbors", "vertex_triangles", "circumcenters", "constraint_edges"]
+__all__ = ["triangle_neighbors", "cut_between_regions", "vertex_triangles", "circumcenters",
+           "constraint_edges"]
 
 
 def triangle_neighbors(triangles, region=None):
@@ -32,11 +33,16 @@ def triangle_neighbors(triangles, region=None):
     nb[order[pair]] = order[pair + 1] // 3
     nb[order[pair + 1]] = order[pair] // 3
     nb = nb.reshape(t, 3)
-    if region is not None:
-        other = nb >= 0
-        cross = np.zeros_like(other)
-        cross[other] = region[nb[other]] != np.repeat(region[:, None], 3, axis=1)[other]
-        nb[cross] = -1
+    return nb if region is None else cut_between_regions(nb, region)
+
+
+def cut_between_regions(nb, region):
+    """Neighbours ``(t, 3)`` with -1 where the neighbour lies in another region (a copy)."""
+    nb = nb.copy()
+    other = nb >= 0
+    cross = np.zeros_like(other)
+    cross[other] = region[nb[other]] != np.repeat(region[:, None], 3, axis=1)[other]
+    nb[cross] = -1
     return nb
 
 

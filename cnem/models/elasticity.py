@@ -21,7 +21,7 @@ from ..assembly.scni import fan_gradient
 from ..assembly.triangles import triangle_basis
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import SolveError
-from ..geometry.topology import constraint_edges, triangle_neighbors
+from ..geometry.topology import constraint_edges
 from .material import lame, parse_materials, stiffness_matrix
 from .solution import ElasticSolution
 
@@ -126,7 +126,7 @@ class Elasticity:
             Outward unit normals.
         """
         tri = self.model.triangles
-        edges, _ = constraint_edges(tri, triangle_neighbors(tri))
+        edges, _ = constraint_edges(tri, self.model.neighbors(across_regions=True))
         d = self.model.nodes[edges[:, 1]] - self.model.nodes[edges[:, 0]]
         normal = np.column_stack([d[:, 1], -d[:, 0]]) / np.linalg.norm(d, axis=1)[:, None]
         return edges, normal

@@ -8,7 +8,6 @@ import scipy.sparse as sp
 from .. import config
 from ..errors import CNEMError, GeometryError
 from ..spatial.rtree import RTree, work_chunks
-from ..geometry.topology import triangle_neighbors
 from . import _kernels as K
 
 __all__ = ["shape_functions", "KINDS"]
@@ -28,8 +27,7 @@ def _topology(model):
         tri = model.triangles
         corners = model.nodes[tri]
         tree = RTree(corners.min(axis=1), corners.max(axis=1))
-        cache["shape"] = (triangle_neighbors(tri, model.triangle_region),
-                          triangle_neighbors(tri), tree)
+        cache["shape"] = model.neighbors(), model.neighbors(across_regions=True), tree
     return cache["shape"]
 
 
