@@ -270,8 +270,9 @@ class BoundaryQuadrature:
         """The shape functions at the points (or at ``points[select]``), sides
         respected, rows in any order: returns ``(Phi, order)``, row ``r`` of ``Phi``
         at ``points[order[r]]`` (indices into the selection)."""
+        hint = self.hint if (self.hint >= 0).any() else None      # none on a crack face
         if select is None:
-            return model.shape_functions(self.points, triangles=self.hint, in_order=False)
+            return model.shape_functions(self.points, triangles=hint, in_order=False)
         return model.shape_functions(self.points[select], triangles=self.hint[select],
                                      in_order=False)
 

@@ -35,6 +35,7 @@ class Cells:
     vertices : (k, 2) ndarray
         Cell ``c`` is ``vertices[offsets[c]:offsets[c + 1]]`` (counter-clockwise).
     area : (m,) ndarray
+        By the shoelace formula unless given (a subset's, say).
     spokes : (k,) bool ndarray or None
         Fan sub-cells only (`cnem.assembly.subdivide`): the edge from vertex
         ``i`` to the next is a spoke, inside a model cell (integrated by its
@@ -52,10 +53,11 @@ class Cells:
     vertices: np.ndarray
     spokes: np.ndarray | None = None
     edge_source: np.ndarray | None = None
-    area: np.ndarray = field(init=False)
+    area: np.ndarray | None = None
 
     def __post_init__(self):
-        object.__setattr__(self, "area", self._moments()[0])
+        if self.area is None:
+            object.__setattr__(self, "area", self._moments()[0])
 
     def _moments(self):
         """Areas and centroids by the shoelace formula, relative to each cell's first
@@ -77,7 +79,8 @@ class Cells:
         verts = np.repeat(self.offsets[index] - offsets[:-1], counts) + np.arange(offsets[-1])
         return Cells(self.node[index], self.region[index], offsets, self.vertices[verts],
                      None if self.spokes is None else self.spokes[verts],
-                     None if self.edge_source is None else self.edge_source[verts])
+                     None if self.edge_source is None else self.edge_source[verts],
+                     self.area[index])
 
     def polygon(self, i):
         """Vertices of cell ``i``, ``(k, 2)``, counter-clockwise."""
