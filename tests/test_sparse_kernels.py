@@ -40,26 +40,40 @@ def test_weighted_gram_matches_scipy(c, nch):
 
 
 @pytest.mark.parametrize("nch", [1, 5])
-def test_boundary_sums_match_scipy(nch):
+@pytest.mark.parametrize("same_values", [False, True])
+def test_weighted_row_sums_match_scipy(nch, same_values):
+    """X = Wx @ P Vx and Y = Wy @ P Vy (P: rows given in another order), one pattern,
+    rows sorted; and the two steps of SCNI (points -> edges -> cells) give
+    to_cells @ W @ phi."""
     rng = np.random.default_rng(nch)
-    m, e, q, n = 12, 30, 90, 20
-    to_cells = _random_csr(rng, (m, e), 0.2)
-    pattern = _random_csr(rng, (e, q), 0.1)
+    m, q, n = 30, 90, 20
+    pattern = _random_csr(rng, (m, q), 0.1)
     wx = pattern.copy()
     wy = sp.csr_matrix((rng.uniform(-1, 1, pattern.nnz), pattern.indices, pattern.indptr),
                        shape=pattern.shape)
-    phi = _random_csr(rng, (q, n), 0.2)
-    order = rng.permutation(q)                     # point p is row where[p] of the values
+    vx = _random_csr(rng, (q, n), 0.2)
+    vy = vx.copy() if same_values else sp.csr_matrix(
+        (rng.uniform(-1, 1, vx.nnz), vx.indices, vx.indptr), shape=vx.shape)
+    order = rng.permutation(q)                     # item p is row where[p] of the values
     where = np.empty(q, dtype=np.int64)
     where[order] = np.arange(q)
-    values = phi[order]
-    indptr, indices, x, y = SK.boundary_sums(to_cells.indptr, to_cells.indices, to_cells.data,
-                                             wx.indptr, wx.indices, wx.data, wy.data,
-                                             values.indptr, values.indices, values.data, where,
-                                             n, nch)
-    for got, w in ((x, wx), (y, wy)):
-        B = sp.csr_matrix((got, indices, indptr), shape=(m, n))
-        np.testing.assert_allclose(B.toarray(), (to_cells @ w @ phi).toarray(), atol=1e-13)
+    indptr, indices, x, y = SK.weighted_row_sums(
+        wx.indptr, wx.indices, wx.data, wy.data, where, vx[order].indptr, vx[order].indices,
+        vx[order].data, vy[order].data, n, nch)
+    for got, w, v in ((x, wx, vx), (y, wy, vy)):
+        got = sp.csr_matrix((got, indices, indptr), shape=(m, n))
+        np.testing.assert_allclose(got.toarray(), (w @ v).toarray(), atol=1e-13)
+    assert all(np.all(np.diff(indices[indptr[i]:indptr[i + 1]]) > 0) for i in range(m))
+    # the second step: cells from edges
+    to_cells = _random_csr(rng, (12, m), 0.2)
+    ex = sp.csr_matrix((x, indices, indptr), shape=(m, n))
+    ey = sp.csr_matrix((y, indices, indptr), shape=(m, n))
+    indptr, indices, cx, cy = SK.weighted_row_sums(
+        to_cells.indptr, to_cells.indices, to_cells.data, to_cells.data, np.arange(m),
+        ex.indptr, ex.indices, ex.data, ey.data, n, nch)
+    for got, w, v in ((cx, wx, vx), (cy, wy, vy)):
+        got = sp.csr_matrix((got, indices, indptr), shape=(12, n))
+        np.testing.assert_allclose(got.toarray(), (to_cells @ w @ v).toarray(), atol=1e-13)
 
 
 @pytest.mark.parametrize("nch", [1, 3, 16])

@@ -42,46 +42,47 @@ def _sort_slots(indices, start, end, slot):
 
 
 @numba.njit(cache=True, parallel=True)
-def boundary_sums(cell_ptr, cell_edge, cell_sign, edge_ptr, edge_point, wx, wy,
-                  phi_ptr, phi_idx, phi_val, point_row, ncol, nch):
-    """``B~x = to_cells @ Wx @ Phi`` and ``B~y`` alike, as two CSR matrices with
-    one pattern.
+def weighted_row_sums(ptr, item, wx, wy, row_of, v_ptr, v_idx, vx, vy, ncol, nch):
+    """``X[i] = sum_p wx[p] Vx[row_of[item[p]]]`` over ``p`` in ``ptr[i]:ptr[i + 1]``,
+    and ``Y`` alike with ``wy``, ``Vy``: two CSR matrices with one pattern.
+
+    The boundary integrals of SCNI in two steps: the integral of every edge
+    from its points (weights times the normal, ``V`` the shape functions), then
+    that of every cell from its edges (``±1 / A_k``, ``V`` the edge integrals).
 
     Parameters
     ----------
-    cell_ptr, cell_edge, cell_sign : CSR (m, e)
-        The edges of every cell and ``±1 / A_k``.
-    edge_ptr, edge_point, wx, wy : CSR (e, q)
-        The quadrature points of every edge and their weights times the normal.
-    phi_ptr, phi_idx, phi_val : CSR (q, ncol)
-        Values at the points, row ``point_row[p]`` for point ``p``.
-    ncol : int
-    nch : int
-        Work chunks shared between threads.
+    ptr, item, wx, wy : CSR (m, r)
+        What each output row sums and with what weights.
+    row_of : (r,) int64
+        The row of ``V`` holding item ``r``.
+    v_ptr, v_idx : CSR pattern (r, ncol)
+        Of ``Vx`` and ``Vy`` (values ``vx``, ``vy``: the same array for both is fine).
+    ncol, nch : int
+        Columns; work chunks shared between threads.
 
     Returns
     -------
     indptr : (m + 1,) int64
     indices : (nnz,) int32
+        Sorted in every row.
     x, y : (nnz,) float64
     """
-    m = len(cell_ptr) - 1
+    m = len(ptr) - 1
     counts = np.zeros(m, dtype=np.int64)
     for ch in numba.prange(nch):
         mark = np.full(ncol, -1, dtype=np.int64)
         lo, hi = _chunk(ch, nch, m)
-        for c in range(lo, hi):
+        for i in range(lo, hi):
             count = 0
-            for ce in range(cell_ptr[c], cell_ptr[c + 1]):
-                e = cell_edge[ce]
-                for ep in range(edge_ptr[e], edge_ptr[e + 1]):
-                    r = point_row[edge_point[ep]]
-                    for k in range(phi_ptr[r], phi_ptr[r + 1]):
-                        j = phi_idx[k]
-                        if mark[j] != c:
-                            mark[j] = c
-                            count += 1
-            counts[c] = count
+            for p in range(ptr[i], ptr[i + 1]):
+                r = row_of[item[p]]
+                for k in range(v_ptr[r], v_ptr[r + 1]):
+                    j = v_idx[k]
+                    if mark[j] != i:
+                        mark[j] = i
+                        count += 1
+            counts[i] = count
     indptr = _offsets(counts)
     indices = np.empty(indptr[m], dtype=np.int32)
     x = np.empty(indptr[m])
@@ -89,27 +90,24 @@ def boundary_sums(cell_ptr, cell_edge, cell_sign, edge_ptr, edge_point, wx, wy,
     for ch in numba.prange(nch):
         slot = np.full(ncol, -1, dtype=np.int64)
         lo, hi = _chunk(ch, nch, m)
-        for c in range(lo, hi):
-            start = indptr[c]
+        for i in range(lo, hi):
+            start = indptr[i]
             end = start
-            for ce in range(cell_ptr[c], cell_ptr[c + 1]):
-                e = cell_edge[ce]
-                s = cell_sign[ce]
-                for ep in range(edge_ptr[e], edge_ptr[e + 1]):
-                    r = point_row[edge_point[ep]]
-                    sx, sy = s * wx[ep], s * wy[ep]
-                    for k in range(phi_ptr[r], phi_ptr[r + 1]):
-                        j = phi_idx[k]
-                        at = slot[j]
-                        if at < start:                  # first time in this row
-                            at = end
-                            slot[j] = at
-                            indices[at] = j
-                            x[at] = 0.0
-                            y[at] = 0.0
-                            end += 1
-                        x[at] += sx * phi_val[k]
-                        y[at] += sy * phi_val[k]
+            for p in range(ptr[i], ptr[i + 1]):
+                r = row_of[item[p]]
+                sx, sy = wx[p], wy[p]
+                for k in range(v_ptr[r], v_ptr[r + 1]):
+                    j = v_idx[k]
+                    at = slot[j]
+                    if at < start:                  # first time in this row
+                        at = end
+                        slot[j] = at
+                        indices[at] = j
+                        x[at] = 0.0
+                        y[at] = 0.0
+                        end += 1
+                    x[at] += sx * vx[k]
+                    y[at] += sy * vy[k]
             _sort_row(indices, x, y, start, end)
     return indptr, indices, x, y
 

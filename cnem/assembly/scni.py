@@ -246,25 +246,39 @@ class BoundaryQuadrature:
     def __init__(self, points, hint, wx, wy, to_cells):
         self.points, self.hint, self.wx, self.wy, self.to_cells = points, hint, wx, wy, to_cells
 
-    def cell_integrals(self, values, rows=None):
+    def cell_integrals(self, values, rows=None, edges=None):
         """``(1 / A_k) ∮_{Γ_k} f n dΓ`` for ``values = f(points)``, ``(q, ...)`` array or
         sparse ``(q, c)`` (then CSR results); returns the x and y parts, ``(m, ...)``.
-        ``rows``: the point of each row of ``values`` when they come in another order."""
-        where = np.arange(len(self.points))
-        if rows is not None:                   # point rows[r] is row r of values
-            where[rows] = np.arange(len(rows))
-        if not sp.issparse(values):
-            values = np.asarray(values)[where]
+        ``rows``: the point of each row of ``values`` when they come in another order.
+        ``edges``: `edge_integrals` of the same sparse values, if already known
+        (quadratures with the same points share them)."""
+        if edges is None and not sp.issparse(values):
+            values = np.asarray(values)[self._value_rows(rows)]
             return self.to_cells @ (self.wx @ values), self.to_cells @ (self.wy @ values)
+        ex, ey = self.edge_integrals(values, rows) if edges is None else edges
+        c = self.to_cells
+        return _csr_pair(*SK.weighted_row_sums(
+            c.indptr, c.indices, c.data, c.data, np.arange(c.shape[1], dtype=np.int64),
+            ex.indptr, ex.indices, ex.data, ey.data, ex.shape[1], work_chunks()),
+            (c.shape[0], ex.shape[1]))
+
+    def edge_integrals(self, values, rows=None):
+        """``∫_e f n dΓ`` of every distinct edge for sparse ``values = f(points)``
+        ``(q, c)`` (``rows`` as in `cell_integrals`): x and y parts, CSR ``(e, c)``
+        with one pattern."""
         phi = values.tocsr()
-        c, w = self.to_cells, self.wx
-        indptr, indices, x, y = SK.boundary_sums(
-            c.indptr, c.indices, c.data, w.indptr, w.indices, w.data, self.wy.data,
-            phi.indptr, phi.indices, phi.data, where, phi.shape[1], work_chunks())
-        shape = (c.shape[0], phi.shape[1])
-        # own index arrays: scipy may sort one matrix's indices in place
-        return sp.csr_matrix((x, indices, indptr), shape=shape), \
-            sp.csr_matrix((y, indices.copy(), indptr.copy()), shape=shape)
+        w = self.wx
+        return _csr_pair(*SK.weighted_row_sums(
+            w.indptr, w.indices, w.data, self.wy.data, self._value_rows(rows),
+            phi.indptr, phi.indices, phi.data, phi.data, phi.shape[1], work_chunks()),
+            (w.shape[0], phi.shape[1]))
+
+    def _value_rows(self, rows):
+        """The row of the values of every point (``rows[r]``: the point of row ``r``)."""
+        where = np.arange(len(self.points))
+        if rows is not None:
+            where[rows] = np.arange(len(rows))
+        return where
 
     def shape_functions(self, model, select=None):
         """The shape functions at the points (or at ``points[select]``), sides
@@ -275,6 +289,13 @@ class BoundaryQuadrature:
             return model.shape_functions(self.points, triangles=hint, in_order=False)
         return model.shape_functions(self.points[select], triangles=self.hint[select],
                                      in_order=False)
+
+
+def _csr_pair(indptr, indices, x, y, shape):
+    """Two CSR matrices on one pattern, each with its own index arrays (scipy may
+    sort one matrix's indices in place)."""
+    return sp.csr_matrix((x, indices, indptr), shape=shape), \
+        sp.csr_matrix((y, indices.copy(), indptr.copy()), shape=shape)
 
 
 def _graded_rule(s, w, start, end):
@@ -646,8 +667,10 @@ def _passes(model, quadratures, runs):
             parts = [[] for _ in run]
         quads = quadratures(run, index)
         phi, order = quads[0].shape_functions(model)
+        edges = quads[0].edge_integrals(phi, rows=order)
+        del phi
         for part, quad in zip(parts, quads):
-            part.append(quad.cell_integrals(phi, rows=order))
+            part.append(quad.cell_integrals(None, edges=edges))
         points += len(quads[0].points)
     return parts, points
 
@@ -665,6 +688,4 @@ def _place_runs(part, targets):
     for (x, y), target in zip(part, targets):
         SK.place_rows(x.indptr, x.indices, x.data, y.data, np.asarray(target, dtype=np.int64),
                       indptr, indices, vx, vy)
-    # own index arrays: scipy may sort one matrix's indices in place
-    return sp.csr_matrix((vx, indices, indptr), shape=(m, n)), \
-        sp.csr_matrix((vy, indices.copy(), indptr.copy()), shape=(m, n))
+    return _csr_pair(indptr, indices, vx, vy, (m, n))
