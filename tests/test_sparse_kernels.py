@@ -77,23 +77,29 @@ def test_weighted_row_sums_match_scipy(nch, same_values):
 
 
 @pytest.mark.parametrize("nch", [1, 3, 16])
-def test_gradient_block_gram_matches_scipy(nch):
-    """Vector operators spread from scalar gradients: K = Q^T W Q by 2 x 2 blocks."""
+@pytest.mark.parametrize("grouped", [False, True])
+def test_gradient_block_gram_matches_scipy(nch, grouped):
+    """Vector operators spread from scalar gradients: K = Q^T W Q by 2 x 2 blocks,
+    the couplings of a cell its weight times those of its group."""
     rng = np.random.default_rng(nch)
     m, n = 40, 25
     G = _random_csr(rng, (m, n), 0.2)
     gy = rng.uniform(-1, 1, G.nnz)
-    coeff = rng.uniform(-1, 1, (m, 4, 4))
+    count = 5 if grouped else m
+    coeff = rng.uniform(-1, 1, (count, 4, 4))
     coeff[:, 1, 2] = 0.0
+    group = rng.integers(0, count, m) if grouped else np.arange(m)
+    weight = rng.uniform(0.5, 2.0, m) if grouped else np.ones(m)
+    per_cell = weight[:, None, None] * coeff[group]
     # descriptor a = 2 c + d: component c, direction d, on dofs 2 j + c
     ops = []
     for c in range(2):
         for values in (G.data, gy):
             ops.append(sp.csr_matrix((values, G.indices * 2 + c, G.indptr), shape=(m, 2 * n)))
-    expected = sum((ops[b].T @ sp.diags(coeff[:, a, b]) @ ops[a]).toarray()
+    expected = sum((ops[b].T @ sp.diags(per_cell[:, a, b]) @ ops[a]).toarray()
                    for a in range(4) for b in range(4))
     indptr, indices, data = SK.gradient_block_gram(G.indptr, G.indices, G.data, gy, coeff,
-                                                   n, nch)
+                                                   group, weight, n, nch)
     K = sp.csr_matrix((data, indices, indptr), shape=(2 * n, 2 * n))
     np.testing.assert_allclose(K.toarray(), expected, atol=1e-13)
     for i in range(2 * n):                                 # sorted, no duplicates

@@ -221,7 +221,7 @@ def _transpose_pattern(ptr, idx, ncol):
 
 
 @numba.njit(cache=True, parallel=True)
-def gradient_block_gram(ptr, idx, gx, gy, coeff, ncol, nch):
+def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
     """``K`` of a vector form that sees only gradients, by 2 x 2 node blocks.
 
     The gradients of the two components are the scalar operators ``gx``,
@@ -232,9 +232,13 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, ncol, nch):
     ptr, idx : CSR pattern (m, ncol)
     gx, gy : (nnz,) float64
         Values of the x and y derivatives.
-    coeff : (m, 4, 4) float64
-        ``coeff[k, a, b]`` for trial descriptor ``a = 2 c + d`` (component ``c``,
-        direction ``d``) and test descriptor ``b``.
+    coeff : (G, 4, 4) float64
+        ``coeff[g, a, b]`` for trial descriptor ``a = 2 c + d`` (component ``c``,
+        direction ``d``) and test descriptor ``b``, in the cells of group ``g``.
+    group : (m,) int64
+        The group of every cell (``arange(m)``: one per cell).
+    weight : (m,) float64
+        Cell ``k`` couples by ``weight[k] * coeff[group[k]]`` (its area).
     ncol, nch : int
 
     Returns
@@ -287,10 +291,11 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, ncol, nch):
                     out_idx[row1 + 2 * q + c] = 2 * indices[q] + c
             for t in range(t_ptr[i], t_ptr[i + 1]):         # then their values
                 k = t_row[t]
-                gi0, gi1 = gx[t_pos[t]], gy[t_pos[t]]
+                gi0, gi1 = weight[k] * gx[t_pos[t]], weight[k] * gy[t_pos[t]]
+                c = group[k]
                 for r in range(2):                          # test component r
                     for a in range(4):
-                        v[r, a] = gi0 * coeff[k, a, 2 * r] + gi1 * coeff[k, a, 2 * r + 1]
+                        v[r, a] = gi0 * coeff[c, a, 2 * r] + gi1 * coeff[c, a, 2 * r + 1]
                 for p in range(ptr[k], ptr[k + 1]):
                     gj0, gj1 = gx[p], gy[p]
                     q = 2 * slot[idx[p]]

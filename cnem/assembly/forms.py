@@ -114,7 +114,7 @@ class BilinearForm(_Form):
             for b, vb in enumerate(units):
                 value = _coefficients(self.form(ua, vb, w), m, f"form {self.__name__}")
                 if np.any(value != 0.0):
-                    yield a, b, value if groups is None else value[groups]
+                    yield a, b, value
 
     def assemble(self, basis, *, groups=None, **kwargs):
         """Sparse matrix ``(N, N)`` (CSR).
@@ -132,23 +132,28 @@ class BilinearForm(_Form):
             Extras ``w`` of the form, per cell (or per group).
         """
         m, g = len(basis.dx), basis.ncomp             # descriptors g, g + 1, ...: gradients
-        # A_k D_ab(k), filled one descriptor pair at a time: gradient pairs in one array
-        grad_weights = np.zeros((m, 2 * g, 2 * g))
+        if groups is None:
+            group, count = np.arange(m), m
+        else:
+            group, count = _check_groups(groups, m, kwargs)
+        # D_ab per group (per cell without groups), one descriptor pair at a time:
+        # gradient pairs in one array, scaled by A_k where used
+        grad_coeff = np.zeros((count, 2 * g, 2 * g))
         other, active = {}, set()
         for a, b, value in self._nonzero_coefficients(basis, kwargs, groups):
             active.add((a, b))
             if a >= g and b >= g:
-                np.multiply(basis.dx, value, out=grad_weights[:, a - g, b - g])
+                grad_coeff[:, a - g, b - g] = value
             else:
-                other[a, b] = basis.dx * value
+                other[a, b] = basis.dx * value[group]
         if not active:
             return sp.csr_matrix((basis.N, basis.N))
         grads = basis.component_gradients() if basis.vector and not other else None
         if grads is not None:          # 2 x 2 node blocks from the scalar gradients
             gx, gy = grads
             indptr, indices, data = SK.gradient_block_gram(gx.indptr, gx.indices, gx.data,
-                                                           gy.data, grad_weights, basis.N // 2,
-                                                           work_chunks())
+                                                           gy.data, grad_coeff, group, basis.dx,
+                                                           basis.N // 2, work_chunks())
             return sp.csr_matrix((data, indices, indptr), shape=(basis.N, basis.N))
         ops = basis.operators
         used = sorted({a for a, _ in active} | {b for _, b in active})
@@ -158,7 +163,7 @@ class BilinearForm(_Form):
                 if (a, b) in other:
                     weights[:, i, j] = other[a, b]
                 elif a >= g and b >= g:
-                    weights[:, i, j] = grad_weights[:, a - g, b - g]
+                    weights[:, i, j] = basis.dx * grad_coeff[group, a - g, b - g]
         stack = sp.vstack([ops[d] for d in used], format="csr")
         t = stack.T.tocsr()
         indptr, indices, data = SK.weighted_gram(stack.indptr, stack.indices, stack.data,
