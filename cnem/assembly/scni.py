@@ -22,7 +22,7 @@ import shapely
 
 from .. import config
 from .._memory import release_free_memory
-from ..geometry.topology import circumcenters, constraint_edges
+from ..geometry.topology import constraint_edges
 from ..shape.natural import path_order
 from ..spatial.rtree import RTree, work_chunks
 from . import _fan_kernels as FK
@@ -80,17 +80,6 @@ def cell_edges(cells):
     return cell, cells.vertices, cells.vertices[nxt]
 
 
-def _circumcircles(model):
-    """Circumcentres ``(t, 2)``, squared radii ``(t,)`` and an R-tree of the
-    circumcircles' boxes of the model's triangles (cached on the model)."""
-    if "circumcircles" not in model._cache:
-        centre = circumcenters(model.nodes, model.triangles)
-        radius2 = ((model.nodes[model.triangles[:, 0]] - centre) ** 2).sum(axis=1)
-        radius = np.sqrt(radius2)[:, None]
-        model._cache["circumcircles"] = centre, radius2, RTree(centre - radius, centre + radius)
-    return model._cache["circumcircles"]
-
-
 def _pieces(model, a, b, whole=None, group=None):
     """Pieces of the edges between circumcircle crossings (``whole``: (e,) bool,
     edges left in one piece).
@@ -105,7 +94,7 @@ def _pieces(model, a, b, whole=None, group=None):
     t0, t1 : (q,) ndarray
         Piece ``i`` is ``t0[i] <= t <= t1[i]`` along edge ``edge[i]``.
     """
-    centre, radius2, tree = _circumcircles(model)
+    centre, radius2, tree = model.circumcircles()
     ne = len(a)
     cut = np.arange(ne) if whole is None else np.flatnonzero(~np.asarray(whole, dtype=bool))
     ca, cb = a[cut], b[cut]

@@ -13,7 +13,8 @@ from ._kernels import polygon_moments
 from .cells import voronoi_cells
 from .cloud import NodeCloud
 from .cracks import split_cracks
-from .topology import cut_between_regions, triangle_neighbors
+from ..spatial.rtree import RTree
+from .topology import circumcenters, cut_between_regions, triangle_neighbors
 
 from .triangulation import constrained_delaunay
 
@@ -142,6 +143,18 @@ class Model:
             every = triangle_neighbors(self.triangles)
             self._cache["neighbors"] = cut_between_regions(every, self.triangle_region), every
         return self._cache["neighbors"][1 if across_regions else 0]
+
+    def circumcircles(self):
+        """The circumcircles of the triangles: centres ``(t, 2)``, squared radii
+        ``(t,)`` and an R-tree over their boxes (which also holds every triangle:
+        point location). Cached."""
+        if "circumcircles" not in self._cache:
+            centre = circumcenters(self.nodes, self.triangles)
+            radius2 = ((self.nodes[self.triangles[:, 0]] - centre) ** 2).sum(axis=1)
+            radius = np.sqrt(radius2)[:, None]
+            self._cache["circumcircles"] = centre, radius2, RTree(centre - radius,
+                                                                  centre + radius)
+        return self._cache["circumcircles"]
 
     def shape_functions(self, points, *, kind="sibson", triangles=None, gradient=False,
                         in_order=True):

@@ -7,7 +7,7 @@ import scipy.sparse as sp
 
 from .. import config
 from ..errors import CNEMError, GeometryError
-from ..spatial.rtree import RTree, work_chunks
+from ..spatial.rtree import work_chunks
 from . import _kernels as K
 
 __all__ = ["shape_functions", "KINDS"]
@@ -17,18 +17,6 @@ KINDS = ("sibson", "laplace")
 #: Room per point for the rows written chunk by chunk (doubled when a chunk overflows;
 #: points have about 5-6 natural neighbours on average).
 ROW_SLOTS = 8
-
-
-def _topology(model):
-    """Neighbours cut across constraints, all neighbours (for walking) and an R-tree
-    over the triangles, cached on the model."""
-    cache = model._cache
-    if "shape" not in cache:
-        tri = model.triangles
-        corners = model.nodes[tri]
-        tree = RTree(corners.min(axis=1), corners.max(axis=1))
-        cache["shape"] = model.neighbors(), model.neighbors(across_regions=True), tree
-    return cache["shape"]
 
 
 def path_order(pts, bounds, per_tile=4):
@@ -57,8 +45,9 @@ def path_order(pts, bounds, per_tile=4):
 
 def _locate_sorted(model, spts, tol):
     """A triangle holding each of the path-ordered points ``spts`` (-1 outside):
-    a walk from each point to the next, the R-tree where the walk cannot go."""
-    nb, nb_all, tree = _topology(model)
+    a walk from each point to the next, the R-tree of the circumcircles (each
+    holds its triangle) where the walk cannot go."""
+    nb_all, tree = model.neighbors(across_regions=True), model.circumcircles()[2]
     nch = work_chunks()
     starts = (np.arange(nch) * len(spts)) // nch
     off, idx = tree.query(spts[starts] - tol, spts[starts] + tol)
@@ -120,7 +109,7 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
     if len(pts) == 0:
         empty = sp.csr_matrix((0, n))
         return (empty, empty.copy(), empty.copy()) if gradient else empty
-    nb = _topology(model)[0]
+    nb = model.neighbors()
     tol = config.SHAPE_TOL * model.domain.diameter
     order = path_order(pts, model.domain.bounds)
     spts = K.gather_rows(pts, order)
