@@ -21,11 +21,11 @@ one side after the other; every run redoes every stage from the node cloud (resp
 nothing), so nothing cached by one run serves the next:
 
 * C-NEM ``model``: ``cnem.discretize(cloud)``;
-* C-NEM ``B~``: the smoothed gradients on a model whose ``_cache`` is empty (cleared), so
-  it includes the model's once-per-model shape-function setup (R-tree, neighbour table)
-  that it triggers: ``cnem.assembly.scni.fan_gradient(model)`` (B~ of the cells and of
-  their fan sub-cells, for the default stabilisation), ``smoothed_gradient(model)`` with
-  ``--stabilization 0``;
+* C-NEM ``B~``: the smoothed gradients on a model whose ``_cache`` is cleared but for the
+  triangle-neighbour table ``discretize`` leaves there, so it includes the once-per-model
+  setup it triggers (the circumcircles and their R-tree):
+  ``cnem.assembly.scni.fan_gradient(model)`` (B~ of the cells and of their fan sub-cells,
+  for the default stabilisation), ``smoothed_gradient(model)`` with ``--stabilization 0``;
 * C-NEM ``K``: ``Elasticity(...).stiffness()`` with the gradients already cached: the cell
   bases, their operators and the assembly of K;
 * skfem ``mesh``, ``basis``, ``K``: ``MeshTri.init_tensor``, ``Basis(...)`` and
@@ -178,7 +178,8 @@ def cnem_pipeline(cloud, run):
     from cnem.assembly.scni import fan_gradient
 
     model = staged(run, "model", lambda: cnem.discretize(cloud, progress=False))
-    model._cache.clear()
+    for key in [key for key in model._cache if key != "neighbors"]:    # built by discretize
+        del model._cache[key]
     # the smoothed gradients Elasticity needs: with the stabilisation those of the fan
     # sub-cells too, computed with the cells' (one set of shape-function values)
     staged(run, "B~", lambda: fan_gradient(model) if CLOUD["stabilization"] > 0

@@ -28,9 +28,9 @@ with two threads.  Each child
 2. builds the model (``discretize`` runs with numba's default thread count and is timed on
    its own; it is *not* part of the rate);
 3. sets the thread count and calls ``model.shape_functions(points[:10])`` once: the first
-   call on a model builds the cached R-tree over the triangles and the triangle-neighbour
-   table; this once-per-model ``setup`` time is reported on its own and excluded from the
-   rate;
+   call on a model builds the cached R-tree over the circumcircles (point location; the
+   triangle-neighbour table comes with the model from ``discretize``); this once-per-model
+   ``setup`` time is reported on its own and excluded from the rate;
 4. times ``model.shape_functions(points)`` (``kind="sibson"``, values only, a
    ``scipy.sparse.csr_matrix``) ``--repeat`` times; rate = query points / median time.
 
@@ -330,8 +330,8 @@ def report(results, args):
         print(f"numba warmed up in each cnem child (tiny model of the same domain, shape functions "
               f"at {WARMUP_POINTS} points) before timing: compile time excluded "
               f"(warm-up {first['warmup']:.2f} s)")
-    print(f"setup = first call on a model ({SETUP_POINTS} points: builds the cached R-tree and "
-          f"neighbour table), excluded from the rates; discretize timed apart, not counted")
+    print(f"setup = first call on a model ({SETUP_POINTS} points: builds the cached R-tree of the "
+          f"circumcircles), excluded from the rates; discretize timed apart, not counted")
     marks = any(ok(r[k]) and not r[k]["reset"] for r in results for k in ("1T", "2T"))
     print("peak MB = VmHWM of the measurement's own fresh child; cnem: reset after discretize "
           "(model + points + shape-function calls)" + ("; * = not reset, whole child" if marks

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 import cases
 from cnem.assembly import cell_edges, smoothed_gradient
@@ -244,3 +245,22 @@ def test_fan_quadratures_take_the_sub_cells_edges_from_their_cells(name, node_ap
         on_vertex = [any((apex[s] == cells.polygon(c)).all(axis=1))
                      for s, c in enumerate(parent) if sub.spokes[sub.offsets[s]:sub.offsets[s + 1]].any()]
         assert any(on_vertex)
+
+
+@pytest.mark.parametrize("name", ["edge_crack_regular", "three_rectangles_irregular"])
+def test_edge_integrals_from_point_rows_or_a_matrix(name):
+    """The edge integrals from the kernel's rows (`point_rows`) equal those from the
+    shape-function matrix, and the cells' integrals from them equal the direct
+    ``to_cells @ W @ Phi``."""
+    from cnem.assembly.scni import boundary_quadrature
+    _, _, model = cases.model(name)
+    quad = boundary_quadrature(model)
+    phi, order = quad.shape_functions(model)
+    ex, ey = quad.edge_integrals(phi, rows=order)
+    rx, ry = quad.edge_integrals(quad.point_rows(model))
+    for a, b in ((ex, rx), (ey, ry)):
+        np.testing.assert_array_equal(a.toarray(), b.toarray())
+    in_points = sp.csr_matrix(phi)[np.argsort(order)]
+    for got, w in zip(quad.cell_integrals(None, edges=(rx, ry)), (quad.wx, quad.wy)):
+        direct = (quad.to_cells @ w @ in_points).toarray()
+        np.testing.assert_allclose(got.toarray(), direct, atol=1e-13 * abs(direct).max())

@@ -455,3 +455,19 @@ def test_gradients_refused_at_nodes_and_on_constraints():
         model.shape_functions(model.nodes[:3], gradient=True)
     with pytest.raises(NotImplementedError, match="sibson"):
         model.shape_functions(model.nodes[:1], kind="laplace", gradient=True)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_point_rows_hold_the_shape_functions(name):
+    """`point_rows` (the kernel's layout, rows in visit order) holds the rows of
+    `shape_functions` for the same points."""
+    from cnem.shape.natural import point_rows
+    _, _, model = cases.model(name)
+    pts = interior_points(name, 60, seed=11)
+    phi = model.shape_functions(pts).toarray()
+    rows = point_rows(model, pts)
+    assert rows.nodes == len(model.nodes) and sorted(rows.order) == list(range(len(pts)))
+    got = np.zeros_like(phi)
+    for s, p in enumerate(rows.order):
+        got[p, rows.cols[rows.start[s]:rows.end[s]]] = rows.vals[rows.start[s]:rows.end[s]]
+    np.testing.assert_array_equal(got, phi)

@@ -57,9 +57,10 @@ def test_weighted_row_sums_match_scipy(nch, same_values):
     order = rng.permutation(q)                     # item p is row where[p] of the values
     where = np.empty(q, dtype=np.int64)
     where[order] = np.arange(q)
+    px, py = vx[order], vy[order]
     indptr, indices, x, y = SK.weighted_row_sums(
-        wx.indptr, wx.indices, wx.data, wy.data, where, vx[order].indptr, vx[order].indices,
-        vx[order].data, vy[order].data, n, nch)
+        wx.indptr, wx.indices, wx.data, wy.data, where, px.indptr[:-1], px.indptr[1:],
+        px.indices, px.data, py.data, n, nch)
     for got, w, v in ((x, wx, vx), (y, wy, vy)):
         got = sp.csr_matrix((got, indices, indptr), shape=(m, n))
         np.testing.assert_allclose(got.toarray(), (w @ v).toarray(), atol=1e-13)
@@ -70,7 +71,7 @@ def test_weighted_row_sums_match_scipy(nch, same_values):
     ey = sp.csr_matrix((y, indices, indptr), shape=(m, n))
     indptr, indices, cx, cy = SK.weighted_row_sums(
         to_cells.indptr, to_cells.indices, to_cells.data, to_cells.data, np.arange(m),
-        ex.indptr, ex.indices, ex.data, ey.data, n, nch)
+        ex.indptr[:-1], ex.indptr[1:], ex.indices, ex.data, ey.data, n, nch)
     for got, w, v in ((cx, wx, vx), (cy, wy, vy)):
         got = sp.csr_matrix((got, indices, indptr), shape=(12, n))
         np.testing.assert_allclose(got.toarray(), (to_cells @ w @ v).toarray(), atol=1e-13)

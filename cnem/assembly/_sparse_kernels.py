@@ -42,7 +42,7 @@ def _sort_slots(indices, start, end, slot):
 
 
 @numba.njit(cache=True, parallel=True)
-def weighted_row_sums(ptr, item, wx, wy, row_of, v_ptr, v_idx, vx, vy, ncol, nch):
+def weighted_row_sums(ptr, item, wx, wy, row_of, v_start, v_end, v_idx, vx, vy, ncol, nch):
     """``X[i] = sum_p wx[p] Vx[row_of[item[p]]]`` over ``p`` in ``ptr[i]:ptr[i + 1]``,
     and ``Y`` alike with ``wy``, ``Vy``: two CSR matrices with one pattern.
 
@@ -56,8 +56,10 @@ def weighted_row_sums(ptr, item, wx, wy, row_of, v_ptr, v_idx, vx, vy, ncol, nch
         What each output row sums and with what weights.
     row_of : (r,) int64
         The row of ``V`` holding item ``r``.
-    v_ptr, v_idx : CSR pattern (r, ncol)
-        Of ``Vx`` and ``Vy`` (values ``vx``, ``vy``: the same array for both is fine).
+    v_start, v_end, v_idx : (rows,) int64, (rows,) int64, (k,) int
+        The pattern of ``Vx`` and ``Vy``: row ``s`` at ``v_idx[v_start[s]:v_end[s]]``
+        (CSR: ``indptr[:-1]``, ``indptr[1:]``), values ``vx``, ``vy`` (the same
+        array for both is fine).
     ncol, nch : int
         Columns; work chunks shared between threads.
 
@@ -77,7 +79,7 @@ def weighted_row_sums(ptr, item, wx, wy, row_of, v_ptr, v_idx, vx, vy, ncol, nch
             count = 0
             for p in range(ptr[i], ptr[i + 1]):
                 r = row_of[item[p]]
-                for k in range(v_ptr[r], v_ptr[r + 1]):
+                for k in range(v_start[r], v_end[r]):
                     j = v_idx[k]
                     if mark[j] != i:
                         mark[j] = i
@@ -96,7 +98,7 @@ def weighted_row_sums(ptr, item, wx, wy, row_of, v_ptr, v_idx, vx, vy, ncol, nch
             for p in range(ptr[i], ptr[i + 1]):
                 r = row_of[item[p]]
                 sx, sy = wx[p], wy[p]
-                for k in range(v_ptr[r], v_ptr[r + 1]):
+                for k in range(v_start[r], v_end[r]):
                     j = v_idx[k]
                     at = slot[j]
                     if at < start:                  # first time in this row

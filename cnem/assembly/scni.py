@@ -23,7 +23,7 @@ import shapely
 from .. import config
 from .._memory import release_free_memory
 from ..geometry.topology import constraint_edges
-from ..shape.natural import path_order
+from ..shape.natural import PointRows, path_order, point_rows
 from ..spatial.rtree import RTree, work_chunks
 from . import _fan_kernels as FK
 from . import _kernels as K
@@ -248,19 +248,33 @@ class BoundaryQuadrature:
         c = self.to_cells
         return _csr_pair(*SK.weighted_row_sums(
             c.indptr, c.indices, c.data, c.data, np.arange(c.shape[1], dtype=np.int64),
-            ex.indptr, ex.indices, ex.data, ey.data, ex.shape[1], work_chunks()),
-            (c.shape[0], ex.shape[1]))
+            ex.indptr[:-1], ex.indptr[1:], ex.indices, ex.data, ey.data, ex.shape[1],
+            work_chunks()), (c.shape[0], ex.shape[1]))
 
     def edge_integrals(self, values, rows=None):
         """``∫_e f n dΓ`` of every distinct edge for sparse ``values = f(points)``
-        ``(q, c)`` (``rows`` as in `cell_integrals`): x and y parts, CSR ``(e, c)``
-        with one pattern."""
-        phi = values.tocsr()
+        ``(q, c)`` (``rows`` as in `cell_integrals`), or for the shape functions
+        as `point_rows` gives them: x and y parts, CSR ``(e, c)`` with one pattern."""
+        if isinstance(values, PointRows):
+            start, end, cols, vals = values.start, values.end, values.cols, values.vals
+            where, ncol = self._value_rows(values.order), values.nodes
+        else:
+            phi = values.tocsr()
+            start, end, cols, vals = phi.indptr[:-1], phi.indptr[1:], phi.indices, phi.data
+            where, ncol = self._value_rows(rows), phi.shape[1]
         w = self.wx
         return _csr_pair(*SK.weighted_row_sums(
-            w.indptr, w.indices, w.data, self.wy.data, self._value_rows(rows),
-            phi.indptr, phi.indices, phi.data, phi.data, phi.shape[1], work_chunks()),
-            (w.shape[0], phi.shape[1]))
+            w.indptr, w.indices, w.data, self.wy.data, where, start, end, cols, vals, vals,
+            ncol, work_chunks()), (w.shape[0], ncol))
+
+    def point_rows(self, model):
+        """The shape functions at the points, sides respected, as `point_rows` leaves
+        them (for `edge_integrals`)."""
+        return point_rows(model, self.points, triangles=self._hint())
+
+    def _hint(self):
+        """The points' triangles where they matter (crack faces), else None."""
+        return self.hint if (self.hint >= 0).any() else None
 
     def _value_rows(self, rows):
         """The row of the values of every point (``rows[r]``: the point of row ``r``)."""
@@ -273,11 +287,11 @@ class BoundaryQuadrature:
         """The shape functions at the points (or at ``points[select]``), sides
         respected, rows in any order: returns ``(Phi, order)``, row ``r`` of ``Phi``
         at ``points[order[r]]`` (indices into the selection)."""
-        hint = self.hint if (self.hint >= 0).any() else None      # none on a crack face
+        hint = self._hint()
         if select is None:
             return model.shape_functions(self.points, triangles=hint, in_order=False)
-        return model.shape_functions(self.points[select], triangles=self.hint[select],
-                                     in_order=False)
+        return model.shape_functions(self.points[select], in_order=False,
+                                     triangles=None if hint is None else hint[select])
 
 
 def _csr_pair(indptr, indices, x, y, shape):
@@ -590,8 +604,10 @@ def fan_gradient(model, *, gauss=2, release=False):
             local = place[parent[index[1]]]
         return fan_quadratures(model, *sets, local, gauss=gauss)
 
-    grads = _gradients(model, [cells, sub], quadratures, passes)
-    model._cache.setdefault(("scni", int(gauss)), grads[0])
+    have_cells = ("scni", int(gauss)) in model._cache
+    grads = _gradients(model, [cells, sub], quadratures, passes, wanted=[not have_cells, True])
+    if not have_cells:
+        model._cache[("scni", int(gauss))] = grads[0]
     if not release:
         model._cache[key] = sub, grads[1]
     return sub, grads[1]
@@ -615,7 +631,7 @@ def _cell_runs(model, cells):
     return [order[lo:lo + size] for lo in range(0, m, size)]
 
 
-def _gradients(model, sets, quadratures, runs=None):
+def _gradients(model, sets, quadratures, runs=None, wanted=None):
     """Smoothed gradients of several sets of cells, pass by pass.
 
     Parameters
@@ -628,38 +644,44 @@ def _gradients(model, sets, quadratures, runs=None):
     runs : list of lists of (r,) int arrays, optional
         For each pass, the cells of every set it takes (the runs of a set cover
         it once); by default one pass takes them all.
+    wanted : list of bool, optional
+        The sets whose gradients are computed (default all; the others only
+        serve the quadrature of the rest).
 
     Returns
     -------
-    list of SmoothedGradient
-        One per set.
+    list of SmoothedGradient or None
+        One per set (None where not wanted).
     """
+    wanted = [True] * len(sets) if wanted is None else wanted
     if runs is None:
-        parts, points = _passes(model, quadratures, [(sets, None)])
-        return [SmoothedGradient(*part[0], points) for part in parts]
+        parts, points = _passes(model, quadratures, [(sets, None)], wanted)
+        return [SmoothedGradient(*part[0], points) if want else None
+                for part, want in zip(parts, wanted)]
     # a generator: one pass's cells alive at a time
     parts, points = _passes(model, quadratures,
-                            (([cells.subset(i) for cells, i in zip(sets, run)], run) for run in runs))
+                            (([cells.subset(i) for cells, i in zip(sets, run)], run) for run in runs),
+                            wanted)
     out = [SmoothedGradient(*_place_runs(parts[i], [run[i] for run in runs]), points)
-           for i in range(len(sets))]
+           if wanted[i] else None for i in range(len(sets))]
     del parts                # the passes' arrays are freed, but the C heap keeps them
     release_free_memory()
     return out
 
 
-def _passes(model, quadratures, runs):
-    """The cell integrals of every run ``(subsets, index)``: ``parts[set][run] = (x, y)``,
-    and the number of quadrature points (the runs' cells are dropped pass by pass)."""
+def _passes(model, quadratures, runs, wanted):
+    """The cell integrals of every run ``(subsets, index)``: ``parts[set][run] = (x, y)``
+    (for the ``wanted`` sets), and the number of quadrature points (the runs' cells
+    are dropped pass by pass)."""
     parts, points = None, 0
     for run, index in runs:
         if parts is None:
             parts = [[] for _ in run]
         quads = quadratures(run, index)
-        phi, order = quads[0].shape_functions(model)
-        edges = quads[0].edge_integrals(phi, rows=order)
-        del phi
-        for part, quad in zip(parts, quads):
-            part.append(quad.cell_integrals(None, edges=edges))
+        edges = quads[0].edge_integrals(quads[0].point_rows(model))
+        for part, quad, want in zip(parts, quads, wanted):
+            if want:
+                part.append(quad.cell_integrals(None, edges=edges))
         points += len(quads[0].points)
     return parts, points
 

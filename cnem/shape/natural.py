@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -10,7 +12,7 @@ from ..errors import CNEMError, GeometryError
 from ..spatial.rtree import work_chunks
 from . import _kernels as K
 
-__all__ = ["shape_functions", "KINDS"]
+__all__ = ["shape_functions", "point_rows", "PointRows", "KINDS"]
 
 KINDS = ("sibson", "laplace")
 
@@ -109,6 +111,57 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
     if len(pts) == 0:
         empty = sp.csr_matrix((0, n))
         return (empty, empty.copy(), empty.copy()) if gradient else empty
+    order, start, size, cols, vals, gx, gy, kinds = _coordinates(model, pts, kind, triangles,
+                                                                 gradient)
+    rows = np.arange(len(pts), dtype=np.int64) if not in_order and not gradient else order
+    offsets, cols, vals, gx, gy = K.permute_rows(start, size, cols, vals, gx, gy, rows)
+    if not in_order and not gradient:
+        return sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n)), order
+    phi = sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n))
+    if not gradient:
+        return phi
+    singular = np.sort(order[kinds != K.CAVITY])
+    if singular.size:
+        raise GeometryError(
+            f"{singular.size} points lie at a node or on a boundary, interface or crack "
+            f"segment, where the gradients are not defined, first {pts[singular[:3]].tolist()}; "
+            "evaluate gradients inside the cells")
+    # own index arrays: scipy may sort one matrix's indices in place
+    return (phi, sp.csr_matrix((gx, cols.copy(), offsets.copy()), shape=phi.shape),
+            sp.csr_matrix((gy, cols.copy(), offsets.copy()), shape=phi.shape))
+
+
+class PointRows(NamedTuple):
+    """Coordinates of points as computed, row by row in the order the points were
+    visited (no CSR matrix built): point ``order[s]`` has the values
+    ``vals[start[s]:end[s]]`` at the nodes ``cols[start[s]:end[s]]``, of
+    ``nodes`` nodes."""
+
+    start: np.ndarray
+    end: np.ndarray
+    cols: np.ndarray
+    vals: np.ndarray
+    order: np.ndarray
+    nodes: int
+
+
+def point_rows(model, points, *, kind="sibson", triangles=None):
+    """`shape_functions` of many points left in the layout the kernel writes them,
+    for consumers that read the rows one by one (points as in `shape_functions`,
+    already validated: ``(p, 2)`` float64, finite, ``p > 0``).
+
+    Returns
+    -------
+    PointRows
+    """
+    pts = np.ascontiguousarray(points, dtype=np.float64)
+    order, start, size, cols, vals, _, _, _ = _coordinates(model, pts, kind, triangles, False)
+    return PointRows(start, start + size, cols, vals, order, len(model.nodes))
+
+
+def _coordinates(model, pts, kind, triangles, gradient):
+    """The kernel's rows for ``(p, 2)`` points (``p > 0``), in visit order ``order``:
+    ``(order, start, size, cols, vals, gx, gy, kinds)`` (see `K.natural`)."""
     nb = model.neighbors()
     tol = config.SHAPE_TOL * model.domain.diameter
     order = path_order(pts, model.domain.bounds)
@@ -147,19 +200,4 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
         raise CNEMError(
             f"the natural-neighbour cavity of {failed.size} points was inconsistent (round-off "
             f"on a circumcircle), first {pts[failed[:3]].tolist()}; please report this case")
-    rows = np.arange(len(pts), dtype=np.int64) if not in_order and not gradient else order
-    offsets, cols, vals, gx, gy = K.permute_rows(start, size, cols, vals, gx, gy, rows)
-    if not in_order and not gradient:
-        return sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n)), order
-    phi = sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n))
-    if not gradient:
-        return phi
-    singular = np.sort(order[kinds != K.CAVITY])
-    if singular.size:
-        raise GeometryError(
-            f"{singular.size} points lie at a node or on a boundary, interface or crack "
-            f"segment, where the gradients are not defined, first {pts[singular[:3]].tolist()}; "
-            "evaluate gradients inside the cells")
-    # own index arrays: scipy may sort one matrix's indices in place
-    return (phi, sp.csr_matrix((gx, cols.copy(), offsets.copy()), shape=phi.shape),
-            sp.csr_matrix((gy, cols.copy(), offsets.copy()), shape=phi.shape))
+    return order, start, size, cols, vals, gx, gy, kinds
