@@ -9,7 +9,7 @@ import scipy.sparse as sp
 
 from .. import config
 from ..errors import CNEMError, GeometryError
-from ..spatial.rtree import work_chunks
+from ..spatial.rtree import RTree, work_chunks
 from . import _kernels as K
 
 __all__ = ["shape_functions", "point_rows", "PointRows", "KINDS"]
@@ -47,19 +47,29 @@ def path_order(pts, bounds, per_tile=4):
 
 def _locate_sorted(model, spts, tol):
     """A triangle holding each of the path-ordered points ``spts`` (-1 outside):
-    a walk from each point to the next, the R-tree of the circumcircles (each
-    holds its triangle) where the walk cannot go."""
-    nb_all, tree = model.neighbors(across_regions=True), model.circumcircles()[2]
+    a walk from each point to the next, started from a few points found with the
+    R-tree of the circumcircles (each holds its triangle); an R-tree of the
+    triangles for the points the walk cannot reach (across holes and cracks)."""
+    nb_all = model.neighbors(across_regions=True)
     nch = work_chunks()
     starts = (np.arange(nch) * len(spts)) // nch
-    off, idx = tree.query(spts[starts] - tol, spts[starts] + tol)
+    off, idx = model.circumcircles()[2].query(spts[starts] - tol, spts[starts] + tol)
     seeds = K.locate(model.nodes, model.triangles, spts[starts], off, idx, tol)
     tri_of = K.locate_walk(model.nodes, model.triangles, nb_all, spts, seeds, nch)
     lost = np.flatnonzero(tri_of < 0)
     if lost.size:
-        off, idx = tree.query(spts[lost] - tol, spts[lost] + tol)
+        off, idx = _triangle_tree(model).query(spts[lost] - tol, spts[lost] + tol)
         tri_of[lost] = K.locate(model.nodes, model.triangles, spts[lost], off, idx, tol)
     return tri_of
+
+
+def _triangle_tree(model):
+    """An R-tree over the boxes of the model's triangles (cached): tighter than the
+    circumcircles' for many points."""
+    if "triangle tree" not in model._cache:
+        corners = model.nodes[model.triangles]
+        model._cache["triangle tree"] = RTree(corners.min(axis=1), corners.max(axis=1))
+    return model._cache["triangle tree"]
 
 
 def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=False,
