@@ -29,8 +29,8 @@ from . import _fan_kernels as FK
 from . import _kernels as K
 from . import _sparse_kernels as SK
 
-__all__ = ["SmoothedGradient", "smoothed_gradient", "fan_gradient", "BoundaryQuadrature",
-           "boundary_quadrature", "boundary_quadratures", "cell_edges"]
+__all__ = ["SmoothedGradient", "smoothed_gradient", "fan_gradient", "fan_quadratures",
+           "BoundaryQuadrature", "boundary_quadrature", "boundary_quadratures", "cell_edges"]
 
 log = logging.getLogger(__name__)
 
