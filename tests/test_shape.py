@@ -471,3 +471,37 @@ def test_point_rows_hold_the_shape_functions(name):
     for s, p in enumerate(rows.order):
         got[p, rows.cols[rows.start[s]:rows.end[s]]] = rows.vals[rows.start[s]:rows.end[s]]
     np.testing.assert_array_equal(got, phi)
+
+
+def test_point_rows_and_unordered_rows_of_no_points_and_bad_kinds():
+    """No points: empty rows (and the unordered matrix comes with its empty order);
+    an unknown kind is refused like `shape_functions` does."""
+    from cnem.shape.natural import point_rows
+    _, _, model = cases.model("square_irregular")
+    rows = point_rows(model, np.zeros((0, 2)))
+    assert len(rows.order) == len(rows.start) == len(rows.end) == 0
+    assert rows.nodes == len(model.nodes)
+    phi, order = model.shape_functions(np.zeros((0, 2)), in_order=False)
+    assert phi.shape == (0, len(model.nodes)) and len(order) == 0
+    with pytest.raises(ValueError, match="kind must be one of"):
+        point_rows(model, np.array([[0.5, 0.5]]), kind="linear")
+    with pytest.raises(cnem.GeometryError, match=r"\(p, 2\)"):
+        point_rows(model, np.array([0.5, 0.5]))
+
+
+@pytest.mark.parametrize("name", ["kinked_crack_irregular", "graded_inclined_crack",
+                                  "plate_hole_irregular"])
+def test_points_the_walks_miss_are_found_by_either_tree(name, monkeypatch):
+    """Unsorted points across cracks and holes, where walks stop: located with the
+    circumcircles' R-tree or with one of the triangles, the same shape functions."""
+    from cnem.shape import natural
+    _, _, model = cases.model(name)
+    pts = interior_points(name, 400, seed=5)
+    results, built = [], []
+    for fraction in (np.inf, 0.0):
+        monkeypatch.setattr(natural, "TRIANGLE_TREE_AFTER", fraction)
+        model._cache.pop("triangle tree", None)
+        results.append(model.shape_functions(pts).toarray())
+        built.append("triangle tree" in model._cache)
+    np.testing.assert_array_equal(*results)
+    assert built == [False, True]            # some walks did stop, and each tree served

@@ -56,10 +56,10 @@ def weighted_row_sums(ptr, item, wx, wy, row_of, v_start, v_end, v_idx, vx, vy, 
         What each output row sums and with what weights.
     row_of : (r,) int64
         The row of ``V`` holding item ``r``.
-    v_start, v_end, v_idx : (rows,) int64, (rows,) int64, (k,) int
+    v_start, v_end, v_idx : (rows,) int64, (rows,) int64, (k,) int32
         The pattern of ``Vx`` and ``Vy``: row ``s`` at ``v_idx[v_start[s]:v_end[s]]``
-        (CSR: ``indptr[:-1]``, ``indptr[1:]``), values ``vx``, ``vy`` (the same
-        array for both is fine).
+        (CSR: ``indptr[:-1]``, ``indptr[1:]`` as int64), values ``vx``, ``vy`` (the
+        same array for both is fine).
     ncol, nch : int
         Columns; work chunks shared between threads.
 

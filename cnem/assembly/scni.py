@@ -248,7 +248,7 @@ class BoundaryQuadrature:
         c = self.to_cells
         return _csr_pair(*SK.weighted_row_sums(
             c.indptr, c.indices, c.data, c.data, np.arange(c.shape[1], dtype=np.int64),
-            ex.indptr[:-1], ex.indptr[1:], ex.indices, ex.data, ey.data, ex.shape[1],
+            *_row_bounds(ex.indptr), ex.indices, ex.data, ey.data, ex.shape[1],
             work_chunks()), (c.shape[0], ex.shape[1]))
 
     def edge_integrals(self, values, rows=None):
@@ -260,7 +260,7 @@ class BoundaryQuadrature:
             where, ncol = self._value_rows(values.order), values.nodes
         else:
             phi = values.tocsr()
-            start, end, cols, vals = phi.indptr[:-1], phi.indptr[1:], phi.indices, phi.data
+            (start, end), cols, vals = _row_bounds(phi.indptr), phi.indices, phi.data
             where, ncol = self._value_rows(rows), phi.shape[1]
         w = self.wx
         return _csr_pair(*SK.weighted_row_sums(
@@ -292,6 +292,12 @@ class BoundaryQuadrature:
             return model.shape_functions(self.points, triangles=hint, in_order=False)
         return model.shape_functions(self.points[select], in_order=False,
                                      triangles=None if hint is None else hint[select])
+
+
+def _row_bounds(indptr):
+    """Starts and ends of the rows of a CSR matrix, as int64 (one kernel signature)."""
+    indptr = np.asarray(indptr, dtype=np.int64)
+    return indptr[:-1], indptr[1:]
 
 
 def _csr_pair(indptr, indices, x, y, shape):

@@ -263,8 +263,8 @@ def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace, gr
 
     Each chunk of points writes its rows one after the other into its own
     region of the output, ``slots`` entries per point (the rows are moved to
-    their final places by `permute_rows`); a chunk whose rows do not fit
-    stops and is reported (call again with more slots).
+    their final places by `permute_rows`, or read where they are); a chunk
+    whose rows do not fit stops and is reported (call again with more slots).
 
     Parameters
     ----------

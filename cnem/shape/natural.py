@@ -20,6 +20,10 @@ KINDS = ("sibson", "laplace")
 #: points have about 5-6 natural neighbours on average).
 ROW_SLOTS = 8
 
+#: Points the walks cannot reach, as a fraction of the triangles, above which they
+#: are located with an R-tree of the triangles (built once) rather than of the circles.
+TRIANGLE_TREE_AFTER = 0.01
+
 
 def path_order(pts, bounds, per_tile=4):
     """Order of points along a serpentine path through a square grid of tiles.
@@ -48,8 +52,9 @@ def path_order(pts, bounds, per_tile=4):
 def _locate_sorted(model, spts, tol):
     """A triangle holding each of the path-ordered points ``spts`` (-1 outside):
     a walk from each point to the next, started from a few points found with the
-    R-tree of the circumcircles (each holds its triangle); an R-tree of the
-    triangles for the points the walk cannot reach (across holes and cracks)."""
+    R-tree of the circumcircles (each holds its triangle); for the points the walk
+    cannot reach (across holes and cracks) the same tree, or one of the triangles
+    when they are many."""
     nb_all = model.neighbors(across_regions=True)
     nch = work_chunks()
     starts = (np.arange(nch) * len(spts)) // nch
@@ -58,14 +63,16 @@ def _locate_sorted(model, spts, tol):
     tri_of = K.locate_walk(model.nodes, model.triangles, nb_all, spts, seeds, nch)
     lost = np.flatnonzero(tri_of < 0)
     if lost.size:
-        off, idx = _triangle_tree(model).query(spts[lost] - tol, spts[lost] + tol)
+        many = lost.size > TRIANGLE_TREE_AFTER * len(model.triangles)
+        tree = _triangle_tree(model) if many else model.circumcircles()[2]
+        off, idx = tree.query(spts[lost] - tol, spts[lost] + tol)
         tri_of[lost] = K.locate(model.nodes, model.triangles, spts[lost], off, idx, tol)
     return tri_of
 
 
 def _triangle_tree(model):
     """An R-tree over the boxes of the model's triangles (cached): tighter than the
-    circumcircles' for many points."""
+    circumcircles', worth building for many points."""
     if "triangle tree" not in model._cache:
         corners = model.nodes[model.triangles]
         model._cache["triangle tree"] = RTree(corners.min(axis=1), corners.max(axis=1))
@@ -120,7 +127,9 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
     n = len(model.nodes)
     if len(pts) == 0:
         empty = sp.csr_matrix((0, n))
-        return (empty, empty.copy(), empty.copy()) if gradient else empty
+        if gradient:
+            return empty, empty.copy(), empty.copy()
+        return empty if in_order else (empty, np.zeros(0, dtype=np.int64))
     order, start, size, cols, vals, gx, gy, kinds = _coordinates(model, pts, kind, triangles,
                                                                  gradient)
     rows = np.arange(len(pts), dtype=np.int64) if not in_order and not gradient else order
@@ -157,14 +166,23 @@ class PointRows(NamedTuple):
 
 def point_rows(model, points, *, kind="sibson", triangles=None):
     """`shape_functions` of many points left in the layout the kernel writes them,
-    for consumers that read the rows one by one (points as in `shape_functions`,
-    already validated: ``(p, 2)`` float64, finite, ``p > 0``).
+    for consumers that read the rows one by one (points and keywords as in
+    `shape_functions`).
 
     Returns
     -------
     PointRows
     """
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, received {kind!r}")
     pts = np.ascontiguousarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 2 or not np.isfinite(pts).all():
+        raise GeometryError(f"points: expected a (p, 2) array of finite coordinates, received "
+                            f"shape {pts.shape}")
+    if len(pts) == 0:
+        empty = np.zeros(0, dtype=np.int64)
+        return PointRows(empty, empty, np.zeros(0, dtype=np.int32), np.zeros(0), empty,
+                         len(model.nodes))
     order, start, size, cols, vals, _, _, _ = _coordinates(model, pts, kind, triangles, False)
     return PointRows(start, start + size, cols, vals, order, len(model.nodes))
 
