@@ -100,12 +100,12 @@ class BilinearForm(_Form):
     def _nonzero_coefficients(self, basis, kwargs, groups=None):
         """``(a, b, D_ab)`` for the descriptor pairs where the form is not zero in
         every cell, one at a time (a large basis holds only one of them); with
-        ``groups``, evaluated once per group (see `assemble`)."""
+        ``groups`` (their number, the keywords checked by `_check_groups`),
+        evaluated once per group (see `assemble`)."""
         if groups is None:
             w, m = _extras(basis, kwargs), len(basis.dx)
         else:
-            groups, m = _check_groups(groups, len(basis.dx), kwargs)
-            w = FormExtraParams(kwargs)
+            w, m = FormExtraParams(kwargs), groups
         units = basis.unit_fields()
         zero = basis.zero_field()
         if np.any(np.asarray(self.form(zero, zero, w)) != 0.0):
@@ -140,7 +140,8 @@ class BilinearForm(_Form):
         # gradient pairs in one array, scaled by A_k where used
         grad_coeff = np.zeros((count, 2 * g, 2 * g))
         other, active = {}, set()
-        for a, b, value in self._nonzero_coefficients(basis, kwargs, groups):
+        for a, b, value in self._nonzero_coefficients(basis, kwargs,
+                                                      None if groups is None else count):
             active.add((a, b))
             if a >= g and b >= g:
                 grad_coeff[:, a - g, b - g] = value

@@ -235,16 +235,19 @@ class BoundaryQuadrature:
     def __init__(self, points, hint, wx, wy, to_cells):
         self.points, self.hint, self.wx, self.wy, self.to_cells = points, hint, wx, wy, to_cells
 
-    def cell_integrals(self, values, rows=None, edges=None):
+    def cell_integrals(self, values, rows=None):
         """``(1 / A_k) ∮_{Γ_k} f n dΓ`` for ``values = f(points)``, ``(q, ...)`` array or
         sparse ``(q, c)`` (then CSR results); returns the x and y parts, ``(m, ...)``.
-        ``rows``: the point of each row of ``values`` when they come in another order.
-        ``edges``: `edge_integrals` of the same sparse values, if already known
-        (quadratures with the same points share them)."""
-        if edges is None and not sp.issparse(values):
+        ``rows``: the point of each row of ``values`` when they come in another order."""
+        if not sp.issparse(values):
             values = np.asarray(values)[self._value_rows(rows)]
             return self.to_cells @ (self.wx @ values), self.to_cells @ (self.wy @ values)
-        ex, ey = self.edge_integrals(values, rows) if edges is None else edges
+        return self.from_edges(self.edge_integrals(values, rows))
+
+    def from_edges(self, edges):
+        """`cell_integrals` from the `edge_integrals` ``(ex, ey)`` of the same points
+        (quadratures with the same points share them): two CSR ``(m, c)``."""
+        ex, ey = edges
         c = self.to_cells
         return _csr_pair(*SK.weighted_row_sums(
             c.indptr, c.indices, c.data, c.data, np.arange(c.shape[1], dtype=np.int64),
@@ -595,19 +598,16 @@ def fan_gradient(model, *, gauss=2, release=False):
     passes = None
     if runs is not None:        # the sub-cells go with their cells' runs
         run_of = np.empty(len(cells), dtype=np.int64)
+        place = np.empty(len(cells), dtype=np.int64)       # of a cell in its run
         for r, run in enumerate(runs):
-            run_of[run] = r
+            run_of[run], place[run] = r, np.arange(len(run))
         key_of = run_of[parent]
         sub_order = np.argsort(key_of, kind="stable")
         cuts = np.searchsorted(key_of[sub_order], np.arange(len(runs) + 1))
         passes = [[run, sub_order[cuts[r]:cuts[r + 1]]] for r, run in enumerate(runs)]
 
     def quadratures(sets, index):
-        local = parent
-        if index is not None:               # the parents' places in their run
-            place = np.empty(len(cells), dtype=np.int64)
-            place[index[0]] = np.arange(len(index[0]))
-            local = place[parent[index[1]]]
+        local = parent if index is None else place[parent[index[1]]]
         return fan_quadratures(model, *sets, local, gauss=gauss)
 
     have_cells = ("scni", int(gauss)) in model._cache
@@ -687,7 +687,7 @@ def _passes(model, quadratures, runs, wanted):
         edges = quads[0].edge_integrals(quads[0].point_rows(model))
         for part, quad, want in zip(parts, quads, wanted):
             if want:
-                part.append(quad.cell_integrals(None, edges=edges))
+                part.append(quad.from_edges(edges))
         points += len(quads[0].points)
     return parts, points
 

@@ -140,8 +140,7 @@ class Model:
         where the neighbour lies in another region. Cached (`discretize` fills it).
         """
         if "neighbors" not in self._cache:
-            every = triangle_neighbors(self.triangles)
-            self._cache["neighbors"] = cut_between_regions(every, self.triangle_region), every
+            self._cache["neighbors"] = _neighbor_tables(self.triangles, self.triangle_region)
         return self._cache["neighbors"][1 if across_regions else 0]
 
     def circumcircles(self):
@@ -208,8 +207,7 @@ def discretize(cloud, *, progress=None):
     nodes, node_of_point, tri, segments, kind = split_cracks(
         cloud.points, tri, cloud.segments, cloud.segment_kind)
     t2 = time.perf_counter()
-    every = triangle_neighbors(tri)
-    neighbors = cut_between_regions(every, region), every
+    neighbors = _neighbor_tables(tri, region)
     shift = nodes.min(axis=0)        # a local frame keeps the snap grid above round-off
     node, cell_region, offsets, vertices = voronoi_cells(nodes - shift, tri, region,
                                                          progress=progress,
@@ -225,4 +223,7 @@ def discretize(cloud, *, progress=None):
     return model
 
 
-
+def _neighbor_tables(triangles, region):
+    """`Model.neighbors` within regions and across them: ``(cut, every)``."""
+    every = triangle_neighbors(triangles)
+    return cut_between_regions(every, region), every
