@@ -16,3 +16,7 @@ class GeometryError(CNEMError, ValueError):
 
 class SolveError(CNEMError, RuntimeError):
     """A linear or nonlinear system could not be solved."""
+
+
+class MissingExtraError(CNEMError, ImportError):
+    """An optional dependency is missing: the message names the extra to install."""

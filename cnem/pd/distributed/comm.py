@@ -1,0 +1,99 @@
+"""MPI through mpi4py (the ``cnem[mpi]`` extra) and the halo exchange of ghost values.
+
+>>> from cnem.pd.distributed.comm import world
+>>> world().size >= 1          # doctest: +SKIP
+True
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import MissingExtraError
+
+__all__ = ["mpi", "world", "Halo", "INSTALL_HINT"]
+
+INSTALL_HINT = 'pip install "cnem[mpi]"  (the mpi4py and mpich wheels)'
+
+
+def mpi():
+    """The ``mpi4py.MPI`` module.
+
+    Raises
+    ------
+    MissingExtraError
+        mpi4py is not installed: the message names the ``cnem[mpi]`` extra.
+    """
+    try:
+        from mpi4py import MPI
+    except ImportError as exc:
+        raise MissingExtraError(
+            f"cnem.pd.distributed needs MPI through mpi4py, which could not be imported "
+            f"({exc}); install the extra: {INSTALL_HINT}. Serial runs need nothing: use "
+            f"cnem.pd instead") from exc
+    return MPI
+
+
+def world(comm=None):
+    """``comm``, or ``MPI.COMM_WORLD`` when it is None (one rank under plain ``python``)."""
+    return mpi().COMM_WORLD if comm is None else comm
+
+
+class Halo:
+    """Copies owned values to the ranks holding them as ghosts.
+
+    Parameters
+    ----------
+    comm : mpi4py communicator
+    owned : (o,) int64 ndarray
+        Global ids of this rank's points, increasing (local rows ``0..o-1``).
+    ghosts : (g,) int64 ndarray
+        Global ids of the ghosts (local rows ``o..o+g-1``).
+    owner : (n,) int ndarray
+        Rank owning each global point.
+
+    Attributes
+    ----------
+    sends, receives : dict rank -> (k,) int64 ndarray
+        Local rows sent to / received from each neighbouring rank.
+    bytes : int
+        Bytes this rank has sent so far.
+    """
+
+    def __init__(self, comm, owned, ghosts, owner):
+        self.comm = comm
+        size = comm.size
+        ghost_rows = len(owned) + np.arange(len(ghosts))
+        by_owner = owner[ghosts]
+        wanted = [ghosts[by_owner == r] for r in range(size)]
+        self.receives = {r: ghost_rows[by_owner == r] for r in range(size) if len(wanted[r])}
+        asked = comm.alltoall(wanted)                # the ids each rank wants from this one
+        self.sends = {r: np.searchsorted(owned, ids).astype(np.int64)
+                      for r, ids in enumerate(asked) if len(ids)}
+        self.bytes = 0
+
+    def exchange(self, values):
+        """Overwrite the ghost rows of ``values`` (``(o + g, ...)``, C-contiguous) with
+        their owners' values."""
+        MPI = mpi()
+        tail = values.shape[1:]
+        requests, inbox = [], []
+        for r, rows in self.receives.items():
+            buf = np.empty((len(rows),) + tail, dtype=values.dtype)
+            requests.append(self.comm.Irecv(buf, source=r, tag=7))
+            inbox.append((rows, buf))
+        outbox = []
+        for r, rows in self.sends.items():
+            buf = np.ascontiguousarray(values[rows])
+            outbox.append(buf)
+            requests.append(self.comm.Isend(buf, dest=r, tag=7))
+            self.bytes += buf.nbytes
+        MPI.Request.Waitall(requests)
+        for rows, buf in inbox:
+            values[rows] = buf
+        return values
+
+    @property
+    def neighbours(self):
+        """Ranks this one exchanges with."""
+        return sorted(set(self.sends) | set(self.receives))

@@ -1,0 +1,320 @@
+"""`Problem` on MPI ranks: explicit dynamics and dynamic relaxation with ghost exchanges.
+
+Each rank computes the bonds of its own points from its and its ghosts'
+displacements (no reverse force exchange): one halo exchange of the
+displacements per force evaluation, and for the state-based solid one more of
+the dilatations and "pressures" ``dW/dtheta`` of the points. Bond breaking is
+decided by the stretch as in serial, and the reverse of a bond is judged by the
+same formula on both of its ranks, so the broken bonds are those of the serial
+run.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from ...assembly.conditions import dirichlet_dofs, per_point
+from .._kernels import pmb_forces
+from ..materials import PLANES
+from ..problem import DynamicRun
+from ..problem import Problem as SerialProblem
+from . import _kernels as K
+from . import checkpoint as ckpt
+from .operators import LocalOperators
+from .output import PieceWriter
+from .relaxation import relax
+
+__all__ = ["Problem", "DistributedRun"]
+
+
+class DistributedRun(DynamicRun):
+    """Result of `Problem.run_dynamic` on the ranks.
+
+    On rank 0 (with ``gather=True``): ``u``, ``velocity``, ``damage`` of all points
+    (global numbering), ``frames`` (list of ``(u, damage)``) and ``broken_bonds``
+    (``(k, 2)`` global point pairs, both directions); None / empty on the other ranks.
+    Every rank: ``times``, ``energy`` (kinetic + elastic, summed over the ranks),
+    ``broken`` (bonds broken during the run, all ranks), ``files`` (the ``.pvtu`` of
+    each frame), ``local`` (dict: ``owned`` global ids, ``u``, ``velocity``,
+    ``damage`` of the owned points) and ``step`` (the last step).
+    """
+
+    def __repr__(self):
+        where = "gathered" if self.u is not None else "local"
+        return (f"<DistributedRun ({where}) t = {self.times[-1]:.3e}, {self.broken} bonds "
+                f"broken>")
+
+
+class Problem:
+    """`cnem.pd.Problem` for a `cnem.pd.distributed.Body`: the same conditions and the
+    same dynamic solvers (`run_dynamic`, `relax`, `stable_time_step`, `damage`), every
+    rank computing its own points.
+
+    Parameters
+    ----------
+    body : cnem.pd.distributed.Body
+    material : cnem.pd.BondBased or cnem.pd.StateBased
+    plane : {"stress", "strain"}
+    surface_correction : bool, optional
+        Default on (as in serial).
+    """
+
+    def __init__(self, body, material, *, plane="stress", surface_correction=None):
+        if plane not in PLANES:
+            raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
+        kind = getattr(material, "kind", None)
+        if kind not in ("bond", "state"):
+            raise ValueError(f"material: expected cnem.pd.BondBased or StateBased (CPD runs "
+                             f"serially only), received {type(material).__name__}")
+        self.body, self.material, self.plane, self.dim = body, material, plane, body.dim
+        self.comm = body.comm
+        self.surface_correction = True if surface_correction is None else \
+            bool(surface_correction)
+        self.ops = LocalOperators(body, material, plane, self.surface_correction)
+        self._dirichlet, self._body = [], []
+        self.alive = np.ones(len(body.bond_j), dtype=np.uint8)
+        self.alive_reverse = np.ones(len(body.bond_j), dtype=np.uint8)
+
+    def __repr__(self):
+        return f"<distributed Problem {self.body!r}, {self.material!r}>"
+
+    @property
+    def root(self):
+        """Whether this is rank 0."""
+        return self.comm.rank == 0
+
+    # -- conditions (global predicates, kept at the owned points) -----------------------
+    def add_dirichlet(self, where, component, value=0.0):
+        """As `cnem.pd.Problem.add_dirichlet` (evaluated on all points on every rank)."""
+        self._dirichlet.append(dirichlet_dofs(self.body.global_points, where, component,
+                                              value, where_to_look="body.points"))
+
+    def add_body_force(self, b):
+        """As `cnem.pd.Problem.add_body_force`."""
+        self._body.append(b)
+
+    def _prescribed(self):
+        """Owned local dofs ``d * row + component`` and their values."""
+        dofs, values = SerialProblem._prescribed(self)
+        d, body = self.dim, self.body
+        node = dofs // d
+        mine = body.part[node] == self.comm.rank
+        local = d * np.searchsorted(body.owned, node[mine]) + dofs[mine] % d
+        return local.astype(np.int64), values[mine]
+
+    def load(self):
+        """External forces of the owned points ``(o, d)``."""
+        b, o = self.body, self.body.n_owned
+        f = np.zeros((o, self.dim))
+        for force in self._body:
+            f += b.volumes[:o, None] * per_point(force, b.points[:o], self.dim, "body force")
+        return f
+
+    # -- global reductions ---------------------------------------------------------------
+    def allsum(self, x):
+        """Sum of a float over the ranks."""
+        return self.comm.allreduce(float(x))
+
+    def norm(self, x):
+        """Euclidean norm of a vector split over the ranks."""
+        return float(np.sqrt(self.allsum(np.dot(x, x))))
+
+    def gather(self, values):
+        """Owned rows of every rank, in global numbering, on rank 0 (None elsewhere)."""
+        parts = self.comm.gather((self.body.owned, np.asarray(values)), root=0)
+        if not self.root:
+            return None
+        out = np.empty((len(self.body),) + np.shape(values)[1:], dtype=np.asarray(values).dtype)
+        for ids, v in parts:
+            out[ids] = v
+        return out
+
+    # -- forces --------------------------------------------------------------------------
+    def internal_force(self, u, limit):
+        """Force per unit volume of the owned points ``(o, d)`` from local displacements
+        ``(o + g, d)`` whose ghost rows are current; bonds beyond ``limit`` break.
+        Returns the force and the number of owned bonds broken."""
+        b, ops = self.body, self.ops
+        o = b.n_owned
+        if self.material.kind == "bond":
+            out = np.empty_like(u)
+            broken = pmb_forces(u, b.xi, b.length, b.offsets, b.bond_j, ops.stiffness,
+                                b.volumes, self.alive, limit, out)
+            return out[:o], int(broken)
+        broken = K.break_bonds(u, b.xi, b.length, b.offsets[:o + 1], b.bond_j, limit,
+                               self.alive, self.alive_reverse)
+        fields = np.zeros((len(b.points), 2))          # theta and P, copied to the ghosts
+        fields[:o, 0] = ops.dilatation(u)
+        theta = np.ascontiguousarray(fields[:o, 0])
+        P = np.empty(o)
+        K.pressure(u, b.xi, b.length, b.offsets[:o + 1], b.bond_j, theta, ops.bulk_volume,
+                   ops.c, self.alive, P)
+        fields[:o, 1] = P
+        b.halo.exchange(fields)
+        out = np.empty((o, self.dim))
+        K.lps_forces(u, b.xi, b.length, b.offsets[:o + 1], b.bond_j, b.volumes, ops.g,
+                     ops.g_reverse, np.ascontiguousarray(fields[:, 0]),
+                     np.ascontiguousarray(fields[:, 1]), ops.c, ops.c_reverse, self.alive,
+                     self.alive_reverse, out)
+        return out, int(broken)
+
+    def energy(self, u, v):
+        """Kinetic plus elastic energy of the whole body (all ranks)."""
+        b, ops, o = self.body, self.ops, self.body.n_owned
+        kinetic = 0.5 * self.material.density * float(b.volumes[:o] @ (v * v).sum(axis=1))
+        if self.material.kind == "bond":
+            y = b.xi + u[b.bond_j] - u[b.bond_i]
+            s = np.sqrt((y * y).sum(axis=1)) / b.length - 1
+            per = 0.25 * ops.bond_stiffness * ops.factor * b.beta * s * s * b.length * \
+                b.volumes[b.bond_j] * self.alive
+            elastic = float(b.volumes[:o] @ np.bincount(b.bond_i, weights=per, minlength=o))
+        else:
+            theta = ops.dilatation(u)
+            ed = ops.deviatoric(u, theta)
+            elastic = 0.5 * float(ops.bulk_volume @ (theta * theta)) + \
+                0.5 * float((ops.c * self.alive) @ (ed * ed))
+        return self.allsum(kinetic + elastic)
+
+    # -- per-point results ---------------------------------------------------------------
+    def damage(self):
+        """Damage of the owned points ``(o,)`` (as `cnem.pd.Problem.damage`)."""
+        b, o, w = self.body, self.body.n_owned, self.ops.weight
+        total = np.bincount(b.bond_i, weights=w, minlength=o)
+        live = np.bincount(b.bond_i, weights=w * self.alive, minlength=o)
+        return 1.0 - live / np.maximum(total, 1e-300)
+
+    def broken_bonds(self):
+        """Broken bonds as ``(k, 2)`` global point pairs, on rank 0 (None elsewhere)."""
+        b = self.body
+        dead = self.alive == 0
+        local = np.concatenate([b.owned, b.ghosts])
+        pairs = np.column_stack([b.owned[b.bond_i[dead]], local[b.bond_j[dead]]])
+        parts = self.comm.gather(pairs, root=0)
+        return np.concatenate(parts) if self.root else None
+
+    def stable_time_step(self, safety=0.8):
+        """`cnem.pd.Problem.stable_time_step` over all ranks. State-based: from an upper
+        bound of the stiffness rows (`LocalOperators.row_bound`), so at most the serial
+        step."""
+        b, ops, o = self.body, self.ops, self.body.n_owned
+        if self.material.kind == "bond":
+            per = ops.bond_stiffness * ops.factor * b.beta * b.volumes[b.bond_j] / b.length
+            diag = np.bincount(b.bond_i, weights=per, minlength=o)
+        else:
+            diag = (ops.row_bound() / b.volumes[:o, None]).reshape(-1)
+        top = self.comm.allreduce(float(diag.max()) if len(diag) else 0.0, op=_max())
+        return safety * float(np.sqrt(2.0 * self.material.density / top))
+
+    # -- dynamics ------------------------------------------------------------------------
+    def run_dynamic(self, dt, steps, *, velocity=None, every=None, output=None, progress=None,
+                    gather=True, checkpoint=None, checkpoint_every=None, restart=None):
+        """Explicit velocity Verlet with bond breaking, as `cnem.pd.Problem.run_dynamic`.
+
+        Parameters
+        ----------
+        dt, steps, velocity, every, progress
+            As in serial (``steps``: the last step of the run, also when resuming).
+            Progress is shown by rank 0 only.
+        output : str or os.PathLike, optional
+            Frames as VTU pieces (one per rank) indexed by one ``.pvtu`` per frame
+            (`cnem.pd.distributed.output.PieceWriter`).
+        gather : bool
+            Gather ``u``, ``velocity``, ``damage``, the frames and the broken bonds on
+            rank 0.
+        checkpoint : str or os.PathLike, optional
+            Stem of the checkpoint files (one per rank), written every
+            ``checkpoint_every`` steps (default: at the last step).
+        restart : str or os.PathLike, optional
+            Stem of a checkpoint to resume from (same body, conditions and rank count):
+            the run continues from its step to ``steps``.
+
+        Returns
+        -------
+        DistributedRun
+        """
+        b, d, o = self.body, self.dim, self.body.n_owned
+        dt, steps = float(dt), int(steps)
+        if not dt > 0 or steps < 1:
+            raise ValueError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
+        every = max(1, steps // 10) if every is None else int(every)
+        save_every = steps if checkpoint_every is None else int(checkpoint_every)
+        rho = self.material.density
+        limit = self.material.stretch_limit(d, self.plane, b.horizon)
+        D, values = self._prescribed()
+        u = np.zeros((len(b.points), d))
+        owned_u = u[:o]
+        owned_u.reshape(-1)[D] = values
+        v = np.zeros((o, d))
+        if velocity is not None:
+            v[:] = per_point(velocity, b.points[:o], d, "velocity")
+        v.reshape(-1)[D] = 0.0
+        first, earlier, broken_here = 0, 0, 0      # earlier: broken before a restart
+        if restart is not None:
+            state = ckpt.load(restart, self.comm, b.owned)
+            first, earlier = int(state["step"]), int(state["broken"])
+            owned_u[:], v[:] = state["u"], state["velocity"]
+            self.alive[:], self.alive_reverse[:] = state["alive"], state["alive_reverse"]
+        fext = self.load() / b.volumes[:o, None]
+        b.halo.exchange(u)
+        force, broken_here = self.internal_force(u, limit)
+        acc = (force + fext) / rho
+        writer = None if output is None else PieceWriter(output, self.comm, b.points[:o], steps)
+        times, frames, energy, files = [], [], [], []
+
+        def store(step):
+            damage = self.damage()
+            times.append(step * dt)
+            if gather:
+                gu, gd = self.gather(owned_u), self.gather(damage)
+                if self.root:
+                    frames.append((gu, gd))
+            energy.append(self.energy(u, v))
+            if writer is not None:
+                files.append(writer.write(step, u=owned_u, damage=damage, velocity=v))
+
+        def save(step):
+            total = earlier + self.comm.allreduce(broken_here)
+            ckpt.save(checkpoint, self.comm, step=step, broken=total, owned=b.owned,
+                      u=owned_u, velocity=v, alive=self.alive, alive_reverse=self.alive_reverse)
+
+        store(first)
+        show = (sys.stderr.isatty() if progress is None else progress) and self.root
+        for step in tqdm(range(first + 1, steps + 1), desc="PD steps", disable=not show,
+                         leave=False):
+            v += 0.5 * dt * acc
+            owned_u += dt * v
+            owned_u.reshape(-1)[D] = values
+            b.halo.exchange(u)
+            force, broken = self.internal_force(u, limit)
+            broken_here += broken
+            acc = (force + fext) / rho
+            v += 0.5 * dt * acc
+            v.reshape(-1)[D] = 0.0
+            if step % every == 0 or step == steps:
+                store(step)
+            if checkpoint is not None and (step % save_every == 0 or step == steps):
+                save(step)
+        damage = self.damage()
+        local = dict(owned=b.owned, u=owned_u.copy(), velocity=v.copy(), damage=damage)
+        return DistributedRun(
+            u=self.gather(owned_u) if gather else None,
+            velocity=self.gather(v) if gather else None,
+            damage=self.gather(damage) if gather else None,
+            broken_bonds=self.broken_bonds() if gather else None,
+            times=np.array(times), frames=frames, energy=np.array(energy), files=files,
+            broken=earlier + self.comm.allreduce(broken_here), local=local, step=steps)
+
+    def relax(self, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress=None):
+        """Adaptive dynamic relaxation over the ranks (`cnem.pd.distributed.relaxation.relax`);
+        ``u``, ``damage`` gathered on rank 0."""
+        return relax(self, tol=tol, max_steps=max_steps, steps=steps, every=every,
+                     progress=progress)
+
+
+def _max():
+    from .comm import mpi
+    return mpi().MAX
+
