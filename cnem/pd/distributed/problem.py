@@ -225,8 +225,8 @@ class Problem:
             Gather ``u``, ``velocity``, ``damage``, the frames and the broken bonds on
             rank 0.
         checkpoint : str or os.PathLike, optional
-            Stem of the checkpoint files (one per rank), written every
-            ``checkpoint_every`` steps (default: at the last step).
+            Stem of the checkpoint files (one per rank), written at the steps that are
+            multiples of ``checkpoint_every`` (default: at the last step only).
         restart : str or os.PathLike, optional
             Stem of a checkpoint to resume from (same body, conditions and rank count):
             the run continues from its step to ``steps``.
@@ -295,7 +295,7 @@ class Problem:
             v.reshape(-1)[D] = 0.0
             if step % every == 0 or step == steps:
                 store(step)
-            if checkpoint is not None and (step % save_every == 0 or step == steps):
+            if checkpoint is not None and step % save_every == 0:
                 save(step)
         damage = self.damage()
         local = dict(owned=b.owned, u=owned_u.copy(), velocity=v.copy(), damage=damage)

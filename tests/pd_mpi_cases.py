@@ -1,0 +1,111 @@
+"""Small peridynamic problems run serially (in the test process) and under mpiexec.
+
+``python tests/pd_mpi_cases.py OUT.npz CASE...`` (under ``mpiexec -n N``) runs the cases
+with `cnem.pd.distributed` and rank 0 saves the gathered results; the tests build
+the same problems with `cnem.pd` and compare. ``setup(module, case)`` is the one
+definition of each problem for both.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import numpy as np
+
+H = 2.5e-3                       # a 40 x 16 cell-centred grid of the 0.1 m x 0.04 m plate
+LENGTH, HEIGHT, NOTCH = 0.1, 0.04, 0.05
+STEPS = 300
+CHECKPOINT = 200                 # the one checkpoint of a run of STEPS steps
+DT = 2.5e-7                      # below the serial stable steps of every case (3.3e-7 and up)
+CASES = ("bond", "state", "periodic", "relax")
+
+
+def plate():
+    """Cell-centred points of the plate (no point on the notch line y = 0)."""
+    x = (np.arange(round(LENGTH / H)) + 0.5) * H
+    y = (np.arange(round(HEIGHT / H)) + 0.5) * H - 0.5 * HEIGHT
+    X, Y = np.meshgrid(x, y, indexing="ij")
+    return np.column_stack([X.ravel(), Y.ravel()])
+
+
+def setup(pd, case, **body_options):
+    """The problem of ``case`` built with ``pd`` (`cnem.pd` or `cnem.pd.distributed`).
+
+    * ``bond``, ``state``: a notched glass plate pulled suddenly by tractions on its
+      top and bottom rows (the crack-branching set-up, coarse), bonds breaking;
+    * ``periodic``: a plate periodic in x and y with a shear velocity field, bonds
+      breaking;
+    * ``relax``: a state-based plate clamped on the left and stretched on the right.
+    """
+    pts = plate()
+    horizon = 3.015 * H
+    if case == "periodic":
+        body = pd.Body(pts + [0.0, 0.5 * HEIGHT], H * H, horizon, period=[LENGTH, HEIGHT],
+                       **body_options)
+        return pd.Problem(body, pd.BondBased(72e9, critical_stretch=4e-4, density=2440.0))
+    if case == "relax":
+        body = pd.Body(pts, H * H, horizon, **body_options)
+        prob = pd.Problem(body, pd.StateBased(72e9, 0.22))
+        prob.add_dirichlet(lambda p: p[:, 0] < H, None)
+        prob.add_dirichlet(lambda p: p[:, 0] > LENGTH - H, 0, 1e-6)
+        return prob
+    body = pd.Body(pts, H * H, horizon, cracks=[[[-horizon, 0.0], [NOTCH, 0.0]]], **body_options)
+    material = pd.BondBased(72e9, critical_stretch=6e-4, density=2440.0) if case == "bond" \
+        else pd.StateBased(72e9, 0.25, critical_stretch=6e-4, density=2440.0)
+    prob = pd.Problem(body, material)
+    edge = 0.5 * HEIGHT - H
+    prob.add_body_force(lambda p: np.where(p[:, 1:] > edge, [0.0, 12e6 / H],
+                                           np.where(p[:, 1:] < -edge, [0.0, -12e6 / H], 0.0)))
+    prob.add_dirichlet(lambda p: (p[:, 0] > LENGTH - H) & (np.abs(p[:, 1]) < H), 1)
+    return prob
+
+
+def shear(p):
+    """Initial velocity of the periodic case: a sine shear, m/s."""
+    return np.column_stack([3.0 * np.sin(2 * np.pi * p[:, 1] / HEIGHT), np.zeros(len(p))])
+
+
+def run(prob, case, **options):
+    """Run ``case`` on ``prob``: a dynamic run or a relaxation."""
+    if case == "relax":
+        return prob.relax(tol=1e-9, progress=False)
+    velocity = shear if case == "periodic" else None
+    return prob.run_dynamic(DT, STEPS, velocity=velocity, progress=False, **options)
+
+
+def main(out, cases):
+    """The ``cases`` with `cnem.pd.distributed` (``"restart"``: a checkpointed and a resumed
+    bond-based run, with VTU frames); rank 0 saves the results to ``out``."""
+    import cnem.pd.distributed as dpd
+    results = {}
+    for case in (c for c in cases if c != "restart"):
+        prob = setup(dpd, case)
+        res = run(prob, case)
+        results[f"{case}_u"] = res.u
+        if case != "relax":
+            results[f"{case}_broken"] = res.broken_bonds
+            results[f"{case}_energy"] = res.energy
+    if "restart" in cases:
+        results.update(restart(dpd, os.path.dirname(out)))
+    from mpi4py import MPI
+    if MPI.COMM_WORLD.rank == 0:
+        np.savez(out, **results)
+
+
+def restart(dpd, folder):
+    """A run checkpointed at step `CHECKPOINT` and one resumed from it (VTU frames)."""
+    results = {}
+    stem = os.path.join(folder, "checkpoint", "run")
+    run(setup(dpd, "bond"), "bond", checkpoint=stem, checkpoint_every=CHECKPOINT)
+    resumed = run(setup(dpd, "bond"), "bond", restart=stem,
+                  output=os.path.join(folder, "frames", "run"), every=50)
+    results["resumed_first"] = resumed.times[0] / DT
+    results["resumed_u"] = resumed.u
+    results["resumed_broken"] = resumed.broken_bonds
+    results["frames"] = np.array([str(f) for f in resumed.files])
+    return results
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2:])
