@@ -48,6 +48,11 @@ def serial():
 LAUNCHES = {2: C.CASES + ("restart",), 3: C.CASES + ("restart",), 4: ("bond",)}
 
 
+def _skip_unless_run(ranks, case):
+    if case not in LAUNCHES[ranks]:
+        pytest.skip(f"{ranks} ranks run {', '.join(LAUNCHES[ranks])} only (time)")
+
+
 def _launch(ranks, tmp):
     env = dict(os.environ, OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1",
                PYTHONPATH=os.pathsep.join([str(HERE.parent), os.environ.get("PYTHONPATH", "")]))
@@ -94,8 +99,7 @@ def test_one_rank_in_process_equals_serial(serial, case):
 @pytest.mark.parametrize("case", ["bond", "state", "periodic"])
 def test_ranks_give_the_serial_dynamics(serial, distributed, case):
     ranks, res = distributed
-    if case not in LAUNCHES[ranks]:
-        pytest.skip(f"{ranks} ranks: {', '.join(LAUNCHES[ranks])} only (time)")
+    _skip_unless_run(ranks, case)
     _assert_same_dynamics(serial, res[f"{case}_u"], res[f"{case}_broken"], case)
     np.testing.assert_allclose(res[f"{case}_energy"], serial[case][1].energy, rtol=1e-10)
 
@@ -103,8 +107,7 @@ def test_ranks_give_the_serial_dynamics(serial, distributed, case):
 @needs_mpi
 def test_relaxation_reaches_the_serial_equilibrium(serial, distributed):
     ranks, res = distributed
-    if "relax" not in LAUNCHES[ranks]:
-        pytest.skip(f"{ranks} ranks: {', '.join(LAUNCHES[ranks])} only (time)")
+    _skip_unless_run(ranks, "relax")
     _, ref = serial["relax"]
     static = serial["relax"][0].solve_static().u
     scale = np.abs(static).max()
@@ -115,8 +118,7 @@ def test_relaxation_reaches_the_serial_equilibrium(serial, distributed):
 @needs_mpi
 def test_resumed_run_equals_the_uninterrupted_one(serial, distributed):
     ranks, res = distributed
-    if "restart" not in LAUNCHES[ranks]:
-        pytest.skip(f"{ranks} ranks: {', '.join(LAUNCHES[ranks])} only (time)")
+    _skip_unless_run(ranks, "restart")
     assert round(float(res["resumed_first"])) == C.CHECKPOINT
     np.testing.assert_array_equal(res["resumed_u"], res["bond_u"])
     np.testing.assert_array_equal(res["resumed_broken"], res["bond_broken"])
@@ -127,8 +129,7 @@ def test_pvtu_frames_hold_the_gathered_displacements(distributed):
     vtk = pytest.importorskip("vtk")
     from vtk.util.numpy_support import vtk_to_numpy
     ranks, res = distributed
-    if "restart" not in LAUNCHES[ranks]:
-        pytest.skip(f"{ranks} ranks: {', '.join(LAUNCHES[ranks])} only (time)")
+    _skip_unless_run(ranks, "restart")
     frames = [pathlib.Path(f) for f in res["frames"]]
     assert frames[-1].name.endswith(f"_{C.STEPS}.pvtu") and len(frames) == 3
     reader = vtk.vtkXMLPUnstructuredGridReader()

@@ -1,0 +1,256 @@
+"""Benchmark: distributed peridynamics (``cnem.pd.distributed``) on 1 and 2 MPI ranks
+against the threaded serial code, with a projection to cluster sizes.
+
+Workload
+--------
+Lattices of spacing ``h`` on the unit square / cube (``k`` points per side), volumes
+``h^d``, horizon ``3.015 h``, ``BondBased(1.0)`` (surface correction on, no bond
+breaking), a random initial velocity (seed 0). Cases: 2-D 1M points (1000^2, ~28M bonds)
+and 3-D 1M points (100^3, ~122M bonds); ``--quick``: 2-D 40k (200^2).
+
+What is measured (each configuration in a fresh process, one after the other)
+-------------------------------------------------------------------------------
+* ``serial 2T``: ``cnem.pd.Body`` + ``cnem.pd.Problem`` with numba at 2 threads;
+* ``1 rank`` / ``2 ranks``: ``mpiexec -n 1 / 2`` of ``cnem.pd.distributed`` with
+  ``NUMBA_NUM_THREADS=OMP_NUM_THREADS=1`` per rank.
+
+``s/step``: ``(T(2 + S) - T(2)) / S`` with ``T(m)`` the wall time of ``run_dynamic(dt, m,
+every=m)`` (the difference removes the set-up of a run and its two stored frames), the
+largest over the ranks. ``halo``: ghosts over owned points, summed over the ranks.
+``bytes/step``: bytes sent by all ranks per step (displacements of the ghosts).
+``exch s/step``: wall time inside the halo exchanges per step (rank mean). ``peak GB``:
+each process's high-water RSS (``VmHWM``, set-up included), the largest rank.
+
+Targets (issue; printed MET / MISSED, never asserted): 2 ranks >= 1.8x one rank;
+2 ranks >= 0.9x the 2-thread serial code; peak memory per rank <= 0.6x the serial peak.
+
+Projection model (printed table)
+--------------------------------
+A rank of ``m = N / P`` points computes its bonds in ``t_c = m t_p`` (``t_p``: the
+measured 1-rank time per point and step) and exchanges ``g(m) = f m`` ghost values with
+``2 d`` neighbours, the ghost fraction of a compact part falling like its surface over
+its volume: ``f(m) = f_2 (m_2 / m)^(1/d)`` from the measured 2-rank fraction ``f_2`` at
+``m_2 = N_2 / 2``. The exchange costs ``t_x = 2 d alpha + 8 d g(m) / beta`` with a
+network latency ``alpha = 5 us`` and the bandwidth ``beta`` measured here (bytes over
+exchange time; shared memory, so a cluster network of ~10 GB/s gives a similar order).
+Parallel efficiency ``E = t_c / (t_c + t_x)`` (no overlap of exchange and interior
+bonds). Beside it: Peridynamics.jl's published thread scaling, 39 % efficiency at 16
+threads on 337,500 points.
+
+How to run
+----------
+::
+
+    python benchmarks/pd_mpi.py              # 2-D 1M and 3-D 1M (minutes, ~15 GB)
+    python benchmarks/pd_mpi.py --quick      # 2-D 40k, seconds
+"""
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+from _harness import mem_available_bytes, peak_rss_bytes
+
+HORIZON_FACTOR = 3.015
+CASES = {"2d-40k": (2, 200), "2d-1M": (2, 1000), "3d-1M": (3, 100)}
+DEFAULT_CASES, QUICK_CASES = ["2d-1M", "3d-1M"], ["2d-40k"]
+STEPS = {"2d-40k": 20, "2d-1M": 20, "3d-1M": 6}
+#: peak bytes per bond of the serial code (Body + Problem + run), for the memory guard
+SERIAL_BYTES_PER_BOND = 150.0
+MEMBERS = {2: 28, 3: 122}
+ALPHA = 5e-6                            # s, network latency of the projection
+JL_EFFICIENCY = (16, 337_500, 0.39)     # Peridynamics.jl: threads, points, efficiency
+TARGET_SPEEDUP, TARGET_VS_THREADS, TARGET_MEMORY = 1.8, 0.9, 0.6
+
+
+def lattice(k, d):
+    h = 1.0 / (k - 1)
+    grid = np.indices((k,) * d, dtype=np.float64).reshape(d, -1).T
+    return np.ascontiguousarray(grid * h), h
+
+
+def worker(case, mode):
+    """Build and time one configuration; the JSON result line is printed by rank 0."""
+    d, k = CASES[case]
+    steps = STEPS[case]
+    points, h = lattice(k, d)
+    velocity = 1e-4 * np.random.default_rng(0).uniform(-1.0, 1.0, points.shape)
+    t0 = time.perf_counter()
+    if mode == "serial":
+        import cnem.pd as pd
+        prob = pd.Problem(pd.Body(points, h ** d, HORIZON_FACTOR * h), pd.BondBased(1.0))
+        rank, comm = 0, None
+        vel = velocity
+    else:
+        import cnem.pd.distributed as pd
+        prob = pd.Problem(pd.Body(points, h ** d, HORIZON_FACTOR * h), pd.BondBased(1.0))
+        comm = prob.comm
+        rank = comm.rank
+        vel = lambda p: velocity[prob.body.owned]           # noqa: E731
+        halo = prob.body.halo
+        spent = [0.0]
+        exchange = halo.exchange
+
+        def timed(values):
+            s = time.perf_counter()
+            out = exchange(values)
+            spent[0] += time.perf_counter() - s
+            return out
+        halo.exchange = timed
+    setup = time.perf_counter() - t0
+    dt = 0.5 * h
+    times = []
+    for m in (2, 2 + steps):
+        if comm is not None:
+            comm.Barrier()
+            before, spent[0] = halo.bytes, 0.0
+        s = time.perf_counter()
+        prob.run_dynamic(dt, m, velocity=vel, every=m, progress=False)
+        times.append(time.perf_counter() - s)
+    step = (times[1] - times[0]) / steps
+    out = dict(case=case, mode=mode, setup=setup, step=step, peak=peak_rss_bytes(),
+               bonds=len(prob.body.bond_j))
+    if comm is not None:
+        out["exchange"] = spent[0] / (2 + steps)
+        out["bytes"] = (halo.bytes - before) / (2 + steps)
+        out["ghosts"], out["owned"] = len(prob.body.ghosts), prob.body.n_owned
+        every = comm.gather(out, root=0)
+        if rank:
+            return
+        out = dict(case=case, mode=mode, ranks=comm.size,
+                   setup=max(r["setup"] for r in every), step=max(r["step"] for r in every),
+                   peak=max(r["peak"] for r in every), bonds=sum(r["bonds"] for r in every),
+                   exchange=float(np.mean([r["exchange"] for r in every])),
+                   bytes=sum(r["bytes"] for r in every),
+                   halo=sum(r["ghosts"] for r in every) / sum(r["owned"] for r in every))
+    print("RESULT " + json.dumps(out), flush=True)
+
+
+def launch(case, mode, ranks):
+    """Run one configuration in a fresh process; its result dict (None if it failed)."""
+    env = dict(os.environ)
+    here = os.path.dirname(os.path.abspath(__file__))
+    script = [sys.executable, os.path.join(here, "pd_mpi.py"), "--worker", case, mode]
+    if mode == "serial":
+        env.update(NUMBA_NUM_THREADS="2", OMP_NUM_THREADS="2")
+        cmd = script
+    else:
+        env.update(NUMBA_NUM_THREADS="1", OMP_NUM_THREADS="1")
+        cmd = [shutil.which("mpiexec"), "-n", str(ranks)] + script
+    proc = subprocess.run(cmd, env=env, capture_output=True, text=True)
+    for line in proc.stdout.splitlines():
+        if line.startswith("RESULT "):
+            return json.loads(line[7:])
+    print(f"    {case} {mode} {ranks}: failed\n{proc.stdout[-2000:]}{proc.stderr[-2000:]}")
+    return None
+
+
+def projection(r1, r2, d, n2):
+    """Projected efficiency table rows: (points, ranks, efficiency)."""
+    t_point = r1["step"] / n2
+    beta = r2["bytes"] / max(r2["exchange"], 1e-12) / 2          # per rank
+    m2 = n2 / 2
+    rows = []
+    for total in (1e7, 1e8):
+        for ranks in (8, 16, 32, 64, 128, 256):
+            m = total / ranks
+            ghosts = r2["halo"] * (m2 / m) ** (1.0 / d) * m
+            tc = m * t_point
+            tx = 2 * d * ALPHA + 8 * d * ghosts / beta
+            rows.append((total, ranks, tc / (tc + tx)))
+    return rows, beta
+
+
+def verdict(ok):
+    return "MET" if ok else "MISSED"
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--quick", action="store_true", help="2-D 40k only (seconds)")
+    parser.add_argument("--cases", nargs="+", choices=list(CASES))
+    parser.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.worker:
+        return worker(*args.worker)
+    if shutil.which("mpiexec") is None:
+        print("benchmarks/pd_mpi.py: mpiexec not found; pip install 'cnem[mpi]'")
+        return None
+    cases = args.cases or (QUICK_CASES if args.quick else DEFAULT_CASES)
+    print(f"benchmarks/pd_mpi.py: cases {cases}; {os.cpu_count()} CPUs, load average "
+          f"{os.getloadavg()[0]:.2f} (other processes slow every configuration)")
+    results = {}
+    for case in cases:
+        d, k = CASES[case]
+        need = SERIAL_BYTES_PER_BOND * MEMBERS[d] * k ** d
+        avail = mem_available_bytes() or float("inf")
+        runs = {}
+        for mode, ranks in (("serial", 1), ("dist", 1), ("dist", 2)):
+            if mode == "serial" and need > 0.8 * avail:
+                print(f"  {case} serial skipped: needs ~{need / 2**30:.1f} GB, "
+                      f"{avail / 2**30:.1f} GB available")
+                continue
+            print(f"  {case} {mode} {ranks} rank(s)", flush=True)
+            runs[(mode, ranks)] = launch(case, mode, ranks)
+        results[case] = runs
+    report(results)
+    return results
+
+
+def report(results):
+    print()
+    head = (f"{'case':<7} {'config':<10} {'bonds':>10} {'setup s':>8} {'s/step':>8} "
+            f"{'peak GB':>8} {'halo':>7} {'MB/step':>8} {'exch s/step':>11}")
+    print(head)
+    print("-" * len(head))
+    for case, runs in results.items():
+        for (mode, ranks), r in runs.items():
+            if r is None:
+                continue
+            name = "serial 2T" if mode == "serial" else f"{ranks} rank(s)"
+            extra = "" if mode == "serial" else \
+                f" {r['halo']:7.4f} {r['bytes'] / 1e6:8.3f} {r['exchange']:11.5f}"
+            print(f"{case:<7} {name:<10} {r['bonds']:>10d} {r['setup']:8.2f} {r['step']:8.4f} "
+                  f"{r['peak'] / 2**30:8.2f}{extra}")
+    print()
+    print("targets (issue):")
+    for case, runs in results.items():
+        s, r1, r2 = runs.get(("serial", 1)), runs.get(("dist", 1)), runs.get(("dist", 2))
+        if r1 and r2:
+            x = r1["step"] / r2["step"]
+            print(f"  {case}: 2 ranks vs 1 rank {x:.2f}x (>= {TARGET_SPEEDUP}) -> "
+                  f"{verdict(x >= TARGET_SPEEDUP)}")
+        if s and r2:
+            x = s["step"] / r2["step"]
+            print(f"  {case}: 2 ranks vs serial at 2 threads {x:.2f}x (>= {TARGET_VS_THREADS})"
+                  f" -> {verdict(x >= TARGET_VS_THREADS)}")
+            x = r2["peak"] / s["peak"]
+            print(f"  {case}: peak memory per rank / serial peak {x:.2f} (<= {TARGET_MEMORY})"
+                  f" -> {verdict(x <= TARGET_MEMORY)}")
+    for case, runs in results.items():
+        r1, r2 = runs.get(("dist", 1)), runs.get(("dist", 2))
+        if not (r1 and r2):
+            continue
+        d, k = CASES[case]
+        rows, beta = projection(r1, r2, d, k ** d)
+        print()
+        print(f"projected efficiency from {case} (halo {r2['halo']:.4f} at 2 ranks, measured "
+              f"exchange bandwidth {beta / 1e9:.2f} GB/s per rank, latency {ALPHA * 1e6:g} us; "
+              f"model in the docstring):")
+        print("  points  " + " ".join(f"{p:>6d}" for p in (8, 16, 32, 64, 128, 256)))
+        for total in (1e7, 1e8):
+            print(f"  {total:.0e}   " + " ".join(f"{e * 100:5.1f}%" for t, p, e in rows
+                                                if t == total))
+        t, n, e = JL_EFFICIENCY
+        print(f"  Peridynamics.jl (published, threads): {e * 100:.0f} % efficiency at {t} "
+              f"threads on {n:,} points")
+
+
+if __name__ == "__main__":
+    main()
