@@ -89,9 +89,10 @@ class Body:
         self.owned, self.ghosts = owned, ghosts
         local = np.concatenate([owned, ghosts])
         index = np.int32 if len(local) < 2 ** 31 - 1 else np.int64
-        in_owned = self.part[members] == rank
-        self.bond_j = np.where(in_owned, np.searchsorted(owned, members),
-                               len(owned) + np.searchsorted(ghosts, members)).astype(index)
+        row_of = np.full(n, -1, dtype=index)          # global id -> local row
+        row_of[local] = np.arange(len(local), dtype=index)
+        self.bond_j = row_of[members]
+        del members, row_of
         self.offsets = np.concatenate([offsets, np.full(len(ghosts), offsets[-1])])
         self.bond_i = np.repeat(np.arange(len(owned), dtype=index), np.diff(offsets))
         self.points, self.volumes = np.ascontiguousarray(pts[local]), vol[local]

@@ -58,7 +58,6 @@ class LocalOperators:
         b = body
         o = b.n_owned
         self.weight = b.beta * b.volumes[b.bond_j]
-        self.unit = b.xi / b.length[:, None]
         if material.kind == "bond":
             self.bond_stiffness = float(material.micromodulus(self.dim, plane, b.horizon,
                                                               b.thickness))
@@ -67,6 +66,8 @@ class LocalOperators:
             self.stiffness = np.ascontiguousarray(self.bond_stiffness * self.factor * b.beta)
             return
         d = self.dim
+        #: unit bond directions (state-based only)
+        self.unit = b.xi / b.length[:, None]
         M = np.zeros((o, d, d))
         np.add.at(M, b.bond_i, self.weight[:, None, None] * b.xi[:, :, None] * b.xi[:, None, :])
         _agree(b.comm, (np.linalg.det(M) > 0).all(),
@@ -154,7 +155,7 @@ class LocalOperators:
         bound (the triangle inequality through the bond operators) for the state-based
         solid (all bonds alive)."""
         b, d, o = self.body, self.dim, self.body.n_owned
-        n = self.unit
+        n = b.xi / b.length[:, None]
         if self.material.kind == "bond":
             w = self.bond_stiffness * self.factor * self.weight * b.volumes[b.bond_i] / b.length
             # both directions of a bond carry 0.5 w; |n_a n_c| summed over c, once off
