@@ -273,15 +273,9 @@ class P1Elasticity(Conditions):
         return self.nodes
 
     def boundary_edges(self):
-        """Edges of the outer boundary, holes and crack faces (the mesh's boundary facets).
-
-        Returns
-        -------
-        edges : (e, 2) int64 ndarray
-            Node pairs, the body on the left (counter-clockwise).
-        normal : (e, 2) ndarray
-            Outward unit normals.
-        """
+        """The mesh's boundary facets as node pairs with the body on the left, and their
+        outward normals (see `Conditions.boundary_edges`; `boundary_facets` in the
+        same order)."""
         facets, _, normal = self.boundary_facets()
         edges = self.mesh.facets[:, facets].T.astype(np.int64)
         d = self.nodes[edges[:, 1]] - self.nodes[edges[:, 0]]
@@ -434,21 +428,9 @@ class P1Solution(Solution):
                    strain=strain, C=C, mesh=problem.mesh, region=problem.region,
                    basis=problem.basis, plane=problem.plane, timings=timings)
 
-    def __repr__(self):
-        return (f"<P1Solution {len(self.u)} nodes, {len(self.stress)} triangles, "
-                f"max |u| {np.abs(self.u).max():.3e}, max von Mises {self.von_mises.max():.3e}>")
-
     def displacement(self, points):
-        """Displacements at points (inside the mesh) through the P1 shape functions.
-
-        Parameters
-        ----------
-        points : (p, 2) array_like
-
-        Returns
-        -------
-        (p, 2) ndarray
-        """
+        """Displacements ``(p, 2)`` at points ``(p, 2)`` inside the mesh, through the P1
+        shape functions."""
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
         values = self.basis.probes(np.ascontiguousarray(pts.T)) @ self.u.reshape(-1)
         return values.reshape(2, -1).T                      # probes give x values, then y

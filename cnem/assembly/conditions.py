@@ -160,6 +160,18 @@ class Conditions:
         self.dirichlet.append(dirichlet_dofs(self.condition_points, where, component, value,
                                              where_to_look=self.points_name))
 
+    def boundary_edges(self):
+        """Edges of the outer boundary, holes and crack faces.
+
+        Returns
+        -------
+        edges : (e, 2) int64 ndarray
+            Node pairs, the body on the left (counter-clockwise).
+        normal : (e, 2) ndarray
+            Outward unit normals.
+        """
+        raise NotImplementedError(f"{type(self).__name__} has no boundary edges")
+
     def add_traction(self, where: Where, t: Any) -> None:
         """Tractions on the boundary edges (outer boundary, holes, crack faces).
 

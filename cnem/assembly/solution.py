@@ -120,13 +120,27 @@ class Solution:
     #: Where ``stress`` and ``strain`` live: "cells", "triangles" or "points".
     stress_at = "points"
 
+    def __repr__(self):
+        return (f"<{type(self).__name__} {len(self.u)} nodes, {len(self.stress)} "
+                f"{self.stress_at}, max |u| {np.abs(self.u).max():.3e}, "
+                f"max von Mises {self.von_mises.max():.3e}>")
+
     @property
     def von_mises(self) -> np.ndarray:
         """``(k,)`` von Mises stress at the places of ``stress``."""
         return von_mises(self.stress)
 
     def displacement(self, points) -> np.ndarray:
-        """Displacements ``(p, d)`` at points ``(p, d)`` of the body."""
+        """Displacements at points of the body, through the solver's interpolation.
+
+        Parameters
+        ----------
+        points : (p, d) array_like
+
+        Returns
+        -------
+        (p, d) ndarray
+        """
         raise NotImplementedError
 
     def nodal_average(self, values) -> np.ndarray:

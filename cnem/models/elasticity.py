@@ -108,15 +108,8 @@ class Elasticity(Conditions):
         return self.model.nodes
 
     def boundary_edges(self):
-        """Edges of the outer boundary, holes and crack faces.
-
-        Returns
-        -------
-        edges : (e, 2) int64 ndarray
-            Node pairs, the body on the left (counter-clockwise).
-        normal : (e, 2) ndarray
-            Outward unit normals.
-        """
+        """The model's constraint edges with the body on one side (see
+        `Conditions.boundary_edges`)."""
         tri = self.model.triangles
         edges, _ = constraint_edges(tri, self.model.neighbors(across_regions=True))
         d = self.model.nodes[edges[:, 1]] - self.model.nodes[edges[:, 0]]

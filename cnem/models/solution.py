@@ -67,21 +67,9 @@ class ElasticSolution(Solution):
                    gradient=gradient, dofs=dofs, enriched=dofs[2 * n:].reshape(-1, 2), C=C,
                    timings=timings, model=problem.model, plane=problem.plane)
 
-    def __repr__(self):
-        return (f"<ElasticSolution {len(self.u)} nodes, {len(self.stress)} cells, "
-                f"max |u| {np.abs(self.u).max():.3e}, max von Mises {self.von_mises.max():.3e}>")
-
     def displacement(self, points):
-        """Displacements at points through the shape functions.
-
-        Parameters
-        ----------
-        points : (p, 2) array_like
-
-        Returns
-        -------
-        (p, 2) ndarray
-        """
+        """Displacements ``(p, 2)`` at points ``(p, 2)`` through the shape functions (and
+        the enrichment functions)."""
         phi = self.model.shape_functions(points)
         out = phi @ self.u
         enrichment = self.problem.enrichment
