@@ -39,7 +39,7 @@ from .errors import GeometryError, SolveError
 from .geometry.cracks import split_cracks
 from .geometry.pslg import BOUNDARY, CRACK
 from .assembly.conditions import Conditions, per_point, traction_at
-from .models.material import lame, parse_materials, stiffness_matrix
+from .material import lame, parse_materials, stiffness_matrix
 from .assembly.solution import Solution, energy_error_density
 
 __all__ = ["P1Elasticity", "P1Solution", "mesh_domain"]

@@ -16,7 +16,7 @@ import cnem.fem as fem
 import cnem.pd as pd
 from cnem.assembly.conditions import Conditions
 from cnem.assembly.solution import Solution
-from cnem.models.material import stiffness_matrix
+from cnem.material import stiffness_matrix
 
 E, NU = 1.0, 0.3
 #: the uniform strain of the patch test, and the linear displacement it comes from
