@@ -12,15 +12,15 @@ run.
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 
 import numpy as np
 from tqdm.auto import tqdm
 
-from ...assembly.conditions import dirichlet_dofs, per_point
+from ...assembly.conditions import Conditions, per_point
 from .._kernels import pmb_forces
-from ..materials import PLANES
-from ..problem import DynamicRun
-from ..problem import Problem as SerialProblem
+from ...material import PLANES
+from ..solution import DynamicRun
 from . import _kernels as K
 from . import checkpoint as ckpt
 from .operators import LocalOperators
@@ -30,6 +30,7 @@ from .relaxation import relax
 __all__ = ["Problem", "DistributedRun"]
 
 
+@dataclass(eq=False, repr=False)
 class DistributedRun(DynamicRun):
     """Result of `Problem.run_dynamic` on the ranks.
 
@@ -42,13 +43,17 @@ class DistributedRun(DynamicRun):
     ``damage`` of the owned points) and ``step`` (the last step).
     """
 
+    broken_bonds: np.ndarray = None
+    local: dict = None
+    step: int = 0
+
     def __repr__(self):
         where = "gathered" if self.u is not None else "local"
         return (f"<DistributedRun ({where}) t = {self.times[-1]:.3e}, {self.broken} bonds "
                 f"broken>")
 
 
-class Problem:
+class Problem(Conditions):
     """`cnem.pd.Problem` for a `cnem.pd.distributed.Body`: the same conditions and the
     same dynamic solvers (`run_dynamic`, `relax`, `stable_time_step`, `damage`), every
     rank computing its own points.
@@ -60,7 +65,13 @@ class Problem:
     plane : {"stress", "strain"}
     surface_correction : bool, optional
         Default on (as in serial).
+
+    Conditions (`cnem.assembly.conditions.Conditions`): Dirichlet predicates see all the
+    points (``body.global_points``) on every rank; body forces are evaluated at the
+    owned points. Tractions are not supported.
     """
+
+    points_name = "body.points"
 
     def __init__(self, body, material, *, plane="stress", surface_correction=None):
         if plane not in PLANES:
@@ -69,12 +80,12 @@ class Problem:
         if kind not in ("bond", "state"):
             raise ValueError(f"material: expected cnem.pd.BondBased or StateBased (CPD runs "
                              f"serially only), received {type(material).__name__}")
+        super().__init__()
         self.body, self.material, self.plane, self.dim = body, material, plane, body.dim
         self.comm = body.comm
         self.surface_correction = True if surface_correction is None else \
             bool(surface_correction)
         self.ops = LocalOperators(body, material, plane, self.surface_correction)
-        self._dirichlet, self._body = [], []
         self.alive = np.ones(len(body.bond_j), dtype=np.uint8)
         self.alive_reverse = np.ones(len(body.bond_j), dtype=np.uint8)
 
@@ -87,18 +98,14 @@ class Problem:
         return self.comm.rank == 0
 
     # -- conditions (global predicates, kept at the owned points) -----------------------
-    def add_dirichlet(self, where, component, value=0.0):
-        """As `cnem.pd.Problem.add_dirichlet` (evaluated on all points on every rank)."""
-        self._dirichlet.append(dirichlet_dofs(self.body.global_points, where, component,
-                                              value, where_to_look="body.points"))
+    @property
+    def condition_points(self):
+        """All points of the body (every rank): what Dirichlet predicates see."""
+        return self.body.global_points
 
-    def add_body_force(self, b):
-        """As `cnem.pd.Problem.add_body_force`."""
-        self._body.append(b)
-
-    def _prescribed(self):
+    def owned_prescribed(self):
         """Owned local dofs ``d * row + component`` and their values."""
-        dofs, values = SerialProblem._prescribed(self)
+        dofs, values = self.prescribed()
         d, body = self.dim, self.body
         node = dofs // d
         mine = body.part[node] == self.comm.rank
@@ -109,8 +116,8 @@ class Problem:
         """External forces of the owned points ``(o, d)``."""
         b, o = self.body, self.body.n_owned
         f = np.zeros((o, self.dim))
-        for force in self._body:
-            f += b.volumes[:o, None] * per_point(force, b.points[:o], self.dim, "body force")
+        for force in self.body_forces_at(b.points[:o]):
+            f += b.volumes[:o, None] * force
         return f
 
     # -- global reductions ---------------------------------------------------------------
@@ -243,7 +250,7 @@ class Problem:
         save_every = steps if checkpoint_every is None else int(checkpoint_every)
         rho = self.material.density
         limit = self.material.stretch_limit(d, self.plane, b.horizon)
-        D, values = self._prescribed()
+        D, values = self.owned_prescribed()
         u = np.zeros((len(b.points), d))
         owned_u = u[:o]
         owned_u.reshape(-1)[D] = values
@@ -300,7 +307,7 @@ class Problem:
         damage = self.damage()
         local = dict(owned=b.owned, u=owned_u.copy(), velocity=v.copy(), damage=damage)
         return DistributedRun(
-            u=self.gather(owned_u) if gather else None,
+            problem=self, u=self.gather(owned_u) if gather else None,
             velocity=self.gather(v) if gather else None,
             damage=self.gather(damage) if gather else None,
             broken_bonds=self.broken_bonds() if gather else None,

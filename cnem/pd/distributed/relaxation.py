@@ -17,7 +17,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ...errors import SolveError
-from ..relaxation import Relaxation
+from ..solution import Relaxation
 
 __all__ = ["relax"]
 
@@ -46,7 +46,7 @@ def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress
         raise ValueError(f"expected tol > 0 and max_steps, steps, every >= 1, received tol={tol}, "
                          f"max_steps={max_steps}, steps={steps}, every={every}")
     body, d, o = problem.body, problem.dim, problem.body.n_owned
-    fixed, values = problem._prescribed()
+    fixed, values = problem.owned_prescribed()
     free = np.setdiff1d(np.arange(d * o), fixed)
     density = 0.25 * problem.ops.row_bound().reshape(-1)[free]
     limit = problem.material.stretch_limit(d, problem.plane, body.horizon)
@@ -116,5 +116,5 @@ def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress
         history.append(res)
         total += used
     flat[free] = x
-    return Relaxation(problem, problem.gather(u[:o]), problem.gather(problem.damage()),
-                      history, total, broken)
+    return Relaxation(problem, problem.gather(u[:o]), damage=problem.gather(problem.damage()),
+                      residual_history=history, iterations=total, broken=broken)
