@@ -53,6 +53,10 @@ class DistributedRun(DynamicRun):
                 f"broken>")
 
 
+#: Points per block of the energy sums (their bonds' temporaries stay small).
+ENERGY_BLOCK = 65536
+
+
 class Problem(Conditions):
     """`cnem.pd.Problem` for a `cnem.pd.distributed.Body`: the same conditions and the
     same dynamic solvers (`run_dynamic`, `relax`, `stable_time_step`, `damage`), every
@@ -173,11 +177,17 @@ class Problem(Conditions):
         b, ops, o = self.body, self.ops, self.body.n_owned
         kinetic = 0.5 * self.material.density * float(b.volumes[:o] @ (v * v).sum(axis=1))
         if self.material.kind == "bond":
-            y = b.xi + u[b.bond_j] - u[b.bond_i]
-            s = np.sqrt((y * y).sum(axis=1)) / b.length - 1
-            per = 0.25 * ops.bond_stiffness * ops.factor * b.beta * s * s * b.length * \
-                b.volumes[b.bond_j] * self.alive
-            elastic = float(b.volumes[:o] @ np.bincount(b.bond_i, weights=per, minlength=o))
+            elastic = 0.0
+            for start in range(0, o, ENERGY_BLOCK):      # blocks of points: small temporaries
+                stop = min(start + ENERGY_BLOCK, o)
+                sl = slice(b.offsets[start], b.offsets[stop])
+                i, j = b.bond_i[sl], b.bond_j[sl]
+                y = b.xi[sl] + u[j] - u[i]
+                s = np.sqrt((y * y).sum(axis=1)) / b.length[sl] - 1
+                per = 0.25 * ops.bond_stiffness * ops.factor[sl] * b.beta[sl] * s * s * \
+                    b.length[sl] * b.volumes[j] * self.alive[sl]
+                elastic += float(b.volumes[start:stop] @ np.bincount(
+                    i - start, weights=per, minlength=stop - start))
         else:
             theta = ops.dilatation(u)
             ed = ops.deviatoric(u, theta)
