@@ -199,6 +199,7 @@ def main(argv=None):
                 continue
             print(f"  {case} {mode} {ranks} rank(s)", flush=True)
             runs[(mode, ranks)] = launch(case, mode, ranks)
+            print(f"    {runs[(mode, ranks)]}", flush=True)
         results[case] = runs
     report(results)
     return results

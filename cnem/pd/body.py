@@ -7,7 +7,7 @@ import numpy as np
 from ..spatial import family_search, remove_crossing
 from ._kernels import bond_geometry
 
-__all__ = ["Body"]
+__all__ = ["Body", "checked_input", "crack_segments"]
 
 
 def _past_the_mouths(crack, tips, reach):
@@ -19,6 +19,40 @@ def _past_the_mouths(crack, tips, reach):
             d = crack[end] - crack[before]
             crack[end] = crack[end] + reach * d / np.hypot(*d)
     return crack
+
+
+def checked_input(points, volumes, horizon, thickness):
+    """The arguments of a `Body`, checked: points ``(n, d)``, volumes ``(n,)``, horizon and
+    thickness (1 in 3-D) as floats.
+
+    Raises
+    ------
+    ValueError
+        Not a non-empty ``(n, 2)`` or ``(n, 3)`` array, or non-positive volumes, horizon
+        or thickness.
+    """
+    pts = np.ascontiguousarray(points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] not in (2, 3) or len(pts) == 0:
+        raise ValueError(f"points: expected a non-empty (n, 2) or (n, 3) array, received "
+                         f"shape {pts.shape}")
+    n, d = pts.shape
+    vol = np.broadcast_to(np.asarray(volumes, dtype=float), (n,)).copy()
+    if not (np.isfinite(vol).all() and (vol > 0).all()):
+        raise ValueError("volumes: expected positive finite volumes, one per point")
+    horizon = float(horizon)
+    if not np.isfinite(horizon) or horizon <= 0:
+        raise ValueError(f"horizon: expected a positive number, received {horizon}")
+    thick = float(thickness) if d == 2 else 1.0
+    if thick <= 0:
+        raise ValueError(f"thickness: expected a positive number, received {thickness}")
+    return pts, vol, horizon, thick
+
+
+def crack_segments(cracks):
+    """The ``(s, 2, 2)`` segments of crack polylines (None without cracks)."""
+    segs = [np.column_stack([c[:-1], c[1:]]).reshape(-1, 2, 2)
+            for c in (np.asarray(c, dtype=float) for c in cracks)]
+    return np.concatenate(segs) if segs else None
 
 
 class Body:
@@ -55,27 +89,14 @@ class Body:
 
     def __init__(self, points, volumes, horizon, *, thickness=1.0, period=None, cracks=(),
                  crossing_points=None):
-        pts = np.ascontiguousarray(points, dtype=float)
-        if pts.ndim != 2 or pts.shape[1] not in (2, 3) or len(pts) == 0:
-            raise ValueError(f"points: expected a non-empty (n, 2) or (n, 3) array, received "
-                             f"shape {pts.shape}")
+        pts, vol, horizon, self.thickness = checked_input(points, volumes, horizon, thickness)
         n, d = pts.shape
-        vol = np.broadcast_to(np.asarray(volumes, dtype=float), (n,)).copy()
-        if not (np.isfinite(vol).all() and (vol > 0).all()):
-            raise ValueError("volumes: expected positive finite volumes, one per point")
-        horizon = float(horizon)
-        if not np.isfinite(horizon) or horizon <= 0:
-            raise ValueError(f"horizon: expected a positive number, received {horizon}")
-        self.thickness = float(thickness) if d == 2 else 1.0
-        if self.thickness <= 0:
-            raise ValueError(f"thickness: expected a positive number, received {thickness}")
         self.points, self.volumes, self.horizon, self.dim = pts, vol, horizon, d
         fam = family_search(pts, horizon, period=period)
-        crack_segments = [np.column_stack([c[:-1], c[1:]]).reshape(-1, 2, 2)
-                          for c in (np.asarray(c, dtype=float) for c in cracks)]
-        if crack_segments:
+        segments = crack_segments(cracks)
+        if segments is not None:
             test = pts if crossing_points is None else np.asarray(crossing_points, dtype=float)
-            fam = remove_crossing(fam, test, np.concatenate(crack_segments))
+            fam = remove_crossing(fam, test, segments)
         self.family = fam
         self.period = fam.period
         index = fam.indices.dtype                  # int32 unless the cloud is huge

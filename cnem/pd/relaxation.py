@@ -49,17 +49,18 @@ __all__ = ["relax", "Relaxation"]
 log = logging.getLogger(__name__)
 
 
-def _damping(u, force, previous, velocity, density):
+def _damping(u, force, previous, velocity, density, dot=np.dot):
     """Kilic & Madenci's ``c = 2 sqrt(u^T K_loc u / u^T u)`` with the diagonal local
-    stiffness from the last force change (0 where the velocity vanishes)."""
+    stiffness from the last force change (0 where the velocity vanishes); ``dot`` is the
+    inner product."""
     moving = velocity != 0.0
     k = np.zeros_like(u)
     k[moving] = -(force[moving] - previous[moving]) / (density[moving] * velocity[moving])
-    num, den = float(u @ (k * u)), float(u @ u)
+    num, den = float(dot(u, k * u)), float(dot(u, u))
     return 2.0 * np.sqrt(num / den) if num > 0.0 and den > 0.0 else 0.0
 
 
-def _settle(x, forces, density, target, budget, record):
+def _settle(x, forces, density, target, budget, record, dot=np.dot):
     """ADR iterations from rest (``dt = 1``) until the out-of-balance force is at
     most ``target``.
 
@@ -76,6 +77,8 @@ def _settle(x, forces, density, target, budget, record):
         Iterations allowed.
     record : callable (float) -> None
         Called with the force norm after every iteration.
+    dot : callable (a, b) -> float
+        Inner product of two dof vectors (a sum over the ranks when they are split).
 
     Returns
     -------
@@ -83,18 +86,26 @@ def _settle(x, forces, density, target, budget, record):
         Force norm reached (above ``target`` when the budget ran out).
     """
     force = forces()
-    norm = float(np.linalg.norm(force))
+    norm = float(np.sqrt(dot(force, force)))
     velocity = 0.5 * force / density
     iterations = 0
     while norm > target and norm > 0.0 and iterations < budget:
         iterations += 1
         x += velocity
         previous, force = force, forces()
-        c = _damping(x, force, previous, velocity, density)
+        c = _damping(x, force, previous, velocity, density, dot)
         velocity = ((2.0 - c) * velocity + 2.0 * force / density) / (2.0 + c)
-        norm = float(np.linalg.norm(force))
+        norm = float(np.sqrt(dot(force, force)))
         record(norm)
     return norm
+
+
+def unsettled(step, norm, scale, target, max_steps):
+    """The `SolveError` of a load step that has not settled within ``max_steps``."""
+    return SolveError(
+        f"dynamic relaxation did not converge in load step {step}: residual "
+        f"{norm:.3e} ({norm / scale:.1e} of the reference {scale:.3e}, wanted "
+        f"{target / scale:.1e}) after {max_steps} iterations; raise max_steps or tol")
 
 
 def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress=None):
@@ -195,10 +206,7 @@ def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress
             norm = _settle(x, lambda: forces()[0], density, target, max_steps - used, record)
             if norm > target:
                 bar.close()
-                raise SolveError(
-                    f"dynamic relaxation did not converge in load step {step}: residual "
-                    f"{norm:.3e} ({norm / scale:.1e} of the reference {scale:.3e}, wanted "
-                    f"{target / scale:.1e}) after {max_steps} iterations; raise max_steps or tol")
+                raise unsettled(step, norm, scale, target, max_steps)
             count = forces(limit)[1]                # break the over-stretched bonds
             if not count:
                 break

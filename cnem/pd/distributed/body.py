@@ -5,20 +5,13 @@ from __future__ import annotations
 import numpy as np
 
 from ...spatial import family_search, remove_crossing
-from ...spatial.rtree import as_points
 from .._kernels import bond_geometry
+from ..body import checked_input, crack_segments
 from . import _kernels as K
 from .comm import Halo, world
 from .partition import bisect, ghost_candidates
 
 __all__ = ["Body"]
-
-
-def _crack_segments(cracks):
-    """(s, 2, 2) segments of the crack polylines (None without cracks)."""
-    segs = [np.column_stack([c[:-1], c[1:]]).reshape(-1, 2, 2)
-            for c in (np.asarray(c, dtype=float) for c in cracks)]
-    return np.concatenate(segs) if segs else None
 
 
 class Body:
@@ -57,18 +50,11 @@ class Body:
     def __init__(self, points, volumes, horizon, *, thickness=1.0, period=None, cracks=(),
                  crossing_points=None, comm=None):
         self.comm = world(comm)
-        pts = as_points(points)
+        pts, vol, horizon, self.thickness = checked_input(points, volumes, horizon, thickness)
         n, d = pts.shape
-        vol = np.broadcast_to(np.asarray(volumes, dtype=float), (n,)).copy()
-        if not (np.isfinite(vol).all() and (vol > 0).all()):
-            raise ValueError("volumes: expected positive finite volumes, one per point")
-        horizon = float(horizon)
-        if not np.isfinite(horizon) or horizon <= 0:
-            raise ValueError(f"horizon: expected a positive number, received {horizon}")
-        self.thickness = float(thickness) if d == 2 else 1.0
         self.global_points, self.horizon, self.dim = pts, horizon, d
         self.global_size = n
-        self._cracks = _crack_segments(cracks)
+        self._cracks = crack_segments(cracks)
         self._crossing = pts if crossing_points is None else \
             np.asarray(crossing_points, dtype=float)
         self.period = np.full(d, np.inf) if period is None else \

@@ -16,7 +16,7 @@ import sys
 import numpy as np
 from tqdm.auto import tqdm
 
-from ...errors import SolveError
+from ..relaxation import _settle, unsettled
 from ..solution import Relaxation
 
 __all__ = ["relax"]
@@ -77,34 +77,20 @@ def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress
         res, used = [start], 0
         bar = tqdm(total=max_steps, desc=f"ADR load step {step}/{steps}", disable=not show,
                    leave=False)
+
+        def record(norm):
+            nonlocal used
+            used += 1
+            if used % every == 0:
+                res.append(norm)
+                bar.update(every)
+
         while True:
-            force = forces()[0]
-            norm = problem.norm(force)
-            velocity = 0.5 * force / density
-            budget = max_steps - used
-            iterations = 0
-            while norm > target and norm > 0.0 and iterations < budget:
-                iterations += 1
-                x += velocity
-                previous, force = force, forces()[0]
-                moving = velocity != 0.0
-                k = np.zeros_like(x)
-                k[moving] = -(force[moving] - previous[moving]) / (density[moving] *
-                                                                   velocity[moving])
-                num, den = problem.allsum(x @ (k * x)), problem.allsum(x @ x)
-                c = 2.0 * np.sqrt(num / den) if num > 0.0 and den > 0.0 else 0.0
-                velocity = ((2.0 - c) * velocity + 2.0 * force / density) / (2.0 + c)
-                norm = problem.norm(force)
-                used += 1
-                if used % every == 0:
-                    res.append(norm)
-                    bar.update(every)
+            norm = _settle(x, lambda: forces()[0], density, target, max_steps - used, record,
+                           dot=lambda a, b: problem.allsum(np.dot(a, b)))
             if norm > target:
                 bar.close()
-                raise SolveError(
-                    f"dynamic relaxation did not converge in load step {step}: residual "
-                    f"{norm:.3e} ({norm / scale:.1e} of the reference {scale:.3e}, wanted "
-                    f"{target / scale:.1e}) after {max_steps} iterations; raise max_steps or tol")
+                raise unsettled(step, norm, scale, target, max_steps)
             count = forces(limit)[1]
             if not count:
                 break
