@@ -15,11 +15,11 @@ import numpy as np
 
 H = 2.5e-3                       # a 40 x 16 cell-centred grid of the 0.1 m x 0.04 m plate
 LENGTH, HEIGHT, NOTCH = 0.1, 0.04, 0.05
-STEPS = {"bond": 300, "state": 120, "periodic": 300}   # the serial state-based run re-assembles
+STEPS = {"bond": 300, "state": 120, "periodic": 300, "cube": 150}   # the serial state-based run re-assembles
                                                           # its stiffness at every breaking step
 CHECKPOINT = 200                 # the one checkpoint of a bond-based run
 DT = 2.5e-7                      # below the serial stable steps of every case (3.3e-7 and up)
-CASES = ("bond", "state", "periodic", "relax")
+CASES = ("bond", "state", "periodic", "cube", "relax")
 
 
 def plate():
@@ -37,6 +37,8 @@ def setup(pd, case, **body_options):
       top and bottom rows (the crack-branching set-up, coarse), bonds breaking;
     * ``periodic``: a plate periodic in x and y with a shear velocity field, bonds
       breaking;
+    * ``cube``: a bond-based 3-D block of 8^3 points blown apart by a radial velocity,
+      bonds breaking;
     * ``relax``: a state-based plate clamped on the left and stretched on the right.
     """
     pts = plate()
@@ -45,6 +47,11 @@ def setup(pd, case, **body_options):
         body = pd.Body(pts + [0.0, 0.5 * HEIGHT], H * H, horizon, period=[LENGTH, HEIGHT],
                        **body_options)
         return pd.Problem(body, pd.BondBased(72e9, critical_stretch=4e-4, density=2440.0))
+    if case == "cube":
+        k = 8
+        grid = (np.indices((k,) * 3, dtype=float).reshape(3, -1).T + 0.5) * H
+        body = pd.Body(grid, H ** 3, 2.015 * H, **body_options)
+        return pd.Problem(body, pd.BondBased(72e9, critical_stretch=3e-4, density=4 * 2440.0))
     if case == "relax":
         body = pd.Body(pts, H * H, horizon, **body_options)
         prob = pd.Problem(body, pd.StateBased(72e9, 0.22))
@@ -62,6 +69,11 @@ def setup(pd, case, **body_options):
     return prob
 
 
+def blast(p):
+    """Initial velocity of the cube: radial from its centre, m/s."""
+    return 0.4 * (p - p.mean(axis=0)) / H
+
+
 def shear(p):
     """Initial velocity of the periodic case: a sine shear, m/s."""
     return np.column_stack([3.0 * np.sin(2 * np.pi * p[:, 1] / HEIGHT), np.zeros(len(p))])
@@ -71,7 +83,7 @@ def run(prob, case, **options):
     """Run ``case`` on ``prob``: a dynamic run or a relaxation."""
     if case == "relax":
         return prob.relax(tol=1e-9, progress=False)
-    velocity = shear if case == "periodic" else None
+    velocity = {"periodic": shear, "cube": blast}.get(case)
     return prob.run_dynamic(DT, STEPS[case], velocity=velocity, progress=False, **options)
 
 

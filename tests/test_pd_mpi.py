@@ -97,7 +97,7 @@ def _assert_same_dynamics(serial, u, broken, case):
 
 
 @needs_mpi
-@pytest.mark.parametrize("case", ["bond", "state", "periodic"])
+@pytest.mark.parametrize("case", ["bond", "state", "periodic", "cube"])
 def test_one_rank_in_process_equals_serial(serial, case):
     import cnem.pd.distributed as dpd
     res = C.run(C.setup(dpd, case), case)
@@ -107,7 +107,7 @@ def test_one_rank_in_process_equals_serial(serial, case):
 
 
 @needs_mpi
-@pytest.mark.parametrize("case", ["bond", "state", "periodic"])
+@pytest.mark.parametrize("case", ["bond", "state", "periodic", "cube"])
 def test_ranks_give_the_serial_dynamics(serial, distributed, case):
     ranks, res = distributed
     _skip_unless_run(ranks, case)
