@@ -44,7 +44,7 @@ from ..assembly.linsolve import free_rigid_motions
 from ..errors import SolveError
 from .solution import Relaxation
 
-__all__ = ["relax", "Relaxation"]
+__all__ = ["relax", "Relaxation", "load_steps", "unsettled"]
 
 log = logging.getLogger(__name__)
 
@@ -108,6 +108,79 @@ def unsettled(step, norm, scale, target, max_steps):
         f"{target / scale:.1e}) after {max_steps} iterations; raise max_steps or tol")
 
 
+def load_steps(x, forces, density, external, load, prescribe, *, tol, noise, limit, steps,
+               max_steps, every, show, dot=np.dot):
+    """The load steps of `relax`: each settles from the last equilibrium, then breaks the
+    over-stretched bonds and settles again until no bond breaks.
+
+    Parameters
+    ----------
+    x : (f,) ndarray
+        Free dofs, updated in place.
+    forces : callable (breaking=inf) -> ((f,) ndarray, int)
+        Out-of-balance force at ``x`` and the bonds broken beyond ``breaking``.
+    density : (f,) ndarray
+    external, load : (f,) ndarray
+        The applied force of the step (filled here) and the full load.
+    prescribe : callable (float) -> None
+        Sets the Dirichlet values to that fraction of theirs.
+    tol, noise, limit : float
+        Relative tolerance, smallest reachable residual, critical stretch.
+    steps, max_steps, every : int
+    show : bool
+        Progress bars.
+    dot : callable (a, b) -> float
+        Inner product of dof vectors (a sum over the ranks when they are split).
+
+    Returns
+    -------
+    history : list of list of float
+    iterations : int
+    broken : int
+    """
+    def norm_of(v):
+        return float(np.sqrt(dot(v, v)))
+
+    broken = 0
+    history, total = [], 0
+    for step in range(1, steps + 1):
+        frac = step / steps
+        prescribe(frac)
+        external[:] = frac * load
+        start = norm_of(forces()[0])
+        scale = norm_of(external) or start
+        target = max(tol * scale, noise)
+        res, used = [start], 0
+        bar = tqdm(total=max_steps, desc=f"ADR load step {step}/{steps}", disable=not show,
+                   leave=False)
+
+        def record(norm):
+            nonlocal used
+            used += 1
+            if used % every == 0:
+                res.append(norm)
+                bar.update(every)
+                bar.set_postfix(residual=f"{norm / max(scale, 1e-300):.1e}", refresh=False)
+
+        while True:
+            norm = _settle(x, lambda: forces()[0], density, target, max_steps - used, record,
+                           dot)
+            if norm > target:
+                bar.close()
+                raise unsettled(step, norm, scale, target, max_steps)
+            count = forces(limit)[1]                # break the over-stretched bonds
+            if not count:
+                break
+            broken += count
+        bar.close()
+        if used % every:
+            res.append(norm)
+        log.info("ADR load step %d: %d iterations, residual %.3e", step, used, norm)
+        history.append(res)
+        total += used
+    return history, total, broken
+
+
 def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress=None):
     """Quasi-static equilibrium of a peridynamic problem by adaptive dynamic relaxation.
 
@@ -168,7 +241,6 @@ def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress
     u = np.zeros((n, d))
     flat, x = u.reshape(-1), np.zeros(len(free))              # x: the free dofs
     external = np.zeros(len(free))
-    broken = 0
     # the force at zero displacement is the round-off of the bond stretches (it should
     # vanish): a residual below a few times it cannot be reached
     noise = 10.0 * float(np.linalg.norm(volumes * problem._internal_force(
@@ -181,42 +253,13 @@ def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress
         force, count = problem._internal_force(u, breaking, state)
         return external + volumes * force.reshape(-1)[free], count
 
+    def prescribe(fraction):
+        flat[fixed] = fraction * values
+
     show = sys.stderr.isatty() if progress is None else progress
-    history, total = [], 0
-    for step in range(1, steps + 1):
-        frac = step / steps
-        flat[fixed] = frac * values
-        external[:] = frac * load[free]
-        start = float(np.linalg.norm(forces()[0]))
-        scale = float(np.linalg.norm(external)) or start
-        target = max(tol * scale, noise)
-        res, used = [start], 0
-        bar = tqdm(total=max_steps, desc=f"ADR load step {step}/{steps}", disable=not show,
-                   leave=False)
-
-        def record(norm):
-            nonlocal used
-            used += 1
-            if used % every == 0:
-                res.append(norm)
-                bar.update(every)
-                bar.set_postfix(residual=f"{norm / max(scale, 1e-300):.1e}", refresh=False)
-
-        while True:
-            norm = _settle(x, lambda: forces()[0], density, target, max_steps - used, record)
-            if norm > target:
-                bar.close()
-                raise unsettled(step, norm, scale, target, max_steps)
-            count = forces(limit)[1]                # break the over-stretched bonds
-            if not count:
-                break
-            broken += count
-        bar.close()
-        if used % every:
-            res.append(norm)
-        log.info("ADR load step %d: %d iterations, residual %.3e", step, used, norm)
-        history.append(res)
-        total += used
+    history, total, broken = load_steps(x, forces, density, external, load[free], prescribe,
+                                        tol=tol, noise=noise, limit=limit, steps=steps,
+                                        max_steps=max_steps, every=every, show=show)
     flat[free] = x
     return Relaxation(problem, u, damage=problem.damage(), residual_history=history,
                       iterations=total, broken=broken)

@@ -10,18 +10,14 @@ the PMB and bounded from above for the state-based solid
 
 from __future__ import annotations
 
-import logging
 import sys
 
 import numpy as np
-from tqdm.auto import tqdm
 
-from ..relaxation import _settle, unsettled
+from ..relaxation import load_steps
 from ..solution import Relaxation
 
 __all__ = ["relax"]
-
-log = logging.getLogger(__name__)
 
 
 def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress=None):
@@ -55,7 +51,6 @@ def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress
     u = np.zeros((len(body.points), d))
     flat = u[:o].reshape(-1)
     x, external = np.zeros(len(free)), np.zeros(len(free))
-    broken = 0
 
     def forces(breaking=np.inf):
         flat[free] = x
@@ -65,42 +60,14 @@ def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress
 
     body.halo.exchange(u)
     noise = 10.0 * problem.norm(volumes * problem.internal_force(u, np.inf)[0].reshape(-1)[free])
+    def prescribe(fraction):
+        flat[fixed] = fraction * values
+
     show = (sys.stderr.isatty() if progress is None else progress) and problem.root
-    history, total = [], 0
-    for step in range(1, steps + 1):
-        frac = step / steps
-        flat[fixed] = frac * values
-        external[:] = frac * load[free]
-        start = problem.norm(forces()[0])
-        scale = problem.norm(external) or start
-        target = max(tol * scale, noise)
-        res, used = [start], 0
-        bar = tqdm(total=max_steps, desc=f"ADR load step {step}/{steps}", disable=not show,
-                   leave=False)
-
-        def record(norm):
-            nonlocal used
-            used += 1
-            if used % every == 0:
-                res.append(norm)
-                bar.update(every)
-
-        while True:
-            norm = _settle(x, lambda: forces()[0], density, target, max_steps - used, record,
-                           dot=lambda a, b: problem.allsum(np.dot(a, b)))
-            if norm > target:
-                bar.close()
-                raise unsettled(step, norm, scale, target, max_steps)
-            count = forces(limit)[1]
-            if not count:
-                break
-            broken += count
-        bar.close()
-        if used % every:
-            res.append(norm)
-        log.info("ADR load step %d: %d iterations, residual %.3e", step, used, norm)
-        history.append(res)
-        total += used
+    history, total, broken = load_steps(x, forces, density, external, load[free], prescribe,
+                                        tol=tol, noise=noise, limit=limit, steps=steps,
+                                        max_steps=max_steps, every=every, show=show,
+                                        dot=lambda a, b: problem.allsum(np.dot(a, b)))
     flat[free] = x
     return Relaxation(problem, problem.gather(u[:o]), damage=problem.gather(problem.damage()),
                       residual_history=history, iterations=total, broken=broken)
