@@ -1,4 +1,4 @@
-"""Fracture with C-NEM: stress intensity factors by the interaction integral.
+"""Fracture with C-NEM: stress intensity factors by the interaction integral, crack growth.
 
 >>> import numpy as np, cnem
 >>> from cnem.fracture import nodal_williams, sif
@@ -13,9 +13,12 @@
 True
 """
 
+from .criteria import CRITERIA, kink
 from .enrichment import Enrichment
+from .growth import grow
+from .history import CrackPath, GrowthEvent, Step
 from .interaction import SIFResult, sif, tip_frame
 from .williams import effective_modulus, kappa, nodal_williams, polar, williams
 
-__all__ = ["sif", "SIFResult", "Enrichment", "tip_frame", "williams", "nodal_williams", "polar", "kappa",
+__all__ = ["sif", "SIFResult", "grow", "CrackPath", "Step", "GrowthEvent", "kink", "CRITERIA", "Enrichment", "tip_frame", "williams", "nodal_williams", "polar", "kappa",
            "effective_modulus"]
