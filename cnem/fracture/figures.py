@@ -60,7 +60,9 @@ def paths(hist, path=None, *, length_unit="", stress_unit="", title=None, field=
     matplotlib.figure.Figure
     """
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 6.0))
+    xmin, ymin, xmax, ymax = hist.domain.bounds
+    aspect = (xmax - xmin) / (ymax - ymin)
+    fig, ax = plt.subplots(figsize=(min(12.0, max(5.0, 5.0 * aspect + 2.2)), 5.5))
     sol = hist.solution
     if field and sol is not None:
         mdl = sol.model
