@@ -117,11 +117,13 @@ def main(angles=ANGLES, *, cloud=CLOUD, outdir="results/growth_kink", plot=True,
         plt.close(fig)
         files.append(out / "kink_angles.png")
         if keep is not None:
-            fig = keep.plot(None, kind="paths", title="gamma = 45 degrees after one increment",
-                            field=True)
+            fig = keep.plot(None, kind="paths", title="gamma = 45 degrees after one increment "
+                            "(zoom on the crack; a = 0.1)",
+                            stress_unit="sigma")
             ax = fig.axes[0]
             ax.set_xlim(-2.5 * HALF_CRACK, 2.5 * HALF_CRACK)
             ax.set_ylim(-2.0 * HALF_CRACK, 2.0 * HALF_CRACK)
+            fig.tight_layout()
             fig.savefig(out / "kink_path.png", dpi=130)
             plt.close(fig)
             files.append(out / "kink_path.png")

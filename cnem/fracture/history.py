@@ -161,8 +161,11 @@ class CrackPath:
 
     @property
     def cycles(self):
-        """(steps + 1,) ndarray: cumulative load cycles at each state (0 at the start)."""
-        c = np.array([s.cycles for s in self.steps])
+        """(steps + 1,) ndarray: cumulative load cycles at each state (0 at the start;
+        NaN throughout without a Paris law)."""
+        c = np.array([s.cycles for s in self.steps], dtype=float)
+        if not np.isfinite(c).any():
+            return np.full(len(c) + 1, np.nan)
         return np.concatenate([[0.0], np.cumsum(c)])
 
     def table(self):
