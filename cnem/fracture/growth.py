@@ -9,14 +9,15 @@ crack vertices become nodes, the nodes too close to a new segment are dropped
 
 >>> import numpy as np, cnem
 >>> dom = cnem.geometry.rectangle(1.0, 2.0, cracks=[[[0.0, 1.0], [0.3, 1.0]]])
->>> def setup(model):
+>>> def setup(model):                       # tension on both ends, symmetric about y = 1
 ...     prob = cnem.Elasticity(model, (1.0, 0.3), plane="strain")
-...     top = lambda x, n: np.abs(x[:, 1] - 2.0) < 1e-9
-...     prob.add_traction(top, [0.0, 1.0])
-...     prob.add_dirichlet(lambda p: np.abs(p[:, 1]) < 1e-9, 1)
-...     prob.add_dirichlet(lambda p: np.hypot(*p.T) < 1e-9, 0)
+...     ends = lambda x, n: np.abs(np.abs(x[:, 1] - 1.0) - 1.0) < 1e-9
+...     prob.add_traction(ends, lambda x, n: n * [0.0, 1.0])
+...     prob.add_dirichlet(lambda p: np.hypot(p[:, 0] - 1.0, p[:, 1]) < 1e-9, None)
+...     prob.add_dirichlet(lambda p: np.hypot(p[:, 0] - 1.0, p[:, 1] - 2.0) < 1e-9, 0)
 ...     return prob
->>> hist = cnem.fracture.grow(dom, 0.1, setup, increment=0.1, steps=1, progress=False)
+>>> hist = cnem.fracture.grow(dom, cnem.nodes.regular(dom, 0.1), setup, increment=0.1, steps=1,
+...                           progress=False)
 >>> hist.cracks[0][-1].round(6).tolist()        # straight on, mode I
 [0.4, 1.0]
 """
@@ -32,12 +33,12 @@ from tqdm.auto import tqdm
 from ..errors import GeometryError, GrowthError, GrowthWarning
 from ..geometry.cloud import NodeCloud
 from ..geometry.model import discretize
+from ..material import kappa as kolosov
 from ..nodes import irregular
 from . import advance
 from .criteria import CRITERIA, kink
 from .history import CrackPath, GrowthEvent, Step
 from .interaction import sif
-from .williams import kappa as kolosov
 
 __all__ = ["grow"]
 
