@@ -126,10 +126,16 @@ def tension_setup(W, H):
     return setup
 
 
-def test_symmetric_problem_grows_on_its_symmetry_line():
+@pytest.fixture(scope="module")
+def sent_run():
     dom = cnem.geometry.rectangle(1.0, 2.0, cracks=[[[0.0, 1.0], [0.3, 1.0]]])
-    hist = grow(dom, cnem.nodes.regular(dom, 0.05), tension_setup(1.0, 2.0), increment=0.05,
-                steps=2, K_Ic=2.0, progress=False)
+    top = lambda sol: float(sol.displacement(np.array([[0.5, 2.0]]))[0, 1])   # noqa: E731
+    return grow(dom, cnem.nodes.regular(dom, 0.05), tension_setup(1.0, 2.0), increment=0.05,
+                steps=2, K_Ic=2.0, measure=top, progress=False)
+
+
+def test_symmetric_problem_grows_on_its_symmetry_line(sent_run):
+    hist = sent_run
     tips = hist.paths()[:, 0]
     assert np.abs(tips[:, 1] - 1.0).max() < 1e-9
     assert tips[:, 0] == pytest.approx([0.3, 0.35, 0.4], abs=1e-12)
@@ -137,6 +143,23 @@ def test_symmetric_problem_grows_on_its_symmetry_line():
     assert np.abs(K[:, 1]).max() < 1e-6 * K[:, 0].min()
     assert np.all(np.diff(K[:, 0]) > 0)                              # K_I grows with a
     assert hist.array("load_factor")[:, 0] == pytest.approx(2.0 / hist.array("K_eq")[:, 0])
+    # a longer crack: a more compliant strip
+    assert np.all(np.diff(hist.array("measure")) > 0)
+
+
+def test_history_writes_one_frame_per_state_and_its_pictures(sent_run, tmp_path):
+    import cnem.io
+    files = sent_run.write(tmp_path / "frames")
+    assert [f.name for f in files] == ["step_000.vtu", "step_001.vtu", "step_002.vtu"]
+    for f, state in zip(files, sent_run.steps + [sent_run.final]):
+        mesh = cnem.io.read(f)
+        assert np.array_equal(mesh.nodes, state.solution.model.nodes)
+        assert mesh.area.sum() == pytest.approx(2.0, rel=1e-12)
+    for kind in ("paths", "sif", "load"):
+        sent_run.plot(tmp_path / f"{kind}.png", kind=kind)
+        assert (tmp_path / f"{kind}.png").stat().st_size > 10_000
+    with pytest.raises(GrowthError, match="kind"):
+        sent_run.plot(kind="map")
 
 
 def test_tip_into_the_far_edge_splits_the_body_with_the_pieces_named():
