@@ -164,7 +164,8 @@ def test_history_writes_one_frame_per_state_and_its_pictures(sent_run, tmp_path)
 
 def test_tip_into_the_far_edge_splits_the_body_with_the_pieces_named():
     dom = cnem.geometry.rectangle(1.0, 2.0, cracks=[[[0.0, 1.0], [0.88, 1.0]]])
-    with pytest.raises(GeometryError, match="2 pieces") as info:
+    with pytest.raises(GeometryError, match="2 pieces") as info, \
+            pytest.warns(GrowthWarning, match="left_domain"):
         grow(dom, cnem.nodes.regular(dom, 0.05), tension_setup(1.0, 2.0), increment=0.2, steps=2,
              progress=False)
     hist = info.value.history
