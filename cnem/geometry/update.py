@@ -10,10 +10,15 @@ reach them:
 * the constrained Delaunay triangulation and the crack opening are redone
   whole (`triangle` takes a fraction of a second at 100k nodes and gives the
   node order of `discretize`);
+* points are the same when they lie within ``MERGE_TOL`` times the diameter
+  (`cnem.nodes.from_points` snaps the points on a boundary again, which may
+  move them by round-off);
 * a *changed* triangle is one of the old or of the new triangulation that the
   other has not (the same points), or one with a corner on a changed point (a
   new, moved or removed point, or an end of a constraint segment that the two
-  clouds do not share: the old tip, which the grown crack now splits);
+  clouds do not share: the old tip, which the grown crack now splits) --
+  except where `triangle` only cut a cocircular quadrilateral by its other
+  diagonal (the same circumcircle on both sides, to round-off);
 * the changed region is the union of the circumcircles of the changed
   triangles. A Voronoi cell lies in the circumcircles of its node's triangles,
   so a cell that does not meet the changed region (nor has a changed triangle
@@ -28,6 +33,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from .. import config
 from ..errors import GeometryError
@@ -97,9 +103,11 @@ def _match_rows(a, b):
     return where[inverse[:len(a)]]
 
 
-def _point_map(old, new):
-    """Index into ``new`` of each point of ``old`` with the same coordinates, -1 if none."""
-    return _match_rows(np.ascontiguousarray(old).view(np.int64), np.ascontiguousarray(new).view(np.int64))
+def _point_map(old, new, tol):
+    """Index into ``new`` of the point of ``old`` within ``tol`` (the same point snapped
+    again, off by round-off), -1 if none."""
+    dist, index = cKDTree(new).query(old, distance_upper_bound=tol)
+    return np.where(np.isfinite(dist), index, -1).astype(np.int64)
 
 
 def _sorted_key(rows, extra=None):
@@ -138,6 +146,41 @@ def _same_triangles(old, new_points_tri, new_of_old, changed):
     return match, old_tri
 
 
+def _same_circles(old, nodes, tri, points_tri, match, old_tri, changed):
+    """Flips between cocircular triangles: the unmatched triangles (of unchanged points)
+    whose circumcircle the other triangulation has too, to round-off.
+
+    `triangle` may cut a cocircular quadrilateral (a lattice's square) by the other
+    diagonal when points elsewhere change; the Voronoi diagram and the natural
+    neighbours there stay the same.
+
+    Returns
+    -------
+    new_flip : (t,) bool ndarray
+    old_flip : (t_old,) bool ndarray
+    """
+    kept = np.zeros(len(old.triangles), dtype=bool)
+    kept[match[match >= 0]] = True
+    new_c = np.flatnonzero((match < 0) & ~changed[points_tri].any(axis=1))
+    old_ok = (old_tri >= 0).all(axis=1) & ~kept
+    old_ok[old_ok] = ~changed[old_tri[old_ok]].any(axis=1)
+    old_c = np.flatnonzero(old_ok)
+    new_flip = np.zeros(len(tri), dtype=bool)
+    old_flip = np.zeros(len(old.triangles), dtype=bool)
+    if len(new_c) == 0 or len(old_c) == 0:
+        return new_flip, old_flip
+    cn, rn = _circles(nodes, tri[new_c])
+    co, ro = _circles(old.nodes, old.triangles[old_c])
+    tol = config.MERGE_TOL * min(rn.min(), ro.min())
+    for centre, radius, other, other_radius, index, flip in (
+            (cn, rn, co, ro, new_c, new_flip), (co, ro, cn, rn, old_c, old_flip)):
+        dist, near = cKDTree(other).query(centre, distance_upper_bound=tol)
+        hit = np.flatnonzero(np.isfinite(dist))
+        hit = hit[np.abs(other_radius[near[hit]] - radius[hit]) <= tol]
+        flip[index[hit]] = True
+    return new_flip, old_flip
+
+
 def _node_map(old, tri, new_points_tri, match, old_tri, n):
     """Old node of each new node through the corners of the triangles both have."""
     old_node = np.full(n, -1, dtype=np.int64)
@@ -150,11 +193,16 @@ def _node_map(old, tri, new_points_tri, match, old_tri, n):
     return old_node
 
 
+def _circles(nodes, triangles):
+    """Circumcentres ``(t, 2)`` and circumradii ``(t,)`` of ``triangles``."""
+    centre = circumcenters(nodes, triangles)
+    return centre, np.sqrt(((nodes[triangles[:, 0]] - centre) ** 2).sum(axis=1))
+
+
 def _disc_boxes(nodes, triangles):
     """Bounding boxes ``(t, 4)`` of the circumcircles of ``triangles``."""
-    centre = circumcenters(nodes, triangles)
-    radius = np.sqrt(((nodes[triangles[:, 0]] - centre) ** 2).sum(axis=1))[:, None]
-    return np.hstack([centre - radius, centre + radius])
+    centre, radius = _circles(nodes, triangles)
+    return np.hstack([centre - radius[:, None], centre + radius[:, None]])
 
 
 def _cell_boxes(cells):
@@ -215,20 +263,22 @@ def update(model, cloud, *, progress=None):
     timings = {}
     nodes, node_of_point, tri, region, segments, kind, neighbors = triangulate(cloud, timings)
     t0 = time.perf_counter()
-    new_of_old = _point_map(model.cloud.points, cloud.points)
+    size = float(np.hypot(*np.ptp(cloud.points, axis=0)))
+    new_of_old = _point_map(model.cloud.points, cloud.points, config.MERGE_TOL * size)
     changed = _changed_points(model, cloud, new_of_old)
     points_tri = node_of_point[tri]
     match, old_tri = _same_triangles(model, points_tri, new_of_old, changed)
     old_node = _node_map(model, tri, points_tri, match, old_tri, len(nodes))
-    kept_old = np.zeros(len(model.triangles), dtype=bool)
+    new_flip, kept_old = _same_circles(model, nodes, tri, points_tri, match, old_tri, changed)
     kept_old[match[match >= 0]] = True
+    gone = (match < 0) & ~new_flip
     discs = np.concatenate([_disc_boxes(model.nodes, model.triangles[~kept_old]),
-                            _disc_boxes(nodes, tri[match < 0])])
-    pad = config.SNAP_TOL * float(np.hypot(*np.ptp(nodes, axis=0)))
+                            _disc_boxes(nodes, tri[gone])])
+    pad = config.SNAP_TOL * size
     touched = np.zeros(len(model.nodes), dtype=bool)
     touched[model.cells.node[_boxes_meet(_cell_boxes(model.cells), discs, pad)]] = True
     redo = old_node < 0
-    redo[tri[match < 0].ravel()] = True
+    redo[tri[gone].ravel()] = True
     redo[old_node >= 0] |= touched[old_node[old_node >= 0]]
     timings["matching"] = time.perf_counter() - t0
     t0 = time.perf_counter()
