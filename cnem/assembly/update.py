@@ -25,7 +25,7 @@ def renumber_rows(matrix, rows, columns, shape, *, drop=False):
     ----------
     matrix : sparse (r, c)
     rows : (k,) int array
-        Rows taken, in order.
+        Row of ``matrix`` that becomes each row of the result; -1 for an empty row.
     columns : (c,) int64 ndarray
         New index of every column; -1 for a column that must not appear.
     shape : tuple
@@ -42,13 +42,30 @@ def renumber_rows(matrix, rows, columns, shape, *, drop=False):
     CNEMError
         A taken row has a non-zero in a column mapped to -1 (and not ``drop``).
     """
-    taken = sp.csr_matrix(matrix)[np.asarray(rows, dtype=np.int64)].tocoo()
-    cols = columns[taken.col]
+    matrix = sp.csr_matrix(matrix)
+    rows = np.asarray(rows, dtype=np.int64)
+    have = rows >= 0
+    counts = np.zeros(len(rows), dtype=np.int64)
+    counts[have] = np.diff(matrix.indptr)[rows[have]]
+    indptr = np.zeros(len(rows) + 1, dtype=np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    starts = np.zeros(len(rows), dtype=np.int64)
+    starts[have] = matrix.indptr[rows[have]]
+    gather = np.repeat(starts - indptr[:-1], counts) + np.arange(indptr[-1])
+    cols = columns[matrix.indices[gather]]
+    data = matrix.data[gather]
     keep = cols >= 0
-    if not drop and not keep.all():
-        raise CNEMError(f"{np.count_nonzero(~keep)} non-zeros of the copied rows fall on "
-                        "columns that have no new index; the rows must be recomputed instead")
-    return sp.csr_matrix((taken.data[keep], (taken.row[keep], cols[keep])), shape=shape)
+    if not keep.all():
+        if not drop:
+            raise CNEMError(f"{np.count_nonzero(~keep)} non-zeros of the copied rows fall on "
+                            "columns that have no new index; the rows must be recomputed instead")
+        cum = np.zeros(len(keep) + 1, dtype=np.int64)
+        np.cumsum(keep, out=cum[1:])
+        indptr, cols, data = cum[indptr], cols[keep], data[keep]
+    out = sp.csr_matrix((data, cols, indptr), shape=shape)
+    out.has_sorted_indices = False
+    out.sort_indices()
+    return out
 
 
 def updated_gradient(old, change, *, gauss=2):
@@ -75,13 +92,13 @@ def updated_gradient(old, change, *, gauss=2):
                         f"{len(change.old.cells)} cells x {len(change.old.nodes)} nodes, "
                         f"received {old.x.shape[0]} x {old.x.shape[1]}")
     redo = change.changed_cells
-    kept = np.flatnonzero(change.old_cell >= 0)
     fresh = smoothed_gradient(model, gauss=gauss, cells=model.cells.subset(redo))
     columns = change.new_node()
-    order = np.argsort(np.concatenate([kept, redo]), kind="stable")
+    place = np.full(m, -1, dtype=np.int64)
+    place[redo] = np.arange(len(redo))
 
-    def stack(old_part, new_part):
-        copied = renumber_rows(old_part, change.old_cell[kept], columns, (len(kept), n))
-        return sp.vstack([copied, new_part], format="csr")[order]
+    def merged(old_part, new_part):
+        copied = renumber_rows(old_part, change.old_cell, columns, (m, n))
+        return copied + renumber_rows(new_part, place, np.arange(n), (m, n))
 
-    return SmoothedGradient(stack(old.x, fresh.x), stack(old.y, fresh.y), fresh.points)
+    return SmoothedGradient(merged(old.x, fresh.x), merged(old.y, fresh.y), fresh.points)

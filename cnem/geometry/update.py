@@ -25,6 +25,10 @@ reach them:
   at its node) is the same cell; the natural neighbours of a point outside
   the region are the same nodes, so the smoothed gradient of such a cell is the
   same row too (`cnem.assembly.update`).
+
+A sliver along a constraint (a node almost on a crack segment) has a large
+circumcircle, and the update then recomputes the cells it covers: still exact,
+less local.
 """
 
 from __future__ import annotations
@@ -245,9 +249,12 @@ def update(model, cloud, *, progress=None):
     -------
     ModelUpdate
         ``.model`` equals ``discretize(cloud)``: the same nodes in the same
-        order, triangles, segments and cells (copied cells bit for bit, the
-        recomputed ones by the same code); ``old_node`` and ``old_cell`` say what
-        was taken from ``model``.
+        order, triangles, segments and cells (node, region, area and polygon;
+        the recomputed cells by the same code; a copied polygon may start at
+        another of its vertices, since `discretize` starts a cell at the
+        triangle that `triangle` numbers first around the node, and its
+        vertices may differ by round-off where a point was snapped again);
+        ``old_node`` and ``old_cell`` say what was taken from ``model``.
 
     Raises
     ------

@@ -105,12 +105,13 @@ def updated_operators(old, new, change):
     added = cells_stiffness(new, redo, _rows(gradient, redo))
     dofs = _dof_map(change.new_node())
     n2 = 2 * len(change.model.nodes)
-    kept = np.flatnonzero(dofs >= 0)
-    rest = (old.stiffness() - removed).tocsr()
-    moved = renumber_rows(rest, kept, dofs, (len(kept), n2), drop=True)
-    rows = sp.csr_matrix((np.ones(len(kept)), (dofs[kept], np.arange(len(kept)))),
-                         shape=(n2, len(kept)))
-    return gradient, (rows @ moved + added).tocsr()
+    old_dof = np.full(n2, -1, dtype=np.int64)
+    old_dof[dofs[dofs >= 0]] = np.flatnonzero(dofs >= 0)
+
+    def moved(K):
+        return renumber_rows(K, old_dof, dofs, (n2, n2), drop=True)
+
+    return gradient, moved(old.stiffness()) + (added - moved(removed))
 
 
 def _rows(gradient, index):
