@@ -190,7 +190,7 @@ class Elasticity:
             ``self``.
         """
         from .local_update import updated_operators
-        gradient, self._K = updated_operators(old, self, change)
+        gradient, self._K = updated_operators(old, self, change, elasticity_form)
         self._basis = CellBasis(self.model, vector=True, gauss=self.gauss, cells=self.cells,
                                 gradient=gradient)
         return self

@@ -25,7 +25,7 @@ from ..errors import CNEMError
 __all__ = ["updated_operators", "cells_stiffness"]
 
 
-def cells_stiffness(prob, index, gradient):
+def cells_stiffness(prob, index, gradient, form):
     """The part of ``prob.stiffness()`` that the cells ``index`` contribute.
 
     Parameters
@@ -36,12 +36,13 @@ def cells_stiffness(prob, index, gradient):
         Cells of ``prob.model``.
     gradient : SmoothedGradient
         ``B~`` of those cells, ``(c, n)``.
+    form : BilinearForm
+        `cnem.models.elasticity.elasticity_form`.
 
     Returns
     -------
     scipy.sparse.csr_matrix, shape (2 n, 2 n)
     """
-    from .elasticity import elasticity_form
     model = prob.model
     cells = model.cells.subset(index)
     a = prob.stabilization
@@ -53,17 +54,17 @@ def cells_stiffness(prob, index, gradient):
     if weight != 0.0:
         lam, mu = prob._lame(weight)
         basis = CellBasis(model, vector=True, cells=cells, gradient=gradient)
-        K = K + elasticity_form.assemble(basis, groups=cells.region, lam=lam, mu=mu)
+        K = K + form.assemble(basis, groups=cells.region, lam=lam, mu=mu)
     if a > 0:
         sub, _ = subdivide(cells, model.nodes, node_apex=tip_cells(model)[index], mark_spokes=True)
         grad = smoothed_gradient(model, gauss=prob.gauss, cells=sub)
         fine = CellBasis(model, vector=True, cells=sub, gradient=grad)
         lam, mu = prob._lame(a)
-        K = K + elasticity_form.assemble(fine, groups=sub.region, lam=lam, mu=mu)
+        K = K + form.assemble(fine, groups=sub.region, lam=lam, mu=mu)
     return K.tocsr()
 
 
-def updated_operators(old, new, change):
+def updated_operators(old, new, change, form):
     """``B~`` and ``K`` of ``new`` from those of ``old``, recomputing the changed cells only.
 
     Parameters
@@ -74,6 +75,8 @@ def updated_operators(old, new, change):
         The problem on ``change.model``: the same materials, plane, ``gauss`` and
         stabilisation, no enrichment.
     change : cnem.geometry.update.ModelUpdate
+    form : BilinearForm
+        The problem's bilinear form (`cnem.models.elasticity.elasticity_form`).
 
     Returns
     -------
@@ -100,9 +103,9 @@ def updated_operators(old, new, change):
     old_grad = old.basis.grad
     gradient = updated_gradient(old_grad, change, gauss=new.gauss)
     dropped = change.dropped_cells
-    removed = cells_stiffness(old, dropped, _rows(old_grad, dropped))
+    removed = cells_stiffness(old, dropped, _rows(old_grad, dropped), form)
     redo = change.changed_cells
-    added = cells_stiffness(new, redo, _rows(gradient, redo))
+    added = cells_stiffness(new, redo, _rows(gradient, redo), form)
     dofs = _dof_map(change.new_node())
     n2 = 2 * len(change.model.nodes)
     old_dof = np.full(n2, -1, dtype=np.int64)
