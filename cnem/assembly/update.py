@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .._parallel import one_thread
 from ..errors import CNEMError
 from .scni import SmoothedGradient, smoothed_gradient
 
@@ -92,7 +93,9 @@ def updated_gradient(old, change, *, gauss=2):
                         f"{len(change.old.cells)} cells x {len(change.old.nodes)} nodes, "
                         f"received {old.x.shape[0]} x {old.x.shape[1]}")
     redo = change.changed_cells
-    fresh = smoothed_gradient(model, gauss=gauss, cells=model.cells.subset(redo))
+    model.circumcircles()               # the whole model's: in parallel
+    with one_thread():                  # a few cells
+        fresh = smoothed_gradient(model, gauss=gauss, cells=model.cells.subset(redo))
     columns = change.new_node()
     place = np.full(m, -1, dtype=np.int64)
     place[redo] = np.arange(len(redo))

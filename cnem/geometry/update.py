@@ -40,6 +40,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import config
+from .._parallel import one_thread
 from ..errors import GeometryError
 from .cells import voronoi_cells
 from .cloud import NodeCloud
@@ -290,11 +291,12 @@ def update(model, cloud, *, progress=None):
     timings["matching"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     shift = nodes.min(axis=0)
-    node, cell_region, offsets, vertices = voronoi_cells(
-        nodes - shift, tri, region, progress=progress, neighbors=neighbors[0],
-        only=np.flatnonzero(redo))
-    vertices += shift
-    fresh = Cells(node, cell_region, offsets, vertices)
+    with one_thread():                  # a few cells
+        node, cell_region, offsets, vertices = voronoi_cells(
+            nodes - shift, tri, region, progress=progress, neighbors=neighbors[0],
+            only=np.flatnonzero(redo))
+        vertices += shift
+        fresh = Cells(node, cell_region, offsets, vertices)
     new_of_old_node = np.full(len(model.nodes), -1, dtype=np.int64)
     new_of_old_node[old_node[old_node >= 0]] = np.flatnonzero(old_node >= 0)
     owner = new_of_old_node[model.cells.node]

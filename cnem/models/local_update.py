@@ -20,6 +20,7 @@ from ..assembly import CellBasis
 from ..assembly.quadrature import subdivide, tip_cells
 from ..assembly.scni import smoothed_gradient
 from ..assembly.update import renumber_rows, updated_gradient
+from .._parallel import one_thread
 from ..errors import CNEMError
 
 __all__ = ["updated_operators", "cells_stiffness"]
@@ -103,9 +104,10 @@ def updated_operators(old, new, change, form):
     old_grad = old.basis.grad
     gradient = updated_gradient(old_grad, change, gauss=new.gauss)
     dropped = change.dropped_cells
-    removed = cells_stiffness(old, dropped, _rows(old_grad, dropped), form)
     redo = change.changed_cells
-    added = cells_stiffness(new, redo, _rows(gradient, redo), form)
+    with one_thread():                  # a few cells
+        removed = cells_stiffness(old, dropped, _rows(old_grad, dropped), form)
+        added = cells_stiffness(new, redo, _rows(gradient, redo), form)
     dofs = _dof_map(change.new_node())
     n2 = 2 * len(change.model.nodes)
     old_dof = np.full(n2, -1, dtype=np.int64)
