@@ -211,9 +211,6 @@ def discretize(cloud, *, progress=None):
         Crossing constraints (`triangle` would need Steiner points), nodes that
         are not vertices of the triangulation.
     """
-    if not isinstance(cloud, NodeCloud):
-        raise GeometryError(f"discretize expects a NodeCloud from cnem.nodes, received "
-                            f"{type(cloud).__name__}; build one with cnem.nodes.from_points")
     timings = {}
     nodes, node_of_point, tri, region, segments, kind, neighbors = triangulate(cloud, timings)
     t2 = time.perf_counter()
@@ -231,7 +228,7 @@ def discretize(cloud, *, progress=None):
     return model
 
 
-def triangulate(cloud, timings):
+def triangulate(cloud, timings, caller="discretize"):
     """The stages of `discretize` before the cells: constrained Delaunay
     triangulation, crack opening and the neighbour tables.
 
@@ -240,6 +237,8 @@ def triangulate(cloud, timings):
     cloud : NodeCloud
     timings : dict
         Receives the seconds of ``triangulation`` and ``splitting``.
+    caller : str
+        Named in the error when ``cloud`` is not a `NodeCloud`.
 
     Returns
     -------
@@ -248,6 +247,9 @@ def triangulate(cloud, timings):
     neighbors : tuple of two (t, 3) int64 ndarray
         Within regions and across them (`Model.neighbors`).
     """
+    if not isinstance(cloud, NodeCloud):
+        raise GeometryError(f"{caller} expects a NodeCloud from cnem.nodes, received "
+                            f"{type(cloud).__name__}; build one with cnem.nodes.from_points")
     t0 = time.perf_counter()
     tri, region = constrained_delaunay(cloud)
     t1 = time.perf_counter()

@@ -43,7 +43,6 @@ from .. import config
 from .._parallel import one_thread
 from ..errors import GeometryError
 from .cells import voronoi_cells
-from .cloud import NodeCloud
 from .model import Cells, Model, triangulate
 from .topology import circumcenters
 
@@ -265,11 +264,9 @@ def update(model, cloud, *, progress=None):
     if not isinstance(model, Model):
         raise GeometryError(f"update expects the old Model, received {type(model).__name__}; "
                             "build the first one with cnem.discretize")
-    if not isinstance(cloud, NodeCloud):
-        raise GeometryError(f"update expects a NodeCloud from cnem.nodes, received "
-                            f"{type(cloud).__name__}; build one with cnem.nodes.from_points")
     timings = {}
-    nodes, node_of_point, tri, region, segments, kind, neighbors = triangulate(cloud, timings)
+    nodes, node_of_point, tri, region, segments, kind, neighbors = triangulate(cloud, timings,
+                                                                               "update")
     t0 = time.perf_counter()
     size = float(np.hypot(*np.ptp(cloud.points, axis=0)))
     new_of_old = _point_map(model.cloud.points, cloud.points, config.MERGE_TOL * size)
