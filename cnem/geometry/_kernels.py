@@ -192,8 +192,8 @@ def _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly
 
 
 @numba.njit(cache=True, parallel=True)
-def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg):
-    """Cells of the nodes that need no clipping.
+def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg, which):
+    """Cells of the nodes ``which`` that need no clipping.
 
     Parameters
     ----------
@@ -208,42 +208,46 @@ def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg):
         Relative distance under which consecutive vertices are merged.
     max_deg : int
         Largest vertex degree.
+    which : (w,) int64
+        The nodes whose cells are wanted.
 
     Returns
     -------
-    status : (n,) int8
-        ``FAST`` or ``SLOW``.
-    poly_offsets : (n + 1,) int64
+    status : (w,) int8
+        ``FAST`` or ``SLOW``, per entry of ``which``.
+    poly_offsets : (w + 1,) int64
     poly : (k, 2) float64
         Vertices of the fast cells, CCW; empty rows for slow nodes.
-    region_tri : (n,) int64
+    region_tri : (w,) int64
         One triangle of each fast node (for its region).
     """
-    n = pts.shape[0]
-    status = np.full(n, SLOW, dtype=np.int8)
-    counts = np.zeros(n, dtype=np.int64)
-    region_tri = np.full(n, -1, dtype=np.int64)
-    for i in numba.prange(n):
+    w = which.shape[0]
+    status = np.full(w, SLOW, dtype=np.int8)
+    counts = np.zeros(w, dtype=np.int64)
+    region_tri = np.full(w, -1, dtype=np.int64)
+    for s in numba.prange(w):
+        i = which[s]
         fan = np.empty(max_deg, dtype=np.int64)
         path = np.empty((max_deg + 2, 2))
         poly = np.empty((max_deg + 3, 2))
         c = _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly)
         if c > 0:
-            status[i] = FAST
-            counts[i] = c
-            region_tri[i] = star[offsets[i]]
-    poly_offsets = np.zeros(n + 1, dtype=np.int64)
-    for i in range(n):
-        poly_offsets[i + 1] = poly_offsets[i] + counts[i]
-    out = np.empty((poly_offsets[n], 2), dtype=np.float64)
-    for i in numba.prange(n):
-        if status[i] != FAST:
+            status[s] = FAST
+            counts[s] = c
+            region_tri[s] = star[offsets[i]]
+    poly_offsets = np.zeros(w + 1, dtype=np.int64)
+    for s in range(w):
+        poly_offsets[s + 1] = poly_offsets[s] + counts[s]
+    out = np.empty((poly_offsets[w], 2), dtype=np.float64)
+    for s in numba.prange(w):
+        if status[s] != FAST:
             continue
+        i = which[s]
         fan = np.empty(max_deg, dtype=np.int64)
         path = np.empty((max_deg + 2, 2))
         poly = np.empty((max_deg + 3, 2))
         c = _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly)
-        out[poly_offsets[i]:poly_offsets[i] + c] = poly[:c]
+        out[poly_offsets[s]:poly_offsets[s] + c] = poly[:c]
     return status, poly_offsets, out, region_tri
 
 

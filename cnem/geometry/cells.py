@@ -134,8 +134,6 @@ class _ExactCells:
         self.edge_tree = cKDTree(mid)
         self.edge_half = 0.5 * np.linalg.norm(nodes[edges[:, 0]] - nodes[edges[:, 1]], axis=1).max()
         self.node_tree = cKDTree(nodes)
-        pairs = np.unique(np.column_stack([triangles.ravel(), np.repeat(region, 3)]), axis=0)
-        self.member = set(map(tuple, pairs.tolist()))
         on_edge = np.column_stack([edges.ravel(), np.repeat(self.edge_region, 2)])
         self.constrained = set(map(tuple, on_edge.tolist()))
         self.circ_r = np.linalg.norm(cc - nodes[triangles[:, 0]], axis=1)
@@ -143,6 +141,10 @@ class _ExactCells:
     def fan(self, i, r):
         ts = self.star[self.offsets[i]:self.offsets[i + 1]]
         return ts[self.region[ts] == r]
+
+    def member(self, j, r):
+        """Whether node ``j`` is a vertex of a triangle of region ``r``."""
+        return bool((self.region[self.star[self.offsets[j]:self.offsets[j + 1]]] == r).any())
 
     def wedge(self, i, r, reach):
         """Directions from node ``i`` into region ``r`` (None: all directions)."""
@@ -199,7 +201,7 @@ class _ExactCells:
         for j, dj in zip(near, dist):
             if dj > 2 * radius:
                 break            # j is farther from every point of the cell than i
-            if dj <= tiny or (int(j), r) not in self.member:
+            if dj <= tiny or not self.member(j, r):
                 continue
             q = self.nodes[j]
             if (corners @ (q - x)).max() <= 0.5 * (q @ q - x @ x):
@@ -234,7 +236,7 @@ class _ExactCells:
         return ring
 
 
-def voronoi_cells(nodes, triangles, region, *, progress=None, neighbors=None):
+def voronoi_cells(nodes, triangles, region, *, progress=None, neighbors=None, only=None):
     """Constrained Voronoi cells of a (crack-split) constrained Delaunay triangulation.
 
     Parameters
@@ -247,10 +249,15 @@ def voronoi_cells(nodes, triangles, region, *, progress=None, neighbors=None):
         Progress bar over the clipped cells (default: when on a terminal).
     neighbors : (t, 3) int64 ndarray, optional
         `triangle_neighbors` of the triangles and regions, if already known.
+    only : (w,) int array_like, optional
+        Compute the cells of these nodes alone (default: of every node); a
+        cell depends only on the triangulation, so these are the same cells
+        as those of the whole diagram (`cnem.geometry.update` relies on it).
 
     Returns
     -------
     node, region : (m,) int64 ndarray
+        Sorted by node, then region.
     offsets : (m + 1,) int64 ndarray
     vertices : (k, 2) ndarray
         Cell ``c`` is ``vertices[offsets[c]:offsets[c + 1]]``, counter-clockwise.
@@ -260,19 +267,21 @@ def voronoi_cells(nodes, triangles, region, *, progress=None, neighbors=None):
     offsets, star = vertex_triangles(triangles, n)
     cc = circumcenters(nodes, triangles)
     max_deg = int(np.diff(offsets).max())
+    which = np.arange(n, dtype=np.int64) if only is None else np.unique(np.asarray(only, dtype=np.int64))
     status, poff, poly, rtri = fast_cells(nodes, triangles, nb, offsets, star, cc,
-                                          config.MERGE_TOL, max_deg)
-    fast = np.flatnonzero(status == FAST)
+                                          config.MERGE_TOL, max_deg, which)
+    is_fast = np.flatnonzero(status == FAST)     # positions in `which`
+    fast = which[is_fast]
     exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc)
-    slow = np.flatnonzero(status != FAST)
+    slow = which[status != FAST]
     pairs = sorted({(int(i), int(r)) for i in slow
                     for r in region[star[offsets[i]:offsets[i + 1]]]})
     slow_polys = [exact.cell(i, r) for i, r in tqdm(
         pairs, desc="clipping cells", disable=None if progress is None else not progress,
         leave=False)]
     cell_node = np.concatenate([fast, np.array([p[0] for p in pairs], dtype=np.int64)])
-    cell_region = np.concatenate([region[rtri[fast]], np.array([p[1] for p in pairs], dtype=np.int64)])
-    counts = np.concatenate([poff[fast + 1] - poff[fast],
+    cell_region = np.concatenate([region[rtri[is_fast]], np.array([p[1] for p in pairs], dtype=np.int64)])
+    counts = np.concatenate([poff[is_fast + 1] - poff[is_fast],
                              np.array([len(p) for p in slow_polys], dtype=np.int64)])
     verts = np.concatenate([poly] + slow_polys) if slow_polys else poly
     order = np.lexsort((cell_region, cell_node))

@@ -126,6 +126,7 @@ class Domain:
         raw = [_as_polygon(r, i, None) for i, r in enumerate(regions)]
         minx, miny, maxx, maxy = shapely.union_all(raw).bounds
         self._diameter = float(np.hypot(maxx - minx, maxy - miny))
+        self._origin = np.array([minx, miny])    # buffers are computed in this local frame
         self._tol = config.SNAP_TOL * self._diameter
         self._regions = tuple(_as_polygon(r, i, self._tol) for i, r in enumerate(regions))
         self._union = shapely.union_all(self._regions)
@@ -164,21 +165,24 @@ class Domain:
         if not np.isfinite(arr).all():
             raise GeometryError(f"{what}: vertices must be finite, received NaN or inf")
         _check_zero_length(arr, False, what, self._tol)
-        line = LineString(arr)
+        line = LineString(arr - self._origin)
         if not line.is_simple:
             raise GeometryError(f"{what} crosses itself; expected a simple polyline")
-        outside = line.difference(self._union.buffer(self._tol))
+        union = shapely.transform(self._union, lambda xy: xy - self._origin)
+        outside = line.difference(union.buffer(self._tol))
         if not outside.is_empty:
+            where = np.asarray(outside.representative_point().coords[0]) + self._origin
             raise GeometryError(
-                f"{what} leaves the domain near {_fmt(outside.representative_point().coords[0])}; "
+                f"{what} leaves the domain near {_fmt(where)}; "
                 "cracks must lie inside the closure of the domain")
-        touch = line.intersection(self._union.boundary.buffer(self._tol))
-        ends = shapely.points(arr[[0, -1]])
+        touch = line.intersection(union.boundary.buffer(self._tol))
+        ends = shapely.points(arr[[0, -1]] - self._origin)
         bad = touch.difference(shapely.union_all(ends).buffer(2 * self._tol))
         if not bad.is_empty and bad.length > 2 * self._tol:
+            where = np.asarray(bad.representative_point().coords[0]) + self._origin
             raise GeometryError(
                 f"{what} touches the outer boundary or a hole away from its ends near "
-                f"{_fmt(bad.representative_point().coords[0])}; only crack ends may lie on it")
+                f"{_fmt(where)}; only crack ends may lie on it")
         return arr
 
     def _check_crack_crossings(self):

@@ -211,30 +211,53 @@ def discretize(cloud, *, progress=None):
         Crossing constraints (`triangle` would need Steiner points), nodes that
         are not vertices of the triangulation.
     """
-    if not isinstance(cloud, NodeCloud):
-        raise GeometryError(f"discretize expects a NodeCloud from cnem.nodes, received "
-                            f"{type(cloud).__name__}; build one with cnem.nodes.from_points")
     timings = {}
-    t0 = time.perf_counter()
-    tri, region = constrained_delaunay(cloud)
-    t1 = time.perf_counter()
-    nodes, node_of_point, tri, segments, kind = split_cracks(
-        cloud.points, tri, cloud.segments, cloud.segment_kind)
+    nodes, node_of_point, tri, region, segments, kind, neighbors = triangulate(cloud, timings)
     t2 = time.perf_counter()
-    neighbors = _neighbor_tables(tri, region)
     shift = nodes.min(axis=0)        # a local frame keeps the snap grid above round-off
     node, cell_region, offsets, vertices = voronoi_cells(nodes - shift, tri, region,
                                                          progress=progress,
                                                          neighbors=neighbors[0])
     vertices += shift
-    t3 = time.perf_counter()
-    timings.update(triangulation=t1 - t0, splitting=t2 - t1, cells=t3 - t2)
+    timings["cells"] = time.perf_counter() - t2
     log.info("discretize: %d nodes, %s", len(nodes),
              ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
     cells = Cells(node, cell_region, offsets, vertices)
     model = Model(cloud, nodes, node_of_point, tri, region, segments, kind, cells, timings)
     model._cache["neighbors"] = neighbors
     return model
+
+
+def triangulate(cloud, timings, caller="discretize"):
+    """The stages of `discretize` before the cells: constrained Delaunay
+    triangulation, crack opening and the neighbour tables.
+
+    Parameters
+    ----------
+    cloud : NodeCloud
+    timings : dict
+        Receives the seconds of ``triangulation`` and ``splitting``.
+    caller : str
+        Named in the error when ``cloud`` is not a `NodeCloud`.
+
+    Returns
+    -------
+    nodes, node_of_point, triangles, triangle_region, segments, segment_kind
+        As the `Model` attributes.
+    neighbors : tuple of two (t, 3) int64 ndarray
+        Within regions and across them (`Model.neighbors`).
+    """
+    if not isinstance(cloud, NodeCloud):
+        raise GeometryError(f"{caller} expects a NodeCloud from cnem.nodes, received "
+                            f"{type(cloud).__name__}; build one with cnem.nodes.from_points")
+    t0 = time.perf_counter()
+    tri, region = constrained_delaunay(cloud)
+    t1 = time.perf_counter()
+    nodes, node_of_point, tri, segments, kind = split_cracks(
+        cloud.points, tri, cloud.segments, cloud.segment_kind)
+    neighbors = _neighbor_tables(tri, region)
+    timings.update(triangulation=t1 - t0, splitting=time.perf_counter() - t1)
+    return nodes, node_of_point, tri, region, segments, kind, neighbors
 
 
 def _neighbor_tables(triangles, region):

@@ -130,6 +130,29 @@ class Elasticity(Conditions):
                                     cells=self.cells)
         return self._basis
 
+    def update_from(self, old, change):
+        """Take ``B~`` and ``K`` from the problem ``old`` on the model before a local
+        update, recomputing only the cells the change reaches
+        (`cnem.models.local_update.updated_operators`); equal to building them here.
+
+        Parameters
+        ----------
+        old : Elasticity
+            On ``change.old``, with the same materials, plane, gauss and stabilisation.
+        change : cnem.geometry.update.ModelUpdate
+            With ``change.model`` this problem's model.
+
+        Returns
+        -------
+        Elasticity
+            ``self``.
+        """
+        from .local_update import updated_operators
+        gradient, self._K = updated_operators(old, self, change, elasticity_form)
+        self._basis = CellBasis(self.model, vector=True, gauss=self.gauss, cells=self.cells,
+                                gradient=gradient)
+        return self
+
     def cell_materials(self):
         """``(m, 2)`` ``(E, nu)`` of every integration cell."""
         return self.materials[self.cells.region]

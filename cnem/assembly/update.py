@@ -1,0 +1,107 @@
+"""Smoothed gradients after a local model update: only the changed cells' rows recomputed.
+
+A cell that `cnem.geometry.update.update` copied from the old model lies outside
+every changed circumcircle, so the natural neighbours of the points on its
+boundary, their shape functions and its row of ``B~`` are those of the old
+model: the row is copied with its columns renumbered to the new nodes. The
+rows of the recomputed cells come from `smoothed_gradient` on those cells alone.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from .._parallel import one_thread
+from ..errors import CNEMError
+from .scni import SmoothedGradient, smoothed_gradient
+
+__all__ = ["updated_gradient", "renumber_rows"]
+
+
+def renumber_rows(matrix, rows, columns, shape, *, drop=False):
+    """Rows ``rows`` of ``matrix`` with their columns renumbered by ``columns``.
+
+    Parameters
+    ----------
+    matrix : sparse (r, c)
+    rows : (k,) int array
+        Row of ``matrix`` that becomes each row of the result; -1 for an empty row.
+    columns : (c,) int64 ndarray
+        New index of every column; -1 for a column that must not appear.
+    shape : tuple
+        ``(k, c_new)``.
+    drop : bool
+        Leave out the entries on columns mapped to -1 (else they raise).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape ``shape``
+
+    Raises
+    ------
+    CNEMError
+        A taken row has a non-zero in a column mapped to -1 (and not ``drop``).
+    """
+    matrix = sp.csr_matrix(matrix)
+    rows = np.asarray(rows, dtype=np.int64)
+    have = rows >= 0
+    counts = np.zeros(len(rows), dtype=np.int64)
+    counts[have] = np.diff(matrix.indptr)[rows[have]]
+    indptr = np.zeros(len(rows) + 1, dtype=np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    starts = np.zeros(len(rows), dtype=np.int64)
+    starts[have] = matrix.indptr[rows[have]]
+    gather = np.repeat(starts - indptr[:-1], counts) + np.arange(indptr[-1])
+    cols = columns[matrix.indices[gather]]
+    data = matrix.data[gather]
+    keep = cols >= 0
+    if not keep.all():
+        if not drop:
+            raise CNEMError(f"{np.count_nonzero(~keep)} non-zeros of the copied rows fall on "
+                            "columns that have no new index; the rows must be recomputed instead")
+        cum = np.zeros(len(keep) + 1, dtype=np.int64)
+        np.cumsum(keep, out=cum[1:])
+        indptr, cols, data = cum[indptr], cols[keep], data[keep]
+    out = sp.csr_matrix((data, cols, indptr), shape=shape)
+    out.has_sorted_indices = False
+    out.sort_indices()
+    return out
+
+
+def updated_gradient(old, change, *, gauss=2):
+    """``B~`` of the updated model: copied rows for the copied cells, the others computed.
+
+    Parameters
+    ----------
+    old : SmoothedGradient
+        ``B~`` of ``change.old`` (its cells), ``x, y`` ``(m_old, n_old)``.
+    change : cnem.geometry.update.ModelUpdate
+    gauss : int
+        As in `smoothed_gradient` (the one ``old`` was computed with).
+
+    Returns
+    -------
+    SmoothedGradient
+        ``x, y`` ``(m, n)`` of ``change.model``; ``points`` counts the quadrature
+        points of the recomputed cells only.
+    """
+    model = change.model
+    m, n = len(model.cells), len(model.nodes)
+    if old.x.shape != (len(change.old.cells), len(change.old.nodes)):
+        raise CNEMError(f"old: expected the smoothed gradient of the old model, "
+                        f"{len(change.old.cells)} cells x {len(change.old.nodes)} nodes, "
+                        f"received {old.x.shape[0]} x {old.x.shape[1]}")
+    redo = change.changed_cells
+    model.circumcircles()               # the whole model's: in parallel
+    with one_thread():                  # a few cells
+        fresh = smoothed_gradient(model, gauss=gauss, cells=model.cells.subset(redo))
+    columns = change.new_node()
+    place = np.full(m, -1, dtype=np.int64)
+    place[redo] = np.arange(len(redo))
+
+    def merged(old_part, new_part):
+        copied = renumber_rows(old_part, change.old_cell, columns, (m, n))
+        return copied + renumber_rows(new_part, place, np.arange(n), (m, n))
+
+    return SmoothedGradient(merged(old.x, fresh.x), merged(old.y, fresh.y), fresh.points)
