@@ -12,7 +12,7 @@ import numpy as np
 
 from .models.material import lame
 
-__all__ = ["LayeredCylinder"]
+__all__ = ["LayeredCylinder", "rayleigh_speed"]
 
 
 class LayeredCylinder:
@@ -98,3 +98,33 @@ class LayeredCylinder:
         srr, stt = lm - dev, lm + dev
         return np.column_stack([srr * c * c + stt * s * s, srr * s * s + stt * c * c,
                                 (srr - stt) * s * c])
+
+
+def rayleigh_speed(E: float, nu: float, density: float, plane: str = "stress") -> float:
+    """Rayleigh (surface) wave speed of an isotropic elastic solid in 2-D.
+
+    Parameters
+    ----------
+    E, nu, density : float
+        Young's modulus, Poisson's ratio and mass density.
+    plane : {"stress", "strain"}
+
+    Returns
+    -------
+    float
+        The root ``c`` in ``(0, c_s)`` of ``(2 - k^2)^2 = 4 sqrt(1 - k^2 r^2) sqrt(1 - k^2)``
+        with ``k = c / c_s``, ``r = c_s / c_d``, ``c_s = sqrt(mu / density)`` and
+        ``c_d`` the dilatational speed of the plane law (``sqrt(E / ((1 - nu^2) density))``
+        in plane stress).
+    """
+    from scipy.optimize import brentq
+    mu = E / (2.0 * (1.0 + nu))
+    modulus = E / (1.0 - nu ** 2) if plane == "stress" else \
+        E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    cs, cd = np.sqrt(mu / density), np.sqrt(modulus / density)
+    r2 = (cs / cd) ** 2
+
+    def rayleigh(k):
+        return (2 - k * k) ** 2 - 4 * np.sqrt(1 - k * k * r2) * np.sqrt(1 - k * k)
+
+    return float(brentq(rayleigh, 0.5, 1.0 - 1e-12) * cs)

@@ -7,7 +7,7 @@ import numpy as np
 
 import cnem.pd as pd
 
-from .common import (EPS, RATIO, constant, convergence_table, finish, lattice, lattice_measure,
+from cnem.demos.cpd.common import (EPS, RATIO, constant, convergence_table, finish, lattice, lattice_measure,
                      solve)
 
 

@@ -11,7 +11,7 @@ import numpy as np
 
 import cnem.pd as pd
 
-from .common import (EPS, TOL, constant, convergence_table, finish, lattice, moduli, per_unit,
+from cnem.demos.cpd.common import (EPS, TOL, constant, convergence_table, finish, lattice, moduli, per_unit,
                      solve)
 
 #: The paper's constants as ratios (see `common.moduli`): cantilever C2 = 1e4, torsion C3 = 1e8.

@@ -1,4 +1,4 @@
-"""Helpers of the CPD examples (`demos/cpd_examples.py`): lattices, the small-strain
+"""Helpers of the CPD examples (`cnem.demos.cpd_examples`): lattices, the small-strain
 moduli of the CPD sums, cell measures, the solve, the convergence tables and the pictures."""
 
 from __future__ import annotations

@@ -1,0 +1,8 @@
+"""The demos: narrative scripts that reproduce the papers' examples (front layer).
+
+Each module states its problem and the expected result in its docstring, has
+``main(**sizes, outdir=..., plot=...) -> dict`` (the numbers it prints) and
+``cli(argv)`` (its command line), and runs as ``python -m cnem.demos.<name>``,
+``cnem demo <name>`` (see `cnem.cli`) or, from a source tree,
+``python demos/<name>.py``. They use only the library's public functions.
+"""

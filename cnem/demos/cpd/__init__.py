@@ -1,0 +1,1 @@
+"""The CPD examples of Javili et al. §6, run by `cnem.demos.cpd_examples` (``cnem pd cpd``)."""
