@@ -26,8 +26,8 @@ iteration, one column per load step) and writes a picture of the deformed body.
    stress near the re-entrant corner.
 
 "C >> C1" is set through the small-strain continuum limit of the CPD sums
-(`cpd.common.moduli`): the interaction adds ``ratio`` times the shear modulus of
-the bonds to the Lame constant lambda (ratio 100 here, `cpd.common.RATIO`). The paper's
+(`cnem.pd.cpd_moduli`): the interaction adds ``ratio`` times the shear modulus of
+the bonds to the Lame constant lambda (ratio 100 here, `cnem.demos.cpd.common.RATIO`). The paper's
 constants, read the same way, are ratio 15 (cantilever, C2 = 1e4, 2-D) and 0.5
 (torsion, C3 = 1e8); those ratios are kept on the grids used here.
 
@@ -57,7 +57,7 @@ Expected result
   nonlocal response smooths the concentration).
 * Pictures ``cpd_<example>.png`` (and ``cpd_lshape_profiles.png``) in ``outdir``.
 
-The code: ``cnem/demos/cpd/common.py`` (lattices, moduli, solve, tables, pictures),
+The code: ``cnem/demos/cpd/common.py`` (solve, tables, pictures),
 ``cnem/demos/cpd/stretch.py`` (examples 1-2), ``cnem/demos/cpd/structures.py`` (3-5).
 Run ``python demos/cpd_examples.py --help`` or ``cnem pd cpd --help``.
 """

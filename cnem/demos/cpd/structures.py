@@ -11,10 +11,12 @@ import numpy as np
 
 import cnem.pd as pd
 
-from cnem.demos.cpd.common import (EPS, TOL, constant, convergence_table, finish, lattice, moduli, per_unit,
-                     solve)
+from cnem.demos.cpd.common import EPS, TOL, convergence_table, finish, solve
+from cnem.pd.cpd_moduli import (constant_for_ratio, lame_constants,
+                                 moduli_per_constant)
+from cnem.pd.lattice import lattice
 
-#: The paper's constants as ratios (see `common.moduli`): cantilever C2 = 1e4, torsion C3 = 1e8.
+#: The paper's constants as ratios (see `cnem.pd.cpd_moduli.lame_constants`): cantilever C2 = 1e4, torsion C3 = 1e8.
 CANTILEVER_RATIO, TORSION_RATIO = 15.0, 0.5
 
 def cantilever(spacing=0.04, *, C1s=(1.0, 2.0, 4.0), height=0.2, aspect=25, m=3.0, steps=20,
@@ -39,8 +41,8 @@ def cantilever(spacing=0.04, *, C1s=(1.0, 2.0, 4.0), height=0.2, aspect=25, m=3.
     h = height / (counts[1] - 1)
     x = lattice(counts, h)
     body = pd.Body(x, h * h, m * h * (1 + EPS))
-    C2 = constant(2, CANTILEVER_RATIO, 2, body.horizon)
-    lam, mu = moduli(pd.CPD(1.0, C2), 2, body.horizon)
+    C2 = constant_for_ratio(2, CANTILEVER_RATIO, 2, body.horizon)
+    lam, mu = lame_constants(pd.CPD(1.0, C2), 2, body.horizon)
     E = 4 * mu * (lam + mu) / (lam + 2 * mu)
     force = load * 3 * E * height ** 3 / 12 / length ** 2
     clamp, end = x[:, 0] < body.horizon, x[:, 0] > length - body.horizon
@@ -87,7 +89,7 @@ def torsion(n=7, *, slenderness=2, m=1.5, angle=180.0, steps=18, outdir="results
     counts = (n, n, int(round(slenderness / h)) + 1)
     x = lattice(counts, h)
     body = pd.Body(x, h ** 3, m * h * (1 + EPS))
-    C3 = constant(3, TORSION_RATIO, 3, body.horizon)
+    C3 = constant_for_ratio(3, TORSION_RATIO, 3, body.horizon)
     top = x[:, 2] > x[:, 2].max() - EPS
     prob = pd.Problem(body, pd.CPD(1.0, 0.0, C3, exponent=0.0))
     prob.add_dirichlet(x[:, 2] < EPS, None, 0.0)
@@ -173,7 +175,7 @@ def lshape(spacing=1 / 40, *, ratios=(2.0, 3.0, 4.0, 5.0), pull=1e-3, outdir="re
     print(f"lshape: {len(x)} points, D = {h:.4g}, u_y = {pull:g} at the top of the left arm")
     for m in ratios:
         body = pd.Body(x, h * h, m * h * (1 + EPS))
-        C1 = 1.0 / per_unit(2, body.horizon, 1.0)[0, 1]
+        C1 = 1.0 / moduli_per_constant(2, body.horizon, 1.0)[0, 1]
         r = solve(body, pd.CPD(C1, exponent=1.0),
                   [(bottom, None, 0.0), (grip, 0, 0.0), (grip, 1, pull)])
         vm = _von_mises(body, r["u"], 1.0, 1.0)
