@@ -19,7 +19,8 @@ def test_lattice_is_the_grid_in_c_order(dim):
         steps = np.diff(grid, axis=axis)
         expected = np.zeros(dim)
         expected[axis] = 0.5
-        np.testing.assert_allclose(steps.reshape(-1, dim), np.tile(expected, (steps.size // dim, 1)))
+        np.testing.assert_allclose(steps.reshape(-1, dim),
+                                   np.tile(expected, (steps.size // dim, 1)))
     np.testing.assert_array_equal(x[0], np.zeros(dim))
 
 

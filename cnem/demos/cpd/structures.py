@@ -16,8 +16,10 @@ from cnem.pd.cpd_moduli import (constant_for_ratio, lame_constants,
                                  moduli_per_constant)
 from cnem.pd.lattice import lattice
 
-#: The paper's constants as ratios (see `cnem.pd.cpd_moduli.lame_constants`): cantilever C2 = 1e4, torsion C3 = 1e8.
+#: The paper's constants as ratios (see `cnem.pd.cpd_moduli`): cantilever C2 = 1e4,
+#: torsion C3 = 1e8.
 CANTILEVER_RATIO, TORSION_RATIO = 15.0, 0.5
+
 
 def cantilever(spacing=0.04, *, C1s=(1.0, 2.0, 4.0), height=0.2, aspect=25, m=3.0, steps=20,
                load=5.0, outdir="results/cpd", plot=True):
