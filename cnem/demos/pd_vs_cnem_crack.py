@@ -41,6 +41,7 @@ import numpy as np
 import cnem
 import cnem.pd as pd
 from cnem.fracture import sif
+from cnem.fracture.opening import crack_opening, k_from_opening
 
 W, A, SIGMA, E, NU = 1.0, 0.25, 1.0, 1.0, 0.3
 SPACINGS = (1 / 16, 1 / 32, 1 / 64)
@@ -74,39 +75,19 @@ def solve_pd(cloud, cnem_problem, horizon_factor=3.0):
 
 
 def opening(model, u):
-    """Crack opening ``u_y(upper) - u_y(lower)`` at the crack-face point pairs.
-
-    Returns
-    -------
-    x : (k,) ndarray
-    delta : (k,) ndarray
-    """
-    from cnem.fracture.williams import node_sides
-    copies = np.bincount(model.node_of_point)[model.node_of_point] == 2
-    idx = np.flatnonzero(copies)
-    side = node_sides(model)[idx, 1] > 0
-    pairs = {}
-    for i, up in zip(idx, side):
-        pairs.setdefault(model.node_of_point[i], [None, None])[int(up)] = i
-    lower, upper = np.array([p for p in pairs.values()]).T
-    x = model.nodes[upper, 0]
-    order = np.argsort(x)
-    return x[order], (u[upper, 1] - u[lower, 1])[order]
+    """Crack opening ``u_y(upper) - u_y(lower)`` at the crack-face point pairs, by x."""
+    points, delta, _ = crack_opening(model, u, [(-A, 0.0), (A, 0.0)])
+    return points[:, 0], delta
 
 
 def griffith(x):
     return 4 * SIGMA / E * np.sqrt(np.clip(A * A - x * x, 0.0, None))
 
 
-def k_from_opening(x, delta, h):
-    """Least-squares fit of delta = C sqrt(r) at 2h < r < a/2 from both tips:
-    K_I = E C sqrt(2 pi) / 8."""
+def k_from_tips(x, delta, h):
+    """K_I fitted to the opening at 2h < r < a/2 from both tips (`k_from_opening`)."""
     r = A - np.abs(x)
-    near = (r > 2 * h) & (r < 0.5 * A)
-    if not near.any():
-        return float("nan")                   # too coarse: no crack point in the fit range
-    C = np.sum(delta[near] * np.sqrt(r[near])) / np.sum(r[near])
-    return E * C * np.sqrt(2 * np.pi) / 8
+    return k_from_opening(r, delta, E, NU, "stress", where=(r > 2 * h) & (r < 0.5 * A))
 
 
 def study(spacings=SPACINGS):
@@ -124,7 +105,7 @@ def study(spacings=SPACINGS):
                          cnem_error=float(np.abs(dc - g).max() / g.max()),
                          pd_error=float(np.abs(dp - g).max() / g.max()),
                          K_cnem=float(sif(csol, (A, 0.0), radius=0.4 * A)[0]),
-                         K_pd=k_from_opening(x, dp, h),
+                         K_pd=k_from_tips(x, dp, h),
                          u_difference=float(np.abs(psol.u - csol.u).max() / np.abs(csol.u).max()),
                          model=model, u_cnem=csol.u, u_pd=psol.u))
     return rows
