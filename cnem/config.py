@@ -4,6 +4,8 @@ All tolerances are *relative*: multiply by the domain diameter (lengths) or
 its square (areas) before comparing.
 """
 
+__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL"]
+
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
 #: are snapped onto it; vertices closer than this are the same vertex.
 SNAP_TOL = 1e-9

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import GeometryError
-from .williams import effective_modulus, node_sides
+from ..material import effective_modulus
 
 __all__ = ["crack_opening", "k_from_opening"]
 
@@ -52,7 +52,7 @@ def crack_opening(model, u, segment):
     on = np.abs(rel @ n) <= 1e-9 * length
     on &= (rel @ t >= -1e-9 * length) & (rel @ t <= length * (1 + 1e-9))
     idx = idx[on]
-    plus = (node_sides(model)[idx] - a) @ n > 0
+    plus = (model.node_sides()[idx] - a) @ n > 0
     pairs = {}
     for i, up in zip(idx, plus):
         pairs.setdefault(model.node_of_point[i], [None, None])[int(up)] = i
