@@ -277,7 +277,7 @@ def test_every_demo_module_has_a_case():
 
     import cnem.demos
     modules = {m.name for m in pkgutil.iter_modules(cnem.demos.__path__) if not m.ispkg}
-    assert modules == {case.module for case in CASES}
+    assert modules == set(cnem.demos.MODULES) == {case.module for case in CASES}
 
 
 @pytest.mark.parametrize("case", CASES, ids=[case.id for case in CASES])

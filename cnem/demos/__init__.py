@@ -6,3 +6,9 @@ Each module states its problem and the expected result in its docstring, has
 ``cnem demo <name>`` (see `cnem.cli`) or, from a source tree,
 ``python demos/<name>.py``. They use only the library's public functions.
 """
+
+#: The demo modules (``cnem.demos.<name>``; `cnem.cli` gives them command-line names).
+MODULES = ("bimaterial_cylinder", "cpd_examples", "cracked_plate_geometry", "inclined_crack",
+           "mode1_crack", "pd_crack_branching", "pd_vs_cnem_crack")
+
+__all__ = ["MODULES"]

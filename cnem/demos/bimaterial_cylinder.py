@@ -50,6 +50,8 @@ from tqdm.auto import tqdm
 import cnem
 from cnem.exact import LayeredCylinder
 
+__all__ = ["main", "cli", "run", "rate", "build", "exact_solution", "GRIDS", "TABLE_I"]
+
 RADII = (0.5, 0.7, 0.9)
 MATERIALS = ((210000.0, 0.3), (105000.0, 0.2))
 PRESSURE = 1.0

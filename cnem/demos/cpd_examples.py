@@ -68,6 +68,8 @@ import argparse
 
 from cnem.demos.cpd import stretch, structures
 
+__all__ = ["main", "cli", "EXAMPLES", "QUICK"]
+
 #: Example name -> function (each returns its numbers and writes ``cpd_<name>.png``).
 RUN = {"tension2d": stretch.tension2d, "cube": stretch.cube,
        "cantilever": structures.cantilever, "torsion": structures.torsion,

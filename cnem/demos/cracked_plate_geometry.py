@@ -42,6 +42,8 @@ import cnem.io
 import cnem.plot
 from cnem.geometry import rectangle
 
+__all__ = ["main", "cli", "build"]
+
 #: Half side W and half crack length a of the paper (mm).
 HALF_WIDTH, HALF_CRACK = 1.0, 0.1
 

@@ -45,6 +45,8 @@ from tqdm.auto import tqdm
 import cnem
 from cnem.fracture import sif
 
+__all__ = ["main", "cli", "sif_study", "muskhelishvili"]
+
 HALF_CRACK = 0.1
 E, NU, SIGMA = 1.0, 0.3, 1.0
 #: (half width W, spacing away from the crack, spacing at the tips, grading rate)

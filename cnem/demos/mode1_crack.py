@@ -50,6 +50,8 @@ from tqdm.auto import tqdm
 import cnem
 from cnem.fracture import polar, sif, williams
 
+__all__ = ["main", "cli", "study"]
+
 L, E, NU, PLANE, KI = 1.0, 1.0, 0.3, "strain", 1.0
 TIP = np.array([0.5, 0.5])
 DIRECTION = np.array([1.0, 0.0])

@@ -81,6 +81,8 @@ import cnem.pd as pd
 from cnem.exact import rayleigh_speed
 from cnem.pd import cracks
 
+__all__ = ["main", "cli", "build", "measure", "plate", "MATERIALS", "QUICK"]
+
 LENGTH, HEIGHT, NOTCH = 0.1, 0.04, 0.05
 THICKNESS = 1.0
 NU = 1.0 / 3.0                      # the PMB in plane stress

@@ -43,6 +43,8 @@ import cnem.pd as pd
 from cnem.fracture import sif
 from cnem.fracture.opening import crack_opening, k_from_opening
 
+__all__ = ["main", "cli", "study"]
+
 W, A, SIGMA, E, NU = 1.0, 0.25, 1.0, 1.0, 0.3
 SPACINGS = (1 / 16, 1 / 32, 1 / 64)
 TOL = 1e-9

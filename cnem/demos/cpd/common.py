@@ -10,6 +10,8 @@ import numpy as np
 
 import cnem.pd as pd
 
+__all__ = ["solve", "convergence_table", "picture", "finish", "RATIO", "TOL", "EPS"]
+
 #: Stiffness ratio of the ">> C1" cases: lambda added per shear modulus of the bonds.
 RATIO = 100.0
 TOL = 1e-10

@@ -11,6 +11,8 @@ from cnem.demos.cpd.common import EPS, RATIO, convergence_table, finish, solve
 from cnem.pd.cpd_moduli import constant_for_ratio
 from cnem.pd.lattice import lattice, lattice_measure
 
+__all__ = ["tension2d", "cube"]
+
 
 def tension2d(spacing=0.02, *, m=3.0, steps=10, ratio=RATIO, outdir="results/cpd", plot=True):
     """§6.1, Figure 5: a unit square stretched to twice its length (n = 1), C2 = 0 and

@@ -16,6 +16,8 @@ from cnem.pd.cpd_moduli import (constant_for_ratio, lame_constants,
                                  moduli_per_constant)
 from cnem.pd.lattice import lattice
 
+__all__ = ["cantilever", "torsion", "lshape"]
+
 #: The paper's constants as ratios (see `cnem.pd.cpd_moduli`): cantilever C2 = 1e4,
 #: torsion C3 = 1e8.
 CANTILEVER_RATIO, TORSION_RATIO = 15.0, 0.5
