@@ -132,7 +132,7 @@ def main(argv=None):
         if not {"-h", "--help"} & set(rest):
             runners[args.command].error("expected a demo name, or 'list'")
         runners[args.command].print_help()
-        print(f"\n{args.command} demos:")
+        print("\ndemos:" if args.command == "demo" else f"\n{args.command} demos:")
         _list(args.command)
         return 0
     if args.name == "list":
