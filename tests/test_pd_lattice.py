@@ -1,5 +1,5 @@
-"""Lattices of PD bodies (`cnem.pd.lattice`) and the small-strain moduli of CPD materials
-(`cnem.pd.cpd_moduli`)."""
+"""Lattices of PD bodies (`cnem.pd.lattice`), the small-strain moduli of CPD materials
+(`cnem.pd.cpd_moduli`) and the nonlocal deformation gradient (`cnem.pd.strain`)."""
 
 import numpy as np
 import pytest
@@ -67,3 +67,17 @@ def test_constant_for_ratio_adds_that_much_lambda(dim, order):
     lam, mu = lame_constants(pd.CPD(C1, *((C, 0.0) if order == 2 else (0.0, C))), dim, horizon)
     assert lam - lam1 == pytest.approx(ratio * mu1, rel=1e-12)
     assert mu >= mu1
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_deformation_gradient_of_an_affine_map_is_exact_everywhere(dim):
+    """Inside and at the boundary (truncated families), a scattered cloud included."""
+    from cnem.pd.strain import deformation_gradient
+    rng = np.random.default_rng(dim)
+    counts = (7, 6, 5)[:dim]
+    x = lattice(counts, 0.25) + rng.uniform(-0.05, 0.05, (np.prod(counts), dim))
+    body = pd.Body(x, 0.25 ** dim, 0.6)
+    F = np.eye(dim) + 0.2 * rng.standard_normal((dim, dim))
+    u = x @ (F - np.eye(dim)).T + rng.standard_normal(dim)          # plus a translation
+    expected = np.broadcast_to(F, (len(x), dim, dim))
+    np.testing.assert_allclose(deformation_gradient(body, u), expected, atol=1e-12)

@@ -15,6 +15,7 @@ from cnem.demos.cpd.common import EPS, TOL, convergence_table, finish, solve
 from cnem.pd.cpd_moduli import (constant_for_ratio, lame_constants,
                                  moduli_per_constant)
 from cnem.pd.lattice import lattice
+from cnem.pd.strain import deformation_gradient
 
 __all__ = ["cantilever", "torsion", "lshape"]
 
@@ -132,15 +133,9 @@ def torsion(n=7, *, slenderness=2, m=1.5, angle=180.0, steps=18, outdir="results
 
 def _von_mises(body, u, lam, mu):
     """von Mises stress per point from the nonlocal deformation gradient
-    ``F = (sum w y xi^T)(sum w xi xi^T)^-1`` (w = partial volumes) and linear
-    elasticity with the material's ``lam, mu`` (2-D, no out-of-plane stress)."""
-    w = body.beta * body.volumes[body.bond_j]
-    y = body.xi + u[body.bond_j] - u[body.bond_i]
-    shape = (len(body), 2, 2)
-    K, N = np.zeros(shape), np.zeros(shape)
-    np.add.at(K, body.bond_i, w[:, None, None] * body.xi[:, :, None] * body.xi[:, None, :])
-    np.add.at(N, body.bond_i, w[:, None, None] * y[:, :, None] * body.xi[:, None, :])
-    G = N @ np.linalg.inv(K) - np.eye(2)
+    (`cnem.pd.strain.deformation_gradient`) and linear elasticity with the material's
+    ``lam, mu`` (2-D, no out-of-plane stress)."""
+    G = deformation_gradient(body, u) - np.eye(2)
     eps = 0.5 * (G + G.transpose(0, 2, 1))
     tr = eps[:, 0, 0] + eps[:, 1, 1]
     sxx, syy, sxy = lam * tr + 2 * mu * eps[:, 0, 0], lam * tr + 2 * mu * eps[:, 1, 1], \
