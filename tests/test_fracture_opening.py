@@ -49,3 +49,28 @@ def test_the_reversed_segment_turns_the_faces(model):
     np.testing.assert_allclose(o2, o1[::-1], rtol=1e-12)     # the normal and the faces turn
     with pytest.raises(GeometryError, match="two distinct end points"):
         crack_opening(model, u, [tip, tip])
+
+
+@pytest.mark.parametrize("gamma", [0.0, 0.4, 1.2])
+@pytest.mark.parametrize("plane", ["stress", "strain"])
+def test_central_crack_fields_agree_with_its_sifs(gamma, plane):
+    """`cnem.exact.CentralCrack`: the opening near a tip is (8 K_I / E') sqrt(r / 2 pi)
+    (so `k_from_opening` returns K_I), the normal stress ahead of a tip is
+    K_I / sqrt(2 pi r) near it and the remote normal stress far from it."""
+    from cnem.exact import CentralCrack
+    a, sigma = 0.3, 2.0
+    crack = CentralCrack(a, sigma, gamma)
+    KI, KII = crack.sif()
+    assert KI == pytest.approx(sigma * np.sqrt(np.pi * a) * np.cos(gamma) ** 2, rel=1e-14)
+    assert KII == pytest.approx(sigma * np.sqrt(np.pi * a) * np.sin(gamma) * np.cos(gamma),
+                                rel=1e-14)
+    r = a * np.geomspace(1e-9, 1e-7, 5)
+    opening = crack.opening(a - r, E, NU, plane)
+    Ep = E if plane == "stress" else E / (1 - NU ** 2)
+    np.testing.assert_allclose(opening, 8 * KI / Ep * np.sqrt(r / (2 * np.pi)), rtol=1e-6)
+    assert k_from_opening(r, opening, E, NU, plane) == pytest.approx(KI, rel=1e-6)
+    assert (crack.opening([-a, a, 2 * a], E, NU, plane) == 0).all()
+    np.testing.assert_allclose(crack.normal_stress_ahead(r), KI / np.sqrt(2 * np.pi * r),
+                               rtol=1e-6)
+    assert crack.normal_stress_ahead(1e9 * a) == pytest.approx(sigma * np.cos(gamma) ** 2,
+                                                                rel=1e-8)

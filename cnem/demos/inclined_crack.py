@@ -43,6 +43,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import cnem
+from cnem.exact import CentralCrack
 from cnem.fracture import sif
 
 __all__ = ["main", "cli", "sif_study", "muskhelishvili"]
@@ -80,9 +81,8 @@ def solve(model, W, enrich=None):
 
 
 def exact_sif(gamma_deg):
-    g = np.deg2rad(gamma_deg)
-    k0 = SIGMA * np.sqrt(np.pi * HALF_CRACK)
-    return k0 * np.cos(g) ** 2, k0 * np.sin(g) * np.cos(g)
+    """K_I, K_II of the crack in an infinite plate (eq. 46)."""
+    return CentralCrack(HALF_CRACK, SIGMA, np.deg2rad(gamma_deg)).sif()
 
 
 def sif_study(angles=ANGLES, cloud=SIF_CLOUD, radius=0.4 * HALF_CRACK):
@@ -102,7 +102,7 @@ def sif_study(angles=ANGLES, cloud=SIF_CLOUD, radius=0.4 * HALF_CRACK):
 
 def muskhelishvili(r):
     """sigma_22 ahead of the tip of a crack in an infinite plate (eq. 45)."""
-    return SIGMA * (HALF_CRACK + r) / np.sqrt(r * (2 * HALF_CRACK + r))
+    return CentralCrack(HALF_CRACK, SIGMA).normal_stress_ahead(r)
 
 
 def stress_ahead(sol, tip):
