@@ -6,7 +6,7 @@ CPD (`cnem.pd.CPD`) adds to the bonds of bond-based PD (one-neighbour
 interactions, constant C1) the areas spanned by pairs of bonds (two-neighbour,
 C2) and, in 3-D, the volumes spanned by triplets of bonds (three-neighbour, C3),
 each with the Seth-Hill energy ``1/2 C |reference measure| S_n(stretch)^2``
-(eq. 41-42). `cnem.pd.Problem.solve_static` finds the equilibrium by
+(eq. 41-42). `cnem.pd.Problem.solve` finds the equilibrium by
 Newton-Raphson with the exact tangent (hyper-dual derivatives). All bodies are
 regular lattices of spacing D with horizon delta = m D; every example prints a
 convergence table like the paper's Tables 4-8 (residual norm per Newton

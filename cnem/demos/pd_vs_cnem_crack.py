@@ -74,7 +74,7 @@ def solve_pd(cloud, cnem_problem, horizon_factor=3.0):
     prob = pd.Problem(body, pd.StateBased(E, NU), plane="stress")
     prob.add_body_force(lambda p: forces / body.volumes[:, None])
     supports(prob)
-    return body, prob.solve_static()
+    return body, prob.solve()
 
 
 def opening(model, u):

@@ -22,7 +22,7 @@ BAR = {2: dict(position_x=0.15, position_y=0.04, width=0.7, height=0.09),
 
 
 def solve(body, material, conditions, *, steps=1, force=None, tol=TOL):
-    """`cnem.pd.Problem.solve_static` of ``body`` with the Dirichlet ``conditions``
+    """`cnem.pd.Problem.solve` of ``body`` with the Dirichlet ``conditions``
     [(where, component, value), ...] and an optional body force, in ``steps`` load steps.
 
     Returns
@@ -37,7 +37,7 @@ def solve(body, material, conditions, *, steps=1, force=None, tol=TOL):
     if force is not None:
         prob.add_body_force(force)
     start = time.perf_counter()
-    sol = prob.solve_static(tol=tol, steps=steps)
+    sol = prob.solve(tol=tol, steps=steps)
     return dict(u=sol.u, history=sol.residual_history, seconds=time.perf_counter() - start)
 
 

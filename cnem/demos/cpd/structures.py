@@ -79,7 +79,7 @@ def torsion(n=7, *, slenderness=2, m=1.5, angle=180.0, steps=18, outdir="results
             plot=True):
     """§6.3, Figures 8-9: a block ``1 x 1 x slenderness``, bottom layer clamped, top
     layer turned by ``angle`` degrees about the axis in ``steps`` increments, C1 = 1, C3
-    from `TORSION_RATIO`, n = 0. Each increment is one `solve_static` from the last
+    from `TORSION_RATIO`, n = 0. Each increment is one `solve` from the last
     state with the top's values of the new angle (a linear ramp of the displacements
     would not be a rotation). Paper: D = 0.02, delta = 3D; here ``n`` points across,
     delta = ``m`` D.
@@ -110,7 +110,7 @@ def torsion(n=7, *, slenderness=2, m=1.5, angle=180.0, steps=18, outdir="results
     u, history, start = None, [], time.perf_counter()
     for theta in np.radians(levels):             # the top's values of this angle replace
         prob.add_dirichlet(top, None, lambda p, t=theta: turn(p, t))   # the previous ones
-        sol = prob.solve_static(tol=TOL, initial=u)
+        sol = prob.solve(tol=TOL, initial=u)
         u, history = sol.u, history + sol.residual_history
     seconds = time.perf_counter() - start
     grid, ref = (x + u).reshape(*counts, 3), x.reshape(*counts, 3)
