@@ -87,15 +87,8 @@ def crack_region(image, origin, spacing, start, reach, *, threshold=0.35):
 
 def crack_tip(mask, origin, spacing, start_x):
     """``x`` of the crack tip: the right-most crack point, or ``start_x`` if none lies
-    right of it.
-
-    Parameters
-    ----------
-    mask : (nx, ny) bool ndarray
-        The crack (`crack_region`).
-    origin : (2,) array_like
-    spacing : float
-    start_x : float
+    right of it (``mask`` the crack's ``(nx, ny)`` image, the other parameters as in
+    `crack_region`).
 
     Returns
     -------
@@ -151,11 +144,8 @@ def branching(mask, origin, spacing, start_x, *, persistence, window):
 
     Parameters
     ----------
-    mask : (nx, ny) bool ndarray
-        The crack (`crack_region`).
-    origin : (2,) array_like
-    spacing : float
-    start_x : float
+    mask, origin, spacing, start_x
+        As in `bands`.
     persistence : float
         Length along ``x`` over which two bands mark a branching (two horizons
         keep the two faces of a wide band from counting).
