@@ -29,6 +29,9 @@ DEMOS = {
     "mode1-crack": "mode1_crack",
     "pd-crack": "pd_vs_cnem_crack",
     "cracked-plate": "cracked_plate_geometry",
+    "growth-sent": "growth_sent",
+    "growth-kink": "growth_kink",
+    "growth-two-holes": "growth_two_holes",
 }
 
 #: ``cnem pd <name>`` -> module of `cnem.demos` (add a PD demo here).

@@ -248,6 +248,25 @@ def check_cpd_examples(demo, results, outdir):
             assert pathlib.Path(f).stat().st_size > 1000, f
 
 
+def check_growth_sent(demo, res, outdir):
+    assert [r["a"] for r in res["rows"]] == pytest.approx([0.2, 0.3, 0.4, 0.5, 0.6])
+    assert res["max_kink_deg"] < 0.1                  # the symmetric cloud keeps the path straight
+    assert res["max_error"] < 0.05                    # K_I against the handbook (coarse cloud)
+
+
+def check_growth_kink(demo, res, outdir):
+    assert res["rows"][0]["exact_deg"] == pytest.approx(-43.22, abs=0.01)
+    assert res["max_error_deg"] < 1.0
+
+
+def check_growth_two_holes(demo, res, outdir):
+    tips = res["tips"]
+    assert np.hypot(*(tips[1:] - tips[:-1]).transpose(2, 0, 1)) == pytest.approx(1.0, rel=1e-9)
+    assert np.all(np.diff(tips[:, 0, 0]) > 0) and np.all(np.diff(tips[:, 1, 0]) < 0)
+    # the plate is point-symmetric about its centre: so are the two paths (to the cloud's asymmetry)
+    assert np.abs(tips[:, 0] + tips[:, 1] - [20.0, 10.0]).max() < 0.15
+
+
 CASES = [
     Case("cracked-plate-30", "cracked_plate_geometry",
          check_cracked_plate(30.0, 0.2, 0.04, 0.3, HAS_PYVISTA),
@@ -269,6 +288,12 @@ CASES = [
     Case("pd-crack-branching", "pd_crack_branching", check_pd_crack_branching,
          sizes=lambda demo: dict(demo.QUICK, progress=False), plot=True),
     Case("cpd-examples", "cpd_examples", check_cpd_examples, sizes=dict(quick=True)),
+    Case("growth-sent", "growth_sent", check_growth_sent, args=(0.05,),
+         sizes=dict(increment=0.1, progress=False), plot=False),
+    Case("growth-kink", "growth_kink", check_growth_kink, args=((30.0,),),
+         sizes=dict(cloud=(0.8, 0.005, 0.3), progress=False), plot=False),
+    Case("growth-two-holes", "growth_two_holes", check_growth_two_holes, args=(0.5,),
+         sizes=dict(steps=2, progress=False), plot=False),
 ]
 
 
