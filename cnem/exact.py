@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .material import lame
+from .material import effective_modulus, lame
 
-__all__ = ["LayeredCylinder"]
+__all__ = ["LayeredCylinder", "CentralCrack", "rayleigh_speed"]
 
 
 class LayeredCylinder:
@@ -98,3 +98,76 @@ class LayeredCylinder:
         srr, stt = lm - dev, lm + dev
         return np.column_stack([srr * c * c + stt * s * s, srr * s * s + stt * c * c,
                                 (srr - stt) * s * c])
+
+
+def rayleigh_speed(E: float, nu: float, density: float, plane: str = "stress") -> float:
+    """Rayleigh (surface) wave speed of an isotropic elastic solid in 2-D.
+
+    Parameters
+    ----------
+    E, nu, density : float
+        Young's modulus, Poisson's ratio and mass density.
+    plane : {"stress", "strain"}
+
+    Returns
+    -------
+    float
+        The root ``c`` in ``(0, c_s)`` of ``(2 - k^2)^2 = 4 sqrt(1 - k^2 r^2) sqrt(1 - k^2)``
+        with ``k = c / c_s``, ``r = c_s / c_d``, ``c_s = sqrt(mu / density)`` and
+        ``c_d`` the dilatational speed of the plane law (``sqrt(E / ((1 - nu^2) density))``
+        in plane stress).
+    """
+    from scipy.optimize import brentq
+    mu = E / (2.0 * (1.0 + nu))
+    modulus = E / (1.0 - nu ** 2) if plane == "stress" else \
+        E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    cs, cd = np.sqrt(mu / density), np.sqrt(modulus / density)
+    r2 = (cs / cd) ** 2
+
+    def rayleigh(k):
+        return (2 - k * k) ** 2 - 4 * np.sqrt(1 - k * k * r2) * np.sqrt(1 - k * k)
+
+    return float(brentq(rayleigh, 0.5, 1.0 - 1e-12) * cs)
+
+
+class CentralCrack:
+    """A straight crack ``|x| < a`` (crack axes) in an infinite plate under a remote
+    uniaxial stress ``sigma`` at ``gamma`` to the crack's normal (Griffith, Muskhelishvili).
+
+    In the crack's axes the remote load has ``sigma_nn = sigma cos^2 gamma`` and
+    ``sigma_nt = sigma sin gamma cos gamma``: ``K_I = sigma_nn sqrt(pi a)``,
+    ``K_II = sigma_nt sqrt(pi a)``; the faces open by
+    ``4 sigma_nn / E' sqrt(a^2 - x^2)`` and slide by ``4 sigma_nt / E' sqrt(a^2 - x^2)``;
+    ahead of a tip (distance ``r``) the normal stress is
+    ``sigma_nn (a + r) / sqrt(r (2 a + r))``.
+
+    Parameters
+    ----------
+    half_length : float
+        ``a``.
+    sigma : float
+        The remote stress.
+    gamma : float
+        Angle (radians) between the load and the crack's normal (0: pure mode I).
+    """
+
+    def __init__(self, half_length: float, sigma: float = 1.0, gamma: float = 0.0):
+        self.a, self.sigma, self.gamma = float(half_length), float(sigma), float(gamma)
+        self.normal = self.sigma * np.cos(self.gamma) ** 2
+        self.shear = self.sigma * np.sin(self.gamma) * np.cos(self.gamma)
+
+    def sif(self):
+        """``(K_I, K_II)``."""
+        k0 = self.sigma * np.sqrt(np.pi * self.a)
+        return k0 * np.cos(self.gamma) ** 2, k0 * np.sin(self.gamma) * np.cos(self.gamma)
+
+    def opening(self, x, E: float, nu: float = 0.0, plane: str = "stress"):
+        """Normal opening ``(p,)`` of the faces at ``x`` (crack axes; 0 outside the crack)."""
+        x = np.asarray(x, dtype=float)
+        return 4 * self.normal / effective_modulus(E, nu, plane) * \
+            np.sqrt(np.clip(self.a * self.a - x * x, 0.0, None))
+
+    def normal_stress_ahead(self, r):
+        """Normal stress ``(p,)`` on the crack line at distance ``r > 0`` ahead of a tip."""
+        r = np.asarray(r, dtype=float)
+        return self.normal * (self.a + r) / np.sqrt(r * (2 * self.a + r))

@@ -1,7 +1,17 @@
-"""Every demo runs at a small size and returns the numbers it promises."""
+"""Every demo runs at a small size and returns the numbers it promises.
 
+One test runs `main` of each demo module of `cnem.demos` with the sizes of its
+row in `CASES` and hands the returned dict to the row's check, which asserts on
+the physics (exact solutions, published values, convergence rates, balances).
+"""
+
+from __future__ import annotations
+
+import importlib
 import importlib.util
 import pathlib
+from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 import pytest
@@ -11,85 +21,80 @@ import cnem
 import cnem.io
 from cnem.geometry import rectangle
 
-DEMOS = pathlib.Path(__file__).resolve().parents[1] / "demos"
+HAS_PYVISTA = importlib.util.find_spec("pyvista") is not None
 
 
-def _load(name):
-    spec = importlib.util.spec_from_file_location(name, DEMOS / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+@dataclass(frozen=True)
+class Case:
+    """One run of a demo: ``cnem.demos.<module>.main(*args, **sizes, outdir=, plot=)``,
+    then ``check(demo, out, outdir)``; ``args`` and ``sizes`` may be functions of the
+    demo module (to use its own constants)."""
+
+    id: str
+    module: str
+    check: Callable
+    args: tuple | Callable = ()
+    sizes: dict | Callable = field(default_factory=dict)
+    plot: bool = HAS_PYVISTA
 
 
-def _has_pyvista():
-    return importlib.util.find_spec("pyvista") is not None
+def check_cracked_plate(gamma, h, h_min, growth, plot):
+    def check(demo, res, outdir):
+        # the plate 2W = 2 is partitioned by the cells
+        assert res["exact_area"] == 4.0
+        assert abs(res["cell_area"] - 4.0) <= 1e-12 * 4.0
+        assert res["area_error"] <= 1e-12
+        assert res["n_cells"] == res["n_nodes"]          # one region: one cell per node
+
+        # independently: the crack 2a = 0.2 through the origin at angle gamma
+        g = np.deg2rad(gamma)
+        tip = 0.1 * np.array([np.cos(g), np.sin(g)])
+        np.testing.assert_allclose(np.sort(res["tips"], axis=0), np.sort([-tip, tip], axis=0),
+                                   atol=1e-15)
+        dom = rectangle(2.0, 2.0, origin=(-1.0, -1.0), cracks=[[-tip, tip]])
+        cloud = cnem.nodes.graded(dom, h, near=dom.tips, h_min=h_min, growth=growth)
+        crack = shapely.LineString([-tip, tip])
+        on_crack = shapely.distance(shapely.points(cloud.points), crack) <= 1e-12
+        at_tip = np.linalg.norm(cloud.points[:, None] - np.array([-tip, tip])[None],
+                                axis=2) <= 1e-12
+        assert res["n_points"] == len(cloud.points)
+        assert res["n_crack_points"] == on_crack.sum() >= 3
+        assert at_tip.sum() == 2 and on_crack[at_tip.any(axis=1)].all()
+        assert res["n_split"] == on_crack.sum() - 2
+        assert res["n_nodes"] == len(cloud.points) + on_crack.sum() - 2
+
+        files = res["files"]
+        assert pathlib.Path(files["vtu"]).stat().st_size > 0
+        back = cnem.io.read(files["vtu"])
+        assert len(back) == res["n_cells"]
+        if plot:
+            for key in ("cells", "tip"):
+                assert pathlib.Path(files[key]).stat().st_size > 1000
+                assert pathlib.Path(files[key]).parent == outdir
+    return check
 
 
-@pytest.mark.parametrize("gamma", [30.0, 0.0])
-def test_cracked_plate_geometry(tmp_path, gamma):
-    demo = _load("cracked_plate_geometry")
-    h, h_min, growth = 0.2, 0.04, 0.3
-    plot = _has_pyvista() and gamma == 30.0
-    res = demo.main(h=h, h_min=h_min, gamma_deg=gamma, growth=growth, outdir=tmp_path,
-                    plot=plot, window_size=(300, 300))
-
-    # the plate 2W = 2 is partitioned by the cells
-    assert res["exact_area"] == 4.0
-    assert abs(res["cell_area"] - 4.0) <= 1e-12 * 4.0
-    assert res["area_error"] <= 1e-12
-    assert res["n_cells"] == res["n_nodes"]          # one region: one cell per node
-
-    # independently: the crack 2a = 0.2 through the origin at angle gamma
-    g = np.deg2rad(gamma)
-    tip = 0.1 * np.array([np.cos(g), np.sin(g)])
-    np.testing.assert_allclose(np.sort(res["tips"], axis=0), np.sort([-tip, tip], axis=0),
-                               atol=1e-15)
-    dom = rectangle(2.0, 2.0, origin=(-1.0, -1.0), cracks=[[-tip, tip]])
-    cloud = cnem.nodes.graded(dom, h, near=dom.tips, h_min=h_min, growth=growth)
-    crack = shapely.LineString([-tip, tip])
-    on_crack = shapely.distance(shapely.points(cloud.points), crack) <= 1e-12
-    at_tip = np.linalg.norm(cloud.points[:, None] - np.array([-tip, tip])[None], axis=2) <= 1e-12
-    assert res["n_points"] == len(cloud.points)
-    assert res["n_crack_points"] == on_crack.sum() >= 3
-    assert at_tip.sum() == 2 and on_crack[at_tip.any(axis=1)].all()
-    assert res["n_split"] == on_crack.sum() - 2
-    assert res["n_nodes"] == len(cloud.points) + on_crack.sum() - 2
-
-    files = res["files"]
-    assert pathlib.Path(files["vtu"]).stat().st_size > 0
-    back = cnem.io.read(files["vtu"])
-    assert len(back) == res["n_cells"]
-    if plot:
-        for key in ("cells", "tip"):
-            assert pathlib.Path(files[key]).stat().st_size > 1000
-            assert pathlib.Path(files[key]).parent == tmp_path
-
-
-def test_bimaterial_cylinder_small(tmp_path):
+def check_cylinder_small(demo, out, outdir):
     """The main demo at its smallest size writes its files and beats FEM P1."""
-    demo = _load("bimaterial_cylinder")
-    out = demo.main(((7, 21), (9, 35)), irregular=(False,), outdir=tmp_path,
-                    plot=_has_pyvista())
     for f in out["files"]:
         assert pathlib.Path(f).stat().st_size > 0, f
     for row in out["rows"]:
         assert row["error"] < row["fem_error"], row
-    read = cnem.io.read(tmp_path / "cylinder.vtu")
+    read = cnem.io.read(outdir / "cylinder.vtu")
     assert read is not None
 
 
-@pytest.mark.parametrize("irregular", [False, True])
-def test_bimaterial_cylinder_matches_table_one(irregular):
+def check_cylinder_table_one(demo, out, outdir):
     """Every cloud of the paper: the error (in the paper's ½-energy convention) is at
     or below Table I, and the fitted rate is at least 0.95 (paper Figure 13)."""
-    demo = _load("bimaterial_cylinder")
-    rows = demo.run(demo.GRIDS, irregular=(irregular,), fem=False)
+    rows = out["rows"]
     for row in rows:
         assert row["error"] / np.sqrt(2.0) <= row["paper"], row
     nodes = [r["nodes"] for r in rows]
     assert demo.rate(nodes, [r["error"] for r in rows]) >= 0.95
     # and against the exact solution directly: u_r at the nodes of the finest cloud
-    sol = rows[-1]["solution"]
+    sol = out["finest"]
+    assert len(sol.model.nodes) == rows[-1]["nodes"]
     x = sol.model.nodes
     r = np.hypot(x[:, 0], x[:, 1])
     exact = demo.exact_solution().radial_displacement(r)
@@ -97,10 +102,8 @@ def test_bimaterial_cylinder_matches_table_one(irregular):
     assert np.abs(ur - exact).max() < 5e-3 * np.abs(exact).max()
 
 
-def test_inclined_crack(tmp_path):
+def check_inclined_crack(demo, out, outdir):
     """K_I, K_II of the inclined crack within 0.02 sigma sqrt(pi a) at both tips."""
-    demo = _load("inclined_crack")
-    out = demo.main((0.0, 45.0), outdir=tmp_path, plot=_has_pyvista())
     assert out["max_error"] < 0.02, out["rows"]
     assert out["max_enriched_error"] < 0.01, out["rows"]
     for row in out["rows"]:
@@ -111,11 +114,9 @@ def test_inclined_crack(tmp_path):
         assert pathlib.Path(f).stat().st_size > 0
 
 
-def test_mode1_crack_small(tmp_path):
+def check_mode1_crack(demo, out, outdir):
     """Plain C-NEM converges at about the singular rate 0.5, like FEM P1, on the
     paper's mode-I crack with exact tractions; enriched C-NEM at rate >= 0.9."""
-    demo = _load("mode1_crack")
-    out = demo.main((1 / 8, 1 / 16, 1 / 32), outdir=tmp_path, plot=_has_pyvista())
     assert 0.4 < out["rates"]["cnem"] < 0.65, out["rates"]
     assert 0.35 < out["rates"]["fem"] < 0.65, out["rates"]
     assert out["rates"]["enriched"] >= 0.9, out["rates"]
@@ -123,35 +124,18 @@ def test_mode1_crack_small(tmp_path):
     assert abs(finest["KI"] - 1.0) < 0.05
 
 
-def test_pd_vs_cnem_crack_small(tmp_path):
+def check_pd_vs_cnem_crack(demo, out, outdir):
     """On the same nodes, C-NEM and state-based PD open the crack like Griffith's
     ellipse (within the finite-plate excess) and agree with each other."""
-    demo = _load("pd_vs_cnem_crack")
-    out = demo.main((1 / 16, 1 / 32), outdir=tmp_path, plot=True)
     for row in out["rows"]:
         assert row["cnem_error"] < 0.15 and row["pd_error"] < 0.15, row
     assert out["rows"][1]["u_difference"] < out["rows"][0]["u_difference"]
     assert abs(out["rows"][1]["K_cnem"] / np.sqrt(np.pi * 0.25) - 1.0) < 0.08
 
 
-def test_pd_crack_branching_quick(tmp_path):
+def check_pd_crack_branching(demo, out, outdir):
     """Dynamic fracture of the pre-notched glass plate (quick size): the crack runs right
-    from the notch tip, slower than Rayleigh waves, only along its path, and branches;
-    the branch measurement recovers a drawn Y-shaped crack."""
-    demo = _load("pd_crack_branching")
-
-    # the measurement alone: a stem to x = 60 mm, then two straight arms at +-20 degrees
-    h, horizon = 0.25e-3, 1e-3
-    points, shape = demo.plate(h)
-    X, Y = (points[:, k].reshape(shape) for k in (0, 1))
-    stem = (X > 0.05) & (X <= 0.06) & (np.abs(Y) < h)
-    arms = (X > 0.06) & (X < 0.08) & (np.abs(np.abs(Y) - np.tan(np.radians(20.0)) * (X - 0.06)) < h)
-    drawn = demo.branching(stem | arms, h, horizon)
-    assert abs(drawn["x"] - 0.06) < h and abs(drawn["y"]) < h
-    assert abs(drawn["half_angle"] - 20.0) < 0.5
-    assert demo.branching(stem, h, horizon) is None
-
-    out = demo.main(**demo.QUICK, outdir=tmp_path, plot=True, progress=False)
+    from the notch tip, slower than Rayleigh waves, only along its path, and branches."""
     mat, nu = demo.MATERIALS["soda-lime"], 1.0 / 3.0
     # Rayleigh speed, Viktorov's approximation with the plane-stress ratio nu / (1 + nu)
     nu_ps = nu / (1.0 + nu)
@@ -184,26 +168,147 @@ def test_pd_crack_branching_quick(tmp_path):
         assert pathlib.Path(f).stat().st_size > 1000
 
 
-def test_growth_sent_small(tmp_path):
-    demo = _load("growth_sent")
-    res = demo.main(0.05, increment=0.1, outdir=tmp_path, plot=False, progress=False)
+def _cpd_histories(result):
+    """Every Newton history of one CPD example's result."""
+    runs = result.get("cases") or result.get("runs") or result.get("results")
+    return [h for r in runs.values() for h in r["history"]] if runs else result["history"]
+
+
+def _quadratic_pairs(history, *, asymptotic=1e-3, floor=1e-12):
+    """``(r_k, r_{k+1})`` of the last iterations of one load step, residuals scaled by the
+    step's first (the solver's own reference): ``r_k`` in the asymptotic range, and
+    ``r_{k+1}`` above the round-off floor (``floor`` times the step's largest residual)."""
+    h = np.asarray(history)
+    return [(a / h[0], b / h[0]) for a, b in zip(h[:-1], h[1:])
+            if a < asymptotic * h[0] and b > floor * h.max()]
+
+
+def check_cpd_examples(demo, results, outdir):
+    """The CPD examples of Javili et al. §6 at their quick sizes: Newton converges
+    quadratically in every load step, and each example shows its physics."""
+    # r_{k+1} <= 1000 r_k^2 near the solution (residuals relative to the step's first):
+    # an inexact tangent (relative error q) gives r_{k+1} ~ q r_k and fails it once
+    # r_k < q / 1000, which the last iterations reach for any q above ~1e-7
+    for example in ("tension2d", "cube", "cantilever", "torsion", "lshape"):
+        steps = _cpd_histories(results[example])
+        assert steps, example
+        checked = 0
+        for history in steps:
+            assert history[-1] <= 1e-8 * max(history), history            # converged
+            for a, b in _quadratic_pairs(history):
+                assert b <= 1000.0 * a * a, (example, history)
+                checked += 1
+        assert checked >= 1, (example, steps)
+
+    # tension: a large C2 preserves the area
+    cases = results["tension2d"]["cases"]
+    free, area = cases["C2=0"], cases["C2>>C1"]
+    assert free["area_ratio"] > 1.1                       # bonds alone: the area grows
+    assert abs(area["area_ratio"] - 1) < abs(free["area_ratio"] - 1) / 5
+    assert abs(area["central_area_ratio"] - 1) < abs(free["central_area_ratio"] - 1) / 5
+    # stretched twice as long at constant area: half as wide
+    assert abs(area["lateral_stretch"] - 0.5) < 0.05
+    assert area["lateral_stretch"] < free["lateral_stretch"] < 1
+
+    # cube: one-neighbour contracts least, three-neighbour keeps the volume
+    cases = results["cube"]["cases"]
+    assert cases["one"]["lateral_stretch"] > max(cases["two"]["lateral_stretch"],
+                                                  cases["three"]["lateral_stretch"])
+    assert abs(cases["three"]["volume_ratio"] - 1) < abs(cases["one"]["volume_ratio"] - 1) / 5
+    assert abs(cases["three"]["lateral_stretch"] - 1 / np.sqrt(2)) < 0.05
+
+    # cantilever: bends with the load and stiffens with C1
+    runs = results["cantilever"]["runs"]
+    tips = np.array([runs[c]["tip"] for c in sorted(runs)])
+    assert (tips[:, 1] < 0).all()                          # the load points down
+    assert (np.diff(np.abs(tips[:, 1])) < 0).all()         # stiffer, less deflection
+    assert (tips[:, 0] < 0).all()                          # a bent beam's end moves back
+
+    # torsion: every section turns in the load's sense
+    res = results["torsion"]
+    angle = demo.QUICK["torsion"]["angle"]
+    rotation = res["rotation"]
+    assert abs(rotation[0]) < 1e-9 and abs(rotation[-1] - angle) < 1e-6
+    assert (np.diff(rotation) > 0).all()                   # more with height, same sense
+    middle = np.interp(0.5 * res["z"][-1], res["z"], rotation)
+    assert 0.25 * angle < middle < 0.75 * angle
+
+    # L-shape: a larger horizon lowers the corner peak
+    per = results["lshape"]["results"]
+    horizons = sorted(per)
+    corner = [per[m]["corner"] for m in horizons]
+    assert (np.diff(corner) < 0).all()
+    smallest = per[horizons[0]]                            # the most local: peak at the corner
+    assert smallest["corner"] == max(smallest["row"].max(), smallest["column"].max())
+
+    # every example writes its picture
+    for name, res in results.items():
+        assert res["files"] or not HAS_PYVISTA, name
+        for f in res["files"]:
+            assert pathlib.Path(f).stat().st_size > 1000, f
+
+
+def check_growth_sent(demo, res, outdir):
     assert [r["a"] for r in res["rows"]] == pytest.approx([0.2, 0.3, 0.4, 0.5, 0.6])
     assert res["max_kink_deg"] < 0.1                  # the symmetric cloud keeps the path straight
     assert res["max_error"] < 0.05                    # K_I against the handbook (coarse cloud)
 
 
-def test_growth_kink_small(tmp_path):
-    demo = _load("growth_kink")
-    res = demo.main((30.0,), cloud=(0.8, 0.005, 0.3), outdir=tmp_path, plot=False, progress=False)
+def check_growth_kink(demo, res, outdir):
     assert res["rows"][0]["exact_deg"] == pytest.approx(-43.22, abs=0.01)
     assert res["max_error_deg"] < 1.0
 
 
-def test_growth_two_holes_small(tmp_path):
-    demo = _load("growth_two_holes")
-    res = demo.main(0.5, steps=2, outdir=tmp_path, plot=False, progress=False)
+def check_growth_two_holes(demo, res, outdir):
     tips = res["tips"]
     assert np.hypot(*(tips[1:] - tips[:-1]).transpose(2, 0, 1)) == pytest.approx(1.0, rel=1e-9)
     assert np.all(np.diff(tips[:, 0, 0]) > 0) and np.all(np.diff(tips[:, 1, 0]) < 0)
     # the plate is point-symmetric about its centre: so are the two paths (to the cloud's asymmetry)
     assert np.abs(tips[:, 0] + tips[:, 1] - [20.0, 10.0]).max() < 0.15
+
+
+CASES = [
+    Case("cracked-plate-30", "cracked_plate_geometry",
+         check_cracked_plate(30.0, 0.2, 0.04, 0.3, HAS_PYVISTA),
+         sizes=dict(h=0.2, h_min=0.04, gamma_deg=30.0, growth=0.3, window_size=(300, 300))),
+    Case("cracked-plate-0", "cracked_plate_geometry",
+         check_cracked_plate(0.0, 0.2, 0.04, 0.3, False),
+         sizes=dict(h=0.2, h_min=0.04, gamma_deg=0.0, growth=0.3, window_size=(300, 300)),
+         plot=False),
+    Case("cylinder-small", "bimaterial_cylinder", check_cylinder_small,
+         args=(((7, 21), (9, 35)),), sizes=dict(irregular=(False,))),
+    Case("cylinder-table-one-regular", "bimaterial_cylinder", check_cylinder_table_one,
+         args=lambda demo: (demo.GRIDS,), sizes=dict(irregular=(False,), fem=False), plot=False),
+    Case("cylinder-table-one-irregular", "bimaterial_cylinder", check_cylinder_table_one,
+         args=lambda demo: (demo.GRIDS,), sizes=dict(irregular=(True,), fem=False), plot=False),
+    Case("inclined-crack", "inclined_crack", check_inclined_crack, args=((0.0, 45.0),)),
+    Case("mode1-crack", "mode1_crack", check_mode1_crack, args=((1 / 8, 1 / 16, 1 / 32),)),
+    Case("pd-vs-cnem-crack", "pd_vs_cnem_crack", check_pd_vs_cnem_crack,
+         args=((1 / 16, 1 / 32),), plot=True),
+    Case("pd-crack-branching", "pd_crack_branching", check_pd_crack_branching,
+         sizes=lambda demo: dict(demo.QUICK, progress=False), plot=True),
+    Case("cpd-examples", "cpd_examples", check_cpd_examples, sizes=dict(quick=True)),
+    Case("growth-sent", "growth_sent", check_growth_sent, args=(0.05,),
+         sizes=dict(increment=0.1, progress=False), plot=False),
+    Case("growth-kink", "growth_kink", check_growth_kink, args=((30.0,),),
+         sizes=dict(cloud=(0.8, 0.005, 0.3), progress=False), plot=False),
+    Case("growth-two-holes", "growth_two_holes", check_growth_two_holes, args=(0.5,),
+         sizes=dict(steps=2, progress=False), plot=False),
+]
+
+
+def test_every_demo_module_has_a_case():
+    import pkgutil
+
+    import cnem.demos
+    modules = {m.name for m in pkgutil.iter_modules(cnem.demos.__path__) if not m.ispkg}
+    assert modules == set(cnem.demos.MODULES) == {case.module for case in CASES}
+
+
+@pytest.mark.parametrize("case", CASES, ids=[case.id for case in CASES])
+def test_demo(case, tmp_path):
+    demo = importlib.import_module(f"cnem.demos.{case.module}")
+    args = case.args(demo) if callable(case.args) else case.args
+    sizes = case.sizes(demo) if callable(case.sizes) else case.sizes
+    out = demo.main(*args, **sizes, outdir=tmp_path, plot=case.plot)
+    case.check(demo, out, tmp_path)

@@ -7,8 +7,11 @@ import numpy as np
 
 import cnem.pd as pd
 
-from .common import (EPS, RATIO, constant, convergence_table, finish, lattice, lattice_measure,
-                     solve)
+from cnem.demos.cpd.common import EPS, RATIO, convergence_table, finish, solve
+from cnem.pd.cpd_moduli import constant_for_ratio
+from cnem.pd.lattice import lattice, lattice_measure
+
+__all__ = ["tension2d", "cube"]
 
 
 def tension2d(spacing=0.02, *, m=3.0, steps=10, ratio=RATIO, outdir="results/cpd", plot=True):
@@ -35,7 +38,8 @@ def tension2d(spacing=0.02, *, m=3.0, steps=10, ratio=RATIO, outdir="results/cpd
     levels = np.arange(1, steps + 1) / steps
     cases, tables = {}, []
     print(f"tension2d: {n}x{n} points, D = {h:.4g}, delta = {m:g}D, {steps} load steps")
-    for name, table, C2 in (("C2=0", 5, 0.0), ("C2>>C1", 4, constant(2, ratio, 2, body.horizon))):
+    stiff = constant_for_ratio(2, ratio, 2, body.horizon)
+    for name, table, C2 in (("C2=0", 5, 0.0), ("C2>>C1", 4, stiff)):
         r = solve(body, pd.CPD(1.0, C2, exponent=1.0),
                   [(left, 0, 0.0), (right, 0, 1.0), (held, 1, 0.0)], steps=steps)
         cells = lattice_measure(x + r["u"], counts).reshape(-1)
@@ -83,7 +87,7 @@ def cube(n=7, *, m=2.0, steps=8, ratio=RATIO, outdir="results/cpd", plot=True):
     centre = np.abs(lattice(np.array(counts) - 1, h)[:, 2] + h / 2 - 0.5) < 1 / 6
     cases, tables = {}, []
     print(f"cube: {n}^3 points, D = {h:.4g}, delta = {m:g}D, {steps} load steps")
-    C2, C3 = constant(2, ratio, 3, body.horizon), constant(3, ratio, 3, body.horizon)
+    C2, C3 = (constant_for_ratio(k, ratio, 3, body.horizon) for k in (2, 3))
     for name, table, (c2, c3) in (("one", 6, (0.0, 0.0)), ("two", 7, (C2, 0.0)),
                                   ("three", 8, (0.0, C3))):
         r = solve(body, pd.CPD(1.0, c2, c3, exponent=1.0), conditions, steps=steps)

@@ -1,16 +1,16 @@
-"""Helpers of the CPD examples (`demos/cpd_examples.py`): lattices, the small-strain
-moduli of the CPD sums, cell measures, the solve, the convergence tables and the pictures."""
+"""Helpers of the CPD examples (`cnem.demos.cpd_examples`): the solve, the convergence
+tables and the pictures (lattices: `cnem.pd.lattice`; moduli: `cnem.pd.cpd_moduli`)."""
 
 from __future__ import annotations
 
-import itertools
-import math
 import pathlib
 import time
 
 import numpy as np
 
 import cnem.pd as pd
+
+__all__ = ["solve", "convergence_table", "picture", "finish", "RATIO", "TOL", "EPS"]
 
 #: Stiffness ratio of the ">> C1" cases: lambda added per shear modulus of the bonds.
 RATIO = 100.0
@@ -21,65 +21,8 @@ BAR = {2: dict(position_x=0.15, position_y=0.04, width=0.7, height=0.09),
        3: dict(position_x=0.8, position_y=0.15, height=0.65)}
 
 
-def lattice(counts, spacing):
-    """Points of a regular lattice, ``(prod(counts), d)`` in C order (so that
-    ``points.reshape(*counts, d)`` is the grid)."""
-    axes = [spacing * np.arange(c) for c in counts]
-    return np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, len(counts))
-
-
-def per_unit(dim, horizon, thickness):
-    """Small-strain continuum limit of the CPD sums: ``(lambda, mu)`` per unit C1, C2, C3
-    (horizon integrals of eq. 41 with ``S ~ strain``: one-neighbour gives the Cauchy
-    solid lambda = mu; in 2-D the area strain of every pair is tr(eps); in 3-D a pair's
-    is ``tr(eps) - m.eps.m`` (m its normal) and a triplet's tr(eps))."""
-    d = horizon
-    if dim == 2:
-        mu1 = thickness * math.pi * d ** 3 / 24
-        return np.array([[mu1, mu1], [8 * math.pi * thickness ** 2 * d ** 6 / 27, 0.0],
-                         [0.0, 0.0]])
-    mu1 = math.pi * d ** 4 / 30
-    return np.array([[mu1, mu1], [math.pi ** 3 * d ** 8 / 30, math.pi ** 3 * d ** 8 / 180],
-                     [math.pi ** 4 * d ** 12 / 32, 0.0]])
-
-
-def moduli(material, dim, horizon, thickness=1.0):
-    """Lame constants ``(lambda, mu)`` of a `cnem.pd.CPD` material in the small-strain
-    continuum limit (the lattice sums are within ~10-40 % of it, lower for delta >= 2D)."""
-    return tuple(np.array([material.C1, material.C2, material.C3]) @
-                 per_unit(dim, horizon, thickness))
-
-
-def constant(order, ratio, dim, horizon, C1=1.0, thickness=1.0):
-    """C2 (``order=2``) or C3 (``order=3``) adding ``ratio`` times the bonds' shear
-    modulus (of this C1) to lambda."""
-    table = per_unit(dim, horizon, thickness)
-    return ratio * C1 * table[0, 1] / table[order - 1, 0]
-
-
-def lattice_measure(y, counts):
-    """Area (2-D) or volume (3-D) of every lattice cell after the deformation ``y``
-    (points ``(n, d)`` in the order of `lattice`), from the d! simplices of each cell
-    (Kuhn triangulation: exact for multilinear cell maps). Returns ``(*(counts - 1),)``."""
-    d = len(counts)
-    grid = y.reshape(*counts, d)
-
-    def corner(offset):
-        return grid[tuple(slice(o, c - 1 + o) for o, c in zip(offset, counts))]
-    total = 0.0
-    for order in itertools.permutations(range(d)):
-        path = [np.zeros(d, dtype=int)]
-        for axis in order:
-            path.append(path[-1] + np.eye(d, dtype=int)[axis])
-        origin = corner(path[0])
-        edges = np.stack([corner(p) - origin for p in path[1:]], -1)
-        sign = (-1) ** sum(a > b for a, b in itertools.combinations(order, 2))
-        total = total + sign * np.linalg.det(edges)
-    return total / math.factorial(d)
-
-
 def solve(body, material, conditions, *, steps=1, force=None, tol=TOL):
-    """`cnem.pd.Problem.solve_static` of ``body`` with the Dirichlet ``conditions``
+    """`cnem.pd.Problem.solve` of ``body`` with the Dirichlet ``conditions``
     [(where, component, value), ...] and an optional body force, in ``steps`` load steps.
 
     Returns
@@ -94,7 +37,7 @@ def solve(body, material, conditions, *, steps=1, force=None, tol=TOL):
     if force is not None:
         prob.add_body_force(force)
     start = time.perf_counter()
-    sol = prob.solve_static(tol=tol, steps=steps)
+    sol = prob.solve(tol=tol, steps=steps)
     return dict(u=sol.u, history=sol.residual_history, seconds=time.perf_counter() - start)
 
 
@@ -116,7 +59,7 @@ def convergence_table(title, history, labels, columns=5):
 def picture(path, panels, *, dim, window=(1200, 600)):
     """The deformed bodies of ``panels`` side by side, at one scale (pyvista, off-screen).
 
-    Each panel is a dict with ``points`` (deformed, (n, d), in `lattice` order),
+    Each panel is a dict with ``points`` (deformed, (n, d), in `cnem.pd.lattice.lattice` order),
     ``counts`` (the lattice shape), ``values`` (n,) of the field named ``field``,
     ``title`` and optionally ``hidden`` (n,) bool (lattice points not in the body) and
     ``reference`` (the undeformed points, drawn light grey behind)."""

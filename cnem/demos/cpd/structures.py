@@ -11,11 +11,18 @@ import numpy as np
 
 import cnem.pd as pd
 
-from .common import (EPS, TOL, constant, convergence_table, finish, lattice, moduli, per_unit,
-                     solve)
+from cnem.demos.cpd.common import EPS, TOL, convergence_table, finish, solve
+from cnem.pd.cpd_moduli import (constant_for_ratio, lame_constants,
+                                 moduli_per_constant)
+from cnem.pd.lattice import lattice
+from cnem.pd.strain import deformation_gradient
 
-#: The paper's constants as ratios (see `common.moduli`): cantilever C2 = 1e4, torsion C3 = 1e8.
+__all__ = ["cantilever", "torsion", "lshape"]
+
+#: The paper's constants as ratios (see `cnem.pd.cpd_moduli`): cantilever C2 = 1e4,
+#: torsion C3 = 1e8.
 CANTILEVER_RATIO, TORSION_RATIO = 15.0, 0.5
+
 
 def cantilever(spacing=0.04, *, C1s=(1.0, 2.0, 4.0), height=0.2, aspect=25, m=3.0, steps=20,
                load=5.0, outdir="results/cpd", plot=True):
@@ -39,8 +46,8 @@ def cantilever(spacing=0.04, *, C1s=(1.0, 2.0, 4.0), height=0.2, aspect=25, m=3.
     h = height / (counts[1] - 1)
     x = lattice(counts, h)
     body = pd.Body(x, h * h, m * h * (1 + EPS))
-    C2 = constant(2, CANTILEVER_RATIO, 2, body.horizon)
-    lam, mu = moduli(pd.CPD(1.0, C2), 2, body.horizon)
+    C2 = constant_for_ratio(2, CANTILEVER_RATIO, 2, body.horizon)
+    lam, mu = lame_constants(pd.CPD(1.0, C2), 2, body.horizon)
     E = 4 * mu * (lam + mu) / (lam + 2 * mu)
     force = load * 3 * E * height ** 3 / 12 / length ** 2
     clamp, end = x[:, 0] < body.horizon, x[:, 0] > length - body.horizon
@@ -72,7 +79,7 @@ def torsion(n=7, *, slenderness=2, m=1.5, angle=180.0, steps=18, outdir="results
             plot=True):
     """§6.3, Figures 8-9: a block ``1 x 1 x slenderness``, bottom layer clamped, top
     layer turned by ``angle`` degrees about the axis in ``steps`` increments, C1 = 1, C3
-    from `TORSION_RATIO`, n = 0. Each increment is one `solve_static` from the last
+    from `TORSION_RATIO`, n = 0. Each increment is one `solve` from the last
     state with the top's values of the new angle (a linear ramp of the displacements
     would not be a rotation). Paper: D = 0.02, delta = 3D; here ``n`` points across,
     delta = ``m`` D.
@@ -87,7 +94,7 @@ def torsion(n=7, *, slenderness=2, m=1.5, angle=180.0, steps=18, outdir="results
     counts = (n, n, int(round(slenderness / h)) + 1)
     x = lattice(counts, h)
     body = pd.Body(x, h ** 3, m * h * (1 + EPS))
-    C3 = constant(3, TORSION_RATIO, 3, body.horizon)
+    C3 = constant_for_ratio(3, TORSION_RATIO, 3, body.horizon)
     top = x[:, 2] > x[:, 2].max() - EPS
     prob = pd.Problem(body, pd.CPD(1.0, 0.0, C3, exponent=0.0))
     prob.add_dirichlet(x[:, 2] < EPS, None, 0.0)
@@ -103,7 +110,7 @@ def torsion(n=7, *, slenderness=2, m=1.5, angle=180.0, steps=18, outdir="results
     u, history, start = None, [], time.perf_counter()
     for theta in np.radians(levels):             # the top's values of this angle replace
         prob.add_dirichlet(top, None, lambda p, t=theta: turn(p, t))   # the previous ones
-        sol = prob.solve_static(tol=TOL, initial=u)
+        sol = prob.solve(tol=TOL, initial=u)
         u, history = sol.u, history + sol.residual_history
     seconds = time.perf_counter() - start
     grid, ref = (x + u).reshape(*counts, 3), x.reshape(*counts, 3)
@@ -126,15 +133,9 @@ def torsion(n=7, *, slenderness=2, m=1.5, angle=180.0, steps=18, outdir="results
 
 def _von_mises(body, u, lam, mu):
     """von Mises stress per point from the nonlocal deformation gradient
-    ``F = (sum w y xi^T)(sum w xi xi^T)^-1`` (w = partial volumes) and linear
-    elasticity with the material's ``lam, mu`` (2-D, no out-of-plane stress)."""
-    w = body.beta * body.volumes[body.bond_j]
-    y = body.xi + u[body.bond_j] - u[body.bond_i]
-    shape = (len(body), 2, 2)
-    K, N = np.zeros(shape), np.zeros(shape)
-    np.add.at(K, body.bond_i, w[:, None, None] * body.xi[:, :, None] * body.xi[:, None, :])
-    np.add.at(N, body.bond_i, w[:, None, None] * y[:, :, None] * body.xi[:, None, :])
-    G = N @ np.linalg.inv(K) - np.eye(2)
+    (`cnem.pd.strain.deformation_gradient`) and linear elasticity with the material's
+    ``lam, mu`` (2-D, no out-of-plane stress)."""
+    G = deformation_gradient(body, u) - np.eye(2)
     eps = 0.5 * (G + G.transpose(0, 2, 1))
     tr = eps[:, 0, 0] + eps[:, 1, 1]
     sxx, syy, sxy = lam * tr + 2 * mu * eps[:, 0, 0], lam * tr + 2 * mu * eps[:, 1, 1], \
@@ -173,7 +174,7 @@ def lshape(spacing=1 / 40, *, ratios=(2.0, 3.0, 4.0, 5.0), pull=1e-3, outdir="re
     print(f"lshape: {len(x)} points, D = {h:.4g}, u_y = {pull:g} at the top of the left arm")
     for m in ratios:
         body = pd.Body(x, h * h, m * h * (1 + EPS))
-        C1 = 1.0 / per_unit(2, body.horizon, 1.0)[0, 1]
+        C1 = 1.0 / moduli_per_constant(2, body.horizon, 1.0)[0, 1]
         r = solve(body, pd.CPD(C1, exponent=1.0),
                   [(bottom, None, 0.0), (grip, 0, 0.0), (grip, 1, pull)])
         vm = _von_mises(body, r["u"], 1.0, 1.0)
