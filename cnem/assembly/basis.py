@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -11,10 +12,15 @@ from skfem.element import DiscreteField
 
 from .scni import smoothed_gradient
 
+if TYPE_CHECKING:
+    from typing import Callable, Literal, Sequence
+    from numpy.typing import ArrayLike
+    from ..geometry.model import Model
+
 __all__ = ["CellBasis", "spread_component"]
 
 
-def spread_component(op, component, ncomp):
+def spread_component(op: sp.csr_matrix, component: int, ncomp: int) -> sp.csr_matrix:
     """Move the columns of a node operator ``(m, n)`` to the dofs of one
     component of an interleaved vector field ``(m, ncomp * n)``."""
     op = op.tocsr()
@@ -58,7 +64,9 @@ class CellBasis:
         The node of each cell.
     """
 
-    def __init__(self, model, *, vector=False, gauss=2, extra=None, cells=None, gradient=None):
+    def __init__(self, model: Model, *, vector: bool = False, gauss: int = 2,
+                 extra: dict[str, np.ndarray] | None = None, cells: np.ndarray | None = None,
+                 gradient: np.ndarray | None = None):
         cells = model.cells if cells is None else cells
         self.cells = cells
         self.grad = gradient if gradient is not None else \
@@ -134,7 +142,7 @@ class CellBasis:
             self._built = values + [spread_component(g, c, 2) for c in range(2) for g in (gx, gy)]
         return self._built
 
-    def component_gradients(self):
+    def component_gradients(self) -> tuple:
         """The scalar x and y derivatives ``(m, nfun)`` CSR behind the gradient
         operators of a vector basis, when both have one pattern (then forms that
         see only gradients are assembled by 2 x 2 node blocks); None for a scalar
@@ -147,7 +155,8 @@ class CellBasis:
             return None
         return gx, gy
 
-    def at_points(self, operators, weights, points):
+    def at_points(self, operators: Sequence[sp.spmatrix], weights: np.ndarray,
+                  points: np.ndarray) -> CellBasis:
         """The same dofs seen at other integration points: a shallow copy with
         ``operators`` (``(q, N)`` each, in the order of `operators`), quadrature
         ``weights`` ``(q,)`` and ``points`` ``(q, 2)`` (``w.x``), for forms
@@ -164,17 +173,17 @@ class CellBasis:
             return DiscreteField(flat[:2], flat[2:6].reshape((2, 2) + flat.shape[1:]))
         return DiscreteField(flat[0], flat[1:3])
 
-    def unit_fields(self):
+    def unit_fields(self) -> list[DiscreteField]:
         """One DiscreteField per descriptor, with that descriptor 1 and the rest 0
         (a trailing axis of length 1 broadcasts against per-cell arrays ``(m,)``)."""
         eye = np.eye(3 * self.ncomp)[:, :, None]
         return [self._field(row, self.vector) for row in eye]
 
-    def zero_field(self):
+    def zero_field(self) -> DiscreteField:
         """A DiscreteField with every descriptor 0."""
         return self._field(np.zeros((3 * self.ncomp, 1)), self.vector)
 
-    def interpolate(self, u):
+    def interpolate(self, u: np.ndarray) -> DiscreteField:
         """A dof vector seen at the cells.
 
         Parameters
@@ -191,7 +200,8 @@ class CellBasis:
             raise ValueError(f"u: expected {self.N} dof values, received shape {u.shape}")
         return self._field(np.array([op @ u for op in self.operators]), self.vector)
 
-    def get_dofs(self, where, component=None):
+    def get_dofs(self, where: Callable[..., np.ndarray] | ArrayLike,
+                 component: Literal[0, 1] | None = None) -> np.ndarray:
         """Dofs of the nodes selected by ``where``.
 
         Parameters
@@ -216,7 +226,7 @@ class CellBasis:
         return 2 * nodes + component
 
 
-def select_nodes(nodes, where):
+def select_nodes(nodes: np.ndarray, where: Callable[..., np.ndarray] | ArrayLike) -> np.ndarray:
     """Indices of the nodes picked by a predicate, a boolean mask or an index array.
 
     Parameters

@@ -21,11 +21,14 @@ own way (`body_forces`, `traction_at`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable, Union
+from typing import TYPE_CHECKING, Any, Callable, Union
 
 import numpy as np
 
 from .basis import select_nodes
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["Conditions", "Traction", "per_point", "traction_at", "dirichlet_dofs"]
 
@@ -33,7 +36,8 @@ __all__ = ["Conditions", "Traction", "per_point", "traction_at", "dirichlet_dofs
 Where = Union[Callable[[np.ndarray], np.ndarray], np.ndarray, list]
 
 
-def per_point(value, points, width, what):
+def per_point(value: ArrayLike | Callable[..., np.ndarray], points: np.ndarray, width: int,
+              what: str) -> np.ndarray:
     """A constant or a callable evaluated at points, as a ``(p, width)`` array.
 
     Raises
@@ -54,13 +58,16 @@ def per_point(value, points, width, what):
     return arr
 
 
-def traction_at(t, points, normal, what="traction"):
+def traction_at(t: ArrayLike | Callable[..., np.ndarray], points: np.ndarray, normal: np.ndarray,
+                what: str = "traction") -> np.ndarray:
     """Traction vectors ``(q, d)`` of a constant or a callable ``t(x, nrm)`` at boundary
     points ``(q, d)`` with outward unit normals ``(q, d)``."""
     return per_point(t(points, normal) if callable(t) else t, points, points.shape[1], what)
 
 
-def dirichlet_dofs(points, where, component, value, *, where_to_look="the nodes"):
+def dirichlet_dofs(points: np.ndarray, where: Where, component: int | None,
+                   value: float | Callable[..., np.ndarray], *,
+                   where_to_look: str = "the nodes") -> tuple[np.ndarray, np.ndarray]:
     """Dofs (interleaved: ``d * node + component``) and values of a Dirichlet condition.
 
     Parameters
@@ -141,7 +148,7 @@ class Conditions:
         self.tractions = []
         self.body_forces = []
 
-    def conditions_repr(self):
+    def conditions_repr(self) -> str:
         """``"a Dirichlet, b traction, c body-force conditions"``, for ``__repr__``."""
         return (f"{len(self.dirichlet)} Dirichlet, {len(self.tractions)} traction, "
                 f"{len(self.body_forces)} body-force conditions")
@@ -160,7 +167,7 @@ class Conditions:
         self.dirichlet.append(dirichlet_dofs(self.condition_points, where, component, value,
                                              where_to_look=self.points_name))
 
-    def boundary_edges(self):
+    def boundary_edges(self) -> tuple[np.ndarray, np.ndarray]:
         """Edges of the outer boundary, holes and crack faces.
 
         Returns
@@ -203,7 +210,7 @@ class Conditions:
         """Body force per unit area (2-D) or volume: ``b(x) -> (p, d)`` or a constant ``(d,)``."""
         self.body_forces.append(b)
 
-    def body_forces_at(self, points):
+    def body_forces_at(self, points: np.ndarray) -> list:
         """The body forces at points, one ``(p, d)`` array per condition.
 
         Parameters
@@ -216,7 +223,7 @@ class Conditions:
         """
         return [per_point(b, points, points.shape[1], "body force") for b in self.body_forces]
 
-    def prescribed(self):
+    def prescribed(self) -> tuple[np.ndarray, np.ndarray]:
         """The prescribed dofs (interleaved ``d * node + component``) and their values,
         the last condition winning where several prescribe one dof.
 

@@ -13,12 +13,18 @@ operators ``P`` of the basis.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import scipy.sparse as sp
 from skfem.assembly.form.form import FormExtraParams
 
 from .._parallel import work_chunks
 from . import _sparse_kernels as SK
+
+if TYPE_CHECKING:
+    from typing import Any
+    from .basis import CellBasis
 
 __all__ = ["BilinearForm", "LinearForm", "Functional", "asm"]
 
@@ -89,7 +95,7 @@ class BilinearForm(_Form):
     True
     """
 
-    def coefficients(self, basis, **kwargs):
+    def coefficients(self, basis: CellBasis, **kwargs: Any) -> np.ndarray:
         """``D[a][b]``: the form at unit descriptors ``u = e_a``, ``v = e_b``, per cell."""
         c = 3 * basis.ncomp
         out = [[np.zeros(len(basis.dx)) for _ in range(c)] for _ in range(c)]
@@ -116,7 +122,8 @@ class BilinearForm(_Form):
                 if np.any(value != 0.0):
                     yield a, b, value
 
-    def assemble(self, basis, *, groups=None, **kwargs):
+    def assemble(self, basis: CellBasis, *, groups: np.ndarray | None = None,
+                 **kwargs: Any) -> sp.csr_matrix:
         """Sparse matrix ``(N, N)`` (CSR).
 
         Parameters
@@ -176,7 +183,7 @@ class BilinearForm(_Form):
 class LinearForm(_Form):
     """A linear form ``l(v, w)``; ``b[i] = l(phi_i)``."""
 
-    def assemble(self, basis, **kwargs):
+    def assemble(self, basis: CellBasis, **kwargs: Any) -> np.ndarray:
         """Dense vector ``(N,)``."""
         w = _extras(basis, kwargs)
         m = len(basis.dx)
@@ -191,16 +198,17 @@ class LinearForm(_Form):
 class Functional(_Form):
     """A functional ``f(w)`` integrated over the cells (one value per cell)."""
 
-    def assemble(self, basis, **kwargs):
+    def assemble(self, basis: CellBasis, **kwargs: Any) -> float:
         """``sum_k A_k f_k``."""
         return float(basis.dx @ self.elemental(basis, **kwargs))
 
-    def elemental(self, basis, **kwargs):
+    def elemental(self, basis: CellBasis, **kwargs: Any) -> np.ndarray:
         """``f`` in every cell, ``(m,)``."""
         return _coefficients(self.form(_extras(basis, kwargs)), len(basis.dx),
                              f"functional {self.__name__}")
 
 
-def asm(form, basis, **kwargs):
+def asm(form: BilinearForm | LinearForm | Functional, basis: CellBasis,
+        **kwargs: Any) -> sp.csr_matrix | np.ndarray | float:
     """``form.assemble(basis, **kwargs)``, like `skfem.asm`."""
     return form.assemble(basis, **kwargs)

@@ -4,6 +4,7 @@ with a check for rigid motions that the boundary conditions leave free."""
 from __future__ import annotations
 
 import logging
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -11,6 +12,9 @@ import scipy.sparse.csgraph as csgraph
 import scipy.sparse.linalg as spla
 
 from ..errors import SolveError
+
+if TYPE_CHECKING:
+    from typing import Callable, Literal
 
 __all__ = ["rigid_modes", "free_rigid_motions", "solve_spd", "DIRECT_NNZ"]
 
@@ -23,7 +27,7 @@ log = logging.getLogger(__name__)
 DIRECT_NNZ = 2_500_000
 
 
-def rigid_modes(points):
+def rigid_modes(points: np.ndarray) -> np.ndarray:
     """Rigid motions of a 2-D or 3-D body, interleaved dofs.
 
     2-D: translations in x, y and the rotation about the centroid; 3-D:
@@ -122,7 +126,7 @@ def _node_components(K, n, d):
     return len(kinds), label
 
 
-def free_rigid_motions(K, points, fixed):
+def free_rigid_motions(K: sp.spmatrix, points: np.ndarray, fixed: np.ndarray) -> list:
     """Rigid motions of each connected part of a 2-D or 3-D body left free by fixed dofs.
 
     Each part's free motions are named in a canonical basis: the free
@@ -171,8 +175,10 @@ def free_rigid_motions(K, points, fixed):
     return free
 
 
-def solve_spd(A, b, *, modes=None, tol=1e-10, method="auto", preconditioner=None,
-              smooth_with_matrix=False):
+def solve_spd(A: sp.spmatrix, b: np.ndarray, *, modes: np.ndarray | None = None, tol: float = 1e-10,
+              method: Literal["auto", "direct", "amg"] = "auto",
+              preconditioner: sp.spmatrix | Callable[..., np.ndarray] | None = None,
+              smooth_with_matrix: bool = False) -> np.ndarray:
     """Solve a symmetric positive definite system.
 
     Parameters

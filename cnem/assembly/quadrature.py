@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
 from . import _fan_kernels as FK
+
+if TYPE_CHECKING:
+    from ..geometry.model import Cells, Model
 
 __all__ = ["cell_triangles", "triangle_quadrature", "cell_quadrature", "subdivide", "tip_cells"]
 
@@ -17,7 +22,8 @@ def _fan(apex, verts, nxt):
     return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
 
 
-def cell_triangles(cells, nodes, *, node_apex=None):
+def cell_triangles(cells: Cells, nodes: np.ndarray, *,
+                   node_apex: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Triangles covering every cell polygon exactly (signed weights allowed).
 
     A fan from the centroid where the polygon is star-shaped from it (the usual
@@ -144,7 +150,8 @@ def _split_at_singular(corners, singular, rel_tol=1e-9):
     return hit, source, apex, b, c
 
 
-def triangle_quadrature(corners, order=4, *, singular=None):
+def triangle_quadrature(corners: np.ndarray, order: int = 4, *,
+                        singular: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Quadrature points and weights on triangles, collapsed at singular points.
 
     Parameters
@@ -182,7 +189,8 @@ def triangle_quadrature(corners, order=4, *, singular=None):
     return np.concatenate(owners), np.concatenate(points), np.concatenate(weights)
 
 
-def cell_quadrature(cells, nodes, order=4, *, singular=None):
+def cell_quadrature(cells: Cells, nodes: np.ndarray, order: int = 4, *,
+                    singular: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Quadrature points and weights on every cell polygon.
 
     Parameters
@@ -209,7 +217,9 @@ def cell_quadrature(cells, nodes, order=4, *, singular=None):
     return owner[triangle], points, weights
 
 
-def subdivide(cells, nodes, *, whole=None, node_apex=None, mark_spokes=False):
+def subdivide(cells: Cells, nodes: np.ndarray, *, whole: np.ndarray | None = None,
+              node_apex: np.ndarray | None = None,
+              mark_spokes: bool = False) -> tuple[Cells, np.ndarray]:
     """Split every integration cell into the triangles of a fan (sub-cells).
 
     Used where one smoothed strain per cell is too few (enriched fields:
@@ -249,7 +259,7 @@ def subdivide(cells, nodes, *, whole=None, node_apex=None, mark_spokes=False):
     return sub, parent
 
 
-def tip_cells(model):
+def tip_cells(model: Model) -> np.ndarray:
     """Cells of the crack-tip nodes, ``(m,)`` bool: a crack ends inside them, so
     their fans run from the node (see `cell_triangles`)."""
     tips = model.domain.tips

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import inspect
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -33,13 +33,13 @@ VOIGT = {2: ((0, 0), (1, 1), (0, 1)),
          3: ((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))}
 
 
-def voigt(tensor):
+def voigt(tensor: np.ndarray) -> np.ndarray:
     """Voigt form of symmetric tensors ``(..., d, d)``: ``(..., 3)`` ``[xx, yy, xy]`` in
     2-D, ``(..., 6)`` ``[xx, yy, zz, yz, xz, xy]`` in 3-D."""
     return np.stack([tensor[..., i, j] for i, j in VOIGT[tensor.shape[-1]]], axis=-1)
 
 
-def engineering_strain(gradient):
+def engineering_strain(gradient: np.ndarray) -> np.ndarray:
     """Engineering strain ``[exx, eyy, 2 exy]`` (3-D: ``[exx, eyy, ezz, 2 eyz, 2 exz,
     2 exy]``) from displacement gradients ``(..., d, d)``, ``[..., i, j] = du_i/dx_j``."""
     g = gradient
@@ -47,7 +47,7 @@ def engineering_strain(gradient):
                      for i, j in VOIGT[g.shape[-1]]], axis=-1)
 
 
-def von_mises(stress):
+def von_mises(stress: np.ndarray) -> np.ndarray:
     """Von Mises stress of Voigt stresses: plane ``(..., 3)`` ``[sxx, syy, sxy]`` (the
     in-plane components), or ``(..., 6)`` in 3-D. Returns ``(...)``."""
     if stress.shape[-1] == 6:
@@ -58,7 +58,8 @@ def von_mises(stress):
     return np.sqrt(sxx ** 2 - sxx * syy + syy ** 2 + 3.0 * sxy ** 2)
 
 
-def energy_error_density(points, region, stress, C, exact_stress):
+def energy_error_density(points: np.ndarray, region: np.ndarray, stress: np.ndarray, C: np.ndarray,
+                         exact_stress: Callable[..., np.ndarray]) -> np.ndarray:
     """``(σh - σ)ᵀ C⁻¹ (σh - σ)`` at quadrature points.
 
     Parameters
@@ -130,7 +131,7 @@ class Solution:
         """``(k,)`` von Mises stress at the places of ``stress``."""
         return von_mises(self.stress)
 
-    def displacement(self, points) -> np.ndarray:
+    def displacement(self, points: np.ndarray) -> np.ndarray:
         """Displacements at points of the body, through the solver's interpolation.
 
         Parameters
@@ -143,16 +144,16 @@ class Solution:
         """
         raise NotImplementedError
 
-    def nodal_average(self, values) -> np.ndarray:
+    def nodal_average(self, values: np.ndarray) -> np.ndarray:
         """Values ``(k, ...)`` at the places of ``stress`` as ``(n, ...)`` at the nodes."""
         raise NotImplementedError
 
-    def plot_mesh(self):
+    def plot_mesh(self) -> None:
         """What a picture draws: ``nodes (n, d)``, ``triangles (t, 3)`` (or None: the
         points alone) and the body's diameter."""
         raise NotImplementedError
 
-    def fields(self):
+    def fields(self) -> tuple[dict, dict]:
         """Fields for files and pictures.
 
         Returns
@@ -168,11 +169,12 @@ class Solution:
             return {**point_data, **cell_data}, {}
         return point_data, cell_data
 
-    def write_fields(self, path, point_data, cell_data):
+    def write_fields(self, path: str, point_data: dict[str, np.ndarray],
+                     cell_data: dict[str, np.ndarray]) -> None:
         """Write `fields` to ``path`` (see `write`)."""
         raise NotImplementedError
 
-    def write(self, path):
+    def write(self, path: str) -> str:
         """Write the nodes (points), their ``u`` and the ``stress``, ``strain`` and
         ``von_mises`` fields to a ``.vtu`` file (see `cnem.io`).
 
@@ -183,7 +185,8 @@ class Solution:
         self.write_fields(path, *self.fields())
         return path
 
-    def plot(self, path=None, *, field="von_mises", scale=None, **kwargs):
+    def plot(self, path: str | None = None, *, field: str = "von_mises", scale: float | None = None,
+             **kwargs: Any) -> Any:
         """Off-screen picture of the deformed body coloured by a field (see
         `cnem.plot.solution`)."""
         from .. import plot

@@ -11,15 +11,20 @@ the SCNI matrix itself (see `cnem.assembly.linsolve.solve_spd`).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import scipy.sparse as sp
 
 from .basis import CellBasis
 
+if TYPE_CHECKING:
+    from ..geometry.model import Model
+
 __all__ = ["triangle_basis"]
 
 
-def triangle_basis(model, *, vector=False):
+def triangle_basis(model: Model, *, vector: bool = False) -> CellBasis:
     """The P1 hat functions of the model's nodes on its triangles, one-point rule.
 
     Parameters

@@ -9,6 +9,8 @@ rows of the recomputed cells come from `smoothed_gradient` on those cells alone.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -16,10 +18,14 @@ from .._parallel import one_thread
 from ..errors import CNEMError
 from .scni import SmoothedGradient, smoothed_gradient
 
+if TYPE_CHECKING:
+    from ..geometry.update import ModelUpdate
+
 __all__ = ["updated_gradient", "renumber_rows"]
 
 
-def renumber_rows(matrix, rows, columns, shape, *, drop=False):
+def renumber_rows(matrix: sp.spmatrix, rows: np.ndarray, columns: np.ndarray, shape: tuple, *,
+                  drop: bool = False) -> sp.spmatrix:
     """Rows ``rows`` of ``matrix`` with their columns renumbered by ``columns``.
 
     Parameters
@@ -69,7 +75,8 @@ def renumber_rows(matrix, rows, columns, shape, *, drop=False):
     return out
 
 
-def updated_gradient(old, change, *, gauss=2):
+def updated_gradient(old: SmoothedGradient, change: ModelUpdate, *,
+                     gauss: int = 2) -> SmoothedGradient:
     """``B~`` of the updated model: copied rows for the copied cells, the others computed.
 
     Parameters
