@@ -13,6 +13,7 @@ along each new segment about one local spacing apart (the new tip among them).
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
@@ -23,6 +24,10 @@ from ..errors import GeometryError
 from ..geometry.domain import Domain
 from ..geometry.pslg import segment_projection
 from ..nodes import from_points
+
+if TYPE_CHECKING:
+    from typing import Literal, Sequence
+    from ..geometry.cloud import NodeCloud
 
 __all__ = ["Hit", "tip_direction", "local_spacing", "first_hit", "grown_cloud", "pieces",
            "check_connected", "rebuilt_domain"]
@@ -51,13 +56,13 @@ class Hit:
     end: int = 0
 
 
-def tip_direction(crack, end):
+def tip_direction(crack: np.ndarray, end: Literal[0, -1]) -> np.ndarray:
     """Unit direction of a crack polyline out of its end ``end`` (0 or -1)."""
     d = crack[0] - crack[1] if end == 0 else crack[-1] - crack[-2]
     return d / np.hypot(*d)
 
 
-def local_spacing(cloud, point, k=8):
+def local_spacing(cloud: NodeCloud, point: np.ndarray, k: int = 8) -> float:
     """Median nominal spacing of the ``k`` cloud nodes nearest to a point."""
     _, idx = cKDTree(cloud.points).query(point, k=min(k, len(cloud.points)))
     return float(np.median(cloud.spacing[np.atleast_1d(idx)]))
@@ -80,7 +85,8 @@ def _points_of(geom):
     return np.concatenate([np.asarray(p.coords, dtype=float)[:, :2] for p in parts])
 
 
-def first_hit(domain, cracks, crack, end, start, stop, reach):
+def first_hit(domain: Domain, cracks: list, crack: int, end: int, start: np.ndarray,
+              stop: np.ndarray, reach: float) -> Hit:
     """The first thing the segment ``start -> stop`` (prolonged by ``reach``) meets.
 
     Parameters
@@ -134,7 +140,8 @@ def first_hit(domain, cracks, crack, end, start, stop, reach):
     return best
 
 
-def grown_cloud(cloud, domain, segments, spacings, clearance):
+def grown_cloud(cloud: NodeCloud, domain: Domain, segments: list, spacings: list,
+                clearance: float) -> NodeCloud:
     """The node cloud of the grown domain.
 
     Parameters
@@ -179,7 +186,7 @@ def grown_cloud(cloud, domain, segments, spacings, clearance):
     return dataclasses.replace(out, spacing=full)
 
 
-def pieces(domain):
+def pieces(domain: Domain) -> list:
     """The connected pieces of a domain cut along its cracks.
 
     Returns
@@ -195,7 +202,7 @@ def pieces(domain):
     return sorted(parts, key=lambda g: -g.area)
 
 
-def check_connected(domain, step):
+def check_connected(domain: Domain, step: int) -> None:
     """Raise `GeometryError` naming the pieces when the cracks cut the body apart."""
     parts = pieces(domain)
     if len(parts) > 1:
@@ -208,6 +215,6 @@ def check_connected(domain, step):
             "run stops here (the crack path so far is in the error's `history`)")
 
 
-def rebuilt_domain(domain, cracks):
+def rebuilt_domain(domain: Domain, cracks: Sequence[np.ndarray]) -> Domain:
     """The same regions with new crack polylines."""
     return Domain(list(domain.regions), cracks=[np.asarray(c) for c in cracks])

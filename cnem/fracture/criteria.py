@@ -29,10 +29,15 @@ faces ``theta = ±pi`` are never a growth direction.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..errors import GrowthError
+
+if TYPE_CHECKING:
+    from typing import Literal
 
 __all__ = ["CRITERIA", "kink", "hoop_angle", "kinked_sif", "sed_factor"]
 
@@ -40,7 +45,7 @@ __all__ = ["CRITERIA", "kink", "hoop_angle", "kinked_sif", "sed_factor"]
 _GRID = np.linspace(-np.pi, np.pi, 721)[1:-1]
 
 
-def hoop_angle(KI, KII):
+def hoop_angle(KI: float | np.ndarray, KII: float | np.ndarray) -> float | np.ndarray:
     """Kink angle of the maximum hoop stress criterion (closed form).
 
     Parameters
@@ -64,7 +69,7 @@ def _hoop_keq(KI, KII, theta):
     return c * (KI * c * c - 1.5 * KII * np.sin(theta))
 
 
-def kinked_sif(KI, KII, theta):
+def kinked_sif(KI: float, KII: float, theta: float | np.ndarray) -> float | np.ndarray:
     """SIFs at the tip of an infinitesimal kink at ``theta`` (Hussain, Pu & Underwood 1974).
 
     Parameters
@@ -84,7 +89,8 @@ def kinked_sif(KI, KII, theta):
             g * (KII * np.cos(theta) + 0.5 * KI * np.sin(theta)))
 
 
-def sed_factor(KI, KII, theta, kappa):
+def sed_factor(KI: float | np.ndarray, KII: float | np.ndarray, theta: float,
+               kappa: float) -> float | np.ndarray:
     """Sih's strain-energy density factor times ``16 mu``.
 
     Returns
@@ -121,7 +127,8 @@ def _interior_minimum(f, opening):
     return best[0], best[1], False
 
 
-def kink(criterion, KI, KII, *, kappa=None):
+def kink(criterion: Literal["max_hoop", "max_energy_release", "min_sed"], KI: float, KII: float, *,
+         kappa: float | None = None) -> tuple[float, float, bool]:
     """Kink angle and equivalent SIF at one tip.
 
     Parameters

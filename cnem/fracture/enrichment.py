@@ -18,12 +18,19 @@ strain per cell would leave the extra dofs without stiffness).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import scipy.sparse as sp
 
 from ..assembly.scni import boundary_quadrature
 from ..geometry.topology import circumcenters
 from .williams import sided_polar
+
+if TYPE_CHECKING:
+    from typing import Callable
+    from numpy.typing import ArrayLike
+    from ..geometry.model import Model
 
 __all__ = ["Enrichment", "FUNCTIONS"]
 
@@ -61,7 +68,7 @@ class Enrichment:
         enriched node ``j`` is column ``j * size + k``.
     """
 
-    def __init__(self, model, tips, radius, *, functions="sqrt"):
+    def __init__(self, model: Model, tips: np.ndarray, radius: float, *, functions: str = "sqrt"):
         if functions not in FUNCTIONS:
             raise ValueError(f"enrich functions: expected one of {tuple(FUNCTIONS)}, "
                              f"received {functions!r}")
@@ -110,7 +117,8 @@ class Enrichment:
         return (f"<Enrichment {self.functions}, {len(self.nodes)} nodes within {self.radius:g} "
                 f"of {len(self.tips)} tip(s)>")
 
-    def evaluate(self, points, tip, sides, *, gradient=False):
+    def evaluate(self, points: np.ndarray, tip: np.ndarray, sides: np.ndarray, *,
+                 gradient: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
         """The functions ``F_k`` about one tip, ``(p, size)``; ``sides`` are points on
         the side wanted for points on the crack faces. With ``gradient=True`` also
         their gradients ``(p, size, 2)`` (points off the tip)."""
@@ -132,7 +140,8 @@ class Enrichment:
             / root[:, None, None]
         return F, dF
 
-    def values(self, points, phi, sides=None, *, gradient=None):
+    def values(self, points: np.ndarray, phi: sp.spmatrix, sides: np.ndarray | None = None, *,
+               gradient: np.ndarray | None = None) -> sp.spmatrix:
         """The functions ``psi_jk`` at points from the shape functions there.
 
         Parameters
@@ -185,7 +194,7 @@ class Enrichment:
             out.append(matrix(d.data[:, None] * shifted + sub.data[:, None] * dF[:, :, axis]))
         return tuple(out)
 
-    def support_radius(self):
+    def support_radius(self) -> np.ndarray:
         """Per tip, a radius about it holding the supports of its enriched functions
         (the circumcircles of the triangles at the enriched nodes)."""
         tri = self.model.triangles
@@ -199,7 +208,7 @@ class Enrichment:
                 out[t] = (np.hypot(*(centre[mine] - self.tips[t]).T) + reach[mine]).max()
         return out
 
-    def in_support(self, points):
+    def in_support(self, points: np.ndarray) -> np.ndarray:
         """``(p,)`` bool: points within `support_radius` of a tip (where enrichment
         functions may be non-zero)."""
         reach = self.support_radius()
@@ -208,7 +217,7 @@ class Enrichment:
             near |= np.hypot(*(points - tip).T) <= reach[t] * (1 + 1e-9)
         return near
 
-    def smoothed_gradient(self, gauss=2, cells=None):
+    def smoothed_gradient(self, gauss: int = 2, cells: np.ndarray | None = None) -> sp.spmatrix:
         """SCNI smoothed gradients of the enrichment functions, with at least
         `MIN_GAUSS` points per piece of cell edge, graded towards the tips.
 
@@ -231,7 +240,8 @@ class Enrichment:
         gx, gy = quad.cell_integrals(full)
         return gx.tocsr(), gy.tocsr()
 
-    def edge_loads(self, edges, normal, t, what="traction"):
+    def edge_loads(self, edges: np.ndarray, normal: np.ndarray,
+                   t: ArrayLike | Callable[..., np.ndarray], what: str = "traction") -> np.ndarray:
         """Loads on the enriched dofs from tractions on boundary edges.
 
         ``∫_edge psi_jk t`` for the edges ending at an enriched node ``j``

@@ -9,9 +9,15 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..plot import nodal_field
+
+if TYPE_CHECKING:
+    from typing import Any
+    from matplotlib.figure import Figure
 
 __all__ = ["paths", "sif_curves", "load_curves"]
 
@@ -41,7 +47,8 @@ def _outline(ax, domain):
             ax.plot(xy[:, 0], xy[:, 1], "k-", lw=1.0)
 
 
-def paths(hist, path=None, *, length_unit="", stress_unit="", title=None, field=True):
+def paths(hist: Any, path: str | None = None, *, length_unit: str = "", stress_unit: str = "",
+          title: str | None = None, field: bool = True) -> Figure:
     """Crack paths over the geometry and the final von Mises field.
 
     Parameters
@@ -89,7 +96,8 @@ def paths(hist, path=None, *, length_unit="", stress_unit="", title=None, field=
     return _finish(fig, path)
 
 
-def sif_curves(hist, path=None, *, length_unit="", sif_unit="", title=None, reference=None):
+def sif_curves(hist: Any, path: str | None = None, *, length_unit: str = "", sif_unit: str = "",
+               title: str | None = None, reference: np.ndarray | None = None) -> Figure:
     """K_I, K_II and K_eq of every tip against its crack length.
 
     Parameters
@@ -119,7 +127,8 @@ def sif_curves(hist, path=None, *, length_unit="", sif_unit="", title=None, refe
     return _finish(fig, path)
 
 
-def load_curves(hist, path=None, *, length_unit="", load_unit="", displacement_unit="", title=None):
+def load_curves(hist: Any, path: str | None = None, *, length_unit: str = "", load_unit: str = "",
+                displacement_unit: str = "", title: str | None = None) -> Figure:
     """Critical load factor against crack length and, when ``measure`` was given,
     the load-displacement curve (``load_factor * measure`` against ``load_factor``).
 

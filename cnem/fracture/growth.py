@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import logging
 import warnings
+from typing import TYPE_CHECKING
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -39,6 +40,10 @@ from . import advance
 from .criteria import CRITERIA, kink
 from .history import CrackPath, GrowthEvent, Step
 from .interaction import sif
+
+if TYPE_CHECKING:
+    from typing import Callable, Literal
+    from ..geometry.domain import Domain
 
 __all__ = ["grow"]
 
@@ -221,9 +226,13 @@ def _cycles(paris, prev, now, increments):
     return increments[i] * rate(k0)
 
 
-def grow(domain, cloud, setup, *, increment, steps, criterion="max_hoop", K_Ic=None, paris=None,
-         exponent=None, max_kink=None, measure=None, radius=None, clearance=0.5, keep=True,
-         progress=True) -> CrackPath:
+def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarray], *,
+         increment: float, steps: int,
+         criterion: Literal["max_hoop", "max_energy_release", "min_sed"] = "max_hoop",
+         K_Ic: float | None = None, paris: np.ndarray | None = None, exponent: float | None = None,
+         max_kink: float | None = None, measure: Callable[..., np.ndarray] | None = None,
+         radius: float | None = None, clearance: float = 0.5, keep: bool = True,
+         progress: bool = True) -> CrackPath:
     """Grow the cracks of a domain step by step (quasi-static LEFM).
 
     Parameters

@@ -9,8 +9,14 @@ from __future__ import annotations
 
 import pathlib
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    import os
+    from typing import Any, Literal
+    from matplotlib.figure import Figure
 
 __all__ = ["GrowthEvent", "Step", "CrackPath", "EVENT_KINDS"]
 
@@ -149,12 +155,12 @@ class CrackPath:
     def _all(self):
         return list(self.steps) + [self.final]
 
-    def paths(self):
+    def paths(self) -> np.ndarray:
         """Tip positions through the run: ``(steps + 1, t, 2)`` (the last row after
         the last increment)."""
         return np.stack([s.tips for s in self._all()])
 
-    def array(self, name):
+    def array(self, name: str) -> np.ndarray:
         """A per-tip field of every state stacked: ``(steps + 1, t, ...)`` or,
         for ``cycles`` and ``measure``, ``(steps + 1,)``."""
         return np.stack([np.asarray(getattr(s, name)) for s in self._all()])
@@ -168,7 +174,7 @@ class CrackPath:
             return np.full(len(c) + 1, np.nan)
         return np.concatenate([[0.0], np.cumsum(c)])
 
-    def table(self):
+    def table(self) -> str:
         """Text table: per state and tip, position, K_I, K_II, K_eq, angle (degrees),
         load factor, cumulative cycles."""
         lines = [f"{'step':>4} {'tip':>3} {'x':>10} {'y':>10} {'length':>9} {'K_I':>10} "
@@ -184,7 +190,7 @@ class CrackPath:
             lines.append(str(e))
         return "\n".join(lines)
 
-    def write(self, folder):
+    def write(self, folder: str | os.PathLike) -> list:
         """One VTU per state, ``step_000.vtu`` ... (``u``, stress, strain, von Mises;
         see `cnem.io.write`), written from the solutions kept with ``keep=True``.
 
@@ -201,7 +207,8 @@ class CrackPath:
             files.append(pathlib.Path(s.solution.write(out / f"step_{k:03d}.vtu")))
         return files
 
-    def plot(self, path=None, *, kind="paths", **kwargs):
+    def plot(self, path: str | None = None, *, kind: Literal["paths", "sif", "load"] = "paths",
+             **kwargs: Any) -> Figure:
         """Pictures of the run (matplotlib, off-screen PNG; see `cnem.fracture.figures`).
 
         Parameters

@@ -14,11 +14,16 @@ quadrature on every cell polygon that reaches into the disc.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..assembly.quadrature import cell_quadrature
 from ..material import effective_modulus
 from .williams import williams
+
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["sif", "SIFResult"]
 
@@ -48,7 +53,7 @@ def _local_spacing(model, tip):
     return float(np.median(np.hypot(edges[..., 0], edges[..., 1])))
 
 
-def sif(sol, tip, *, radius=None, order=4):
+def sif(sol: Any, tip: np.ndarray, *, radius: float | None = None, order: int = 4) -> SIFResult:
     """Stress intensity factors K_I, K_II at a crack tip.
 
     Parameters

@@ -8,15 +8,22 @@ crack's opening, whatever solved for the displacement.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..errors import GeometryError
 from ..material import effective_modulus
 
+if TYPE_CHECKING:
+    from typing import Literal
+    from ..geometry.model import Model
+
 __all__ = ["crack_opening", "k_from_opening"]
 
 
-def crack_opening(model, u, segment):
+def crack_opening(model: Model, u: np.ndarray,
+                  segment: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Normal opening and sliding of a straight crack at its split nodes.
 
     Parameters
@@ -65,7 +72,8 @@ def crack_opening(model, u, segment):
     return model.nodes[upper], jump @ n, jump @ t
 
 
-def k_from_opening(r, opening, E, nu, plane, *, where=None):
+def k_from_opening(r: np.ndarray, opening: np.ndarray, E: float, nu: float,
+                   plane: Literal["stress", "strain"], *, where: np.ndarray | None = None) -> float:
     """K_I fitted to a crack opening near a tip: ``opening = (8 K_I / E') sqrt(r / 2 pi)``.
 
     Parameters

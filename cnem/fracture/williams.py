@@ -7,14 +7,21 @@ and ``theta`` polar about the tip (``theta = ±pi`` on the two crack faces).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..material import kappa
 
+if TYPE_CHECKING:
+    from typing import Literal
+    from ..geometry.model import Model
+
 __all__ = ["williams", "polar", "sided_polar", "nodal_williams"]
 
 
-def williams(r, theta, KI, KII, E, nu, plane):
+def williams(r: np.ndarray, theta: np.ndarray, KI: float, KII: float, E: float, nu: float,
+             plane: Literal["stress", "strain"]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Displacements, stresses and x1-derivatives of the displacements of the
     leading Williams terms.
 
@@ -62,7 +69,7 @@ def williams(r, theta, KI, KII, E, nu, plane):
     return u, np.stack([s11, s22, s12], axis=-1), du
 
 
-def polar(points, tip, direction):
+def polar(points: np.ndarray, tip: np.ndarray, direction: np.ndarray) -> tuple:
     """Crack-tip polar coordinates ``(r, theta)`` of global points.
 
     Parameters
@@ -77,7 +84,8 @@ def polar(points, tip, direction):
     return np.hypot(x1, x2), np.arctan2(x2, x1)
 
 
-def sided_polar(points, tip, direction, sides):
+def sided_polar(points: np.ndarray, tip: np.ndarray, direction: np.ndarray,
+                sides: np.ndarray) -> tuple:
     """`polar`, with ``theta = ±pi`` on the crack line behind the tip chosen by
     the side of a reference point per point (``sides``, ``(p, 2)``)."""
     r, theta = polar(points, tip, direction)
@@ -87,7 +95,8 @@ def sided_polar(points, tip, direction, sides):
     return r, theta
 
 
-def nodal_williams(model, tip, KI, KII, E, nu, plane):
+def nodal_williams(model: Model, tip: np.ndarray, KI: float, KII: float, E: float, nu: float,
+                   plane: Literal["stress", "strain"]) -> np.ndarray:
     """The Williams displacement at every node of a model, in global axes.
 
     A node on a crack face takes the value of its own face (``theta = ±pi``
