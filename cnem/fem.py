@@ -24,7 +24,7 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, Callable, Literal, Sequence
 
 import numpy as np
 import triangle
@@ -41,6 +41,10 @@ from .geometry.pslg import BOUNDARY, CRACK
 from .assembly.conditions import Conditions, per_point, traction_at
 from .material import lame, parse_materials, stiffness_matrix
 from .assembly.solution import Solution, energy_error_density
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
+    from .geometry.domain import Domain
 
 __all__ = ["P1Elasticity", "P1Solution", "mesh_domain"]
 
@@ -109,7 +113,8 @@ def _triangulate(data, quality, max_area):
     return triangle.triangulate(data, switches)
 
 
-def mesh_domain(domain, *, nodes=None, max_area=None, quality=30.0):
+def mesh_domain(domain: Domain, *, nodes: int | None = None, max_area: float | None = None,
+                quality: float = 30.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Quality triangle mesh of a domain, opened along its cracks.
 
     Parameters
@@ -238,8 +243,10 @@ class P1Elasticity(Conditions):
         Seconds spent meshing (``"mesh"``).
     """
 
-    def __init__(self, domain, materials, *, plane="stress", nodes=None, max_area=None,
-                 quality=30.0):
+    def __init__(self, domain: Domain,
+                 materials: tuple[float, float] | Sequence[tuple[float, float]], *,
+                 plane: str = "stress", nodes: np.ndarray | None = None,
+                 max_area: float | None = None, quality: float = 30.0):
         self.domain = domain
         self.materials = parse_materials(materials, len(domain.regions))
         lame(1.0, 0.0, plane)                       # validates `plane`
@@ -272,7 +279,7 @@ class P1Elasticity(Conditions):
         """``(n, 2)`` the nodes that conditions refer to (`nodes`)."""
         return self.nodes
 
-    def boundary_edges(self):
+    def boundary_edges(self) -> tuple:
         """The mesh's boundary facets as node pairs with the body on the left, and their
         outward normals (see `Conditions.boundary_edges`; `boundary_facets` in the
         same order)."""
@@ -283,7 +290,7 @@ class P1Elasticity(Conditions):
         edges[flip] = edges[flip][:, ::-1]
         return edges, normal
 
-    def boundary_facets(self):
+    def boundary_facets(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The boundary edges as scikit-fem facets (the older name of `boundary_edges`,
         in the same order).
 
@@ -303,17 +310,17 @@ class P1Elasticity(Conditions):
         return self._boundary
 
     # -- assembly -----------------------------------------------------------------------
-    def element_materials(self):
+    def element_materials(self) -> np.ndarray:
         """``(t, 2)`` ``(E, nu)`` of every triangle."""
         return self.materials[self.region]
 
-    def stiffness(self):
+    def stiffness(self) -> sp.csr_matrix:
         """Global stiffness ``(2 n, 2 n)`` CSR, per-triangle Lamé parameters."""
         E, nu = self.element_materials().T
         lam, mu = lame(E, nu, self.plane)
         return linear_elasticity(lam[:, None], mu[:, None]).assemble(self.basis)
 
-    def load(self):
+    def load(self) -> np.ndarray:
         """Load vector ``(2 n,)`` of the tractions and body forces."""
         f = np.zeros(self.basis.N)
         element = ElementVector(ElementTriP1())
@@ -326,7 +333,8 @@ class P1Elasticity(Conditions):
         return f
 
     # -- solve --------------------------------------------------------------------------
-    def solve(self, *, method="auto", tol=1e-10):
+    def solve(self, *, method: Literal["auto", "direct", "amg"] = "auto",
+              tol: float = 1e-10) -> P1Solution:
         """Solve ``K u = f`` with the Dirichlet values imposed.
 
         Parameters
@@ -428,14 +436,14 @@ class P1Solution(Solution):
                    strain=strain, C=C, mesh=problem.mesh, region=problem.region,
                    basis=problem.basis, plane=problem.plane, timings=timings)
 
-    def displacement(self, points):
+    def displacement(self, points: np.ndarray) -> np.ndarray:
         """Displacements ``(p, 2)`` at points ``(p, 2)`` inside the mesh, through the P1
         shape functions."""
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
         values = self.basis.probes(np.ascontiguousarray(pts.T)) @ self.u.reshape(-1)
         return values.reshape(2, -1).T                      # probes give x values, then y
 
-    def energy_error(self, exact_stress, *, order=4):
+    def energy_error(self, exact_stress: Callable[..., np.ndarray], *, order: int = 4) -> float:
         """Error in the energy norm against an exact stress field.
 
         ``sqrt(sum_T ∫_T (σh - σ)ᵀ C⁻¹ (σh - σ) dΩ)`` with a triangle rule of
@@ -465,12 +473,12 @@ class P1Solution(Solution):
                                        self.C[owner], exact_stress)
         return float(np.sqrt(weights @ density))
 
-    def energy(self):
+    def energy(self) -> float:
         """Strain energy ``1/2 sum_T A_T σ_T · ε_T``."""
         area = self.basis.dx.sum(axis=1)
         return 0.5 * float(area @ (self.stress * self.strain).sum(axis=1))
 
-    def nodal_average(self, values):
+    def nodal_average(self, values: np.ndarray) -> np.ndarray:
         """Triangle values ``(t, ...)`` at the nodes: the area-weighted mean over the
         triangles around each node, ``(n, ...)``."""
         values = np.asarray(values, dtype=float)
@@ -482,11 +490,12 @@ class P1Solution(Solution):
                         for col in flat.T], axis=1) / weight[:, None]
         return out.reshape((n,) + values.shape[1:])
 
-    def plot_mesh(self):
+    def plot_mesh(self) -> tuple:
         """The mesh nodes and triangles and the domain's diameter."""
         return self.mesh.p.T, self.mesh.t.T, self.problem.domain.diameter
 
-    def write_fields(self, path, point_data, cell_data):
+    def write_fields(self, path: str, point_data: dict[str, np.ndarray],
+                     cell_data: dict[str, np.ndarray]) -> None:
         """The mesh with the fields (`cnem.io.write_points` with its triangles)."""
         from . import io
         io.write_points(self.mesh.p.T, path, triangles=self.mesh.t.T, point_data=point_data,

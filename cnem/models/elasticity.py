@@ -5,6 +5,7 @@ from __future__ import annotations
 import logging
 import sys
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -24,6 +25,12 @@ from ..errors import SolveError
 from ..geometry.topology import constraint_edges
 from ..material import lame, parse_materials, stiffness_matrix
 from .solution import ElasticSolution
+
+if TYPE_CHECKING:
+    from typing import Literal, Sequence
+    from ..fracture.enrichment import Enrichment
+    from ..geometry.model import Model
+    from ..geometry.update import ModelUpdate
 
 __all__ = ["Elasticity", "elasticity_form"]
 
@@ -74,8 +81,9 @@ class Elasticity(Conditions):
     True
     """
 
-    def __init__(self, model, materials, *, plane="stress", gauss=2, enrich=None,
-                 stabilization=1.0):
+    def __init__(self, model: Model, materials: tuple[float, float] | Sequence[tuple[float, float]],
+                 *, plane: str = "stress", gauss: int = 2, enrich: Enrichment | None = None,
+                 stabilization: float = 1.0):
         from ..fracture.enrichment import Enrichment
         self.model = model
         self.enrichment = Enrichment.from_spec(model, enrich)
@@ -107,7 +115,7 @@ class Elasticity(Conditions):
         """``(n, 2)`` the nodes that conditions refer to (``model.nodes``)."""
         return self.model.nodes
 
-    def boundary_edges(self):
+    def boundary_edges(self) -> tuple:
         """The model's constraint edges with the body on one side (see
         `Conditions.boundary_edges`)."""
         tri = self.model.triangles
@@ -130,7 +138,7 @@ class Elasticity(Conditions):
                                     cells=self.cells)
         return self._basis
 
-    def update_from(self, old, change):
+    def update_from(self, old: Elasticity, change: ModelUpdate) -> Elasticity:
         """Take ``B~`` and ``K`` from the problem ``old`` on the model before a local
         update, recomputing only the cells the change reaches
         (`cnem.models.local_update.updated_operators`); equal to building them here.
@@ -153,11 +161,11 @@ class Elasticity(Conditions):
                                 gradient=gradient)
         return self
 
-    def cell_materials(self):
+    def cell_materials(self) -> np.ndarray:
         """``(m, 2)`` ``(E, nu)`` of every integration cell."""
         return self.materials[self.cells.region]
 
-    def stiffness(self):
+    def stiffness(self) -> sp.csr_matrix:
         """Global stiffness ``K`` (eq. 33), ``(2 n, 2 n)`` CSR."""
         if self._K is None:
             a = self.stabilization
@@ -229,7 +237,7 @@ class Elasticity(Conditions):
         lam, mu = self._lame(weight)
         return elasticity_form.assemble(at_points, groups=cells.region[owner], lam=lam, mu=mu)
 
-    def load(self):
+    def load(self) -> np.ndarray:
         """Load vector ``f`` (eq. 21), ``(2 n,)`` (then the enriched dofs' loads)."""
         n = len(self.model.nodes)
         f = np.zeros((n, 2))
@@ -254,7 +262,7 @@ class Elasticity(Conditions):
         # (the enrichment functions vanish at the nodes: no nodal body-force share)
         return np.concatenate([f.reshape(-1), enriched.reshape(-1)])
 
-    def prescribed(self):
+    def prescribed(self) -> tuple[np.ndarray, np.ndarray]:
         """The prescribed dofs and values (`Conditions.prescribed`), with the enriched
         dofs of constrained nodes held at 0.
 
@@ -278,7 +286,7 @@ class Elasticity(Conditions):
             values = np.concatenate([values, np.zeros(len(extra))])
         return dofs, values
 
-    def solver_options(self, dofs):
+    def solver_options(self, dofs: np.ndarray) -> dict:
         """The keywords of `cnem.assembly.linsolve.solve_spd` for the system on ``dofs``
         (the free ones): the P1 matrix its smoothed aggregation is built on (made only
         if the iterative path is taken), and for plain SCNI smoothing with K itself
@@ -291,7 +299,7 @@ class Elasticity(Conditions):
         return dict(preconditioner=lambda: self.preconditioner_matrix(dofs),
                     smooth_with_matrix=self.stabilization == 0)
 
-    def preconditioner_matrix(self, dofs=None):
+    def preconditioner_matrix(self, dofs: np.ndarray | None = None) -> sp.spmatrix | np.ndarray:
         """The P1 stiffness of the nodes on the model's triangles (same materials):
         where smoothed aggregation is built for large solves (see
         `cnem.assembly.triangles`).
@@ -319,7 +327,8 @@ class Elasticity(Conditions):
         return P if dofs is None else P[dofs][:, dofs]
 
     # -- solve --------------------------------------------------------------------------
-    def solve(self, *, method="auto", tol=1e-10, progress=None):
+    def solve(self, *, method: Literal["auto", "direct", "amg"] = "auto", tol: float = 1e-10,
+              progress: bool | None = None) -> ElasticSolution:
         """Solve ``K d = f`` with the Dirichlet values imposed.
 
         Parameters

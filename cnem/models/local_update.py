@@ -13,6 +13,8 @@ of vanishing from the pattern; those of removed nodes are dropped.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -23,10 +25,17 @@ from ..assembly.update import renumber_rows, updated_gradient
 from .._parallel import one_thread
 from ..errors import CNEMError
 
+if TYPE_CHECKING:
+    from typing import Any
+    from ..assembly.forms import BilinearForm
+    from ..assembly.scni import SmoothedGradient
+    from ..geometry.update import ModelUpdate
+
 __all__ = ["updated_operators", "cells_stiffness"]
 
 
-def cells_stiffness(prob, index, gradient, form):
+def cells_stiffness(prob: Any, index: np.ndarray, gradient: SmoothedGradient,
+                    form: BilinearForm) -> sp.spmatrix:
     """The part of ``prob.stiffness()`` that the cells ``index`` contribute.
 
     Parameters
@@ -65,7 +74,8 @@ def cells_stiffness(prob, index, gradient, form):
     return K.tocsr()
 
 
-def updated_operators(old, new, change, form):
+def updated_operators(old: Any, new: Any, change: ModelUpdate,
+                      form: BilinearForm) -> tuple[SmoothedGradient, sp.spmatrix]:
     """``B~`` and ``K`` of ``new`` from those of ``old``, recomputing the changed cells only.
 
     Parameters

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable, Literal
 
 import numpy as np
 
@@ -67,7 +67,7 @@ class ElasticSolution(Solution):
                    gradient=gradient, dofs=dofs, enriched=dofs[2 * n:].reshape(-1, 2), C=C,
                    timings=timings, model=problem.model, plane=problem.plane)
 
-    def displacement(self, points):
+    def displacement(self, points: np.ndarray) -> np.ndarray:
         """Displacements ``(p, 2)`` at points ``(p, 2)`` through the shape functions (and
         the enrichment functions)."""
         phi = self.model.shape_functions(points)
@@ -77,7 +77,7 @@ class ElasticSolution(Solution):
             out += enrichment.values(np.asarray(points, dtype=float), phi) @ self.enriched
         return out
 
-    def displacement_gradient(self, points):
+    def displacement_gradient(self, points: np.ndarray) -> np.ndarray:
         """The gradient of the displacement field itself (not smoothed) at points
         inside the cells: Sibson gradients, plus the enrichment's.
 
@@ -101,7 +101,8 @@ class ElasticSolution(Solution):
             out += np.stack([ex @ self.enriched, ey @ self.enriched], axis=2)
         return out
 
-    def energy_error(self, exact_stress, *, order=4, strain="smoothed"):
+    def energy_error(self, exact_stress: Callable[..., np.ndarray], *, order: int = 4,
+                     strain: Literal["smoothed", "pointwise"] = "smoothed") -> float:
         """Error in the energy norm against an exact stress field.
 
         ``sqrt(sum_k ∫_{cell k} (σh - σ)ᵀ C⁻¹ (σh - σ) dΩ)`` by a quadrature on
@@ -139,11 +140,11 @@ class ElasticSolution(Solution):
                                        exact_stress)
         return float(np.sqrt(weights @ density))
 
-    def energy(self):
+    def energy(self) -> float:
         """Strain energy ``1/2 sum_k A_k σ_k · ε_k``."""
         return 0.5 * float(self.cells.area @ (self.stress * self.strain).sum(axis=1))
 
-    def nodal_average(self, values):
+    def nodal_average(self, values: np.ndarray) -> np.ndarray:
         """Cell values ``(m, ...)`` at the nodes: each node's cell (area-weighted over the
         cells of a node on an interface), ``(n, ...)``."""
         cells, n = self.cells, len(self.model.nodes)
@@ -154,11 +155,12 @@ class ElasticSolution(Solution):
                         for col in flat.T], axis=1)
         return out.reshape((n,) + values.shape[1:])
 
-    def plot_mesh(self):
+    def plot_mesh(self) -> tuple:
         """The nodes, the constrained Delaunay triangles and the domain's diameter."""
         return self.model.nodes, self.model.triangles, self.model.domain.diameter
 
-    def write_fields(self, path, point_data, cell_data):
+    def write_fields(self, path: str, point_data: dict[str, np.ndarray],
+                     cell_data: dict[str, np.ndarray]) -> None:
         """Nodes and integration cells with the fields (`cnem.io.write`)."""
         from .. import io
         io.write(self.model, path, point_data=point_data, cell_data=cell_data)
