@@ -18,11 +18,16 @@ from __future__ import annotations
 
 import copy
 from itertools import combinations
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
 
 from ._cpd_kernels import add_rows, scatter_hessian
+
+if TYPE_CHECKING:
+    from typing import Any
+    from .body import Body
 
 __all__ = ["Interactions", "CHUNK", "DEGENERATE", "MAX_INTERACTIONS"]
 
@@ -137,7 +142,7 @@ class Interactions:
         Signed reference volumes ``V``.
     """
 
-    def __init__(self, body, material):
+    def __init__(self, body: Body, material: Any):
         self.body, self.material = body, material
         n, d, nb = len(body), body.dim, len(body.bond_i)
         self.shape = (n * d, n * d)
@@ -198,7 +203,8 @@ class Interactions:
         self.pos_diag = pos[2 * m + 2 * nb:]
 
     # -- evaluation ----------------------------------------------------------------------
-    def evaluate(self, u, *, tangent=True):
+    def evaluate(self, u: np.ndarray, *,
+                 tangent: bool = True) -> tuple[float, np.ndarray, np.ndarray | None]:
         """Energy, internal force ``dPsi/du`` (eq. 19) and tangent ``d2Psi/du2`` (eq. 20).
 
         Parameters
@@ -273,7 +279,7 @@ class Interactions:
         data[self.pos_diag] += point
         return sp.bsr_matrix((data, self.indices, self.indptr), shape=self.shape).tocsr()
 
-    def with_material(self, material):
+    def with_material(self, material: Any) -> Interactions:
         """The same interactions and pattern with another `CPD` material (e.g. other
         constants or ``derivatives``) that needs no other kinds of interactions."""
         needs = (material.C2 > 0 or material.C3 > 0, material.C3 > 0)
@@ -286,15 +292,15 @@ class Interactions:
         other.material = material
         return other
 
-    def internal_force(self, u):
+    def internal_force(self, u: np.ndarray) -> np.ndarray:
         """``dPsi/du``, ``(n d,)``."""
         return self.evaluate(u, tangent=False)[1]
 
-    def tangent(self, u):
+    def tangent(self, u: np.ndarray) -> sp.csr_matrix:
         """``d2Psi/du2``, sparse ``(n d, n d)``."""
         return self.evaluate(u)[2]
 
-    def pattern(self):
+    def pattern(self) -> sp.csr_matrix:
         """Sparsity pattern of the tangent (ones), sparse ``(n d, n d)``."""
         d = self.body.dim
         ones = np.ones((len(self.indices), d, d))

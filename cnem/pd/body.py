@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..spatial import family_search, remove_crossing
 from ._kernels import bond_geometry
+
+if TYPE_CHECKING:
+    from typing import Sequence
+    from numpy.typing import ArrayLike
 
 __all__ = ["Body", "checked_input", "crack_segments"]
 
@@ -21,7 +27,8 @@ def _past_the_mouths(crack, tips, reach):
     return crack
 
 
-def checked_input(points, volumes, horizon, thickness):
+def checked_input(points: np.ndarray, volumes: float | ArrayLike, horizon: float,
+                  thickness: float) -> tuple:
     """The arguments of a `Body`, checked: points ``(n, d)``, volumes ``(n,)``, horizon and
     thickness (1 in 3-D) as floats.
 
@@ -48,7 +55,7 @@ def checked_input(points, volumes, horizon, thickness):
     return pts, vol, horizon, thick
 
 
-def crack_segments(cracks):
+def crack_segments(cracks: Sequence[ArrayLike]) -> np.ndarray | None:
     """The ``(s, 2, 2)`` segments of crack polylines (None without cracks)."""
     segs = [np.column_stack([c[:-1], c[1:]]).reshape(-1, 2, 2)
             for c in (np.asarray(c, dtype=float) for c in cracks)]
@@ -87,8 +94,9 @@ class Body:
         Partial-volume factors of bonds cut by the horizon.
     """
 
-    def __init__(self, points, volumes, horizon, *, thickness=1.0, period=None, cracks=(),
-                 crossing_points=None):
+    def __init__(self, points: np.ndarray, volumes: float | ArrayLike, horizon: float, *,
+                 thickness: float = 1.0, period: ArrayLike | None = None, cracks: tuple = (),
+                 crossing_points: int | None = None):
         pts, vol, horizon, self.thickness = checked_input(points, volumes, horizon, thickness)
         n, d = pts.shape
         self.points, self.volumes, self.horizon, self.dim = pts, vol, horizon, d

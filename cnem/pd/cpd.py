@@ -39,10 +39,16 @@ central finite differences (for comparison).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .. import hyperdual as hd
 from ._cpd_assembly import Interactions
+
+if TYPE_CHECKING:
+    from typing import Callable
+    from .body import Body
 
 __all__ = ["CPD", "Interactions", "seth_hill", "DERIVATIVES", "FD_STEP"]
 
@@ -52,7 +58,7 @@ DERIVATIVES = ("hyperdual", "analytic", "fd")
 FD_STEP = 1e-4
 
 
-def seth_hill(exponent):
+def seth_hill(exponent: float) -> Callable[[np.ndarray], np.ndarray]:
     """Seth-Hill energy ``p(lam) = S(lam)^2 / 2``, ``S = (lam^n - 1) / n`` or ``ln lam`` (n = 0).
 
     Works on arrays and on `cnem.hyperdual.HyperDual` numbers (eq. 41-42 per unit
@@ -105,8 +111,10 @@ class CPD:
 
     kind = "cpd"
 
-    def __init__(self, C1, C2=0.0, C3=0.0, *, exponent=2.0, psi1=None, psi2=None, psi3=None,
-                 derivatives="hyperdual"):
+    def __init__(self, C1: float, C2: float = 0.0, C3: float = 0.0, *, exponent: float = 2.0,
+                 psi1: Callable[..., np.ndarray] | None = None,
+                 psi2: Callable[..., np.ndarray] | None = None,
+                 psi3: Callable[..., np.ndarray] | None = None, derivatives: str = "hyperdual"):
         C = [float(C1), float(C2), float(C3)]
         if not (np.isfinite(C).all() and C[0] > 0 and C[1] >= 0 and C[2] >= 0):
             raise ValueError(f"CPD: expected C1 > 0, C2 >= 0, C3 >= 0 (finite), received "
@@ -134,7 +142,7 @@ class CPD:
         self.psi = tuple(default if p is None else p for p in given)
         self.user = tuple(p is not None for p in given)
 
-    def interactions(self, body):
+    def interactions(self, body: Body) -> Interactions:
         """The interactions of ``body`` this material needs.
 
         Returns
@@ -154,7 +162,8 @@ class CPD:
                              f"in 3-D only; for a 2-D body set C3=0")
         return Interactions(body, self)
 
-    def measure_derivatives(self, order, g, ref):
+    def measure_derivatives(self, order: int, g: np.ndarray,
+                            ref: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Energy of ``order``-neighbour interactions, ``phi = C |R| p(lam)``, and its
         first and second derivatives with respect to the deformation measure
         (eq. 35, 39).

@@ -16,8 +16,12 @@ True
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .cpd import CPD
 
 __all__ = ["moduli_per_constant", "lame_constants", "constant_for_ratio"]
 
@@ -47,7 +51,7 @@ def moduli_per_constant(dim: int, horizon: float, thickness: float = 1.0) -> np.
                      [math.pi ** 4 * d ** 12 / 32, 0.0]])
 
 
-def lame_constants(material, dim: int, horizon: float, thickness: float = 1.0):
+def lame_constants(material: CPD, dim: int, horizon: float, thickness: float = 1.0) -> np.ndarray:
     """Lame constants ``(lambda, mu)`` of a `cnem.pd.CPD` material in the small-strain
     continuum limit.
 

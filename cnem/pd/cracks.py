@@ -21,10 +21,15 @@ transposed or flipped image.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from scipy import ndimage
 
 from ..errors import GeometryError
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 __all__ = ["crack_region", "crack_tip", "bands", "branching", "first_passage", "mean_speed",
            "local_speeds"]
@@ -51,7 +56,8 @@ def _index_at(coordinate, lowest, h):
     return int(np.ceil((coordinate - lowest) / h - _ON_LINE))
 
 
-def crack_region(image, origin, spacing, start, reach, *, threshold=0.35):
+def crack_region(image: np.ndarray, origin: np.ndarray, spacing: float, start: np.ndarray,
+                 reach: float, *, threshold: float = 0.35) -> np.ndarray:
     """The damaged points connected to the start of the crack.
 
     Points with damage above ``threshold`` are grouped into 8-connected sets;
@@ -85,7 +91,7 @@ def crack_region(image, origin, spacing, start, reach, *, threshold=0.35):
     return np.isin(labels, np.unique(near[near > 0]))
 
 
-def crack_tip(mask, origin, spacing, start_x):
+def crack_tip(mask: np.ndarray, origin: ArrayLike, spacing: float, start_x: float) -> float:
     """``x`` of the crack tip: the right-most crack point, or ``start_x`` if none lies
     right of it (``mask`` the crack's ``(nx, ny)`` image, the other parameters as in
     `crack_region`).
@@ -99,7 +105,8 @@ def crack_tip(mask, origin, spacing, start_x):
     return float(start_x) if len(cols) == 0 else max(float(start_x), x0 + cols[-1] * h)
 
 
-def bands(mask, origin, spacing, start_x):
+def bands(mask: np.ndarray, origin: np.ndarray, spacing: float,
+          start_x: float) -> tuple[np.ndarray, list]:
     """The damage bands of every grid column at or right of ``start_x``.
 
     A band is a run of crack points along ``y``, separated from the next by at
@@ -132,7 +139,8 @@ def bands(mask, origin, spacing, start_x):
     return x0 + np.arange(first, mask.shape[0]) * h, centres
 
 
-def branching(mask, origin, spacing, start_x, *, persistence, window):
+def branching(mask: np.ndarray, origin: ArrayLike, spacing: float, start_x: float, *,
+              persistence: float, window: float) -> dict | None:
     """Branching point and half-angle of a crack image.
 
     The two branches are the upper-most and lower-most damage bands of the
@@ -177,7 +185,7 @@ def branching(mask, origin, spacing, start_x, *, persistence, window):
                 half_angle=0.5 * float(np.degrees(np.arctan(upper[0]) - np.arctan(lower[0]))))
 
 
-def first_passage(times, position, x):
+def first_passage(times: np.ndarray, position: np.ndarray, x: float) -> float:
     """First time a non-decreasing ``position`` reaches ``x`` (linear between samples).
 
     Parameters
@@ -201,7 +209,7 @@ def first_passage(times, position, x):
                  * (times[k] - times[k - 1]))
 
 
-def mean_speed(times, position):
+def mean_speed(times: np.ndarray, position: np.ndarray) -> float:
     """Least-squares slope of ``position(times)``.
 
     Parameters
@@ -216,7 +224,8 @@ def mean_speed(times, position):
     return float(np.polyfit(times, position, 1)[0]) if len(times) >= 3 else float("nan")
 
 
-def local_speeds(times, position, window, *, where=None):
+def local_speeds(times: np.ndarray, position: np.ndarray, window: float, *,
+                 where: np.ndarray | None = None) -> np.ndarray:
     """Speeds from least-squares fits of ``position`` over ``window`` around each sample.
 
     Parameters

@@ -8,9 +8,14 @@ from __future__ import annotations
 
 import os
 import pathlib
+from typing import TYPE_CHECKING
 
 import meshio
 import numpy as np
+
+if TYPE_CHECKING:
+    from pathlib import Path
+    from typing import Any
 
 __all__ = ["FrameWriter"]
 
@@ -31,7 +36,7 @@ class FrameWriter:
         The largest step number, to zero-pad the numbers to one width.
     """
 
-    def __init__(self, output, points, last):
+    def __init__(self, output: str | os.PathLike, points: np.ndarray, last: int):
         text = os.fspath(output)
         path = pathlib.Path(text)
         if path.is_dir() or text.endswith((os.sep, "/")):
@@ -45,7 +50,7 @@ class FrameWriter:
         self.points[:, :pts.shape[1]] = pts
         self.cells = [meshio.CellBlock("vertex", np.arange(len(pts), dtype=np.int64)[:, None])]
 
-    def write(self, step, **point_data):
+    def write(self, step: int, **point_data: Any) -> Path | None:
         """Write ``point_data`` (arrays of ``n`` rows, as given) for ``step``.
 
         Returns

@@ -13,13 +13,17 @@ from __future__ import annotations
 
 import itertools
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from typing import Sequence
 
 __all__ = ["lattice", "lattice_measure"]
 
 
-def lattice(counts, spacing: float) -> np.ndarray:
+def lattice(counts: Sequence, spacing: float) -> np.ndarray:
     """Points of a regular lattice with its first point at the origin.
 
     Parameters
@@ -37,7 +41,7 @@ def lattice(counts, spacing: float) -> np.ndarray:
     return np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, len(counts))
 
 
-def lattice_measure(y, counts) -> np.ndarray:
+def lattice_measure(y: np.ndarray, counts: Sequence) -> np.ndarray:
     """Area (2-D) or volume (3-D) of every lattice cell after a deformation.
 
     Each cell is split into the d! simplices of its Kuhn triangulation (one per

@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+if TYPE_CHECKING:
+    from typing import Literal
 
 __all__ = ["BondBased", "StateBased"]
 
@@ -37,7 +42,8 @@ class BondBased:
 
     kind = "bond"
 
-    def __init__(self, E, *, critical_stretch=None, fracture_energy=None, density=1.0):
+    def __init__(self, E: float, *, critical_stretch: float | None = None,
+                 fracture_energy: float | None = None, density: float = 1.0):
         self.E = _positive("E", E)
         self.critical_stretch = None if critical_stretch is None else _positive(
             "critical_stretch", critical_stretch)
@@ -45,17 +51,18 @@ class BondBased:
             "fracture_energy", fracture_energy)
         self.density = _positive("density", density)
 
-    def poisson(self, dim, plane):
+    def poisson(self, dim: int, plane: Literal['stress', 'strain']) -> float:
         return 1.0 / 3.0 if (dim == 2 and plane == "stress") else 0.25
 
-    def micromodulus(self, dim, plane, horizon, thickness):
+    def micromodulus(self, dim: int, plane: Literal['stress', 'strain'], horizon: float,
+                     thickness: float) -> float:
         if dim == 3:
             return 12.0 * self.E / (np.pi * horizon ** 4)
         if plane == "stress":
             return 9.0 * self.E / (np.pi * thickness * horizon ** 3)
         return 48.0 * self.E / (5.0 * np.pi * thickness * horizon ** 3)
 
-    def stretch_limit(self, dim, plane, horizon):
+    def stretch_limit(self, dim: int, plane: Literal['stress', 'strain'], horizon: float) -> float:
         """The critical stretch (given, or from the fracture energy; inf if neither)."""
         if self.critical_stretch is not None:
             return self.critical_stretch
@@ -89,7 +96,8 @@ class StateBased:
 
     kind = "state"
 
-    def __init__(self, E, nu, *, critical_stretch=None, density=1.0):
+    def __init__(self, E: float, nu: float, *, critical_stretch: float | None = None,
+                 density: float = 1.0):
         self.E = _positive("E", E)
         nu = float(nu)
         if not -1.0 < nu < 0.5:
@@ -99,7 +107,7 @@ class StateBased:
             "critical_stretch", critical_stretch)
         self.density = _positive("density", density)
 
-    def moduli(self, dim, plane):
+    def moduli(self, dim: int, plane: Literal['stress', 'strain']) -> tuple:
         """Bulk modulus of the d-dimensional law and the shear modulus."""
         E, nu = self.E, self.nu
         mu = E / (2.0 * (1.0 + nu))
@@ -110,7 +118,7 @@ class StateBased:
             lam = 2.0 * lam * mu / (lam + 2.0 * mu)
         return lam + mu, mu
 
-    def stretch_limit(self, dim, plane, horizon):
+    def stretch_limit(self, dim: int, plane: Literal['stress', 'strain'], horizon: float) -> float:
         return np.inf if self.critical_stretch is None else self.critical_stretch
 
     def __repr__(self):

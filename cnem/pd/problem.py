@@ -5,6 +5,7 @@ from __future__ import annotations
 import logging
 import sys
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -18,6 +19,14 @@ from .frames import FrameWriter
 from ..material import PLANES
 from .relaxation import relax
 from .solution import DynamicRun, StaticSolution
+
+if TYPE_CHECKING:
+    import os
+    from typing import Callable
+    from numpy.typing import ArrayLike
+    from .body import Body
+    from .materials import BondBased, StateBased
+    from .solution import Relaxation
 
 __all__ = ["Problem"]
 
@@ -43,7 +52,8 @@ class Problem(Conditions):
         which uses the plain volumes.
     """
 
-    def __init__(self, body, material, *, plane="stress", surface_correction=None):
+    def __init__(self, body: Body, material: BondBased | StateBased, *, plane: str = "stress",
+                 surface_correction: bool | None = None):
         if plane not in PLANES:
             raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
         kind = getattr(material, "kind", None)
@@ -117,7 +127,7 @@ class Problem(Conditions):
             raise ValueError("a point has too few bonds to span every direction: enlarge the horizon")
         return np.einsum("bij,bj->bi", np.linalg.inv(M)[b.bond_i], b.xi) * w[:, None]
 
-    def displacement_gradient(self, u):
+    def displacement_gradient(self, u: np.ndarray) -> np.ndarray:
         """Nonlocal displacement gradient of every point, ``(n, d, d)``,
         ``[i, a, c] = du_a/dx_c`` (see `gradient_weights`; all bonds of the family).
 
@@ -161,7 +171,7 @@ class Problem(Conditions):
                 "Problem.interactions.evaluate(u) for energy, forces and tangent")
 
     # -- energies -----------------------------------------------------------------------
-    def energy_density(self, u, factor=None):
+    def energy_density(self, u: np.ndarray, factor: np.ndarray | None = None) -> np.ndarray:
         """Strain energy density of every point, ``(n,)``."""
         self._linear_only("energy_density")
         b = self.body
@@ -274,7 +284,7 @@ class Problem(Conditions):
         gj = (coef[b.bond_j].T * G).sum(axis=0)
         return 0.5 * (gi + gj)
 
-    def stiffness(self):
+    def stiffness(self) -> sp.csr_matrix:
         """Sparse stiffness ``(d n, d n)``: the Hessian of the total strain energy
         ``sum_i V_i W_i`` (exact tangent of the linear models), live bonds only."""
         self._linear_only("stiffness")
@@ -288,7 +298,7 @@ class Problem(Conditions):
         dil = self.T.T @ sp.diags(self.bulk * b.volumes) @ self.T
         return (dil + self.Edev.T @ sp.diags(w) @ self.Edev).tocsr()
 
-    def stress_tensor(self, u):
+    def stress_tensor(self, u: np.ndarray) -> np.ndarray:
         """Stress of every point from its bonds, ``(n, d, d)`` (``dW_i / d eps`` for a
         uniform strain: the classical stress in a uniform field). The solutions give
         it in Voigt form as ``stress``."""
@@ -320,7 +330,8 @@ class Problem(Conditions):
         """``(n, d)`` the points that conditions refer to (``body.points``)."""
         return self.body.points
 
-    def add_traction(self, where, t):
+    def add_traction(self, where: Callable[..., np.ndarray] | ArrayLike,
+                     t: ArrayLike | Callable[..., np.ndarray]) -> None:
         """Not for peridynamics: a nonlocal body has no boundary edges to load.
 
         Raises
@@ -335,7 +346,7 @@ class Problem(Conditions):
             "boundary edges); give the load as a body force with add_body_force, e.g. "
             "t / dx on the layer of points along the edge (dx the point spacing)")
 
-    def load(self):
+    def load(self) -> np.ndarray:
         """External forces ``(d n,)``: body forces times volumes."""
         f = np.zeros((len(self.body), self.dim))
         for b in self.body_forces_at(self.body.points):
@@ -356,14 +367,15 @@ class Problem(Conditions):
         Kmat = self.stiffness()
         return lambda u, tangent: (Kmat @ u, Kmat), Kmat
 
-    def solve_static(self, *, tol=1e-10, steps=1, initial=None, max_iterations=20,
-                     line_search=False):
+    def solve_static(self, *, tol: float = 1e-10, steps: int = 1, initial: ArrayLike | None = None,
+                     max_iterations: int = 20, line_search: bool = False) -> Relaxation:
         """The former name of `solve` (the static Newton solve), kept as an alias:
         the same parameters and result."""
         return self.solve(tol=tol, steps=steps, initial=initial, max_iterations=max_iterations,
                           line_search=line_search)
 
-    def solve(self, *, tol=1e-10, steps=1, initial=None, max_iterations=20, line_search=False):
+    def solve(self, *, tol: float = 1e-10, steps: int = 1, initial: np.ndarray | None = None,
+              max_iterations: int = 20, line_search: bool = False) -> StaticSolution:
         """Newton-Raphson with the exact tangent, Dirichlet values and loads ramped in
         ``steps`` equal increments.
 
@@ -483,7 +495,7 @@ class Problem(Conditions):
         return trial
 
     # -- dynamics -----------------------------------------------------------------------
-    def stable_time_step(self, safety=0.8):
+    def stable_time_step(self, safety: float = 0.8) -> float:
         """Silling & Askari's bound ``sqrt(2 rho / sum_j C_ij V_j)`` (the smallest
         over points) times ``safety``."""
         self._linear_only("stable_time_step")
@@ -496,7 +508,7 @@ class Problem(Conditions):
             diag = np.abs(Kmat).sum(axis=1).A.reshape(-1) / np.repeat(b.volumes, self.dim)
         return safety * float(np.sqrt(2.0 * self.material.density / diag.max()))
 
-    def damage(self):
+    def damage(self) -> np.ndarray:
         """``1 - (live bond volume) / (all bond volume)`` per point, ``(n,)``."""
         b = self.body
         total = np.bincount(b.bond_i, weights=self.weight, minlength=len(b))
@@ -526,7 +538,10 @@ class Problem(Conditions):
             state["K"] = self.stiffness()
         return -(state["K"] @ u.reshape(-1)).reshape(u.shape) / b.volumes[:, None], broken
 
-    def run_dynamic(self, dt, steps, *, velocity=None, every=None, output=None, progress=None):
+    def run_dynamic(self, dt: float, steps: int, *,
+                    velocity: np.ndarray | Callable[..., np.ndarray] | None = None,
+                    every: int | None = None, output: str | os.PathLike | None = None,
+                    progress: bool | None = None) -> DynamicRun:
         """Explicit velocity Verlet with bond breaking.
 
         Parameters
@@ -596,7 +611,8 @@ class Problem(Conditions):
                           frames=frames, energy=np.array(energy), broken=total_broken,
                           files=files)
 
-    def relax(self, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress=None):
+    def relax(self, *, tol: float = 1e-8, max_steps: int = 100_000, steps: int = 1,
+              every: int | None = None, progress: bool | None = None) -> Relaxation:
         """Quasi-static equilibrium by adaptive dynamic relaxation (Kilic & Madenci 2010),
         with bond breaking: see `cnem.pd.relaxation.relax` for the parameters.
 

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import logging
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -43,6 +44,9 @@ from tqdm.auto import tqdm
 from ..assembly.linsolve import free_rigid_motions
 from ..errors import SolveError
 from .solution import Relaxation
+
+if TYPE_CHECKING:
+    from typing import Any, Callable
 
 __all__ = ["relax", "Relaxation", "load_steps", "unsettled"]
 
@@ -100,7 +104,7 @@ def _settle(x, forces, density, target, budget, record, dot=np.dot):
     return norm
 
 
-def unsettled(step, norm, scale, target, max_steps):
+def unsettled(step: int, norm: float, scale: float, target: float, max_steps: int) -> SolveError:
     """The `SolveError` of a load step that has not settled within ``max_steps``."""
     return SolveError(
         f"dynamic relaxation did not converge in load step {step}: residual "
@@ -108,8 +112,10 @@ def unsettled(step, norm, scale, target, max_steps):
         f"{target / scale:.1e}) after {max_steps} iterations; raise max_steps or tol")
 
 
-def load_steps(x, forces, density, external, load, prescribe, *, tol, noise, limit, steps,
-               max_steps, every, show, dot=np.dot):
+def load_steps(x: np.ndarray, forces: Callable[..., np.ndarray], density: np.ndarray,
+               external: np.ndarray, load: np.ndarray, prescribe: Callable[..., np.ndarray], *,
+               tol: float, noise: float, limit: float, steps: int, max_steps: int, every: int,
+               show: bool, dot: Callable[..., np.ndarray] = np.dot) -> tuple[list, int, int]:
     """The load steps of `relax`: each settles from the last equilibrium, then breaks the
     over-stretched bonds and settles again until no bond breaks.
 
@@ -181,7 +187,8 @@ def load_steps(x, forces, density, external, load, prescribe, *, tol, noise, lim
     return history, total, broken
 
 
-def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress=None):
+def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: int = 1,
+          every: int | None = None, progress: bool | None = None) -> Relaxation:
     """Quasi-static equilibrium of a peridynamic problem by adaptive dynamic relaxation.
 
     Bonds break at equilibrium only (the fictitious transient must not break

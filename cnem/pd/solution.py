@@ -37,7 +37,7 @@ class PointSolution(Solution):
 
     stress_at = "points"
 
-    def stress_tensor(self):
+    def stress_tensor(self) -> np.ndarray:
         """Stress of every point, ``(n, d, d)`` (see `cnem.pd.Problem.stress_tensor`; not
         for CPD)."""
         return self.problem.stress_tensor(self.u)
@@ -52,14 +52,14 @@ class PointSolution(Solution):
         """``(n, 3)`` or ``(n, 6)`` engineering strain of every point."""
         return engineering_strain(self.problem.displacement_gradient(self.u))
 
-    def fields(self):
+    def fields(self) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
         """`Solution.fields` at the points (``u`` and ``strain`` only for CPD, which has
         no stress of its own here)."""
         if self.problem.material.kind == "cpd":
             return {"u": self.u, "strain": self.strain}, {}
         return super().fields()
 
-    def displacement(self, points):
+    def displacement(self, points: np.ndarray) -> np.ndarray:
         """Displacements at points of the body.
 
         A body made from a C-NEM node cloud (`cnem.pd.Body.from_cloud`)
@@ -95,11 +95,11 @@ class PointSolution(Solution):
                              f"{pts[outside][0].tolist()}; give points inside the body")
         return out
 
-    def nodal_average(self, values):
+    def nodal_average(self, values: np.ndarray) -> np.ndarray:
         """Point values are the nodal values: ``values`` itself."""
         return np.asarray(values, dtype=float)
 
-    def plot_mesh(self):
+    def plot_mesh(self) -> tuple:
         """The points, the C-NEM model's triangles for a body made from a node cloud
         (else None: the points are drawn alone), and the points' bounding-box diagonal."""
         body = self.problem.body
@@ -107,7 +107,8 @@ class PointSolution(Solution):
         diameter = float(np.linalg.norm(np.ptp(body.points, axis=0)))
         return body.points, None if model is None else model.triangles, diameter
 
-    def write_fields(self, path, point_data, cell_data):
+    def write_fields(self, path: str, point_data: dict[str, np.ndarray],
+                     cell_data: dict[str, np.ndarray]) -> None:
         """The points as vertex cells with the fields (`cnem.io.write_points`)."""
         from .. import io
         io.write_points(self.problem.body.points, path, point_data=point_data)
@@ -162,7 +163,7 @@ class DynamicRun(PointSolution):
     broken: int = 0
     files: list = field(default_factory=list)
 
-    def fields(self):
+    def fields(self) -> tuple:
         """`Solution.fields` with ``damage`` and ``velocity`` at the points."""
         point_data, cell_data = super().fields()
         return {**point_data, "damage": self.damage, "velocity": self.velocity}, cell_data
@@ -194,7 +195,7 @@ class Relaxation(PointSolution):
     iterations: int = 0
     broken: int = 0
 
-    def fields(self):
+    def fields(self) -> tuple:
         """`Solution.fields` with ``damage`` at the points."""
         point_data, cell_data = super().fields()
         return {**point_data, "damage": self.damage}, cell_data

@@ -11,12 +11,17 @@ True
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+if TYPE_CHECKING:
+    from .body import Body
 
 __all__ = ["deformation_gradient"]
 
 
-def deformation_gradient(body, u) -> np.ndarray:
+def deformation_gradient(body: Body, u: np.ndarray) -> np.ndarray:
     """``F_i = (sum_j w y xi^T) (sum_j w xi xi^T)^-1`` over the bonds of every point.
 
     ``xi`` is a bond in the reference configuration, ``y = xi + u_j - u_i`` the

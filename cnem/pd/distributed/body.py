@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ...spatial import family_search, remove_crossing
@@ -10,6 +12,10 @@ from ..body import checked_input, crack_segments
 from . import _kernels as K
 from .comm import Halo, world
 from .partition import bisect, ghost_candidates
+
+if TYPE_CHECKING:
+    from typing import Any
+    from numpy.typing import ArrayLike
 
 __all__ = ["Body"]
 
@@ -47,8 +53,9 @@ class Body:
     halo : Halo
     """
 
-    def __init__(self, points, volumes, horizon, *, thickness=1.0, period=None, cracks=(),
-                 crossing_points=None, comm=None):
+    def __init__(self, points: np.ndarray, volumes: float | ArrayLike, horizon: float, *,
+                 thickness: float = 1.0, period: ArrayLike | None = None, cracks: tuple = (),
+                 crossing_points: int | None = None, comm: Any = None):
         self.comm = world(comm)
         pts, vol, horizon, self.thickness = checked_input(points, volumes, horizon, thickness)
         n, d = pts.shape

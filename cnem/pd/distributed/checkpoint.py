@@ -10,19 +10,24 @@ from __future__ import annotations
 
 import os
 import pathlib
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from pathlib import Path
+    from typing import Any
 
 __all__ = ["checkpoint_path", "save", "load"]
 
 
-def checkpoint_path(stem, rank, size):
+def checkpoint_path(stem: Path, rank: int, size: int) -> Path:
     """``<stem>.rank<r>-of-<size>.npz``."""
     stem = pathlib.Path(os.fspath(stem))
     return stem.with_name(f"{stem.name}.rank{rank}-of-{size}.npz")
 
 
-def save(stem, comm, **arrays):
+def save(stem: str | os.PathLike, comm: Any, **arrays: Any) -> Path:
     """Write this rank's file (folders created); returns its path."""
     path = checkpoint_path(stem, comm.rank, comm.size)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -32,7 +37,7 @@ def save(stem, comm, **arrays):
     return path
 
 
-def load(stem, comm, owned):
+def load(stem: str | os.PathLike, comm: Any, owned: np.ndarray) -> dict[str, np.ndarray]:
     """This rank's arrays; ``owned`` (global ids) must match the saved ones.
 
     Raises

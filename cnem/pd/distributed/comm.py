@@ -7,16 +7,21 @@ True
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ...errors import MissingExtraError
+
+if TYPE_CHECKING:
+    from typing import Any
 
 __all__ = ["mpi", "world", "Halo", "INSTALL_HINT"]
 
 INSTALL_HINT = 'pip install "cnem[mpi]"  (the mpi4py and mpich wheels)'
 
 
-def mpi():
+def mpi() -> Any:
     """The ``mpi4py.MPI`` module.
 
     Raises
@@ -34,7 +39,7 @@ def mpi():
     return MPI
 
 
-def world(comm=None):
+def world(comm: Any = None) -> Any:
     """``comm``, or ``MPI.COMM_WORLD`` when it is None (one rank under plain ``python``)."""
     return mpi().COMM_WORLD if comm is None else comm
 
@@ -60,7 +65,7 @@ class Halo:
         Bytes this rank has sent so far.
     """
 
-    def __init__(self, comm, owned, ghosts, owner):
+    def __init__(self, comm: Any, owned: np.ndarray, ghosts: np.ndarray, owner: np.ndarray):
         self.comm = comm
         size = comm.size
         ghost_rows = len(owned) + np.arange(len(ghosts))
@@ -72,7 +77,7 @@ class Halo:
                       for r, ids in enumerate(asked) if len(ids)}
         self.bytes = 0
 
-    def exchange(self, values):
+    def exchange(self, values: np.ndarray) -> np.ndarray:
         """Overwrite the ghost rows of ``values`` (``(o + g, ...)``, C-contiguous) with
         their owners' values."""
         MPI = mpi()

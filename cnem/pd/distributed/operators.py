@@ -8,11 +8,18 @@ coefficients, inverse moment tensors, ``alpha``) are copied to the ghosts once.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .. import _kernels as PK
 from ..problem import Problem as SerialProblem
 from . import _kernels as K
+
+if TYPE_CHECKING:
+    from typing import Literal
+    from ..materials import BondBased, StateBased
+    from .body import Body
 
 __all__ = ["LocalOperators"]
 
@@ -53,7 +60,8 @@ class LocalOperators:
         State-based: ``k V_i``.
     """
 
-    def __init__(self, body, material, plane, surface_correction):
+    def __init__(self, body: Body, material: BondBased | StateBased,
+                 plane: Literal['stress', 'strain'], surface_correction: bool | None):
         self.body, self.material, self.plane, self.dim = body, material, plane, body.dim
         b = body
         o = b.n_owned
@@ -136,21 +144,21 @@ class LocalOperators:
         return 0.5 * (gi + gj)
 
     # -- state-based fields ------------------------------------------------------------
-    def dilatation(self, u):
+    def dilatation(self, u: np.ndarray) -> np.ndarray:
         """``theta`` of the owned points ``(o,)`` from local displacements ``(o + g, d)``."""
         theta = np.empty(self.body.n_owned)
         K.dilatation(np.ascontiguousarray(u), self.body.offsets[:self.body.n_owned + 1],
                      self.body.bond_j, self.g, theta)
         return theta
 
-    def deviatoric(self, u, theta):
+    def deviatoric(self, u: np.ndarray, theta: np.ndarray) -> np.ndarray:
         """``e^d_b`` of the owned bonds (``theta`` of the owned points)."""
         b = self.body
         e = (self.unit * (u[b.bond_j] - u[b.bond_i])).sum(axis=1)
         return e - b.length / self.dim * theta[b.bond_i]
 
     # -- Gershgorin bounds of the stiffness rows -----------------------------------------
-    def row_bound(self):
+    def row_bound(self) -> np.ndarray:
         """``sum_j |K_ij|`` of every owned dof, ``(o, d)``: exact for the PMB, an upper
         bound (the triangle inequality through the bond operators) for the state-based
         solid (all bonds alive)."""

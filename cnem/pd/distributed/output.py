@@ -8,10 +8,16 @@ ParaView opens ``stem_<step>.pvtu`` as one data set (the pieces
 from __future__ import annotations
 
 from xml.sax.saxutils import quoteattr
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..frames import FrameWriter
+
+if TYPE_CHECKING:
+    import os
+    from pathlib import Path
+    from typing import Any
 
 __all__ = ["PieceWriter"]
 
@@ -30,7 +36,7 @@ class PieceWriter:
         The largest step number (zero-padding width).
     """
 
-    def __init__(self, output, comm, points, last):
+    def __init__(self, output: str | os.PathLike, comm: Any, points: np.ndarray, last: int):
         self.comm = comm
         stem = FrameWriter(output, points[:0], last).stem
         self.stem, self.width = stem, len(str(int(last)))
@@ -39,7 +45,7 @@ class PieceWriter:
     def _piece_name(self, rank, step):
         return f"{self.stem.name}_r{rank:04d}_{step:0{self.width}d}.vtu"
 
-    def write(self, step, **point_data):
+    def write(self, step: int, **point_data: Any) -> Path | None:
         """Write this rank's piece (and, on rank 0, the index) of frame ``step``.
 
         Returns

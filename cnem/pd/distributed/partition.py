@@ -16,7 +16,7 @@ from ...spatial import RTree
 __all__ = ["bisect", "ghost_candidates"]
 
 
-def bisect(points, weights, parts):
+def bisect(points: np.ndarray, weights: np.ndarray, parts: int) -> np.ndarray:
     """Recursive coordinate bisection: each cut halves the weight across the longest
     extent of the current set (the parts of a cut in proportion to their ranks).
 
@@ -51,7 +51,8 @@ def bisect(points, weights, parts):
     return part
 
 
-def ghost_candidates(points, part, rank, reach, period=None):
+def ghost_candidates(points: np.ndarray, part: np.ndarray, rank: int, reach: float,
+                     period: np.ndarray | None = None) -> np.ndarray:
     """Points within the bounding box of part ``rank`` grown by ``reach``, not in it.
 
     Parameters

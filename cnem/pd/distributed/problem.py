@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import sys
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -26,6 +27,13 @@ from . import checkpoint as ckpt
 from .operators import LocalOperators
 from .output import PieceWriter
 from .relaxation import relax
+
+if TYPE_CHECKING:
+    import os
+    from numpy.typing import ArrayLike
+    from ..materials import BondBased, StateBased
+    from ..solution import Relaxation
+    from .body import Body
 
 __all__ = ["Problem", "DistributedRun"]
 
@@ -77,7 +85,8 @@ class Problem(Conditions):
 
     points_name = "body.points"
 
-    def __init__(self, body, material, *, plane="stress", surface_correction=None):
+    def __init__(self, body: Body, material: BondBased | StateBased, *, plane: str = "stress",
+                 surface_correction: bool | None = None):
         if plane not in PLANES:
             raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
         kind = getattr(material, "kind", None)
@@ -107,7 +116,7 @@ class Problem(Conditions):
         """All points of the body (every rank): what Dirichlet predicates see."""
         return self.body.global_points
 
-    def owned_prescribed(self):
+    def owned_prescribed(self) -> tuple:
         """Owned local dofs ``d * row + component`` and their values."""
         dofs, values = self.prescribed()
         d, body = self.dim, self.body
@@ -116,7 +125,7 @@ class Problem(Conditions):
         local = d * np.searchsorted(body.owned, node[mine]) + dofs[mine] % d
         return local.astype(np.int64), values[mine]
 
-    def load(self):
+    def load(self) -> np.ndarray:
         """External forces of the owned points ``(o, d)``."""
         b, o = self.body, self.body.n_owned
         f = np.zeros((o, self.dim))
@@ -125,15 +134,15 @@ class Problem(Conditions):
         return f
 
     # -- global reductions ---------------------------------------------------------------
-    def allsum(self, x):
+    def allsum(self, x: np.ndarray) -> float:
         """Sum of a float over the ranks."""
         return self.comm.allreduce(float(x))
 
-    def norm(self, x):
+    def norm(self, x: np.ndarray) -> float:
         """Euclidean norm of a vector split over the ranks."""
         return float(np.sqrt(self.allsum(np.dot(x, x))))
 
-    def gather(self, values):
+    def gather(self, values: np.ndarray) -> np.ndarray | None:
         """Owned rows of every rank, in global numbering, on rank 0 (None elsewhere)."""
         parts = self.comm.gather((self.body.owned, np.asarray(values)), root=0)
         if not self.root:
@@ -144,7 +153,7 @@ class Problem(Conditions):
         return out
 
     # -- forces --------------------------------------------------------------------------
-    def internal_force(self, u, limit):
+    def internal_force(self, u: np.ndarray, limit: float) -> tuple[np.ndarray, int]:
         """Force per unit volume of the owned points ``(o, d)`` from local displacements
         ``(o + g, d)`` whose ghost rows are current; bonds beyond ``limit`` break.
         Returns the force and the number of owned bonds broken."""
@@ -172,7 +181,7 @@ class Problem(Conditions):
                      self.alive_reverse, out)
         return out, int(broken)
 
-    def energy(self, u, v):
+    def energy(self, u: np.ndarray, v: np.ndarray) -> float:
         """Kinetic plus elastic energy of the whole body (all ranks)."""
         b, ops, o = self.body, self.ops, self.body.n_owned
         kinetic = 0.5 * self.material.density * float(b.volumes[:o] @ (v * v).sum(axis=1))
@@ -196,14 +205,14 @@ class Problem(Conditions):
         return self.allsum(kinetic + elastic)
 
     # -- per-point results ---------------------------------------------------------------
-    def damage(self):
+    def damage(self) -> np.ndarray:
         """Damage of the owned points ``(o,)`` (as `cnem.pd.Problem.damage`)."""
         b, o, w = self.body, self.body.n_owned, self.ops.weight
         total = np.bincount(b.bond_i, weights=w, minlength=o)
         live = np.bincount(b.bond_i, weights=w * self.alive, minlength=o)
         return 1.0 - live / np.maximum(total, 1e-300)
 
-    def broken_bonds(self):
+    def broken_bonds(self) -> np.ndarray | None:
         """Broken bonds as ``(k, 2)`` global point pairs, on rank 0 (None elsewhere)."""
         b = self.body
         dead = self.alive == 0
@@ -212,7 +221,7 @@ class Problem(Conditions):
         parts = self.comm.gather(pairs, root=0)
         return np.concatenate(parts) if self.root else None
 
-    def stable_time_step(self, safety=0.8):
+    def stable_time_step(self, safety: float = 0.8) -> float:
         """`cnem.pd.Problem.stable_time_step` over all ranks. State-based: from an upper
         bound of the stiffness rows (`LocalOperators.row_bound`), so at most the serial
         step."""
@@ -226,8 +235,12 @@ class Problem(Conditions):
         return safety * float(np.sqrt(2.0 * self.material.density / top))
 
     # -- dynamics ------------------------------------------------------------------------
-    def run_dynamic(self, dt, steps, *, velocity=None, every=None, output=None, progress=None,
-                    gather=True, checkpoint=None, checkpoint_every=None, restart=None):
+    def run_dynamic(self, dt: float, steps: int, *, velocity: ArrayLike | None = None,
+                    every: int | None = None, output: str | os.PathLike | None = None,
+                    progress: bool | None = None, gather: bool = True,
+                    checkpoint: str | os.PathLike | None = None,
+                    checkpoint_every: int | None = None,
+                    restart: str | os.PathLike | None = None) -> DistributedRun:
         """Explicit velocity Verlet with bond breaking, as `cnem.pd.Problem.run_dynamic`.
 
         Parameters
@@ -324,7 +337,8 @@ class Problem(Conditions):
             times=np.array(times), frames=frames, energy=np.array(energy), files=files,
             broken=earlier + self.comm.allreduce(broken_here), local=local, step=steps)
 
-    def relax(self, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress=None):
+    def relax(self, *, tol: float = 1e-8, max_steps: int = 100_000, steps: int = 1,
+              every: int | None = None, progress: bool | None = None) -> Relaxation:
         """Adaptive dynamic relaxation over the ranks (`cnem.pd.distributed.relaxation.relax`);
         ``u``, ``damage`` gathered on rank 0."""
         return relax(self, tol=tol, max_steps=max_steps, steps=steps, every=every,

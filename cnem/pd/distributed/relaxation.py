@@ -11,16 +11,21 @@ the PMB and bounded from above for the state-based solid
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..relaxation import load_steps
 from ..solution import Relaxation
 
+if TYPE_CHECKING:
+    from typing import Any
+
 __all__ = ["relax"]
 
 
-def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress=None):
+def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: int = 1,
+          every: int | None = None, progress: bool | None = None) -> Relaxation:
     """Quasi-static equilibrium by ADR on the ranks; parameters as `cnem.pd.relaxation.relax`.
 
     Returns
