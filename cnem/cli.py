@@ -19,6 +19,10 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Sequence
 
 __all__ = ["main", "DEMOS", "PD_DEMOS"]
 
@@ -109,7 +113,7 @@ def _info():
     print(f"  numba threads: {numba.get_num_threads()}")
 
 
-def main(argv=None):
+def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``cnem`` command (and ``python -m cnem``)."""
     argv = sys.argv[1:] if argv is None else list(argv)
     parser = argparse.ArgumentParser(prog="cnem", description=__doc__.split("\n")[0],

@@ -43,12 +43,18 @@ import argparse
 import pathlib
 import sys
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 from tqdm.auto import tqdm
 
 import cnem
 from cnem.exact import LayeredCylinder
+
+if TYPE_CHECKING:
+    from typing import Sequence
+    from ..geometry.cloud import NodeCloud
+    from ..geometry.domain import Domain
 
 __all__ = ["main", "cli", "run", "rate", "build", "exact_solution", "GRIDS", "TABLE_I"]
 
@@ -84,7 +90,8 @@ def grid_for(nodes):
 GRIDS = tuple(grid_for(n) for n in TABLE_I)
 
 
-def build(n_radial, n_angular, *, irregular=False, seed=0):
+def build(n_radial: int, n_angular: int, *, irregular: bool = False,
+          seed: int = 0) -> tuple[Domain, NodeCloud]:
     """The quarter cylinder and a polar node lattice on it.
 
     Returns
@@ -111,7 +118,7 @@ def build(n_radial, n_angular, *, irregular=False, seed=0):
     return dom, cnem.nodes.from_points(dom, pts)
 
 
-def exact_solution(plane="stress"):
+def exact_solution(plane: str = "stress") -> LayeredCylinder:
     return LayeredCylinder(RADII, MATERIALS, pressure=PRESSURE, plane=plane)
 
 
@@ -146,12 +153,13 @@ def solve_fem(domain, nodes):
     return sol, time.perf_counter() - t0
 
 
-def rate(nodes, errors):
+def rate(nodes: np.ndarray, errors: np.ndarray) -> float:
     """Fitted convergence rate of ``errors`` against h ~ nodes^(-1/2)."""
     return np.polyfit(-0.5 * np.log(nodes), np.log(errors), 1)[0]
 
 
-def run(grids=GRIDS, irregular=(False, True), fem=True, seed=0):
+def run(grids: tuple = GRIDS, irregular: tuple = (False, True), fem: bool = True,
+        seed: int = 0) -> list:
     """Solve every cloud; one row per (cloud kind, size).
 
     Returns
@@ -282,8 +290,8 @@ def plot_profiles(sol, path):
     plt.close(fig)
 
 
-def main(grids=GRIDS, *, irregular=(False, True), fem=True, outdir="results/bimaterial_cylinder",
-         plot=True, seed=0):
+def main(grids: tuple = GRIDS, *, irregular: tuple = (False, True), fem: bool = True,
+         outdir: str = "results/bimaterial_cylinder", plot: bool = True, seed: int = 0) -> dict:
     """Run the study, print the table, write the figures.
 
     Returns
@@ -322,7 +330,7 @@ def main(grids=GRIDS, *, irregular=(False, True), fem=True, outdir="results/bima
                 rates=rates, fem_rate=fem_rate, finest=finest, files=[str(f) for f in files])
 
 
-def cli(argv=None):
+def cli(argv: Sequence[str] | None = None) -> None:
     """Command line: ``python demos/bimaterial_cylinder.py --help`` or ``cnem demo cylinder``."""
     parser = argparse.ArgumentParser(prog="cnem demo cylinder", description=__doc__.split("\n")[0])
     parser.add_argument("--nodes", type=int, nargs="+",

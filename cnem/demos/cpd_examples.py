@@ -65,8 +65,12 @@ Run ``python demos/cpd_examples.py --help`` or ``cnem pd cpd --help``.
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from cnem.demos.cpd import stretch, structures
+
+if TYPE_CHECKING:
+    from typing import Sequence
 
 __all__ = ["main", "cli", "EXAMPLES", "QUICK"]
 
@@ -86,7 +90,8 @@ QUICK = {
 }
 
 
-def main(examples=EXAMPLES, *, quick=False, outdir="results/cpd", plot=True):
+def main(examples: tuple = EXAMPLES, *, quick: bool = False, outdir: str = "results/cpd",
+         plot: bool = True) -> dict:
     """Run the examples (names from `EXAMPLES`), print their tables, write their pictures.
 
     Returns
@@ -100,7 +105,7 @@ def main(examples=EXAMPLES, *, quick=False, outdir="results/cpd", plot=True):
     return {e: RUN[e](**(QUICK[e] if quick else {}), outdir=outdir, plot=plot) for e in examples}
 
 
-def cli(argv=None):
+def cli(argv: Sequence[str] | None = None) -> None:
     """Command line: ``python demos/cpd_examples.py --help`` or ``cnem pd cpd``."""
     parser = argparse.ArgumentParser(prog="cnem pd cpd", description=__doc__.split("\n")[0])
     parser.add_argument("--example", choices=EXAMPLES + ("all",), default="all",

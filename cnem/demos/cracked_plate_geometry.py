@@ -34,6 +34,7 @@ from __future__ import annotations
 import argparse
 import pathlib
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -42,13 +43,19 @@ import cnem.io
 import cnem.plot
 from cnem.geometry import rectangle
 
+if TYPE_CHECKING:
+    from typing import Sequence
+    from ..geometry.cloud import NodeCloud
+    from ..geometry.domain import Domain
+
 __all__ = ["main", "cli", "build"]
 
 #: Half side W and half crack length a of the paper (mm).
 HALF_WIDTH, HALF_CRACK = 1.0, 0.1
 
 
-def build(h=0.1, h_min=0.01, gamma_deg=30.0, growth=0.1):
+def build(h: float = 0.1, h_min: float = 0.01, gamma_deg: float = 30.0,
+          growth: float = 0.1) -> tuple[Domain, NodeCloud]:
     """The cracked plate and its graded node cloud.
 
     Returns
@@ -64,8 +71,9 @@ def build(h=0.1, h_min=0.01, gamma_deg=30.0, growth=0.1):
     return dom, cloud
 
 
-def main(h=0.1, h_min=0.01, gamma_deg=30.0, growth=0.1, outdir="out", plot=True,
-         window_size=(1200, 1200)):
+def main(h: float = 0.1, h_min: float = 0.01, gamma_deg: float = 30.0, growth: float = 0.1,
+         outdir: str = "out", plot: bool = True,
+         window_size: tuple[int, int] = (1200, 1200)) -> dict:
     """Build, discretise, write and draw the cracked plate.
 
     Parameters
@@ -130,7 +138,7 @@ def main(h=0.1, h_min=0.01, gamma_deg=30.0, growth=0.1, outdir="out", plot=True,
     }
 
 
-def cli(argv=None):
+def cli(argv: Sequence[str] | None = None) -> None:
     """Command line: ``python demos/cracked_plate_geometry.py --help`` or ``cnem demo cracked-plate``."""
     parser = argparse.ArgumentParser(prog="cnem demo cracked-plate",
                                      description=__doc__.splitlines()[0])

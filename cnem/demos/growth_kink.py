@@ -26,11 +26,15 @@ from __future__ import annotations
 
 import argparse
 import pathlib
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 import cnem
 from cnem.fracture.criteria import hoop_angle
+
+if TYPE_CHECKING:
+    from typing import Sequence
 
 __all__ = ["main", "cli"]
 
@@ -74,7 +78,8 @@ def first_kink(gamma_deg, cloud=CLOUD, progress=False):
                               progress=progress)
 
 
-def main(angles=ANGLES, *, cloud=CLOUD, outdir="results/growth_kink", plot=True, progress=True):
+def main(angles: tuple = ANGLES, *, cloud: tuple = CLOUD, outdir: str = "results/growth_kink",
+         plot: bool = True, progress: bool = True) -> dict:
     """Kink angles for every gamma.
 
     Returns
@@ -133,7 +138,7 @@ def main(angles=ANGLES, *, cloud=CLOUD, outdir="results/growth_kink", plot=True,
                 files=[str(f) for f in files])
 
 
-def cli(argv=None):
+def cli(argv: Sequence[str] | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_kink --help`` or ``cnem demo growth-kink``."""
     parser = argparse.ArgumentParser(prog="cnem demo growth-kink", description=__doc__.split("\n")[0])
     parser.add_argument("--angles", type=float, nargs="+", default=list(ANGLES))

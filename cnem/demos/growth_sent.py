@@ -32,10 +32,14 @@ from __future__ import annotations
 
 import argparse
 import pathlib
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 import cnem
+
+if TYPE_CHECKING:
+    from typing import Sequence
 
 __all__ = ["main", "cli"]
 
@@ -64,8 +68,8 @@ def setup(model):
     return prob
 
 
-def main(h=0.02, *, a0=0.2, a1=0.6, increment=0.02, outdir="results/growth_sent", plot=True,
-         progress=True):
+def main(h: float = 0.02, *, a0: float = 0.2, a1: float = 0.6, increment: float = 0.02,
+         outdir: str = "results/growth_sent", plot: bool = True, progress: bool = True) -> dict:
     """Grow the crack from ``a0`` to ``a1`` (fractions of W) on a regular cloud of spacing ``h``.
 
     Returns
@@ -104,7 +108,7 @@ def main(h=0.02, *, a0=0.2, a1=0.6, increment=0.02, outdir="results/growth_sent"
                 nodes=len(hist.model.nodes), files=[str(f) for f in files], history=hist)
 
 
-def cli(argv=None):
+def cli(argv: Sequence[str] | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_sent --help`` or ``cnem demo growth-sent``."""
     parser = argparse.ArgumentParser(prog="cnem demo growth-sent", description=__doc__.split("\n")[0])
     parser.add_argument("--h", type=float, default=0.02, help="node spacing (fraction of W)")

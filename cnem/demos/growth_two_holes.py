@@ -28,11 +28,15 @@ from __future__ import annotations
 
 import argparse
 import pathlib
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 import cnem
 from cnem.geometry import arc
+
+if TYPE_CHECKING:
+    from typing import Sequence
 
 __all__ = ["main", "cli"]
 
@@ -64,8 +68,9 @@ def run(h=0.25, increment=1.0, steps=12, progress=True):
     return cnem.fracture.grow(dom, h, setup, increment=increment, steps=steps, progress=progress)
 
 
-def main(h=0.25, *, increment=1.0, steps=12, outdir="results/growth_two_holes", plot=True,
-         progress=True):
+def main(h: float = 0.25, *, increment: float = 1.0, steps: int = 12,
+         outdir: str = "results/growth_two_holes", plot: bool = True,
+         progress: bool = True) -> dict:
     """Grow both cracks; print the tips at every step.
 
     Returns
@@ -107,7 +112,7 @@ def main(h=0.25, *, increment=1.0, steps=12, outdir="results/growth_two_holes", 
                 files=[str(f) for f in files], history=hist)
 
 
-def cli(argv=None):
+def cli(argv: Sequence[str] | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_two_holes --help`` or ``cnem demo growth-two-holes``."""
     parser = argparse.ArgumentParser(prog="cnem demo growth-two-holes", description=__doc__.split("\n")[0])
     parser.add_argument("--h", type=float, default=0.25, help="node spacing (mm)")

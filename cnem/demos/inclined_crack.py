@@ -38,6 +38,7 @@ from __future__ import annotations
 import argparse
 import pathlib
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -45,6 +46,9 @@ from tqdm.auto import tqdm
 import cnem
 from cnem.exact import CentralCrack
 from cnem.fracture import sif
+
+if TYPE_CHECKING:
+    from typing import Sequence
 
 __all__ = ["main", "cli", "sif_study", "muskhelishvili"]
 
@@ -85,7 +89,8 @@ def exact_sif(gamma_deg):
     return CentralCrack(HALF_CRACK, SIGMA, np.deg2rad(gamma_deg)).sif()
 
 
-def sif_study(angles=ANGLES, cloud=SIF_CLOUD, radius=0.4 * HALF_CRACK):
+def sif_study(angles: tuple = ANGLES, cloud: tuple = SIF_CLOUD,
+              radius: float = 0.4 * HALF_CRACK) -> list[dict]:
     """K_I, K_II at both tips for every angle. Returns a list of dict rows."""
     rows = []
     for gamma in tqdm(angles, desc="angles", disable=not sys.stderr.isatty(), leave=False):
@@ -100,7 +105,7 @@ def sif_study(angles=ANGLES, cloud=SIF_CLOUD, radius=0.4 * HALF_CRACK):
     return rows
 
 
-def muskhelishvili(r):
+def muskhelishvili(r: float) -> np.ndarray:
     """sigma_22 ahead of the tip of a crack in an infinite plate (eq. 45)."""
     return CentralCrack(HALF_CRACK, SIGMA).normal_stress_ahead(r)
 
@@ -173,8 +178,8 @@ def _plots(rows, ahead, out):
     plt.close(fig)
 
 
-def main(angles=ANGLES, *, sif_cloud=SIF_CLOUD, paper_cloud=PAPER_CLOUD,
-         outdir="results/inclined_crack", plot=True):
+def main(angles: tuple = ANGLES, *, sif_cloud: tuple = SIF_CLOUD, paper_cloud: tuple = PAPER_CLOUD,
+         outdir: str = "results/inclined_crack", plot: bool = True) -> dict:
     """Run both studies, print the table, write the figures.
 
     Returns
@@ -208,7 +213,7 @@ def main(angles=ANGLES, *, sif_cloud=SIF_CLOUD, paper_cloud=PAPER_CLOUD,
                 files=[str(f) for f in files])
 
 
-def cli(argv=None):
+def cli(argv: Sequence[str] | None = None) -> None:
     """Command line: ``python demos/inclined_crack.py --help`` or ``cnem demo inclined-crack``."""
     parser = argparse.ArgumentParser(prog="cnem demo inclined-crack", description=__doc__.split("\n")[0])
     parser.add_argument("--angles", type=float, nargs="+", default=list(ANGLES))

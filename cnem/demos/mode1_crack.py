@@ -43,12 +43,16 @@ from __future__ import annotations
 import argparse
 import pathlib
 import sys
+from typing import TYPE_CHECKING
 
 import numpy as np
 from tqdm.auto import tqdm
 
 import cnem
 from cnem.fracture import polar, sif, williams
+
+if TYPE_CHECKING:
+    from typing import Sequence
 
 __all__ = ["main", "cli", "study"]
 
@@ -115,7 +119,7 @@ def rate(h, errors):
     return float(np.polyfit(np.log(h), np.log(errors), 1)[0])
 
 
-def study(spacings=SPACINGS, methods=("cnem", "enriched", "fem")):
+def study(spacings: tuple = SPACINGS, methods: tuple = ("cnem", "enriched", "fem")) -> list[dict]:
     """Energy errors per method and spacing. Returns a list of dict rows."""
     rows = []
     jobs = [(m, h) for m in methods for h in spacings]
@@ -175,8 +179,8 @@ def _plot(rows, rates, path):
     plt.close(fig)
 
 
-def main(spacings=SPACINGS, *, methods=("cnem", "enriched", "fem"), outdir="results/mode1_crack",
-         plot=True):
+def main(spacings: tuple = SPACINGS, *, methods: tuple = ("cnem", "enriched", "fem"),
+         outdir: str = "results/mode1_crack", plot: bool = True) -> dict:
     """Run the convergence study, print the table, write the figures.
 
     Returns
@@ -201,7 +205,7 @@ def main(spacings=SPACINGS, *, methods=("cnem", "enriched", "fem"), outdir="resu
     return dict(rows=rows, rates=rates, files=[str(f) for f in files])
 
 
-def cli(argv=None):
+def cli(argv: Sequence[str] | None = None) -> None:
     """Command line: ``python demos/mode1_crack.py --help`` or ``cnem demo mode1-crack``."""
     parser = argparse.ArgumentParser(prog="cnem demo mode1-crack", description=__doc__.split("\n")[0])
     parser.add_argument("--n", type=int, nargs="+", default=[8, 16, 32, 64],

@@ -74,12 +74,18 @@ from __future__ import annotations
 import argparse
 import pathlib
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 import cnem.pd as pd
 from cnem.exact import rayleigh_speed
 from cnem.pd import cracks
+
+if TYPE_CHECKING:
+    from typing import Literal, Sequence
+    from ..pd.problem import Problem
+    from ..pd.solution import DynamicRun
 
 __all__ = ["main", "cli", "build", "measure", "plate", "MATERIALS", "QUICK"]
 
@@ -100,7 +106,7 @@ ANGLE_WINDOW = 5e-3                 # length of the branches fitted for the angl
 QUICK = dict(h=0.5e-3, m=4.0, t_end=30e-6)
 
 
-def plate(h):
+def plate(h: float) -> tuple[np.ndarray, np.ndarray]:
     """Cell-centred grid points of the plate.
 
     Parameters
@@ -136,7 +142,8 @@ def plate(h):
     return np.column_stack([X.ravel(), Y.ravel()]), (nx, ny)
 
 
-def build(h, m, material="soda-lime", stress=None):
+def build(h: float, m: float, material: str = "soda-lime",
+          stress: float | None = None) -> tuple[Problem, np.ndarray]:
     """The loaded, pre-cracked plate.
 
     Parameters
@@ -182,7 +189,8 @@ def build(h, m, material="soda-lime", stress=None):
     return problem, shape
 
 
-def measure(problem, shape, run, h, threshold=THRESHOLD, speed_window=3e-6):
+def measure(problem: Problem, shape: np.ndarray, run: DynamicRun, h: float,
+            threshold: float = THRESHOLD, speed_window: float = 3e-6) -> dict:
     """Crack-tip history, speeds, branching and energy balance of a run.
 
     Parameters
@@ -302,8 +310,10 @@ def _plots(problem, shape, run, res, h, out, montage=6):
     return [out / "branching_damage.png", out / "branching_history.png"]
 
 
-def main(h=0.25e-3, m=4.0, t_end=46e-6, *, material="soda-lime", stress=None, frame_every=1e-6,
-         outdir="results/pd_crack_branching", plot=True, progress=None):
+def main(h: float = 0.25e-3, m: float = 4.0, t_end: float = 46e-6, *,
+         material: Literal["soda-lime", "duran50"] = "soda-lime", stress: float | None = None,
+         frame_every: float = 1e-6, outdir: str = "results/pd_crack_branching", plot: bool = True,
+         progress: bool | None = None) -> dict:
     """Run the branching problem, measure the crack, print the comparison, write the figures.
 
     Parameters
@@ -391,7 +401,7 @@ def report(r, h, horizon, material, mat):
     return "\n".join(lines)
 
 
-def cli(argv=None):
+def cli(argv: Sequence[str] | None = None) -> None:
     """Command line: ``python demos/pd_crack_branching.py --help`` or ``cnem pd branching``."""
     parser = argparse.ArgumentParser(prog="cnem pd branching", description=__doc__.split("\n")[0])
     parser.add_argument("--h", type=float, default=0.25, help="grid spacing in mm (default 0.25)")

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import argparse
 import pathlib
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -43,6 +44,9 @@ import cnem.pd as pd
 from cnem.exact import CentralCrack
 from cnem.fracture import sif
 from cnem.fracture.opening import crack_opening, k_from_opening
+
+if TYPE_CHECKING:
+    from typing import Sequence
 
 __all__ = ["main", "cli", "study"]
 
@@ -94,7 +98,7 @@ def k_from_tips(x, delta, h):
     return k_from_opening(r, delta, E, NU, "stress", where=(r > 2 * h) & (r < 0.5 * A))
 
 
-def study(spacings=SPACINGS):
+def study(spacings: tuple = SPACINGS) -> list[dict]:
     rows = []
     for h in spacings:
         cloud = cnem.nodes.regular(domain(), h)
@@ -160,7 +164,8 @@ def _plots(rows, out):
     plt.close(fig)
 
 
-def main(spacings=SPACINGS, *, outdir="results/pd_vs_cnem_crack", plot=True):
+def main(spacings: tuple = SPACINGS, *, outdir: str = "results/pd_vs_cnem_crack",
+         plot: bool = True) -> dict:
     """Run the comparison, print the table, write the figures.
 
     Returns
@@ -183,7 +188,7 @@ def main(spacings=SPACINGS, *, outdir="results/pd_vs_cnem_crack", plot=True):
     return dict(rows=[{k: r[k] for k in keep} for r in rows], files=[str(f) for f in files])
 
 
-def cli(argv=None):
+def cli(argv: Sequence[str] | None = None) -> None:
     """Command line: ``python demos/pd_vs_cnem_crack.py --help`` or ``cnem demo pd-crack``."""
     parser = argparse.ArgumentParser(prog="cnem demo pd-crack", description=__doc__.split("\n")[0])
     parser.add_argument("--n", type=int, nargs="+", default=[16, 32, 64],

@@ -5,10 +5,16 @@ from __future__ import annotations
 
 import pathlib
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 import cnem.pd as pd
+
+if TYPE_CHECKING:
+    from typing import Sequence
+    from ...pd.body import Body
+    from ...pd.cpd import CPD
 
 __all__ = ["solve", "convergence_table", "picture", "finish", "RATIO", "TOL", "EPS"]
 
@@ -21,7 +27,8 @@ BAR = {2: dict(position_x=0.15, position_y=0.04, width=0.7, height=0.09),
        3: dict(position_x=0.8, position_y=0.15, height=0.65)}
 
 
-def solve(body, material, conditions, *, steps=1, force=None, tol=TOL):
+def solve(body: Body, material: CPD, conditions: list[tuple], *, steps: int = 1,
+          force: np.ndarray | None = None, tol: float = TOL) -> dict:
     """`cnem.pd.Problem.solve` of ``body`` with the Dirichlet ``conditions``
     [(where, component, value), ...] and an optional body force, in ``steps`` load steps.
 
@@ -41,7 +48,8 @@ def solve(body, material, conditions, *, steps=1, force=None, tol=TOL):
     return dict(u=sol.u, history=sol.residual_history, seconds=time.perf_counter() - start)
 
 
-def convergence_table(title, history, labels, columns=5):
+def convergence_table(title: str, history: Sequence[float], labels: Sequence[str],
+                      columns: int = 5) -> str:
     """The residual norms per Newton iteration (rows) of up to ``columns`` load steps
     (evenly chosen, always the last), like the paper's Tables 4-8."""
     pick = np.unique(np.linspace(0, len(history) - 1, min(columns, len(history))).round()
@@ -56,7 +64,8 @@ def convergence_table(title, history, labels, columns=5):
     return "\n".join(lines)
 
 
-def picture(path, panels, *, dim, window=(1200, 600)):
+def picture(path: str, panels: list[dict], *, dim: int,
+            window: tuple = (1200, 600)) -> str | np.ndarray:
     """The deformed bodies of ``panels`` side by side, at one scale (pyvista, off-screen).
 
     Each panel is a dict with ``points`` (deformed, (n, d), in `cnem.pd.lattice.lattice` order),
@@ -108,7 +117,8 @@ def picture(path, panels, *, dim, window=(1200, 600)):
     return str(path)
 
 
-def finish(name, result, outdir, plot, panels, dim, window=(1200, 600)):
+def finish(name: str, result: dict, outdir: str, plot: bool, panels: list[dict], dim: int,
+           window: tuple = (1200, 600)) -> dict:
     """Print the example's tables, write its picture, return its numbers."""
     for text in result.pop("tables"):
         print(text + "\n")
