@@ -33,7 +33,7 @@ from skfem.models.elasticity import linear_elasticity
 
 from .assembly.quadrature import triangle_quadrature
 from .assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
-from .errors import GeometryError, SolveError
+from .errors import ConditionError, GeometryError, InputError, SolveError
 from .geometry.cracks import split_cracks
 from .geometry.pslg import BOUNDARY, CRACK
 from .assembly.conditions import dirichlet_dofs, per_point
@@ -136,20 +136,20 @@ def mesh_domain(domain, *, nodes=None, max_area=None, quality=30.0):
 
     Raises
     ------
-    ValueError
+    InputError
         Both ``nodes`` and ``max_area`` given, non-positive values, a quality
         above 34 degrees, or a target node count below the coarsest mesh.
     GeometryError
         If a crack cannot be opened.
     """
     if nodes is not None and max_area is not None:
-        raise ValueError(f"give either nodes or max_area, received nodes={nodes!r} and "
-                         f"max_area={max_area!r}")
+        raise InputError(f"give either nodes or max_area, received nodes={nodes!r} and "
+                         f"max_area={max_area!r}; drop one of them")
     if not 0.0 < float(quality) <= 34.0:
-        raise ValueError(f"quality: expected a minimum angle in (0, 34] degrees, received "
+        raise InputError(f"quality: expected a minimum angle in (0, 34] degrees, received "
                          f"{quality!r} (triangle may not terminate above 34)")
     if max_area is not None and not float(max_area) > 0.0:
-        raise ValueError(f"max_area: expected a positive number, received {max_area!r}")
+        raise InputError(f"max_area: expected a positive number, received {max_area!r}")
     data = _pslg_input(domain)
     if nodes is None:
         out = _triangulate(data, quality, max_area)
@@ -174,12 +174,12 @@ def _mesh_for_nodes(data, area, target, quality):
     """Mesh whose node count is within `_NODES_STOP` of ``target`` if possible
     (secant on ``log count`` against ``log max_area``)."""
     if target < 3:
-        raise ValueError(f"nodes: expected a target node count >= 3, received {target}")
+        raise InputError(f"nodes: expected a target node count >= 3, received {target}")
     coarsest = _triangulate(data, quality, None)
     if len(coarsest["vertices"]) >= (1.0 - _NODES_RTOL) * target:
         if len(coarsest["vertices"]) <= (1.0 + _NODES_RTOL) * target:
             return coarsest
-        raise ValueError(f"nodes: the coarsest quality-{quality:g} mesh of this domain already "
+        raise InputError(f"nodes: the coarsest quality-{quality:g} mesh of this domain already "
                          f"has {len(coarsest['vertices'])} nodes, more than the target {target}; "
                          "ask for more nodes or a coarser domain description")
     tries = []
@@ -312,10 +312,11 @@ class P1Elasticity:
         facets, midpoint, normal = self.boundary_facets()
         pick = np.asarray(where(midpoint, normal)) if callable(where) else np.asarray(where)
         if pick.shape != (len(facets),) or pick.dtype != bool:
-            raise ValueError(f"add_traction: where(x, nrm) must return a ({len(facets)},) bool "
-                             f"array, received dtype {pick.dtype} shape {pick.shape}")
+            raise ConditionError(f"add_traction: where(x, nrm) must return a ({len(facets)},) bool "
+                                 f"array, received dtype {pick.dtype} shape {pick.shape}")
         if not pick.any():
-            raise ValueError("add_traction: `where` selects no boundary facet")
+            raise ConditionError("add_traction: `where` selects no boundary facet; check the "
+                                 "predicate against the facet midpoints and outward normals")
         self._tractions.append((facets[pick], t))
 
     def add_body_force(self, b):

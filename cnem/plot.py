@@ -19,7 +19,7 @@ import pathlib
 
 import numpy as np
 
-from .errors import CNEMError
+from .errors import PlotDependencyError, PlotError, PlotInputError
 from .io import cell_topology
 
 __all__ = ["model", "solution", "cells_polydata", "region_color", "PlotError", "REGION_COLORS",
@@ -46,16 +46,12 @@ REGION_COLORS = np.array([
 INSTALL_HINT = 'install the plotting extra: pip install "cnem[plot]"'
 
 
-class PlotError(CNEMError, RuntimeError):
-    """pyvista is missing or cannot render off-screen."""
-
-
 def _pyvista():
     """pyvista, set to render off-screen, or a `PlotError` saying how to get it."""
     try:
         import pyvista
     except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise PlotError(f"cnem.plot needs pyvista, which cannot be imported ({exc}); "
+        raise PlotDependencyError(f"cnem.plot needs pyvista, which cannot be imported ({exc}); "
                         f"{INSTALL_HINT}") from exc
     pyvista.OFF_SCREEN = True
     return pyvista
@@ -147,8 +143,10 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
 
     Raises
     ------
-    PlotError
-        pyvista missing, or the picture cannot be rendered.
+    PlotDependencyError
+        pyvista missing, or the picture cannot be rendered (an `ImportError`).
+    PlotInputError
+        empty ``bounds`` (a `ValueError`).
     """
     pv = _pyvista()
     mdl = model
@@ -158,8 +156,8 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
         bounds = (xmin, ymin, xmax, ymax)
     bx0, by0, bx1, by1 = map(float, bounds)
     if not (bx1 > bx0 and by1 > by0):
-        raise PlotError(f"bounds must be (xmin, ymin, xmax, ymax) with xmin < xmax and "
-                        f"ymin < ymax, received {tuple(bounds)}")
+        raise PlotInputError(f"bounds must be (xmin, ymin, xmax, ymax) with xmin < xmax and "
+                             f"ymin < ymax, received {tuple(bounds)}; give a non-empty view")
     width, height = map(int, window_size)
     lift = 1e-4 * dom.diameter        # draw lines above the cells (parallel view: no shift)
     pl = _plotter(pv, width, height)
@@ -196,9 +194,9 @@ def _plotter(pv, width, height):
     try:
         pl = pv.Plotter(off_screen=True, window_size=(width, height))
     except Exception as exc:  # pragma: no cover - depends on the environment
-        raise PlotError(f"pyvista cannot open an off-screen window ({exc}); {INSTALL_HINT} "
-                        f"and make sure VTK has an off-screen backend (OSMesa/EGL) or a display"
-                        ) from exc
+        raise PlotDependencyError(f"pyvista cannot open an off-screen window ({exc}); "
+                                  f"{INSTALL_HINT} and make sure VTK has an off-screen backend "
+                                  f"(OSMesa/EGL) or a display") from exc
     pl.set_background("white")
     return pl
 
@@ -226,8 +224,9 @@ def _save(pl, path, what):
             pl.screenshot(str(path))
         except Exception as exc:  # pragma: no cover - depends on the environment
             pl.close()
-            raise PlotError(f"pyvista could not render {str(path)!r} off-screen ({exc}); "
-                            f"{INSTALL_HINT}, with a VTK that renders off-screen") from exc
+            raise PlotDependencyError(f"pyvista could not render {str(path)!r} off-screen "
+                                      f"({exc}); {INSTALL_HINT}, with a VTK that renders "
+                                      f"off-screen") from exc
         log.info("cnem.plot.%s: wrote %s", what, path)
     return pl
 
@@ -252,11 +251,13 @@ def nodal_field(sol, field):
         if values.shape == (n,):
             return values
         if values.shape != (len(cells.area),):
-            raise PlotError(f"field: expected a name in {SOLUTION_FIELDS}, or values at the "
-                            f"{n} nodes or the {len(cells.area)} cells, received shape {values.shape}")
+            raise PlotInputError(f"field: expected a name in {SOLUTION_FIELDS}, or values at "
+                                 f"the {n} nodes or the {len(cells.area)} cells, received shape "
+                                 f"{values.shape}; pass one value per node or per cell")
         per_cell = values
     elif field not in SOLUTION_FIELDS:
-        raise PlotError(f"field must be one of {SOLUTION_FIELDS}, received {field!r}")
+        raise PlotInputError(f"field must be one of {SOLUTION_FIELDS} or an array of values, "
+                             f"received {field!r}; pick one of those names")
     elif field in ("ux", "uy", "|u|"):
         return {"ux": sol.u[:, 0], "uy": sol.u[:, 1], "|u|": np.hypot(*sol.u.T)}[field]
     else:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ConditionError
 from .basis import select_nodes
 
 __all__ = ["per_point", "dirichlet_dofs"]
@@ -14,7 +15,7 @@ def per_point(value, points, width, what):
 
     Raises
     ------
-    ValueError
+    ConditionError
         Values of the wrong shape, or not finite (``what`` names them).
     """
     arr = np.asarray(value(points) if callable(value) else value, dtype=float)
@@ -23,10 +24,12 @@ def per_point(value, points, width, what):
     try:
         arr = np.broadcast_to(arr, (len(points), width))
     except ValueError:
-        raise ValueError(f"{what}: expected a number or one value per point, shape "
-                         f"({len(points)}, {width}), received shape {arr.shape}") from None
+        raise ConditionError(f"{what}: expected a number or one value per point, shape "
+                             f"({len(points)}, {width}), received shape {arr.shape}; return one "
+                             f"row per point") from None
     if not np.isfinite(arr).all():
-        raise ValueError(f"{what}: values must be finite, received NaN or inf")
+        raise ConditionError(f"{what}: expected finite values, received NaN or inf; check "
+                             f"the value or function given")
     return arr
 
 
@@ -50,10 +53,11 @@ def dirichlet_dofs(points, where, component, value, *, where_to_look="the nodes"
     """
     d = points.shape[1]
     if component is not None and component not in range(d):
-        raise ValueError(f"component: expected None or 0..{d - 1}, received {component!r}")
+        raise ConditionError(f"component: expected None (all) or 0..{d - 1}, received "
+                             f"{component!r}")
     nodes = select_nodes(points, where)
     if nodes.size == 0:
-        raise ValueError(f"add_dirichlet: `where` selects no node; check the predicate against "
+        raise ConditionError(f"add_dirichlet: `where` selects no node; check the predicate against "
                          f"{where_to_look} (boundary nodes lie exactly on the boundary)")
     comps = np.arange(d) if component is None else np.array([component])
     vals = per_point(value, points[nodes], len(comps), "add_dirichlet value")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import check_choice
 from ..models.material import PLANES
 
 __all__ = ["kappa", "effective_modulus", "williams"]
@@ -16,8 +17,7 @@ __all__ = ["kappa", "effective_modulus", "williams"]
 
 def kappa(nu, plane):
     """Kolosov's constant."""
-    if plane not in PLANES:
-        raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
+    check_choice("plane", plane, PLANES)
     return 3.0 - 4.0 * nu if plane == "strain" else (3.0 - nu) / (1.0 + nu)
 
 

@@ -20,7 +20,7 @@ from ..assembly.quadrature import cell_quadrature, subdivide, tip_cells
 from ..assembly.scni import fan_gradient
 from ..assembly.triangles import triangle_basis
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
-from ..errors import SolveError
+from ..errors import ConditionError, InputError, SolveError
 from ..geometry.topology import constraint_edges
 from .material import lame, parse_materials, stiffness_matrix
 from .solution import ElasticSolution
@@ -87,7 +87,7 @@ class Elasticity:
         lame(1.0, 0.0, plane)                       # validates `plane`
         self.stabilization = float(stabilization)
         if not (np.isfinite(self.stabilization) and self.stabilization >= 0):
-            raise ValueError(f"stabilization: expected a number >= 0, received {stabilization!r}")
+            raise InputError(f"stabilization: expected a number >= 0, received {stabilization!r}")
         self.plane = plane
         self.gauss = gauss
         self._dirichlet = []
@@ -147,10 +147,11 @@ class Elasticity:
         mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
         pick = np.asarray(where(mid, normal)) if callable(where) else np.asarray(where)
         if pick.shape != (len(edges),) or pick.dtype != bool:
-            raise ValueError(f"add_traction: where(x, nrm) must return a ({len(edges)},) bool "
-                             f"array, received dtype {pick.dtype} shape {pick.shape}")
+            raise ConditionError(f"add_traction: where(x, nrm) must return a ({len(edges)},) bool "
+                                 f"array, received dtype {pick.dtype} shape {pick.shape}")
         if not pick.any():
-            raise ValueError("add_traction: `where` selects no boundary edge")
+            raise ConditionError("add_traction: `where` selects no boundary edge; check the "
+                                 "predicate against the edge midpoints and outward normals")
         self._tractions.append((edges[pick], normal[pick], t))
 
     def add_body_force(self, b):

@@ -7,6 +7,7 @@ import inspect
 import numpy as np
 
 from ..assembly.quadrature import cell_quadrature
+from ..errors import InputError, check_choice
 
 __all__ = ["ElasticSolution", "von_mises", "energy_error_density"]
 
@@ -47,8 +48,8 @@ def energy_error_density(points, region, stress, C, exact_stress):
         exact = exact_stress(points)
     exact = np.asarray(exact, dtype=float)
     if exact.shape != (len(points), 3):
-        raise ValueError(f"exact_stress must return ({len(points)}, 3) values "
-                         f"[sxx, syy, sxy], received shape {exact.shape}")
+        raise InputError(f"exact_stress must return ({len(points)}, 3) values "
+                         f"[sxx, syy, sxy], received shape {exact.shape}; return one row per point")
     diff = stress - exact
     return np.einsum("qi,qij,qj->q", diff, np.linalg.inv(C), diff)
 
@@ -180,8 +181,7 @@ class ElasticSolution:
         -------
         float
         """
-        if strain not in ("smoothed", "pointwise"):
-            raise ValueError(f"strain: expected 'smoothed' or 'pointwise', received {strain!r}")
+        check_choice("strain", strain, ("smoothed", "pointwise"))
         cell, points, weights = cell_quadrature(self.cells, self.model.nodes, order,
                                                 singular=self.model.domain.tips)
         if strain == "smoothed":
