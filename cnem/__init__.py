@@ -9,7 +9,7 @@
 
 from . import (assembly, exact, fracture, geometry, hyperdual, io, models, nodes, plot, shape,
                spatial)
-from .errors import CNEMError, GeometryError, SolveError
+from .errors import (CNEMError, ConditionError, FormatError, FormError, FractureError, GeometryError, HyperDualError, InputError, LimitError, MaterialError, OptionError, PlotDependencyError, PlotError, PlotInputError, SolveError, SpatialError, UnsupportedError)  # noqa: E501
 from .geometry import Domain, Model, NodeCloud, discretize
 from .models import ElasticSolution, Elasticity
 
@@ -18,4 +18,7 @@ __version__ = "0.1.0"
 __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
            "nodes", "geometry", "assembly", "models", "exact", "fracture", "io", "plot", "shape",
            "spatial", "hyperdual",
-           "CNEMError", "GeometryError", "SolveError", "__version__"]
+           "CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError", "FormError",
+           "ConditionError", "SpatialError", "FractureError", "FormatError", "HyperDualError",
+           "LimitError", "UnsupportedError", "SolveError", "PlotError", "PlotDependencyError",
+           "PlotInputError", "__version__"]

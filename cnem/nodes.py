@@ -21,7 +21,7 @@ from scipy.spatial import cKDTree
 from . import config
 from .errors import GeometryError
 from .geometry.cloud import NodeCloud
-from .geometry.pslg import segment_projection
+from .geometry.pslg import SegmentKind, segment_projection
 
 __all__ = ["regular", "irregular", "graded", "from_points", "NodeCloud"]
 
@@ -50,7 +50,7 @@ def _tip_to_tip(dom):
     if len(dom.tips) == 0:
         return np.zeros(len(edges), dtype=bool)
     is_tip = cKDTree(dom.tips).query(v)[0] <= dom.tolerance
-    return (kinds == 2) & is_tip[edges[:, 0]] & is_tip[edges[:, 1]]
+    return (kinds == SegmentKind.CRACK) & is_tip[edges[:, 0]] & is_tip[edges[:, 1]]
 
 
 def _boundary_nodes(dom, spacing_of, jitter=None):

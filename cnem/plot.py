@@ -20,6 +20,7 @@ import pathlib
 import numpy as np
 
 from .errors import PlotDependencyError, PlotError, PlotInputError
+from .geometry.pslg import SegmentKind
 from .io import cell_topology
 
 __all__ = ["model", "solution", "cells_polydata", "region_color", "PlotError", "REGION_COLORS",
@@ -127,7 +128,7 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
         Write a PNG there (parent folders are created).
     show_triangles, show_nodes, show_cracks : bool
         Draw the constrained Delaunay triangles, the nodes, the crack faces
-        (segments with ``segment_kind == 2``).
+        (segments with ``segment_kind == SegmentKind.CRACK``).
     window_size : (2,) int
         Picture size in pixels, ``(width, height)``.
     bounds : (4,) float, optional
@@ -171,7 +172,7 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
                     color=(0.55, 0.55, 0.55), line_width=max(0.5, 0.5 * width / 1200),
                     lighting=False)
     if show_cracks:
-        crack = np.asarray(mdl.segments)[np.asarray(mdl.segment_kind) == 2]
+        crack = np.asarray(mdl.segments)[np.asarray(mdl.segment_kind) == SegmentKind.CRACK]
         if len(crack):
             pl.add_mesh(_lines(pv, mdl.nodes, crack, 2 * lift), color="red",
                         line_width=max(3.0, 4.0 * width / 1200), lighting=False)

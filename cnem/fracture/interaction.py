@@ -52,8 +52,8 @@ def tip_frame(domain, tip):
     """
     tips = domain.tips
     if len(tips) == 0:
-        raise FractureError("expected a domain with a crack tip (a crack end inside the body), "
-                            "received none; give a crack that ends inside the domain")
+        raise FractureError("the domain has no crack tip (a crack end inside the body): its "
+                            "cracks, if any, end on the boundary; give a crack that ends inside")
     tip = np.asarray(tip, dtype=float).reshape(-1)
     if tip.shape != (2,):
         raise FractureError(f"tip: expected a point (2,), received shape {tip.shape}")
