@@ -51,6 +51,17 @@ CELLS_PER_HORIZON = 2
 #: horizon for all points).
 COLUMNS_PER_HORIZON = 3
 
+#: `cnem.fem.mesh_domain` with a node target stops once the node count is within this
+#: relative distance of the target ...
+MESH_NODES_STOP = 0.02
+
+#: ... or after this many meshes (a secant on log count against log max_area) ...
+MESH_NODES_TRIES = 6
+
+#: ... and warns when the best is further than this from the target (the coarsest
+#: mesh is taken when it is this close).
+MESH_NODES_RTOL = 0.05
+
 # ---------------------------------------------------------------- linear solves
 #: Above this many matrix non-zeros `cnem.assembly.linsolve.solve_spd` uses
 #: pyamg-preconditioned CG: about 200k unknowns of linear triangles (12 non-zeros

@@ -33,6 +33,7 @@ from skfem.models.elasticity import linear_elasticity
 
 from .assembly.quadrature import triangle_quadrature
 from .assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
+from . import config
 from .errors import ConditionError, GeometryError, InputError, SolveError
 from .geometry.cracks import split_cracks
 from .geometry.pslg import BOUNDARY, CRACK
@@ -46,9 +47,6 @@ log = logging.getLogger(__name__)
 
 #: Segment markers handed to `triangle` are ``kind + _MARK`` (0 and 1 are its own).
 _MARK = 2
-#: `mesh_domain` with a node target: stop within `_NODES_STOP` (relative) after at
-#: most `_NODES_TRIES` meshes, warn beyond `_NODES_RTOL`.
-_NODES_STOP, _NODES_RTOL, _NODES_TRIES = 0.02, 0.05, 6
 
 
 # ---------------------------------------------------------------------- meshing
@@ -171,24 +169,24 @@ def mesh_domain(domain, *, nodes=None, max_area=None, quality=30.0):
 
 
 def _mesh_for_nodes(data, area, target, quality):
-    """Mesh whose node count is within `_NODES_STOP` of ``target`` if possible
+    """Mesh whose node count is within `cnem.config.MESH_NODES_STOP` of ``target`` if possible
     (secant on ``log count`` against ``log max_area``)."""
     if target < 3:
         raise InputError(f"nodes: expected a target node count >= 3, received {target}")
     coarsest = _triangulate(data, quality, None)
-    if len(coarsest["vertices"]) >= (1.0 - _NODES_RTOL) * target:
-        if len(coarsest["vertices"]) <= (1.0 + _NODES_RTOL) * target:
+    if len(coarsest["vertices"]) >= (1.0 - config.MESH_NODES_RTOL) * target:
+        if len(coarsest["vertices"]) <= (1.0 + config.MESH_NODES_RTOL) * target:
             return coarsest
         raise InputError(f"nodes: the coarsest quality-{quality:g} mesh of this domain already "
                          f"has {len(coarsest['vertices'])} nodes, more than the target {target}; "
                          "ask for more nodes or a coarser domain description")
     tries = []
     max_area = 2.0 * area / target
-    for _ in range(_NODES_TRIES):
+    for _ in range(config.MESH_NODES_TRIES):
         out = _triangulate(data, quality, max_area)
         count = len(out["vertices"])
         tries.append((abs(count / target - 1.0), count, max_area, out))
-        if abs(count / target - 1.0) <= _NODES_STOP:
+        if abs(count / target - 1.0) <= config.MESH_NODES_STOP:
             break
         slope = -1.0
         if len(tries) >= 2 and tries[-1][2] != tries[-2][2] and tries[-1][1] != tries[-2][1]:
@@ -197,7 +195,7 @@ def _mesh_for_nodes(data, area, target, quality):
             slope = min(max(slope, -2.0), -0.5)
         max_area *= (target / count) ** (1.0 / slope)
     best = min(tries, key=lambda item: item[0])
-    if best[0] > _NODES_RTOL:
+    if best[0] > config.MESH_NODES_RTOL:
         log.warning("mesh_domain: %d nodes for a target of %d (max area %.3g)",
                     best[1], target, best[2])
     log.info("mesh_domain: %d nodes (target %d) after %d meshes", best[1], target, len(tries))
