@@ -10,6 +10,12 @@ where a numba kernel needs a compile-time constant the comment says so.
 True
 """
 
+__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLEARANCE", "FANOUT",
+           "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
+           "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
+           "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
+           "FD_STEP", "HYPERDUAL_CHUNK"]
+
 # ---------------------------------------------------------------- geometry tolerances
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
 #: are snapped onto it; vertices closer than this are the same vertex.

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import MaterialError
-from .models.material import lame
+from .material import lame
 
 __all__ = ["LayeredCylinder"]
 

@@ -304,12 +304,14 @@ BUILTIN_ERRORS = {name for name, obj in vars(builtins).items()
 
 
 def _raised_builtins(path):
-    """``(line, name)`` of every ``raise`` of a builtin exception class in a file."""
+    """``(line, name)`` of every ``raise`` of a builtin exception class in a file, but
+    the abstract-method idiom: a bare ``raise NotImplementedError`` (no message)."""
     found = []
     for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
         if isinstance(node, ast.Raise) and node.exc is not None:
             exc = node.exc.func if isinstance(node.exc, ast.Call) else node.exc
-            if isinstance(exc, ast.Name) and exc.id in BUILTIN_ERRORS:
+            abstract = isinstance(node.exc, ast.Name) and node.exc.id == "NotImplementedError"
+            if isinstance(exc, ast.Name) and exc.id in BUILTIN_ERRORS and not abstract:
                 found.append((node.lineno, exc.id))
     return found
 
@@ -334,8 +336,11 @@ def test_every_raise_uses_the_error_family():
 def test_the_scan_sees_bare_raises(tmp_path):
     # the walk above must not pass vacuously
     path = tmp_path / "sample.py"
-    path.write_text("def f(x):\n    if x:\n        raise ValueError('no')\n    raise KeyError\n")
-    assert sorted(_raised_builtins(path)) == [(3, "ValueError"), (4, "KeyError")]
+    path.write_text("def f(x):\n    if x:\n        raise ValueError('no')\n    raise KeyError\n"
+                    "def g():\n    raise NotImplementedError\n"
+                    "def h():\n    raise NotImplementedError('no tractions')\n")
+    assert sorted(_raised_builtins(path)) == [(3, "ValueError"), (4, "KeyError"),
+                                              (8, "NotImplementedError")]
 
 
 def _modules():

@@ -24,7 +24,8 @@ from .. import config
 from .._memory import release_free_memory
 from ..geometry.topology import constraint_edges
 from ..shape.natural import PointRows, path_order, point_rows
-from ..spatial.rtree import RTree, work_chunks
+from .._parallel import work_chunks
+from ..spatial.rtree import RTree
 from . import _fan_kernels as FK
 from . import _kernels as K
 from . import _sparse_kernels as SK

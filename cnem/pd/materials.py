@@ -6,9 +6,7 @@ import numpy as np
 
 from ..errors import MaterialError
 
-__all__ = ["BondBased", "StateBased", "PLANES"]
-
-PLANES = ("stress", "strain")
+__all__ = ["BondBased", "StateBased"]
 
 
 def _positive(name, value):

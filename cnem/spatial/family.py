@@ -25,7 +25,8 @@ from .. import config
 from ..errors import LimitError, SpatialError, check_choice
 from . import _family_kernels as K
 from . import _pair_kernels as P
-from .rtree import RTree, as_points, check_period, work_chunks
+from .._parallel import work_chunks
+from .rtree import RTree, as_points, check_period
 
 __all__ = ["Family", "family_search", "METHODS"]
 

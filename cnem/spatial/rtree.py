@@ -10,19 +10,14 @@
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from .. import config
+from .._parallel import work_chunks
 from ..errors import SpatialError
 from . import _rtree_kernels as K
 
-__all__ = ["RTree", "check_period", "as_points", "work_chunks"]
-
-
-def work_chunks():
-    """Number of chunks a parallel loop is cut into (a few per thread)."""
-    return 8 * numba.get_num_threads()
+__all__ = ["RTree", "check_period", "as_points"]
 
 
 def as_points(points, name="points"):
