@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import (CNEMError, ConditionError, FormatError, FormError, FractureError, GeometryError, HyperDualError, InputError, LimitError, MaterialError, OptionError, PlotDependencyError, PlotError, PlotInputError, SolveError, SpatialError, UnsupportedError)  # noqa: E501
+from .errors import (CNEMError, ConditionError, FormatError, FormError, FractureError, GeometryError, GrowthError, GrowthWarning, HyperDualError, InputError, LimitError, MaterialError, OptionError, PlotDependencyError, PlotError, PlotInputError, SolveError, SpatialError, UnsupportedError)  # noqa: E501
 
 __version__ = "0.1.0"
 
@@ -49,7 +49,8 @@ __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticS
            "nodes", "geometry", "assembly", "models", "exact", "fracture", "io", "plot", "shape",
            "spatial", "hyperdual", "pd", "fem", "material",
            "CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError", "FormError",
-           "ConditionError", "SpatialError", "FractureError", "FormatError", "HyperDualError",
+           "ConditionError", "SpatialError", "FractureError", "GrowthError", "FormatError",
+           "HyperDualError", "GrowthWarning",
            "LimitError", "UnsupportedError", "SolveError", "PlotError", "PlotDependencyError",
            "PlotInputError", "__version__"]
 

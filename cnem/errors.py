@@ -16,6 +16,7 @@ keeps working while ``except cnem.CNEMError`` catches everything cnem raises.
     │   ├── ConditionError               supports and loads: `where`, components, values
     │   ├── SpatialError                 boxes, periodic cells, radii, families
     │   ├── FractureError                crack tips, integration radii, enrichment
+    │   ├── GrowthError                  crack-growth criterion, increment, toughness, Paris law
     │   ├── FormatError                  files that `cnem.io` cannot write or read
     │   ├── HyperDualError               hyper-dual shapes and outputs
     │   └── LimitError                   a problem larger than a bound in `cnem.config`
@@ -24,6 +25,8 @@ keeps working while ``except cnem.CNEMError`` catches everything cnem raises.
     └── PlotError                        `cnem.plot` cannot draw
         ├── PlotDependencyError (ImportError)    pyvista missing or unable to render
         └── PlotInputError (InputError)          a bad field name or view
+
+    GrowthWarning (UserWarning)          a crack-growth event worth a look (not an error)
 
 >>> from cnem import errors
 >>> errors.check_choice("plane", "strain", ("stress", "strain"))
@@ -38,9 +41,9 @@ OptionError True
 from __future__ import annotations
 
 __all__ = ["CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError",
-           "FormError", "ConditionError", "SpatialError", "FractureError", "FormatError",
-           "HyperDualError", "LimitError", "UnsupportedError", "SolveError", "PlotError",
-           "PlotDependencyError", "PlotInputError", "check_choice"]
+           "FormError", "ConditionError", "SpatialError", "FractureError", "GrowthError",
+           "FormatError", "HyperDualError", "LimitError", "UnsupportedError", "SolveError",
+           "PlotError", "PlotDependencyError", "PlotInputError", "GrowthWarning", "check_choice"]
 
 
 class CNEMError(Exception):
@@ -79,6 +82,10 @@ class FractureError(InputError):
     """Invalid crack-tip input: no tip, a bad integration radius, a bad enrichment."""
 
 
+class GrowthError(InputError):
+    """Invalid crack-growth input (criterion, increment, toughness, Paris constants)."""
+
+
 class FormatError(InputError):
     """A file name or a file's contents that `cnem.io` cannot handle."""
 
@@ -97,6 +104,11 @@ class UnsupportedError(CNEMError, NotImplementedError):
 
 class SolveError(CNEMError, RuntimeError):
     """A linear or nonlinear system could not be solved."""
+
+
+class GrowthWarning(UserWarning):
+    """A crack-growth event the user should look at (see `cnem.fracture.history.EVENT_KINDS`);
+    a warning, not an error: the only class here outside `CNEMError`."""
 
 
 class PlotError(CNEMError):

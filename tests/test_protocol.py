@@ -119,6 +119,36 @@ def test_pd_solve_static_is_solve():
     np.testing.assert_array_equal(prob.solve_static(steps=2).u, prob.solve(steps=2).u)
 
 
+def test_pd_results_are_declared_dataclasses(tmp_path):
+    """Dynamics and relaxation return `Solution` dataclasses with only declared fields."""
+    prob = _pd(0.1)
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+    prob.add_body_force([1e-3, 0.0])
+    n = len(prob.body.points)
+    for result in (prob.run_dynamic(0.2 * prob.stable_time_step(), 5, progress=False),
+                   prob.relax(tol=1e-6, progress=False)):
+        assert isinstance(result, Solution) and dataclasses.is_dataclass(result)
+        declared = {f.name for f in dataclasses.fields(result)}
+        assert set(vars(result)) <= declared, set(vars(result)) - declared
+        assert result.stress.shape == result.strain.shape == (n, 3)
+        np.testing.assert_array_equal(result.stress, result.stress_tensor()[:, [0, 1, 0], [0, 1, 1]])
+        point_data = meshio.read(result.write(tmp_path / "pd.vtu")).point_data
+        np.testing.assert_array_equal(point_data["damage"], result.damage)
+
+
+def test_cpd_solutions_write_without_stress(tmp_path):
+    g = np.arange(0.0, 1.0 + 1e-9, 0.25)
+    pts = np.stack(np.meshgrid(g, g, indexing="ij"), -1).reshape(-1, 2)
+    prob = pd.Problem(pd.Body(pts, 0.0625, 0.4), pd.CPD(1.0))
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+    prob.add_dirichlet(lambda p: p[:, 0] > 1 - 1e-9, 0, 0.01)
+    sol = prob.solve()
+    with pytest.raises(NotImplementedError, match="CPD"):
+        sol.stress
+    assert sol.strain.shape == (len(pts), 3)
+    assert set(meshio.read(sol.write(tmp_path / "cpd.vtu")).point_data) == {"u", "strain"}
+
+
 def test_every_solution_has_the_same_fields(solved, tmp_path):
     name, prob, sol = solved
     n = len(prob.condition_points)

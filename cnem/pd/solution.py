@@ -45,11 +45,20 @@ class PointSolution(Solution):
 
     @cached_property
     def stress(self):
+        """``(n, 3)`` or ``(n, 6)`` Voigt stress of every point (not for CPD)."""
         return voigt(self.stress_tensor())
 
     @cached_property
     def strain(self):
+        """``(n, 3)`` or ``(n, 6)`` engineering strain of every point."""
         return engineering_strain(self.problem.displacement_gradient(self.u))
+
+    def fields(self):
+        """`Solution.fields` at the points (``u`` and ``strain`` only for CPD, which has
+        no stress of its own here)."""
+        if self.problem.material.kind == "cpd":
+            return {"u": self.u, "strain": self.strain}, {}
+        return super().fields()
 
     def displacement(self, points):
         """Displacements at points of the body.
