@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import CNEMError, GeometryError, SolveError
+from .errors import (CNEMError, ConditionError, FormatError, FormError, FractureError, GeometryError, GrowthError, GrowthWarning, HyperDualError, InputError, LimitError, MaterialError, OptionError, PlotDependencyError, PlotError, PlotInputError, SolveError, SpatialError, UnsupportedError)  # noqa: E501
 
 __version__ = "0.1.0"
 
@@ -48,7 +48,11 @@ _NAMES = {"Domain": "geometry", "NodeCloud": "geometry", "Model": "geometry",
 __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
            "nodes", "geometry", "assembly", "models", "exact", "fracture", "io", "plot", "shape",
            "spatial", "hyperdual", "pd", "fem", "material",
-           "CNEMError", "GeometryError", "SolveError", "__version__"]
+           "CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError", "FormError",
+           "ConditionError", "SpatialError", "FractureError", "GrowthError", "FormatError",
+           "HyperDualError", "GrowthWarning",
+           "LimitError", "UnsupportedError", "SolveError", "PlotError", "PlotDependencyError",
+           "PlotInputError", "__version__"]
 
 
 def __getattr__(name: str):
