@@ -32,7 +32,11 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import (CNEMError, ConditionError, FormatError, FormError, FractureError, GeometryError, GrowthError, GrowthWarning, HyperDualError, InputError, LimitError, MaterialError, OptionError, PlotDependencyError, PlotError, PlotInputError, SolveError, SpatialError, UnsupportedError)  # noqa: E501
+from .errors import (CNEMError, ConditionError, FormatError, FormError, FractureError,
+                     GeometryError, GrowthError, GrowthWarning, HyperDualError, InputError,
+                     LimitError, MaterialError, MissingExtraError, OptionError,
+                     PlotDependencyError, PlotError, PlotInputError, SolveError, SpatialError,
+                     UnsupportedError)
 
 __version__ = "0.1.0"
 
@@ -50,7 +54,7 @@ __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticS
            "spatial", "hyperdual", "pd", "fem", "material",
            "CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError", "FormError",
            "ConditionError", "SpatialError", "FractureError", "GrowthError", "FormatError",
-           "HyperDualError", "GrowthWarning",
+           "HyperDualError", "GrowthWarning", "MissingExtraError",
            "LimitError", "UnsupportedError", "SolveError", "PlotError", "PlotDependencyError",
            "PlotInputError", "__version__"]
 
