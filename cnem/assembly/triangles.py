@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import GeometryError
 from .basis import CellBasis
 
 if TYPE_CHECKING:
@@ -47,8 +48,9 @@ def triangle_basis(model: Model, *, vector: bool = False) -> CellBasis:
     e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
     twice = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
     if not (twice > 0).all():
-        raise ValueError(f"triangle_basis: {int((twice <= 0).sum())} of {len(tri)} triangles "
-                         "are degenerate or clockwise")
+        raise GeometryError(f"triangle_basis: {int((twice <= 0).sum())} of {len(tri)} triangles "
+                            "are degenerate or clockwise; expected counter-clockwise triangles of "
+                            "positive area: move the collinear nodes")
     dx = -opposite[:, :, 1] / twice[:, None]
     dy = opposite[:, :, 0] / twice[:, None]
     t, n = len(tri), len(model.nodes)

@@ -68,6 +68,7 @@ import argparse
 from typing import TYPE_CHECKING
 
 from cnem.demos.cpd import stretch, structures
+from cnem.errors import OptionError
 
 if TYPE_CHECKING:
     from typing import Sequence
@@ -101,7 +102,7 @@ def main(examples: tuple = EXAMPLES, *, quick: bool = False, outdir: str = "resu
     """
     unknown = [e for e in examples if e not in EXAMPLES]
     if unknown:
-        raise ValueError(f"examples: expected names from {EXAMPLES}, received {unknown}")
+        raise OptionError(f"examples: expected names from {EXAMPLES}, received {unknown}")
     return {e: RUN[e](**(QUICK[e] if quick else {}), outdir=outdir, plot=plot) for e in examples}
 
 

@@ -6,6 +6,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..errors import MaterialError
+
 if TYPE_CHECKING:
     from typing import Literal
 
@@ -15,7 +17,7 @@ __all__ = ["BondBased", "StateBased"]
 def _positive(name, value):
     value = float(value)
     if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"{name}: expected a positive number, received {value}")
+        raise MaterialError(f"{name}: expected a positive number, received {value}")
     return value
 
 
@@ -101,7 +103,7 @@ class StateBased:
         self.E = _positive("E", E)
         nu = float(nu)
         if not -1.0 < nu < 0.5:
-            raise ValueError(f"nu: expected a Poisson ratio in (-1, 0.5), received {nu}")
+            raise MaterialError(f"nu: expected a Poisson ratio in (-1, 0.5), received {nu}")
         self.nu = nu
         self.critical_stretch = None if critical_stretch is None else _positive(
             "critical_stretch", critical_stretch)

@@ -14,6 +14,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ...errors import InputError
+
 if TYPE_CHECKING:
     from pathlib import Path
     from typing import Any
@@ -47,12 +49,12 @@ def load(stem: str | os.PathLike, comm: Any, owned: np.ndarray) -> dict[str, np.
     """
     path = checkpoint_path(stem, comm.rank, comm.size)
     if not path.exists():
-        raise ValueError(f"restart: expected the checkpoint {path} (written by a run on "
+        raise InputError(f"restart: expected the checkpoint {path} (written by a run on "
                          f"{comm.size} ranks), found none; restart on the rank count of the "
                          f"run that wrote it")
     with np.load(path) as data:
         arrays = dict(data)
     if not np.array_equal(arrays["owned"], owned):
-        raise ValueError(f"restart: {path} holds another partition of the points; restart "
+        raise InputError(f"restart: {path} holds another partition of the points; restart "
                          f"the same body on the same number of ranks")
     return arrays

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import _kernels as PK
+from ...errors import InputError
 from ..problem import Problem as SerialProblem
 from . import _kernels as K
 
@@ -25,9 +26,9 @@ __all__ = ["LocalOperators"]
 
 
 def _agree(comm, ok, message):
-    """Raise ``ValueError(message)`` on every rank if ``ok`` is False on any."""
+    """Raise ``InputError(message)`` on every rank if ``ok`` is False on any."""
     if not comm.allreduce(bool(ok), op=_land()):
-        raise ValueError(message)
+        raise InputError(message)
 
 
 def _land():
