@@ -143,7 +143,7 @@ class CellBasis:
             self._built = values + [spread_component(g, c, 2) for c in range(2) for g in (gx, gy)]
         return self._built
 
-    def component_gradients(self) -> tuple:
+    def component_gradients(self) -> tuple[sp.csr_matrix, sp.csr_matrix] | None:
         """The scalar x and y derivatives ``(m, nfun)`` CSR behind the gradient
         operators of a vector basis, when both have one pattern (then forms that
         see only gradients are assembled by 2 x 2 node blocks); None for a scalar

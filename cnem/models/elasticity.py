@@ -299,7 +299,7 @@ class Elasticity(Conditions):
         return dict(preconditioner=lambda: self.preconditioner_matrix(dofs),
                     smooth_with_matrix=self.stabilization == 0)
 
-    def preconditioner_matrix(self, dofs: np.ndarray | None = None) -> sp.spmatrix | np.ndarray:
+    def preconditioner_matrix(self, dofs: np.ndarray | None = None) -> sp.spmatrix | None:
         """The P1 stiffness of the nodes on the model's triangles (same materials):
         where smoothed aggregation is built for large solves (see
         `cnem.assembly.triangles`).
