@@ -1,7 +1,10 @@
-"""Tolerances used across cnem, kept in one place.
+"""Tolerances and tuning constants used across cnem, kept in one place.
 
 All tolerances are *relative*: multiply by the domain diameter (lengths) or
-its square (areas) before comparing.
+its square (areas) before comparing. The modules read them as ``config.NAME``
+when they run, so a change here (or a monkeypatch in a test) takes effect at
+the next call. (``cnem.shape._kernels.MAX_CAVITY`` stays in its kernel module:
+numba compiles it into the kernels as a constant.)
 """
 
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
@@ -21,3 +24,20 @@ GRID_TOL = 1e-13
 #: Relative distance (times the domain diameter) under which a query point is
 #: taken to be at a node or on a constraint edge in the shape functions.
 SHAPE_TOL = 1e-12
+
+# -- tuning (speed and memory only: results do not depend on them) ----------------------
+
+#: Cells whose boundary quadrature is built and evaluated in one pass of the SCNI
+#: smoothed gradients (`cnem.assembly.passes`): bounds the memory of the points
+#: and their shape functions, and keeps a pass in cache.
+CELLS_PER_PASS = 10_000
+
+#: Room per point for the shape-function rows written chunk by chunk
+#: (`cnem.shape.natural`; doubled when a chunk overflows: points have about 5-6
+#: natural neighbours on average).
+ROW_SLOTS = 8
+
+#: Points the walks of the point location cannot reach, as a fraction of the
+#: triangles, above which they are located with an R-tree of the triangles
+#: (`Model.triangle_tree`, built once) rather than of the circumcircles.
+TRIANGLE_TREE_AFTER = 0.01

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly.scni import boundary_quadrature
+from ..assembly.edge_quadrature import boundary_quadrature
 from ..geometry.topology import circumcenters
 from .williams import node_sides, sided_polar
 
