@@ -19,8 +19,8 @@ from skfem import condense, solve
 from .basis import CellBasis, select_nodes
 from .forms import BilinearForm, Functional, LinearForm, asm
 from .edges import cell_edges
-from .gradients import SmoothedGradient, SmoothedGradients, smoothed_gradient
+from .gradients import SmoothedGradient, SmoothedGradients, fan_gradient, smoothed_gradient
 
 __all__ = ["CellBasis", "BilinearForm", "LinearForm", "Functional", "asm", "condense", "solve",
-           "SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "cell_edges",
+           "SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient", "cell_edges",
            "select_nodes"]
