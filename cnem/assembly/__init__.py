@@ -22,5 +22,5 @@ from .edges import cell_edges
 from .gradients import SmoothedGradient, SmoothedGradients, fan_gradient, smoothed_gradient
 
 __all__ = ["CellBasis", "BilinearForm", "LinearForm", "Functional", "asm", "condense", "solve",
-           "SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient", "cell_edges",
-           "select_nodes"]
+           "SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient",
+           "cell_edges", "select_nodes"]

@@ -14,7 +14,7 @@ from ..spatial.rtree import RTree
 __all__ = ["crack_faces", "slit_edges", "face_triangles"]
 
 
-def crack_faces(model):
+def crack_faces(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Crack-face edges, each oriented with its own face's triangle on the left.
 
     Returns
@@ -32,7 +32,8 @@ def crack_faces(model):
     return model.nodes[edges[:, 0]], model.nodes[edges[:, 1]], owner
 
 
-def slit_edges(model, faces, cells):
+def slit_edges(model, faces: tuple, cells
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Crack faces running inside cells (near crack tips a cell can wrap around the
     end of a crack; its polygon then does not show the slit, but the slit's two
     faces are part of the cell's boundary, with different shape functions).
@@ -86,7 +87,7 @@ def _line_parts(geom):
     return []
 
 
-def face_triangles(model, a, b, faces):
+def face_triangles(model, a: np.ndarray, b: np.ndarray, faces: tuple) -> np.ndarray:
     """For cell edges lying on a crack face, the triangle of that face on the
     cell's side (the shape functions there depend on the side); -1 elsewhere.
 

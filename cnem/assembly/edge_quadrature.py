@@ -112,7 +112,8 @@ class BoundaryQuadrature:
                                      triangles=None if hint is None else hint[select])
 
 
-def graded_rule(s, w, start, end):
+def graded_rule(s: np.ndarray, w: np.ndarray, start: np.ndarray, end: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
     """Gauss points ``s`` and weights ``w`` on ``[0, 1]`` per piece, graded towards
     the ends flagged in ``start`` / ``end`` by ``t = s^2`` (``1 - (1 - s)^2``): a
     ``sqrt(t)`` behaviour at that end becomes smooth. Returns ``(q, g)`` arrays."""
@@ -123,7 +124,8 @@ def graded_rule(s, w, start, end):
     return S, W
 
 
-def boundary_quadrature(model, *, gauss=2, cells=None, singular=None):
+def boundary_quadrature(model, *, gauss: int = 2, cells=None, singular=None
+                        ) -> BoundaryQuadrature:
     """Gauss points on every cell boundary: each edge cut at circumcircle crossings,
     ``gauss`` points per piece, crack faces seen from their side, slits in tip cells.
 
@@ -166,7 +168,8 @@ def _set_edges(model, cells, faces):
     return cell, a, b, hint, spoke
 
 
-def boundary_quadratures(model, cell_sets, *, gauss=2, singular=None):
+def boundary_quadratures(model, cell_sets, *, gauss: int = 2, singular=None
+                         ) -> list[BoundaryQuadrature]:
     """`boundary_quadrature` of several sets of cells with one set of points.
 
     An edge that several sets share (the same ends bit for bit, the same side of
@@ -208,14 +211,17 @@ def boundary_quadratures(model, cell_sets, *, gauss=2, singular=None):
     return out
 
 
-def check_gauss(gauss):
+def check_gauss(gauss) -> int:
+    """The number of Gauss points per piece of edge, checked (a positive int)."""
     gauss = int(gauss)
     if gauss < 1:
         raise ValueError(f"gauss: expected a positive number of Gauss points, received {gauss}")
     return gauss
 
 
-def edge_points(model, rows, hint, whole, group, gauss, singular):
+def edge_points(model, rows: np.ndarray, hint: np.ndarray, whole: np.ndarray, group: np.ndarray,
+                gauss: int, singular
+                ) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix, sp.csr_matrix]:
     """Gauss points on the distinct edges ``rows`` (see `distinct_edges`), cut at
     circumcircle crossings unless ``whole`` (then their midpoint alone); ``group``
     as in `circle_pieces`. Returns ``points, hint, wx, wy`` of `BoundaryQuadrature`."""
@@ -242,7 +248,8 @@ def edge_points(model, rows, hint, whole, group, gauss, singular):
     return points, np.repeat(hint, np.diff(indptr)), wx, wy
 
 
-def edges_to_cells(cells, edge_cell, sign, occurrence, count):
+def edges_to_cells(cells, edge_cell: np.ndarray, sign: np.ndarray, occurrence: np.ndarray,
+                   count: int) -> sp.csr_matrix:
     """``±1 / A_k`` from the cells to the ``count`` distinct edges, ``(m, count)``
     CSR, for the directed edges of the cells (cell ``edge_cell``, distinct edge
     ``occurrence``, ``sign`` against it)."""

@@ -14,7 +14,7 @@ from . import _kernels as K
 __all__ = ["cell_edges", "circle_pieces", "distinct_edges"]
 
 
-def cell_edges(cells):
+def cell_edges(cells) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Directed edges of every cell polygon (counter-clockwise).
 
     Returns
@@ -32,7 +32,8 @@ def cell_edges(cells):
     return cell, cells.vertices, cells.vertices[nxt]
 
 
-def circle_pieces(model, a, b, whole=None, group=None):
+def circle_pieces(model, a: np.ndarray, b: np.ndarray, whole: np.ndarray | None = None,
+                  group: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Pieces of the edges between circumcircle crossings (``whole``: (e,) bool,
     edges left in one piece).
 
@@ -68,7 +69,8 @@ def circle_pieces(model, a, b, whole=None, group=None):
     return K.edge_pieces(offsets, t)
 
 
-def distinct_edges(a, b, hint):
+def distinct_edges(a: np.ndarray, b: np.ndarray, hint: np.ndarray
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The distinct edges among directed edges ``(e, 2)`` (the same ends bit for bit
     and the same ``hint``, either way round).
 

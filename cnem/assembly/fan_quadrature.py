@@ -18,7 +18,8 @@ __all__ = ["fan_quadratures"]
 log = logging.getLogger(__name__)
 
 
-def fan_quadratures(model, cells, sub, parent, *, gauss=2):
+def fan_quadratures(model, cells, sub, parent, *, gauss: int = 2
+                    ) -> tuple[BoundaryQuadrature, BoundaryQuadrature]:
     """`boundary_quadratures` of cells and of their fan sub-cells (`subdivide` with
     ``mark_spokes``), the sub-cells' edges taken from where they come from.
 

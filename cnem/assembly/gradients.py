@@ -3,12 +3,17 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .edge_quadrature import boundary_quadratures, check_gauss
 from .fan_quadrature import fan_quadratures
 from .passes import cell_runs, gradients_in_passes
 from .quadrature import subdivide, tip_cells
+
+if TYPE_CHECKING:
+    from ..geometry.model import Cells
 
 __all__ = ["SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient"]
 
@@ -66,7 +71,7 @@ def smoothed_gradient(model, *, gauss: int = 2, cells=None) -> SmoothedGradient:
     return SmoothedGradient(*grad, points)
 
 
-def fan_gradient(model, *, gauss: int = 2):
+def fan_gradient(model, *, gauss: int = 2) -> tuple[Cells, SmoothedGradient]:
     """Smoothed gradients on the fan sub-cells of the model's cells, computed afresh
     (`SmoothedGradients.fan` computes them with the cells' and keeps them).
 
@@ -162,7 +167,7 @@ class SmoothedGradients:
             return self.cells()
         return smoothed_gradient(self.model, gauss=self.gauss, cells=cells)
 
-    def fan(self, *, release: bool = False):
+    def fan(self, *, release: bool = False) -> tuple[Cells, SmoothedGradient]:
         """Smoothed gradients on the fan sub-cells of the model's cells (`fan_gradient`),
         computed on first call together with the cells' `cells` when those are not
         there yet (kept too), from one set of points.
@@ -176,10 +181,8 @@ class SmoothedGradients:
 
         Returns
         -------
-        sub : Cells
-            ``s`` fan sub-cells.
-        grad : SmoothedGradient
-            ``x, y`` sparse ``(s, n)``.
+        sub, grad : Cells, SmoothedGradient
+            As `fan_gradient` returns them.
         """
         if self._fan is None:
             of_cells, sub, grad = _fan_gradients(self.model, self.gauss,

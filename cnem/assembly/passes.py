@@ -45,7 +45,8 @@ def cell_runs(model, cells) -> list[np.ndarray] | None:
     return [order[lo:lo + size] for lo in range(0, m, size)]
 
 
-def gradients_in_passes(model, sets, quadratures, runs=None, wanted=None):
+def gradients_in_passes(model, sets: list, quadratures, runs: list | None = None,
+                        wanted: list[bool] | None = None) -> tuple[list, int]:
     """Smoothed gradients of several sets of cells, pass by pass.
 
     Parameters
