@@ -5,17 +5,61 @@
 >>> model = cnem.discretize(cnem.nodes.regular(dom, 0.1))
 >>> float(round(model.cells.area.sum(), 12))
 1.0
+
+``import cnem`` loads nothing but this file and the error classes: each subpackage
+(``cnem.pd``, ``cnem.fracture``, ...) and each workflow name (``cnem.Domain``, ...) is
+imported on first use (PEP 562), so the command line starts at once and a script
+pays only for what it uses.
+
+The layers, lowest first (a module imports only from its own layer or lower ones;
+``tests/test_architecture.py`` checks it, ``docs/architecture.md`` draws it):
+
+========== ==============================================================================
+core       ``errors``, ``config``, ``_parallel``, ``_memory``, ``_predicates``,
+           ``hyperdual``, ``material``, ``exact``
+spatial    ``spatial``: packed R-tree (periodic), family search, bond crossing
+shape      ``shape``: constrained natural-neighbour coordinates on a triangulation
+geometry   ``geometry``, ``nodes``: domains, node clouds, ``discretize`` -> ``Model``
+output     ``io``, ``plot``: VTU files and off-screen pictures
+assembly   ``assembly``: SCNI smoothed gradients, bases, forms, conditions, solvers
+fracture   ``fracture``: Williams fields, SIFs, enrichment, crack growth
+problems   ``models`` (C-NEM elasticity), ``fem`` (P1 anchor), ``pd`` (peridynamics)
+front      ``cli``, ``__main__``, the demos
+========== ==============================================================================
 """
 
-from . import (assembly, exact, fracture, geometry, hyperdual, io, models, nodes, plot, shape,
-               spatial)
+from __future__ import annotations
+
+import importlib
+
 from .errors import CNEMError, GeometryError, SolveError
-from .geometry import Domain, Model, NodeCloud, discretize
-from .models import ElasticSolution, Elasticity
 
 __version__ = "0.1.0"
 
+#: Submodules and subpackages reachable as attributes of ``cnem`` (loaded on first use).
+_MODULES = frozenset({"assembly", "cli", "config", "errors", "exact", "fem", "fracture",
+                      "geometry", "hyperdual", "io", "material", "models", "nodes", "pd",
+                      "plot", "shape", "spatial"})
+
+#: The core workflow names -> the module that defines them.
+_NAMES = {"Domain": "geometry", "NodeCloud": "geometry", "Model": "geometry",
+          "discretize": "geometry", "Elasticity": "models", "ElasticSolution": "models"}
+
 __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
            "nodes", "geometry", "assembly", "models", "exact", "fracture", "io", "plot", "shape",
-           "spatial", "hyperdual",
+           "spatial", "hyperdual", "pd", "fem", "material",
            "CNEMError", "GeometryError", "SolveError", "__version__"]
+
+
+def __getattr__(name: str):
+    if name in _MODULES:
+        return importlib.import_module(f".{name}", __name__)
+    if name in _NAMES:
+        value = getattr(importlib.import_module(f".{_NAMES[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'cnem' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__) | _MODULES)

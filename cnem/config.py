@@ -7,6 +7,9 @@ the next call. (``cnem.shape._kernels.MAX_CAVITY`` stays in its kernel module:
 numba compiles it into the kernels as a constant.)
 """
 
+__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CELLS_PER_PASS",
+           "ROW_SLOTS", "TRIANGLE_TREE_AFTER"]
+
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
 #: are snapped onto it; vertices closer than this are the same vertex.
 SNAP_TOL = 1e-9

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .models.material import lame
+from .material import lame
 
 __all__ = ["LayeredCylinder"]
 

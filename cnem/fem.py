@@ -37,7 +37,7 @@ from .errors import GeometryError, SolveError
 from .geometry.cracks import split_cracks
 from .geometry.pslg import BOUNDARY, CRACK
 from .assembly.conditions import dirichlet_dofs, per_point
-from .models.material import lame, parse_materials, stiffness_matrix
+from .material import lame, parse_materials, stiffness_matrix
 from .models.solution import energy_error_density, von_mises
 
 __all__ = ["P1Elasticity", "P1Solution", "mesh_domain"]

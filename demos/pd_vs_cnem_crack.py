@@ -81,10 +81,9 @@ def opening(model, u):
     x : (k,) ndarray
     delta : (k,) ndarray
     """
-    from cnem.fracture.williams import node_sides
     copies = np.bincount(model.node_of_point)[model.node_of_point] == 2
     idx = np.flatnonzero(copies)
-    side = node_sides(model)[idx, 1] > 0
+    side = model.node_sides()[idx, 1] > 0
     pairs = {}
     for i, up in zip(idx, side):
         pairs.setdefault(model.node_of_point[i], [None, None])[int(up)] = i

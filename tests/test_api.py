@@ -12,9 +12,6 @@ import pytest
 
 import cnem
 
-PACKAGES = ["cnem", "cnem.geometry", "cnem.nodes"]
-
-
 def _modules():
     names = ["cnem"]
     for info in pkgutil.walk_packages(cnem.__path__, prefix="cnem."):
@@ -22,9 +19,24 @@ def _modules():
     return sorted(names)
 
 
-@pytest.mark.parametrize("package", PACKAGES)
+def _public_modules():
+    """Every module whose own name has no leading underscore (kernels are private)."""
+    return [name for name in _modules() if not name.rpartition(".")[2].startswith("_")]
+
+
+def _import(module):
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        if exc.name and not exc.name.startswith("cnem"):
+            pytest.skip(f"optional dependency {exc.name} is not installed")
+        raise
+
+
+@pytest.mark.parametrize("package", _public_modules())
 def test_all_names_resolve(package):
-    mod = importlib.import_module(package)
+    mod = _import(package)
+    assert hasattr(mod, "__all__"), f"{package} declares no __all__"
     assert mod.__all__, f"{package} declares an empty __all__"
     assert len(set(mod.__all__)) == len(mod.__all__), f"{package}.__all__ repeats a name"
     for name in mod.__all__:
@@ -46,12 +58,7 @@ def test_core_workflow_names():
 
 @pytest.mark.parametrize("module", _modules())
 def test_doctests(module):
-    try:
-        mod = importlib.import_module(module)
-    except ImportError as exc:
-        if exc.name and not exc.name.startswith("cnem"):
-            pytest.skip(f"optional dependency {exc.name} is not installed")
-        raise
+    mod = _import(module)
     finder = doctest.DocTestFinder(exclude_empty=True)
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
     report = []
@@ -77,3 +84,25 @@ def test_frozen_data_objects():
         with pytest.raises(dataclasses.FrozenInstanceError):
             setattr(obj, field, np.zeros(1))
     assert "nodes" in repr(model) and "cells" in repr(model)
+
+
+def test_no_kernel_compiles_at_import():
+    """Every numba kernel compiles (or loads from its cache) on its first call, not when
+    its module is imported: a fresh interpreter imports every module and finds no kernel
+    with a compiled signature."""
+    import subprocess
+    import sys
+    code = ("import importlib, pkgutil, sys, cnem\n"
+            "from numba.core.dispatcher import Dispatcher\n"
+            "for info in pkgutil.walk_packages(cnem.__path__, prefix='cnem.'):\n"
+            "    try:\n"
+            "        importlib.import_module(info.name)\n"
+            "    except ImportError as exc:\n"
+            "        if (exc.name or 'cnem').startswith('cnem'): raise\n"
+            "kernels = [(n, k, v) for n, m in list(sys.modules.items()) if n.split('.')[0] == 'cnem'"
+            " for k, v in vars(m).items() if isinstance(v, Dispatcher)]\n"
+            "print(len(kernels), sorted(f'{n}.{k}' for n, k, v in kernels if v.signatures))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.split(maxsplit=1)
+    assert int(out[0]) > 50, "the kernels were not found"
+    assert out[1].strip() == "[]", f"kernels compiled at import: {out[1]}"

@@ -7,7 +7,7 @@ import pytest
 
 import cnem
 from cnem import fem
-from cnem.models.material import lame, stiffness_matrix
+from cnem.material import lame, stiffness_matrix
 
 SOFT, STIFF = (1000.0, 0.3), (3000.0, 0.2)
 

@@ -22,7 +22,7 @@ import cnem
 from cnem.assembly import BilinearForm, linsolve
 from cnem.assembly.triangles import triangle_basis
 from cnem.models.elasticity import elasticity_form
-from cnem.models.material import lame
+from cnem.material import lame
 
 E, NU = 1000.0, 0.3
 

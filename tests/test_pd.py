@@ -12,7 +12,7 @@ import pytest
 
 import cnem
 import cnem.pd as pd
-from cnem.models.material import stiffness_matrix
+from cnem.material import stiffness_matrix
 
 
 def _grid(h, width=1.0, height=1.0, dim=2):

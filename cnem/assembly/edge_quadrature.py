@@ -16,7 +16,7 @@ import scipy.sparse as sp
 from .. import config
 from ..geometry.pslg import CRACK
 from ..shape.natural import PointRows, point_rows
-from ..spatial.rtree import work_chunks
+from .._parallel import work_chunks
 from . import _kernels as K
 from . import _sparse_kernels as SK
 from .crack_faces import crack_faces, face_triangles, slit_edges

@@ -17,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem.assembly.form.form import FormExtraParams
 
-from ..spatial.rtree import work_chunks
+from .._parallel import work_chunks
 from . import _sparse_kernels as SK
 
 __all__ = ["BilinearForm", "LinearForm", "Functional", "asm"]

@@ -14,8 +14,13 @@ True
 """
 
 from .enrichment import Enrichment
-from .interaction import SIFResult, sif, tip_frame
-from .williams import effective_modulus, kappa, nodal_williams, polar, williams
+from ..geometry.domain import Domain
+from .interaction import SIFResult, sif
+from ..material import effective_modulus, kappa
+from .williams import nodal_williams, polar, williams
 
 __all__ = ["sif", "SIFResult", "Enrichment", "tip_frame", "williams", "nodal_williams", "polar", "kappa",
            "effective_modulus"]
+
+#: `Domain.tip_frame` as a function of ``(domain, tip)``.
+tip_frame = Domain.tip_frame

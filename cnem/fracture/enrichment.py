@@ -23,7 +23,7 @@ import scipy.sparse as sp
 
 from ..assembly.edge_quadrature import boundary_quadrature
 from ..geometry.topology import circumcenters
-from .williams import node_sides, sided_polar
+from .williams import sided_polar
 
 __all__ = ["Enrichment", "FUNCTIONS"]
 
@@ -62,7 +62,6 @@ class Enrichment:
     """
 
     def __init__(self, model, tips, radius, *, functions="sqrt"):
-        from .interaction import tip_frame
         if functions not in FUNCTIONS:
             raise ValueError(f"enrich functions: expected one of {tuple(FUNCTIONS)}, "
                              f"received {functions!r}")
@@ -70,7 +69,7 @@ class Enrichment:
         pts = np.atleast_2d(np.asarray(tips, dtype=float))
         if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) == 0:
             raise ValueError(f"enrich tips: expected points (t, 2), received shape {pts.shape}")
-        frames = [tip_frame(model.domain, p) for p in pts]
+        frames = [model.domain.tip_frame(p) for p in pts]
         self.tips = np.array([f[0] for f in frames])
         self.directions = np.array([f[1] for f in frames])
         radius = float(radius)
@@ -85,7 +84,7 @@ class Enrichment:
         self.tip_of = dist.argmin(axis=1)[self.nodes]
         # F_k at the nodes, each on its own crack face
         self._at_nodes = np.zeros((len(self.nodes), self.size))
-        sides = node_sides(model)[self.nodes]
+        sides = model.node_sides()[self.nodes]
         for t in range(len(self.tips)):
             mine = self.tip_of == t
             self._at_nodes[mine] = self.evaluate(model.nodes[self.nodes[mine]], t, sides[mine])

@@ -17,9 +17,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..assembly.quadrature import cell_quadrature
-from .williams import effective_modulus, williams
+from ..material import effective_modulus
+from .williams import williams
 
-__all__ = ["sif", "tip_frame", "SIFResult"]
+__all__ = ["sif", "SIFResult"]
 
 
 class SIFResult(tuple):
@@ -37,31 +38,6 @@ class SIFResult(tuple):
     @property
     def KII(self):
         return self[1]
-
-
-def tip_frame(domain, tip):
-    """The crack tip nearest to a point, and the crack's direction there.
-
-    Returns
-    -------
-    tip : (2,) ndarray
-        The tip (a crack end inside the domain).
-    direction : (2,) ndarray
-        Unit vector along the crack's last segment, pointing out of the crack.
-    """
-    tips = domain.tips
-    if len(tips) == 0:
-        raise ValueError("the domain has no crack tip (crack ends inside the body)")
-    tip = np.asarray(tip, dtype=float).reshape(-1)
-    if tip.shape != (2,):
-        raise ValueError(f"tip: expected a point (2,), received shape {tip.shape}")
-    at = tips[np.argmin(np.hypot(*(tips - tip).T))]
-    for crack in domain.cracks:
-        for end, before in ((crack[-1], crack[-2]), (crack[0], crack[1])):
-            if np.array_equal(end, at):
-                d = end - before
-                return at.copy(), d / np.hypot(*d)
-    raise AssertionError("a tip that is no crack end")      # pragma: no cover
 
 
 def _local_spacing(model, tip):
@@ -101,7 +77,7 @@ def sif(sol, tip, *, radius=None, order=4):
         integral needs one material), leaves no cell, or is not a positive number.
     """
     model = sol.model
-    at, d = tip_frame(model.domain, tip)
+    at, d = model.domain.tip_frame(tip)
     if radius is None:
         radius = 6.0 * _local_spacing(model, at)
     radius = float(radius)

@@ -9,22 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..models.material import PLANES
+from ..material import kappa
 
-__all__ = ["kappa", "effective_modulus", "williams"]
-
-
-def kappa(nu, plane):
-    """Kolosov's constant."""
-    if plane not in PLANES:
-        raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
-    return 3.0 - 4.0 * nu if plane == "strain" else (3.0 - nu) / (1.0 + nu)
-
-
-def effective_modulus(E, nu, plane):
-    """``E' = E`` (plane stress) or ``E / (1 - nu^2)`` (plane strain): ``G = K^2 / E'``."""
-    kappa(nu, plane)
-    return E if plane == "stress" else E / (1.0 - nu * nu)
+__all__ = ["williams", "polar", "sided_polar", "nodal_williams"]
 
 
 def williams(r, theta, KI, KII, E, nu, plane):
@@ -90,21 +77,6 @@ def polar(points, tip, direction):
     return np.hypot(x1, x2), np.arctan2(x2, x1)
 
 
-def node_sides(model):
-    """A point on the side of each node: the area-weighted centroid of its cells
-    (for the two copies of a crack-face node, a point on each one's face).
-
-    Returns
-    -------
-    (n, 2) ndarray
-    """
-    cells = model.cells
-    n = len(model.nodes)
-    weight = np.bincount(cells.node, weights=cells.area, minlength=n)
-    return np.column_stack([np.bincount(cells.node, weights=cells.area * c, minlength=n)
-                            for c in cells.centroid().T]) / weight[:, None]
-
-
 def sided_polar(points, tip, direction, sides):
     """`polar`, with ``theta = ±pi`` on the crack line behind the tip chosen by
     the side of a reference point per point (``sides``, ``(p, 2)``)."""
@@ -126,7 +98,7 @@ def nodal_williams(model, tip, KI, KII, E, nu, plane):
     ----------
     model : Model
     tip : (2,) array_like
-        A point; the crack tip nearest to it is used (see `tip_frame`).
+        A point; the crack tip nearest to it is used (see `Domain.tip_frame`).
     KI, KII, E, nu : float
     plane : {"stress", "strain"}
 
@@ -134,9 +106,8 @@ def nodal_williams(model, tip, KI, KII, E, nu, plane):
     -------
     (n, 2) ndarray
     """
-    from .interaction import tip_frame
-    at, d = tip_frame(model.domain, tip)
-    r, theta = sided_polar(model.nodes, at, d, node_sides(model))
+    at, d = model.domain.tip_frame(tip)
+    r, theta = sided_polar(model.nodes, at, d, model.node_sides())
     with np.errstate(divide="ignore", invalid="ignore"):
         u = williams(r, theta, KI, KII, E, nu, plane)[0]
     u[r == 0.0] = 0.0

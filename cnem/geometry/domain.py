@@ -258,6 +258,35 @@ class Domain:
         """(t, 2) ndarray: crack ends that lie inside the domain."""
         return self._tips
 
+    def tip_frame(self, tip):
+        """The crack tip nearest to a point, and the crack's direction there.
+
+        Parameters
+        ----------
+        tip : (2,) array_like
+            A point; the nearest crack tip (a crack end inside the domain) is used.
+
+        Returns
+        -------
+        tip : (2,) ndarray
+            The tip.
+        direction : (2,) ndarray
+            Unit vector along the crack's last segment, pointing out of the crack.
+        """
+        tips = self.tips
+        if len(tips) == 0:
+            raise ValueError("the domain has no crack tip (crack ends inside the body)")
+        tip = np.asarray(tip, dtype=float).reshape(-1)
+        if tip.shape != (2,):
+            raise ValueError(f"tip: expected a point (2,), received shape {tip.shape}")
+        at = tips[np.argmin(np.hypot(*(tips - tip).T))]
+        for crack in self.cracks:
+            for end, before in ((crack[-1], crack[-2]), (crack[0], crack[1])):
+                if np.array_equal(end, at):
+                    d = end - before
+                    return at.copy(), d / np.hypot(*d)
+        raise AssertionError("a tip that is no crack end")      # pragma: no cover
+
     def contains(self, points):
         """Whether points lie in the closed domain.
 

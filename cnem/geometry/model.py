@@ -13,6 +13,7 @@ from ._kernels import polygon_moments
 from .cells import voronoi_cells
 from .cloud import NodeCloud
 from .cracks import split_cracks
+from ..shape import shape_functions
 from ..spatial.rtree import RTree
 from .topology import circumcenters, cut_between_regions, triangle_neighbors
 
@@ -177,6 +178,20 @@ class Model:
             self._derived[name] = build()
         return self._derived[name]
 
+    def node_sides(self):
+        """A point on the side of each node: the area-weighted centroid of its cells
+        (for the two copies of a crack-face node, a point on each one's face).
+
+        Returns
+        -------
+        (n, 2) ndarray
+        """
+        cells = self.cells
+        n = len(self.nodes)
+        weight = np.bincount(cells.node, weights=cells.area, minlength=n)
+        return np.column_stack([np.bincount(cells.node, weights=cells.area * c, minlength=n)
+                                for c in cells.centroid().T]) / weight[:, None]
+
     def shape_functions(self, points, *, kind="sibson", triangles=None, gradient=False,
                         in_order=True):
         """Constrained natural-neighbour coordinates, see `cnem.shape.shape_functions`.
@@ -186,7 +201,6 @@ class Model:
         scipy.sparse.csr_matrix, shape (p, n)
             Or ``(Phi, dPhi_dx, dPhi_dy)`` with ``gradient=True``.
         """
-        from ..shape import shape_functions
         return shape_functions(self, points, kind=kind, triangles=triangles, gradient=gradient,
                                in_order=in_order)
 

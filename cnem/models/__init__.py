@@ -11,7 +11,7 @@ True
 """
 
 from .elasticity import Elasticity, elasticity_form
-from .material import lame, stiffness_matrix
+from ..material import lame, stiffness_matrix
 from .solution import ElasticSolution, von_mises
 
 __all__ = ["Elasticity", "ElasticSolution", "elasticity_form", "lame", "stiffness_matrix",

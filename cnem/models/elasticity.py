@@ -22,7 +22,7 @@ from ..assembly.triangles import triangle_basis
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import GeometryError, SolveError
 from ..geometry.topology import constraint_edges
-from .material import lame, parse_materials, stiffness_matrix
+from ..material import lame, parse_materials, stiffness_matrix
 from .solution import ElasticSolution
 
 __all__ = ["Elasticity", "elasticity_form"]

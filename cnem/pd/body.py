@@ -102,14 +102,13 @@ class Body:
             Horizon in units of the mean node spacing (``sqrt(area / n)``).
         thickness : float
         """
-        from ..fracture.williams import node_sides
         from ..geometry import discretize
         model = discretize(cloud, progress=False)
         area = np.bincount(model.cells.node, weights=model.cells.area, minlength=len(model.nodes))
         h = np.sqrt(model.domain.area / len(np.unique(model.node_of_point)))
         copies = np.bincount(model.node_of_point)[model.node_of_point] > 1
         # a crack-face copy is nudged towards its own face for the crossing test only
-        shift = node_sides(model) - model.nodes
+        shift = model.node_sides() - model.nodes
         norm = np.maximum(np.hypot(*shift.T), 1e-300)[:, None]
         nudged = model.nodes + np.where(copies[:, None], 1e-6 * h * shift / norm, 0.0)
         horizon = horizon_factor * h

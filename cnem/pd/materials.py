@@ -4,9 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["BondBased", "StateBased", "PLANES"]
-
-PLANES = ("stress", "strain")
+__all__ = ["BondBased", "StateBased"]
 
 
 def _positive(name, value):

@@ -15,7 +15,7 @@ from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import SolveError
 from . import _kernels as K
 from .frames import FrameWriter
-from .materials import PLANES
+from ..material import PLANES
 from .relaxation import relax
 
 __all__ = ["Problem", "StaticSolution", "DynamicRun"]

@@ -9,7 +9,7 @@ import scipy.sparse as sp
 
 from .. import config
 from ..errors import CNEMError, GeometryError
-from ..spatial.rtree import work_chunks
+from .._parallel import work_chunks
 from . import _kernels as K
 
 __all__ = ["shape_functions", "point_rows", "PointRows", "KINDS"]

@@ -23,7 +23,8 @@ from scipy.spatial import cKDTree
 
 from . import _family_kernels as K
 from . import _pair_kernels as P
-from .rtree import RTree, as_points, check_period, work_chunks
+from .._parallel import work_chunks
+from .rtree import RTree, as_points, check_period
 
 __all__ = ["Family", "family_search", "METHODS", "BRUTE_LIMIT"]
 

@@ -10,20 +10,15 @@
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
+from .._parallel import work_chunks
 from . import _rtree_kernels as K
 
-__all__ = ["RTree", "check_period", "as_points", "work_chunks"]
+__all__ = ["RTree", "check_period", "as_points"]
 
 #: Children per node (and boxes per leaf).
 FANOUT = 16
-
-
-def work_chunks():
-    """Number of chunks a parallel loop is cut into (a few per thread)."""
-    return 8 * numba.get_num_threads()
 
 
 def as_points(points, name="points"):

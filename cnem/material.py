@@ -1,11 +1,16 @@
-"""Isotropic linear elastic materials in plane stress and plane strain (eq. 24-25)."""
+"""Isotropic linear elasticity in plane stress and plane strain (eq. 24-25 of the C-NEM paper).
+
+The constitutive facts that C-NEM, the P1 anchor, fracture and peridynamics share: the
+planes, the Lamé parameters, the matrix ``C``, Kolosov's constant and the effective modulus.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["PLANES", "parse_materials", "lame", "stiffness_matrix"]
+__all__ = ["PLANES", "parse_materials", "lame", "stiffness_matrix", "kappa", "effective_modulus"]
 
+#: The 2-D idealisations: plane stress or plane strain.
 PLANES = ("stress", "strain")
 
 
@@ -62,3 +67,16 @@ def stiffness_matrix(E, nu, plane):
     C[..., 0, 1] = C[..., 1, 0] = lam
     C[..., 2, 2] = mu
     return C
+
+
+def kappa(nu, plane):
+    """Kolosov's constant: ``3 - 4 nu`` (plane strain) or ``(3 - nu) / (1 + nu)`` (plane stress)."""
+    if plane not in PLANES:
+        raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
+    return 3.0 - 4.0 * nu if plane == "strain" else (3.0 - nu) / (1.0 + nu)
+
+
+def effective_modulus(E, nu, plane):
+    """``E' = E`` (plane stress) or ``E / (1 - nu^2)`` (plane strain): ``G = K^2 / E'``."""
+    kappa(nu, plane)
+    return E if plane == "stress" else E / (1.0 - nu * nu)
