@@ -89,7 +89,7 @@ def newton(body, inter, u, repeat):
     import cnem.pd as pd
     from cnem.assembly.linsolve import rigid_modes, solve_spd
     prob = strip_problem(body, pd.CPD(1.0, 1.0))
-    D, values = prob._prescribed()
+    D, values = prob.prescribed()
     free = np.setdiff1d(np.arange(u.size), D)
     modes = rigid_modes(body.points)[free]
     x = u.reshape(-1).copy()

@@ -1,7 +1,7 @@
 """`P1Elasticity`: a linear finite element (scikit-fem P1 triangles) anchor for C-NEM.
 
 The same problem definition as `cnem.Elasticity` (Dirichlet conditions on
-nodes, tractions on boundary facets, body forces), solved on a quality mesh
+nodes, tractions on boundary edges, body forces), solved on a quality mesh
 of the domain made by `triangle`: every triangle lies in one region, material
 interfaces are mesh edges and cracks are opened (their nodes duplicated, tips
 excepted), so that crack faces are traction-free boundaries.
@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import logging
 import time
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import triangle
@@ -36,9 +38,9 @@ from .assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from .errors import GeometryError, SolveError
 from .geometry.cracks import split_cracks
 from .geometry.pslg import BOUNDARY, CRACK
-from .assembly.conditions import dirichlet_dofs, per_point
+from .assembly.conditions import Conditions, per_point, traction_at
 from .material import lame, parse_materials, stiffness_matrix
-from .models.solution import energy_error_density, von_mises
+from .assembly.solution import Solution, energy_error_density
 
 __all__ = ["P1Elasticity", "P1Solution", "mesh_domain"]
 
@@ -205,7 +207,7 @@ def _mesh_for_nodes(data, area, target, quality):
 
 
 # ------------------------------------------------------------------------ problem
-class P1Elasticity:
+class P1Elasticity(Conditions):
     """Plane linear elasticity with linear triangles (scikit-fem), the reference
     for `cnem.Elasticity`.
 
@@ -248,39 +250,42 @@ class P1Elasticity:
         self.mesh = MeshTri(np.ascontiguousarray(points.T), np.ascontiguousarray(tri.T))
         self.basis = Basis(self.mesh, ElementVector(ElementTriP1()))
         self.timings = {"mesh": time.perf_counter() - t0}
-        self._values = np.full(self.basis.N, np.nan)    # prescribed displacements
-        self._tractions = []
-        self._body = []
         self._boundary = None
+        super().__init__()
 
     def __repr__(self):
         return (f"<P1Elasticity plane {self.plane}, {len(self.nodes)} nodes, "
-                f"{self.mesh.t.shape[1]} triangles, {np.count_nonzero(~np.isnan(self._values))} "
-                f"prescribed dofs, {len(self._tractions)} traction, {len(self._body)} "
-                "body-force conditions>")
+                f"{self.mesh.t.shape[1]} triangles, {len(self.prescribed()[0])} prescribed dofs, "
+                f"{self.conditions_repr()}>")
 
     @property
     def nodes(self):
         """``(n, 2)`` node coordinates (crack nodes once per face)."""
         return self.mesh.p.T
 
-    # -- conditions ---------------------------------------------------------------------
-    def add_dirichlet(self, where, component, value=0.0):
-        """Prescribe nodal displacements (later conditions win on shared dofs).
+    # -- conditions (`Conditions`: add_dirichlet, add_traction, add_body_force) ---------
+    points_name = "prob.nodes"
+    edges_name = "boundary facet"
 
-        Parameters
-        ----------
-        where : callable ``(n, 2) -> (n,) bool``, or a boolean mask / index array over nodes
-        component : {0, 1, None}
-            ``None`` prescribes both.
-        value : float, or callable ``(p, 2) -> (p,)`` (``(p, 2)`` for both components)
-        """
-        dofs, vals = dirichlet_dofs(self.nodes, where, component, value,
-                                    where_to_look="prob.nodes")
-        self._values[dofs] = vals
+    @property
+    def condition_points(self):
+        """``(n, 2)`` the nodes that conditions refer to (`nodes`)."""
+        return self.nodes
+
+    def boundary_edges(self):
+        """The mesh's boundary facets as node pairs with the body on the left, and their
+        outward normals (see `Conditions.boundary_edges`; `boundary_facets` in the
+        same order)."""
+        facets, _, normal = self.boundary_facets()
+        edges = self.mesh.facets[:, facets].T.astype(np.int64)
+        d = self.nodes[edges[:, 1]] - self.nodes[edges[:, 0]]
+        flip = d[:, 1] * normal[:, 0] - d[:, 0] * normal[:, 1] < 0     # normal on the left
+        edges[flip] = edges[flip][:, ::-1]
+        return edges, normal
 
     def boundary_facets(self):
-        """Facets of the outer boundary, holes and crack faces.
+        """The boundary edges as scikit-fem facets (the older name of `boundary_edges`,
+        in the same order).
 
         Returns
         -------
@@ -297,32 +302,6 @@ class P1Elasticity:
             self._boundary = facets, midpoint, np.asarray(fb.normals)[:, :, 0].T
         return self._boundary
 
-    def add_traction(self, where, t):
-        """Tractions on boundary facets (outer boundary, holes, crack faces).
-
-        Parameters
-        ----------
-        where : callable ``(x, nrm) -> (e,) bool``, or an ``(e,)`` bool mask
-            Midpoints ``(e, 2)`` and outward unit normals ``(e, 2)`` of the
-            facets of `boundary_facets`.
-        t : (2,) array_like, or callable ``(x, nrm) -> (q, 2)``
-            Traction vectors at points ``x (q, 2)`` with normals ``nrm (q, 2)``;
-            3-point Gauss on each facet (exact up to quadratic tractions).
-        """
-        facets, midpoint, normal = self.boundary_facets()
-        pick = np.asarray(where(midpoint, normal)) if callable(where) else np.asarray(where)
-        if pick.shape != (len(facets),) or pick.dtype != bool:
-            raise ValueError(f"add_traction: where(x, nrm) must return a ({len(facets)},) bool "
-                             f"array, received dtype {pick.dtype} shape {pick.shape}")
-        if not pick.any():
-            raise ValueError("add_traction: `where` selects no boundary facet")
-        self._tractions.append((facets[pick], t))
-
-    def add_body_force(self, b):
-        """Body force per unit area: ``b(x) -> (p, 2)`` or a constant ``(2,)``
-        (Gauss quadrature on the triangles)."""
-        self._body.append(b)
-
     # -- assembly -----------------------------------------------------------------------
     def element_materials(self):
         """``(t, 2)`` ``(E, nu)`` of every triangle."""
@@ -338,10 +317,11 @@ class P1Elasticity:
         """Load vector ``(2 n,)`` of the tractions and body forces."""
         f = np.zeros(self.basis.N)
         element = ElementVector(ElementTriP1())
-        for facets, t in self._tractions:
-            fb = FacetBasis(self.mesh, element, facets=facets, intorder=5)
-            f += _vector_load(t, "traction", normal=True).assemble(fb)
-        for b in self._body:
+        facets = self.boundary_facets()[0]
+        for traction in self.tractions:
+            fb = FacetBasis(self.mesh, element, facets=facets[traction.index], intorder=5)
+            f += _vector_load(traction.value, "traction", normal=True).assemble(fb)
+        for b in self.body_forces:
             f += _vector_load(b, "body force", normal=False).assemble(self.basis)
         return f
 
@@ -369,20 +349,20 @@ class P1Elasticity:
         K = self.stiffness()
         f = self.load()
         t1 = time.perf_counter()
-        D = np.flatnonzero(~np.isnan(self._values))
+        D, values = self.prescribed()
         free = free_rigid_motions(K, self.nodes, D)
         if free:
             raise SolveError("the system is singular: the Dirichlet conditions leave free the "
                              + "; ".join(free) + ". Fix them with add_dirichlet")
         x = np.zeros(K.shape[0])
-        x[D] = self._values[D]
+        x[D] = values
         A, b, _, interior = condense(K, f, x=x, D=D)
         x[interior] = solve_spd(A, b, modes=rigid_modes(self.nodes)[interior], tol=tol,
                                 method=method)
         t2 = time.perf_counter()
         timings = dict(self.timings, assembly=t1 - t0, solve=t2 - t1)
         log.info("P1 elasticity: %s", ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
-        return P1Solution(self, x, timings)
+        return P1Solution.from_dofs(self, x, timings)
 
 
 def _vector_load(value, what, *, normal):
@@ -393,9 +373,8 @@ def _vector_load(value, what, *, normal):
     def form(v, w):
         shape = w.x.shape                                   # (2, elements, points)
         x = w.x.reshape(2, -1).T
-        if callable(value):
-            args = (x, w.n.reshape(2, -1).T) if normal else (x,)
-            vals = per_point(value(*args), x, 2, what)
+        if normal:
+            vals = traction_at(value, x, w.n.reshape(2, -1).T, what)
         else:
             vals = per_point(value, x, 2, what)
         return dot(vals.T.reshape(shape), v)
@@ -404,60 +383,54 @@ def _vector_load(value, what, *, normal):
 
 
 # ----------------------------------------------------------------------- solution
-class P1Solution:
-    """The solution of a `P1Elasticity` problem.
+@dataclass(eq=False, repr=False)
+class P1Solution(Solution):
+    """The solution of a `P1Elasticity` problem (the fields of `cnem.assembly.solution`).
 
     Attributes
     ----------
     u : (n, 2) ndarray
         Nodal displacements.
-    strain : (t, 3) ndarray
-        ``[exx, eyy, 2 exy]`` per triangle (constant on each).
     stress : (t, 3) ndarray
-        ``[sxx, syy, sxy]`` per triangle.
+        ``[sxx, syy, sxy]`` per triangle (constant on each).
+    strain : (t, 3) ndarray
+        ``[exx, eyy, 2 exy]`` per triangle.
     C : (t, 3, 3) ndarray
         Elastic matrix of each triangle.
     mesh : skfem.MeshTri
     region : (t,) int64 ndarray
         Region index of each triangle.
+    basis : skfem.Basis
+    plane : {"stress", "strain"}
     timings : dict
         Seconds spent in ``"mesh"``, ``"assembly"`` and ``"solve"``.
     """
 
-    def __init__(self, problem, x, timings):
-        self.problem = problem
-        self.mesh = problem.mesh
-        self.region = problem.region
-        self.basis = problem.basis
-        self.plane = problem.plane
-        self.timings = timings
-        self.u = x.reshape(-1, 2)
-        eps = sym_grad(self.basis.interpolate(x))[:, :, :, 0]          # (2, 2, t)
-        self.strain = np.column_stack([eps[0, 0], eps[1, 1], 2.0 * eps[0, 1]])
+    stress: np.ndarray
+    strain: np.ndarray
+    C: np.ndarray
+    mesh: Any
+    region: np.ndarray
+    basis: Any
+    plane: str
+    timings: dict
+
+    stress_at = "triangles"
+
+    @classmethod
+    def from_dofs(cls, problem, x, timings):
+        """The solution of ``problem`` with the interleaved nodal unknowns ``x (2 n,)``."""
+        eps = sym_grad(problem.basis.interpolate(x))[:, :, :, 0]          # (2, 2, t)
+        strain = np.column_stack([eps[0, 0], eps[1, 1], 2.0 * eps[0, 1]])
         E, nu = problem.element_materials().T
-        self.C = stiffness_matrix(E, nu, self.plane)
-        self.stress = np.einsum("kij,kj->ki", self.C, self.strain)
-
-    def __repr__(self):
-        return (f"<P1Solution {len(self.u)} nodes, {len(self.stress)} triangles, "
-                f"max |u| {np.abs(self.u).max():.3e}, max von Mises {self.von_mises.max():.3e}>")
-
-    @property
-    def von_mises(self):
-        """``(t,)`` von Mises stress per triangle."""
-        return von_mises(self.stress)
+        C = stiffness_matrix(E, nu, problem.plane)
+        return cls(problem=problem, u=x.reshape(-1, 2), stress=np.einsum("kij,kj->ki", C, strain),
+                   strain=strain, C=C, mesh=problem.mesh, region=problem.region,
+                   basis=problem.basis, plane=problem.plane, timings=timings)
 
     def displacement(self, points):
-        """Displacements at points (inside the mesh) through the P1 shape functions.
-
-        Parameters
-        ----------
-        points : (p, 2) array_like
-
-        Returns
-        -------
-        (p, 2) ndarray
-        """
+        """Displacements ``(p, 2)`` at points ``(p, 2)`` inside the mesh, through the P1
+        shape functions."""
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
         values = self.basis.probes(np.ascontiguousarray(pts.T)) @ self.u.reshape(-1)
         return values.reshape(2, -1).T                      # probes give x values, then y
@@ -496,3 +469,25 @@ class P1Solution:
         """Strain energy ``1/2 sum_T A_T σ_T · ε_T``."""
         area = self.basis.dx.sum(axis=1)
         return 0.5 * float(area @ (self.stress * self.strain).sum(axis=1))
+
+    def nodal_average(self, values):
+        """Triangle values ``(t, ...)`` at the nodes: the area-weighted mean over the
+        triangles around each node, ``(n, ...)``."""
+        values = np.asarray(values, dtype=float)
+        n, tri = self.mesh.p.shape[1], self.mesh.t.T
+        area = np.repeat(self.basis.dx.sum(axis=1), 3)
+        flat = values.reshape(len(values), -1)
+        weight = np.bincount(tri.ravel(), weights=area, minlength=n)
+        out = np.stack([np.bincount(tri.ravel(), weights=area * np.repeat(col, 3), minlength=n)
+                        for col in flat.T], axis=1) / weight[:, None]
+        return out.reshape((n,) + values.shape[1:])
+
+    def plot_mesh(self):
+        """The mesh nodes and triangles and the domain's diameter."""
+        return self.mesh.p.T, self.mesh.t.T, self.problem.domain.diameter
+
+    def write_fields(self, path, point_data, cell_data):
+        """The mesh with the fields (`cnem.io.write_points` with its triangles)."""
+        from . import io
+        io.write_points(self.mesh.p.T, path, triangles=self.mesh.t.T, point_data=point_data,
+                        cell_data=cell_data)

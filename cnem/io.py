@@ -40,7 +40,7 @@ import numpy as np
 from .errors import CNEMError
 from .geometry.model import Cells
 
-__all__ = ["write", "write_nodes", "read", "CellMesh", "FormatError", "SUFFIXES"]
+__all__ = ["write", "write_nodes", "write_points", "read", "CellMesh", "FormatError", "SUFFIXES"]
 
 log = logging.getLogger(__name__)
 
@@ -238,6 +238,47 @@ def write_nodes(model, path, *, point_data=None):
         "kind": [np.full(len(tri), -1, np.int64), np.asarray(model.segment_kind, np.int64)],
     }
     meshio.write(path, meshio.Mesh(points, cells, point_data=pdata, cell_data=cdata),
+                 file_format=fmt, binary=True)
+    return path
+
+
+def write_points(points, path, *, triangles=None, point_data=None, cell_data=None):
+    """Write points (2-D or 3-D), as ``vertex`` cells or with triangles on them.
+
+    Parameters
+    ----------
+    points : (n, 2) or (n, 3) array_like
+        Written with ``z = 0`` in 2-D.
+    path : str or os.PathLike
+        Suffix ``.vtu``.
+    triangles : (t, 3) int array_like, optional
+        Cells; without them every point is a ``vertex`` cell.
+    point_data : dict of str -> (n,) or (n, c) array_like, optional
+    cell_data : dict of str -> (t,) or (t, c) array_like, optional
+        Values on the triangles (or on the vertex cells: one per point).
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    FormatError
+        Unsupported suffix or arrays of the wrong length.
+    """
+    path, fmt = _format(path)
+    pts = np.asarray(points, dtype=np.float64)
+    full = np.zeros((len(pts), 3))
+    full[:, :pts.shape[1]] = pts
+    if triangles is None:
+        block = meshio.CellBlock("vertex", np.arange(len(pts), dtype=np.int64)[:, None])
+    else:
+        block = meshio.CellBlock("triangle", np.asarray(triangles, dtype=np.int64))
+    pdata = {name: _checked(value, len(pts), f"point_data[{name!r}]")[0]
+             for name, value in (point_data or {}).items()}
+    cdata = {name: [_checked(value, len(block.data), f"cell_data[{name!r}]")[0]]
+             for name, value in (cell_data or {}).items()}
+    meshio.write(path, meshio.Mesh(full, [block], point_data=pdata, cell_data=cdata),
                  file_format=fmt, binary=True)
     return path
 

@@ -237,47 +237,57 @@ SOLUTION_FIELDS = ("von_mises", "sxx", "syy", "sxy", "exx", "eyy", "gxy", "ux", 
 
 
 def nodal_field(sol, field):
-    """A solution field at the nodes: displacements as they are, cell fields
-    (stress, strain) from each node's cell (area-weighted over the cells of a
-    node on an interface).
+    """A solution field at the nodes: displacements as they are, the fields at the
+    places of ``sol.stress`` (cells, triangles or points) through
+    ``sol.nodal_average`` (a C-NEM node takes its cell's value, area-weighted over
+    the cells of a node on an interface).
+
+    Parameters
+    ----------
+    sol : cnem.assembly.solution.Solution
+    field : str or ndarray
+        One of `SOLUTION_FIELDS`, or values ``(n,)`` at the nodes or ``(k,)`` at the
+        places of ``sol.stress``.
 
     Returns
     -------
     (n,) ndarray
     """
-    cells = sol.cells
-    n = len(sol.model.nodes)
+    n, k = len(sol.u), len(sol.stress)
     if not isinstance(field, str):
         values = np.asarray(field, dtype=float)
         if values.shape == (n,):
             return values
-        if values.shape != (len(cells.area),):
+        if values.shape != (k,):
             raise PlotError(f"field: expected a name in {SOLUTION_FIELDS}, or values at the "
-                            f"{n} nodes or the {len(cells.area)} cells, received shape {values.shape}")
-        per_cell = values
+                            f"{n} nodes or the {k} {sol.stress_at}, received shape {values.shape}")
+        per_place = values
     elif field not in SOLUTION_FIELDS:
         raise PlotError(f"field must be one of {SOLUTION_FIELDS}, received {field!r}")
     elif field in ("ux", "uy", "|u|"):
-        return {"ux": sol.u[:, 0], "uy": sol.u[:, 1], "|u|": np.hypot(*sol.u.T)}[field]
+        return {"ux": sol.u[:, 0], "uy": sol.u[:, 1], "|u|": np.linalg.norm(sol.u, axis=1)}[field]
     else:
-        per_cell = {"von_mises": sol.von_mises, "sxx": sol.stress[:, 0], "syy": sol.stress[:, 1],
-                    "sxy": sol.stress[:, 2], "exx": sol.strain[:, 0], "eyy": sol.strain[:, 1],
-                    "gxy": sol.strain[:, 2]}[field]
-    weight = np.bincount(cells.node, weights=cells.area, minlength=n)
-    return np.bincount(cells.node, weights=cells.area * per_cell, minlength=n) / weight
+        shear = sol.stress.shape[1] - 1                     # the xy entry of the Voigt order
+        per_place = {"von_mises": sol.von_mises, "sxx": sol.stress[:, 0], "syy": sol.stress[:, 1],
+                     "sxy": sol.stress[:, shear], "exx": sol.strain[:, 0],
+                     "eyy": sol.strain[:, 1], "gxy": sol.strain[:, shear]}[field]
+    return sol.nodal_average(per_place)
 
 
 def solution(sol, path=None, *, field="von_mises", scale=None, window_size=(1200, 1200),
              show_edges=False, cmap="viridis", title=None):
     """The deformed body coloured by a field (off-screen).
 
-    The constrained Delaunay triangles are moved by ``scale * u`` (crack faces
-    have their own nodes, so cracks open) and coloured by the field at the
-    nodes (`nodal_field`), interpolated across the triangles.
+    The solution's triangles (``sol.plot_mesh()``: C-NEM's constrained Delaunay
+    triangles, the P1 mesh) are moved by ``scale * u`` (crack faces have their
+    own nodes, so cracks open) and coloured by the field at the nodes
+    (`nodal_field`), interpolated across the triangles; a solution without
+    triangles (peridynamics) is drawn as its moved points.
 
     Parameters
     ----------
-    sol : ElasticSolution
+    sol : cnem.assembly.solution.Solution
+        An `ElasticSolution`, `cnem.fem.P1Solution` or a `cnem.pd` solution.
     path : str or os.PathLike, optional
         Write a PNG there.
     field : str or ndarray
@@ -299,24 +309,30 @@ def solution(sol, path=None, *, field="von_mises", scale=None, window_size=(1200
     pyvista.Plotter
     """
     pv = _pyvista()
-    mdl = sol.model
+    nodes, triangles, diameter = sol.plot_mesh()
     values = nodal_field(sol, field)
     name = field if isinstance(field, str) else (title or "field")
     umax = float(np.abs(sol.u).max())
     if scale is None:
-        scale = 0.05 * mdl.domain.diameter / umax if umax > 0 else 0.0
-    moved = mdl.nodes + scale * sol.u
-    faces = np.column_stack([np.full(len(mdl.triangles), 3), mdl.triangles]).ravel()
-    mesh = pv.PolyData(_lift(moved, 0.0), faces=faces)
+        scale = 0.05 * diameter / umax if umax > 0 else 0.0
+    moved = nodes + scale * sol.u
+    lifted = _lift(moved[:, :2], 0.0) if moved.shape[1] == 2 else moved
+    points_only = {}
+    if triangles is None:
+        mesh = pv.PolyData(lifted)
+        points_only = {"point_size": 8, "render_points_as_spheres": True}
+    else:
+        faces = np.column_stack([np.full(len(triangles), 3), triangles]).ravel()
+        mesh = pv.PolyData(lifted, faces=faces)
     mesh.point_data[name] = values
     width, height = map(int, window_size)
     pl = _plotter(pv, width, height)
     pl.add_mesh(mesh, scalars=name, cmap=cmap, lighting=False, show_edges=show_edges,
                 edge_color=(0.4, 0.4, 0.4),
                 scalar_bar_args={"title": f"{title or name} (deformation x{scale:.3g})",
-                                 "color": "black", "vertical": False})
-    lo, hi = moved.min(axis=0), moved.max(axis=0)
+                                 "color": "black", "vertical": False}, **points_only)
+    lo, hi = moved[:, :2].min(axis=0), moved[:, :2].max(axis=0)
     pad = 0.08 * (hi - lo).max()
     _top_view(pl, (lo[0] - pad, lo[1] - 2 * pad, hi[0] + pad, hi[1] + pad), width, height,
-              mdl.domain.diameter)
+              diameter)
     return _save(pl, path, "solution")

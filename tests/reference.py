@@ -709,3 +709,98 @@ def smoothed_gradient(model, gauss=2):
     np.add.at(gx, owner, weights[:, :1] * phi)
     np.add.at(gy, owner, weights[:, 1:] * phi)
     return gx / area[:, None], gy / area[:, None]
+
+# ------------------------------------------------------------------ peridynamic forces
+def pd_bonds(points, volumes, horizon, thickness=1.0):
+    """Every bond ``(i, j)`` with ``0 < |x_j - x_i| < horizon`` by a double loop, with its
+    partial-volume factor ``clip((delta + dx / 2 - L) / dx, 0, 1)``, ``dx`` the mean of
+    the two points' spacings ``(V / t)^(1/d)``.
+
+    Returns
+    -------
+    list of (i, j, beta)
+    """
+    n, d = points.shape
+    spacing = (volumes / thickness) ** (1.0 / d)
+    bonds = []
+    for i in range(n):
+        for j in range(n):
+            L = float(np.sqrt(((points[j] - points[i]) ** 2).sum()))
+            if 0.0 < L < horizon:
+                dx = 0.5 * (spacing[i] + spacing[j])
+                bonds.append((i, j, min(max((horizon + 0.5 * dx - L) / dx, 0.0), 1.0)))
+    return bonds
+
+
+def pmb_force(points, volumes, horizon, u, c, factor, thickness=1.0):
+    """Bond-based PMB force density ``f_i = sum_j c g_ij beta_ij s_ij (y_ij / |y_ij|) V_j``
+    with ``y_ij = x_j + u_j - x_i - u_i`` and the stretch ``s_ij = |y_ij| / |x_j - x_i| - 1``.
+
+    Parameters
+    ----------
+    points : (n, d) ndarray
+    volumes : (n,) ndarray
+    horizon : float
+    u : (n, d) ndarray
+    c : float
+        Micromodulus.
+    factor : callable ``(i, j) -> float``
+        Surface-correction factor ``g_ij`` of the bond.
+
+    Returns
+    -------
+    (n, d) ndarray
+    """
+    f = np.zeros_like(points)
+    for i, j, beta in pd_bonds(points, volumes, horizon, thickness):
+        xi = points[j] - points[i]
+        y = xi + u[j] - u[i]
+        stretch = np.linalg.norm(y) / np.linalg.norm(xi) - 1.0
+        f[i] += c * factor(i, j) * beta * stretch * y / np.linalg.norm(y) * volumes[j]
+    return f
+
+
+def lps_force(points, volumes, horizon, u, bulk, shear, factor, thickness=1.0):
+    """Linearised state-based (LPS) force density ``f = -(d Pi / d u) / V`` of the energy
+    ``Pi = sum_i V_i W_i``, ``W_i = k theta_i^2 / 2 + (alpha_i / 2) sum_j g_ij w_ij
+    (e^d_ij)^2``, by loops over the points and their families.
+
+    With ``w_ij = beta_ij V_j``, the moment tensor ``M_i = sum_j w_ij xi xi^T``, the
+    dilatation ``theta_i = sum_j w_ij (u_j - u_i) . M_i^-1 xi_ij``, the extension
+    ``e_ij = n_ij . (u_j - u_i)``, its deviatoric part ``e^d_ij = e_ij - L_ij theta_i / d``,
+    ``m_i = sum_j w_ij L_ij^2`` and ``alpha_i = mu d (d + 2) / m_i``.
+
+    Returns
+    -------
+    (n, d) ndarray
+    """
+    n, d = points.shape
+    family = [[] for _ in range(n)]
+    for i, j, beta in pd_bonds(points, volumes, horizon, thickness):
+        family[i].append((j, beta * volumes[j]))
+    grad = np.zeros_like(points)                     # d Pi / d u
+    for i in range(n):
+        M = np.zeros((d, d))
+        m = 0.0
+        for j, w in family[i]:
+            xi = points[j] - points[i]
+            M += w * np.outer(xi, xi)
+            m += w * (xi @ xi)
+        Minv = np.linalg.inv(M)
+        alpha = shear * d * (d + 2) / m
+        g = {j: w * Minv @ (points[j] - points[i]) for j, w in family[i]}
+        theta = sum(g[j] @ (u[j] - u[i]) for j, _ in family[i])
+        ed = {}
+        for j, w in family[i]:
+            xi = points[j] - points[i]
+            L = np.linalg.norm(xi)
+            ed[j] = (xi / L) @ (u[j] - u[i]) - L * theta / d
+        # d W_i / d theta_i, with the deviatoric extensions' share of theta
+        A = bulk * theta - alpha / d * sum(factor(i, j) * w * ed[j] * np.linalg.norm(
+            points[j] - points[i]) for j, w in family[i])
+        for j, w in family[i]:
+            xi = points[j] - points[i]
+            part = volumes[i] * (A * g[j] + alpha * factor(i, j) * w * ed[j] * xi / np.linalg.norm(xi))
+            grad[j] += part
+            grad[i] -= part
+    return -grad / volumes[:, None]

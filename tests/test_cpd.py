@@ -252,7 +252,7 @@ def test_errors():
         pd.CPD(1.0).interactions(body2).with_material(pd.CPD(1.0, 1.0))
     prob, _ = _stretched_strip(pd.CPD(1.0), 0.1)
     with pytest.raises(NotImplementedError, match="CPD"):
-        prob.solve_static().stress()
+        prob.solve_static().stress
     free = pd.Problem(body2, pd.CPD(1.0, 1.0))
     with pytest.raises(cnem.SolveError, match="translation in x.*translation in y.*rotation"):
         free.solve_static()
@@ -264,7 +264,7 @@ def test_linear_model_methods_refuse_cpd():
     pts = np.stack(np.meshgrid(g, g, indexing="ij"), -1).reshape(-1, 2)
     prob = cnem.pd.Problem(cnem.pd.Body(pts, 1.0, 1.5), cnem.pd.CPD(1.0))
     u = np.zeros_like(pts)
-    for call in (lambda: prob.stiffness(), lambda: prob.stress(u), lambda: prob.energy_density(u),
+    for call in (lambda: prob.stiffness(), lambda: prob.stress_tensor(u), lambda: prob.energy_density(u),
                  lambda: prob.stable_time_step(), lambda: prob.run_dynamic(1e-3, 1),
                  lambda: prob.relax()):
         with pytest.raises(NotImplementedError, match="not for CPD"):

@@ -182,3 +182,28 @@ def test_pd_crack_branching_quick(tmp_path):
     assert 0.9 < out["dissipated"] / out["griffith"] < 3.0
     for f in out["files"]:
         assert pathlib.Path(f).stat().st_size > 1000
+
+
+def test_growth_sent_small(tmp_path):
+    demo = _load("growth_sent")
+    res = demo.main(0.05, increment=0.1, outdir=tmp_path, plot=False, progress=False)
+    assert [r["a"] for r in res["rows"]] == pytest.approx([0.2, 0.3, 0.4, 0.5, 0.6])
+    assert res["max_kink_deg"] < 0.1                  # the symmetric cloud keeps the path straight
+    assert res["max_error"] < 0.05                    # K_I against the handbook (coarse cloud)
+
+
+def test_growth_kink_small(tmp_path):
+    demo = _load("growth_kink")
+    res = demo.main((30.0,), cloud=(0.8, 0.005, 0.3), outdir=tmp_path, plot=False, progress=False)
+    assert res["rows"][0]["exact_deg"] == pytest.approx(-43.22, abs=0.01)
+    assert res["max_error_deg"] < 1.0
+
+
+def test_growth_two_holes_small(tmp_path):
+    demo = _load("growth_two_holes")
+    res = demo.main(0.5, steps=2, outdir=tmp_path, plot=False, progress=False)
+    tips = res["tips"]
+    assert np.hypot(*(tips[1:] - tips[:-1]).transpose(2, 0, 1)) == pytest.approx(1.0, rel=1e-9)
+    assert np.all(np.diff(tips[:, 0, 0]) > 0) and np.all(np.diff(tips[:, 1, 0]) < 0)
+    # the plate is point-symmetric about its centre: so are the two paths (to the cloud's asymmetry)
+    assert np.abs(tips[:, 0] + tips[:, 1] - [20.0, 10.0]).max() < 0.15

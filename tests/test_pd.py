@@ -39,7 +39,7 @@ def test_uniform_strain_gives_the_classical_stress_in_the_bulk(material, nu, pla
     bulk = (np.abs(pts - 0.5) < 0.5 - 10 * h).all(axis=1)     # beyond three horizons
     for eps in ([[1e-3, 0], [0, 0]], [[0, 1e-3], [1e-3, 0]], [[1e-3, -5e-4], [-5e-4, 2e-3]]):
         eps = np.array(eps)
-        stress = _voigt(prob.stress(pts @ eps.T))[bulk]
+        stress = _voigt(prob.stress_tensor(pts @ eps.T))[bulk]
         exact = C @ [eps[0, 0], eps[1, 1], 2 * eps[0, 1]]
         np.testing.assert_allclose(stress, np.broadcast_to(exact, stress.shape),
                                    atol=0.01 * np.abs(exact).max())
@@ -53,7 +53,7 @@ def test_uniform_strain_in_3d():
     pts = _grid(h, dim=3)
     prob = pd.Problem(pd.Body(pts, h ** 3, 3.015 * h), pd.StateBased(1.0, 0.3))
     eps = np.array([[1e-3, 2e-4, 0], [2e-4, -5e-4, 1e-4], [0, 1e-4, 3e-4]])
-    stress = prob.stress(pts @ eps.T)
+    stress = prob.stress_tensor(pts @ eps.T)
     bulk = (np.abs(pts - 0.5) < 0.5 - 3.5 * h).all(axis=1)
     E, nu = 1.0, 0.3
     lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))

@@ -41,7 +41,7 @@ def test_relaxation_matches_the_static_solution(material, load):
     assert np.abs(relaxed.u - static).max() <= 1e-6 * np.abs(static).max()
     assert relaxed.iterations > 0 and relaxed.broken == 0
     np.testing.assert_array_equal(relaxed.damage, 0.0)
-    np.testing.assert_allclose(relaxed.stress(), prob.stress(relaxed.u))
+    np.testing.assert_allclose(relaxed.stress_tensor(), prob.stress_tensor(relaxed.u))
 
 
 def test_load_steps_reach_the_same_equilibrium():

@@ -1,12 +1,36 @@
-"""Boundary-condition data shared by every solver (C-NEM, FEM P1, peridynamics)."""
+"""Boundary conditions written once for every solver (C-NEM, FEM P1, peridynamics).
+
+`Conditions` is the base of every problem class: it stores the Dirichlet,
+traction and body-force conditions with the meanings of ``API.md`` and turns
+them into prescribed dof values; each solver only integrates the loads in its
+own way (`body_forces`, `traction_at`).
+
+>>> import numpy as np
+>>> from cnem.assembly.conditions import Conditions
+>>> class Points(Conditions):
+...     def __init__(self, points):
+...         super().__init__()
+...         self.condition_points = points
+>>> prob = Points(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]))
+>>> prob.add_dirichlet(lambda p: p[:, 0] > 0.5, 0, 1.0)
+>>> prob.add_dirichlet([2], None, 2.0)                        # later conditions win
+>>> prob.prescribed()
+(array([2, 4, 5]), array([1., 2., 2.]))
+"""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Callable, Union
 
 import numpy as np
 
 from .basis import select_nodes
 
-__all__ = ["per_point", "dirichlet_dofs"]
+__all__ = ["Conditions", "Traction", "per_point", "traction_at", "dirichlet_dofs"]
+
+#: What `where` may be: a predicate over points, a boolean mask or indices.
+Where = Union[Callable[[np.ndarray], np.ndarray], np.ndarray, list]
 
 
 def per_point(value, points, width, what):
@@ -28,6 +52,12 @@ def per_point(value, points, width, what):
     if not np.isfinite(arr).all():
         raise ValueError(f"{what}: values must be finite, received NaN or inf")
     return arr
+
+
+def traction_at(t, points, normal, what="traction"):
+    """Traction vectors ``(q, d)`` of a constant or a callable ``t(x, nrm)`` at boundary
+    points ``(q, d)`` with outward unit normals ``(q, d)``."""
+    return per_point(t(points, normal) if callable(t) else t, points, points.shape[1], what)
 
 
 def dirichlet_dofs(points, where, component, value, *, where_to_look="the nodes"):
@@ -58,3 +88,147 @@ def dirichlet_dofs(points, where, component, value, *, where_to_look="the nodes"
     comps = np.arange(d) if component is None else np.array([component])
     vals = per_point(value, points[nodes], len(comps), "add_dirichlet value")
     return (d * nodes[:, None] + comps[None, :]).reshape(-1), np.ascontiguousarray(vals).reshape(-1)
+
+
+@dataclass(frozen=True, eq=False)
+class Traction:
+    """A traction condition on some boundary edges of a problem.
+
+    Attributes
+    ----------
+    index : (k,) int64 ndarray
+        The edges' rows in the problem's ``boundary_edges()``.
+    edges : (k, 2) int64 ndarray
+        Their node pairs, the body on the left.
+    normal : (k, 2) ndarray
+        Their outward unit normals.
+    value : (2,) array_like or callable ``(x, nrm) -> (q, 2)``
+        The traction (see `traction_at`).
+    """
+
+    index: np.ndarray
+    edges: np.ndarray
+    normal: np.ndarray
+    value: Any
+
+
+class Conditions:
+    """Dirichlet, traction and body-force conditions of a problem.
+
+    A problem class derives from it, calls ``super().__init__()`` and offers
+
+    * ``condition_points`` : ``(n, d)`` ndarray, the nodes (points) that
+      Dirichlet predicates, masks and indices refer to;
+    * ``boundary_edges()`` -> ``edges (e, 2)``, ``normal (e, 2)`` (node pairs with
+      the body on the left, outward unit normals) if it takes tractions.
+
+    Attributes
+    ----------
+    dirichlet : list of (dofs (k,), values (k,))
+        The Dirichlet conditions in the order given (`prescribed` merges them).
+    tractions : list of Traction
+    body_forces : list
+        Constants ``(d,)`` or callables ``b(x) -> (p, d)``.
+    """
+
+    #: Named in the error of a Dirichlet predicate that selects nothing.
+    points_name = "the nodes"
+    #: What the error of a traction predicate that selects nothing calls the edges.
+    edges_name = "boundary edge"
+
+    def __init__(self):
+        self.dirichlet = []
+        self.tractions = []
+        self.body_forces = []
+
+    def conditions_repr(self):
+        """``"a Dirichlet, b traction, c body-force conditions"``, for ``__repr__``."""
+        return (f"{len(self.dirichlet)} Dirichlet, {len(self.tractions)} traction, "
+                f"{len(self.body_forces)} body-force conditions")
+
+    def add_dirichlet(self, where: Where, component: int | None, value: Any = 0.0) -> None:
+        """Prescribe displacements at nodes (later conditions win on shared dofs).
+
+        Parameters
+        ----------
+        where : callable ``(n, d) -> (n,) bool``, or a boolean mask / index array over
+            the nodes (``condition_points``)
+        component : {0, ..., d - 1, None}
+            ``None`` prescribes every component.
+        value : float, or callable ``(p, d) -> (p,)`` (``(p, d)`` for every component)
+        """
+        self.dirichlet.append(dirichlet_dofs(self.condition_points, where, component, value,
+                                             where_to_look=self.points_name))
+
+    def boundary_edges(self):
+        """Edges of the outer boundary, holes and crack faces.
+
+        Returns
+        -------
+        edges : (e, 2) int64 ndarray
+            Node pairs, the body on the left (counter-clockwise).
+        normal : (e, 2) ndarray
+            Outward unit normals.
+        """
+        raise NotImplementedError(f"{type(self).__name__} has no boundary edges")
+
+    def add_traction(self, where: Where, t: Any) -> None:
+        """Tractions on the boundary edges (outer boundary, holes, crack faces).
+
+        Parameters
+        ----------
+        where : callable ``(x, nrm) -> (e,) bool``, or an ``(e,)`` bool mask
+            Midpoints ``(e, 2)`` and outward unit normals ``(e, 2)`` of the edges
+            of ``boundary_edges()``.
+        t : (2,) array_like, or callable ``(x, nrm) -> (q, 2)``
+            Traction vectors at boundary points ``x (q, 2)`` with normals
+            ``nrm (q, 2)``; each solver integrates them exactly up to quadratic
+            tractions along an edge.
+        """
+        edges, normal = self.boundary_edges()
+        x = self.condition_points
+        mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
+        pick = np.asarray(where(mid, normal)) if callable(where) else np.asarray(where)
+        if pick.shape != (len(edges),) or pick.dtype != bool:
+            raise ValueError(f"add_traction: where(x, nrm) must return a ({len(edges)},) bool "
+                             f"array, received dtype {pick.dtype} shape {pick.shape}")
+        if not pick.any():
+            raise ValueError(f"add_traction: `where` selects no {self.edges_name}; check the "
+                             "predicate against the midpoints and outward normals of "
+                             "boundary_edges()")
+        index = np.flatnonzero(pick)
+        self.tractions.append(Traction(index, edges[index], normal[index], t))
+
+    def add_body_force(self, b: Any) -> None:
+        """Body force per unit area (2-D) or volume: ``b(x) -> (p, d)`` or a constant ``(d,)``."""
+        self.body_forces.append(b)
+
+    def body_forces_at(self, points):
+        """The body forces at points, one ``(p, d)`` array per condition.
+
+        Parameters
+        ----------
+        points : (p, d) ndarray
+
+        Returns
+        -------
+        list of (p, d) ndarray
+        """
+        return [per_point(b, points, points.shape[1], "body force") for b in self.body_forces]
+
+    def prescribed(self):
+        """The prescribed dofs (interleaved ``d * node + component``) and their values,
+        the last condition winning where several prescribe one dof.
+
+        Returns
+        -------
+        dofs : (k,) int64 ndarray
+            Sorted, distinct.
+        values : (k,) ndarray
+        """
+        dofs = np.zeros(0, dtype=np.int64)
+        values = np.zeros(0)
+        for d, v in self.dirichlet:
+            dofs, values = np.concatenate([dofs, d]), np.concatenate([values, v])
+        last = len(dofs) - 1 - np.unique(dofs[::-1], return_index=True)[1]
+        return dofs[last], values[last]

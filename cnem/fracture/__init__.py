@@ -1,4 +1,4 @@
-"""Fracture with C-NEM: stress intensity factors by the interaction integral.
+"""Fracture with C-NEM: stress intensity factors by the interaction integral, crack growth.
 
 >>> import numpy as np, cnem
 >>> from cnem.fracture import nodal_williams, sif
@@ -13,14 +13,17 @@
 True
 """
 
+from .criteria import CRITERIA, kink
 from .enrichment import Enrichment
 from ..geometry.domain import Domain
+from .growth import grow
+from .history import CrackPath, GrowthEvent, Step
 from .interaction import SIFResult, sif
 from ..material import effective_modulus, kappa
 from .williams import nodal_williams, polar, williams
 
 __all__ = ["sif", "SIFResult", "Enrichment", "tip_frame", "williams", "nodal_williams", "polar", "kappa",
-           "effective_modulus"]
+           "effective_modulus", "grow", "CrackPath", "Step", "GrowthEvent", "kink", "CRITERIA"]
 
 #: `Domain.tip_frame` as a function of ``(domain, tip)``.
 tip_frame = Domain.tip_frame

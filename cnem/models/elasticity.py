@@ -14,7 +14,7 @@ from skfem.models.elasticity import linear_stress
 from tqdm.auto import tqdm
 
 from ..assembly import BilinearForm, CellBasis
-from ..assembly.conditions import dirichlet_dofs, per_point
+from ..assembly.conditions import Conditions, traction_at
 from ..assembly.basis import spread_component
 from ..assembly.quadrature import cell_quadrature, subdivide, tip_cells
 from ..assembly.gradients import SmoothedGradients
@@ -36,7 +36,7 @@ def elasticity_form(u, v, w):
     return ddot(linear_stress(w.lam, w.mu)(sym_grad(u)), sym_grad(v))
 
 
-class Elasticity:
+class Elasticity(Conditions):
     """Plane linear elasticity on a C-NEM model.
 
     Parameters
@@ -102,73 +102,31 @@ class Elasticity:
                                 f"SmoothedGradients(model, gauss={gauss})")
         #: the owner of the smoothed gradients this problem uses
         self.gradients = gradients
-        self._dirichlet = []
-        self._tractions = []
-        self._body = []
+        super().__init__()
         self._basis = None
         self._K = None
 
     def __repr__(self):
         return (f"<Elasticity plane {self.plane}, {len(self.model.nodes)} nodes, "
-                f"{len(self._dirichlet)} Dirichlet, {len(self._tractions)} traction, "
-                f"{len(self._body)} body-force conditions>")
+                f"{self.conditions_repr()}>")
 
-    # -- conditions ---------------------------------------------------------------------
-    def add_dirichlet(self, where, component, value=0.0):
-        """Prescribe displacements at nodes (direct imposition: Kronecker delta).
+    # -- conditions (`Conditions`: add_dirichlet, add_traction, add_body_force) ---------
+    #: Dirichlet predicates see the model's nodes (direct imposition: Kronecker delta).
+    points_name = "model.nodes"
 
-        Parameters
-        ----------
-        where : callable ``(p, 2) -> (p,) bool``, or a boolean mask / index array over nodes
-        component : {0, 1, None}
-            ``None`` prescribes both.
-        value : float, or callable ``(p, 2) -> (p,)`` (``(p, 2)`` for both components)
-        """
-        self._dirichlet.append(dirichlet_dofs(self.model.nodes, where, component, value,
-                                              where_to_look="model.nodes"))
+    @property
+    def condition_points(self):
+        """``(n, 2)`` the nodes that conditions refer to (``model.nodes``)."""
+        return self.model.nodes
 
     def boundary_edges(self):
-        """Edges of the outer boundary, holes and crack faces.
-
-        Returns
-        -------
-        edges : (e, 2) int64 ndarray
-            Node pairs, the body on the left (counter-clockwise).
-        normal : (e, 2) ndarray
-            Outward unit normals.
-        """
+        """The model's constraint edges with the body on one side (see
+        `Conditions.boundary_edges`)."""
         tri = self.model.triangles
         edges, _ = constraint_edges(tri, self.model.neighbors(across_regions=True))
         d = self.model.nodes[edges[:, 1]] - self.model.nodes[edges[:, 0]]
         normal = np.column_stack([d[:, 1], -d[:, 0]]) / np.linalg.norm(d, axis=1)[:, None]
         return edges, normal
-
-    def add_traction(self, where, t):
-        """Tractions on the boundary edges (outer, holes, crack faces).
-
-        Parameters
-        ----------
-        where : callable ``(x, nrm) -> (e,) bool``
-            Midpoints ``(e, 2)`` and outward unit normals ``(e, 2)`` of the edges.
-        t : (2,) array_like, or callable ``(x, nrm) -> (q, 2)``
-            Traction vectors; integrated by 3-point Gauss quadrature on each
-            edge (exact for tractions up to quadratic along an edge).
-        """
-        edges, normal = self.boundary_edges()
-        x = self.model.nodes
-        mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
-        pick = np.asarray(where(mid, normal)) if callable(where) else np.asarray(where)
-        if pick.shape != (len(edges),) or pick.dtype != bool:
-            raise ValueError(f"add_traction: where(x, nrm) must return a ({len(edges)},) bool "
-                             f"array, received dtype {pick.dtype} shape {pick.shape}")
-        if not pick.any():
-            raise ValueError("add_traction: `where` selects no boundary edge")
-        self._tractions.append((edges[pick], normal[pick], t))
-
-    def add_body_force(self, b):
-        """Body force per unit area: ``b(x) -> (p, 2)`` or a constant ``(2,)``
-        (nodal integration: the value at each cell's node times its area)."""
-        self._body.append(b)
 
     # -- assembly -----------------------------------------------------------------------
     @property
@@ -268,30 +226,33 @@ class Elasticity:
         g, w = np.polynomial.legendre.leggauss(3)
         s, w = 0.5 * (g + 1.0), 0.5 * w
         x = self.model.nodes
-        for edges, normal, t in self._tractions:
+        for traction in self.tractions:
+            edges, normal, t = traction.edges, traction.normal, traction.value
             a, b = x[edges[:, 0]], x[edges[:, 1]]
             length = np.linalg.norm(b - a, axis=1)
             for sk, wk in zip(s, w):
                 pts = a + sk * (b - a)
-                tr = per_point(t(pts, normal) if callable(t) else t, pts, 2, "traction")
+                tr = traction_at(t, pts, normal)
                 np.add.at(f, edges[:, 0], (wk * (1.0 - sk) * length)[:, None] * tr)
                 np.add.at(f, edges[:, 1], (wk * sk * length)[:, None] * tr)
             if self.enrichment is not None:
                 enriched += self.enrichment.edge_loads(edges, normal, t)
         cells = self.cells
-        for b in self._body:
-            pts = x[cells.node]
-            np.add.at(f, cells.node, cells.area[:, None] * per_point(b, pts, 2, "body force"))
+        for b in self.body_forces_at(x[cells.node]):
+            np.add.at(f, cells.node, cells.area[:, None] * b)
         # (the enrichment functions vanish at the nodes: no nodal body-force share)
         return np.concatenate([f.reshape(-1), enriched.reshape(-1)])
 
-    def _prescribed(self):
-        dofs = np.zeros(0, dtype=np.int64)
-        values = np.zeros(0)
-        for d, v in self._dirichlet:            # later conditions win
-            dofs, values = np.concatenate([dofs, d]), np.concatenate([values, v])
-        last = len(dofs) - 1 - np.unique(dofs[::-1], return_index=True)[1]
-        dofs, values = dofs[last], values[last]
+    def prescribed(self):
+        """The prescribed dofs and values (`Conditions.prescribed`), with the enriched
+        dofs of constrained nodes held at 0.
+
+        Returns
+        -------
+        dofs : (k,) int64 ndarray
+        values : (k,) ndarray
+        """
+        dofs, values = super().prescribed()
         if self.enrichment is not None:
             # enriched dofs of constrained nodes are held at 0, so that every test
             # function vanishes on the Dirichlet boundary
@@ -386,7 +347,7 @@ class Elasticity:
         f = self.load()
         t2 = time.perf_counter()
         bar.update()
-        D, values = self._prescribed()
+        D, values = self.prescribed()
         n2 = 2 * len(self.model.nodes)
         free = free_rigid_motions(K[:n2, :n2], self.model.nodes, D[D < n2])
         if free:
@@ -409,4 +370,4 @@ class Elasticity:
         log.info("elasticity: %s", ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
         E, nu = self.cell_materials().T
         C = stiffness_matrix(E, nu, self.plane)
-        return ElasticSolution(self, x, C, timings)
+        return ElasticSolution.from_dofs(self, x, C, timings)

@@ -2,128 +2,74 @@
 
 from __future__ import annotations
 
-import inspect
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ..assembly.quadrature import cell_quadrature
+from ..assembly.solution import Solution, energy_error_density, engineering_strain, von_mises
 
 __all__ = ["ElasticSolution", "von_mises", "energy_error_density"]
 
 
-def von_mises(stress):
-    """Plane von Mises stress of ``(..., 3)`` ``[sxx, syy, sxy]`` (in-plane components)."""
-    sxx, syy, sxy = stress[..., 0], stress[..., 1], stress[..., 2]
-    return np.sqrt(sxx ** 2 - sxx * syy + syy ** 2 + 3.0 * sxy ** 2)
-
-
-def engineering_strain(gradient):
-    """``[exx, eyy, 2 exy]`` from displacement gradients ``(..., 2, 2)``, ``(..., 3)``."""
-    g = gradient
-    return np.stack([g[..., 0, 0], g[..., 1, 1], g[..., 0, 1] + g[..., 1, 0]], axis=-1)
-
-
-def energy_error_density(points, region, stress, C, exact_stress):
-    """``(σh - σ)ᵀ C⁻¹ (σh - σ)`` at quadrature points.
-
-    Parameters
-    ----------
-    points : (q, 2) ndarray
-    region : (q,) int ndarray
-        Region of the cell (or element) holding each point.
-    stress : (q, 3) ndarray
-        The approximate stress ``σh`` at the points.
-    C : (q, 3, 3) ndarray
-        The elastic matrix at the points.
-    exact_stress : callable ``(q, 2) -> (q, 3)`` or ``(q, 2), (q,) -> (q, 3)``
-
-    Returns
-    -------
-    (q,) ndarray
-    """
-    if _takes_region(exact_stress):
-        exact = exact_stress(points, region)
-    else:
-        exact = exact_stress(points)
-    exact = np.asarray(exact, dtype=float)
-    if exact.shape != (len(points), 3):
-        raise ValueError(f"exact_stress must return ({len(points)}, 3) values "
-                         f"[sxx, syy, sxy], received shape {exact.shape}")
-    diff = stress - exact
-    return np.einsum("qi,qij,qj->q", diff, np.linalg.inv(C), diff)
-
-
-def _takes_region(func):
-    """Whether ``func`` accepts two positional arguments ``(x, region)``."""
-    try:
-        inspect.signature(func).bind(None, None)
-    except (TypeError, ValueError):                  # one argument, or no signature
-        return False
-    return True
-
-
-class ElasticSolution:
-    """The solution of an `Elasticity` problem.
+@dataclass(eq=False, repr=False)
+class ElasticSolution(Solution):
+    """The solution of an `Elasticity` problem (the fields of `cnem.assembly.solution`).
 
     Attributes
     ----------
     u : (n, 2) ndarray
         Nodal displacements (the displacement at node ``i`` is ``u[i]``).
-    enriched : (e, 2) ndarray
-        Coefficients of the enrichment functions, if any.
-    dofs : (2 n + 2 e,) ndarray
-        All unknowns.
-    gradient : (m, 2, 2) ndarray
-        Smoothed displacement gradient per cell, ``[k, i, j] = du_i/dx_j``.
-    strain : (m, 3) ndarray
-        ``[exx, eyy, 2 exy]`` per integration cell (smoothed, eq. 29).
     stress : (m, 3) ndarray
         ``[sxx, syy, sxy]`` per integration cell (eq. 34).
+    strain : (m, 3) ndarray
+        ``[exx, eyy, 2 exy]`` per integration cell (smoothed, eq. 29).
+    cells : Cells
+        The integration cells of ``stress`` and ``strain`` (``model.cells``, or
+        their sub-cells with enrichment).
+    gradient : (m, 2, 2) ndarray
+        Smoothed displacement gradient per cell, ``[k, i, j] = du_i/dx_j``.
+    dofs : (2 n + 2 e,) ndarray
+        All unknowns.
+    enriched : (e, 2) ndarray
+        Coefficients of the enrichment functions (empty without enrichment).
     C : (m, 3, 3) ndarray
         Elastic matrix of each cell.
     timings : dict
         Seconds spent in each stage.
+    model : Model
+    plane : {"stress", "strain"}
     """
 
-    def __init__(self, problem, dofs, C, timings):
-        self.problem = problem
-        self.model = problem.model
-        #: the integration cells of ``stress`` and ``strain`` (``model.cells``, or their
-        #: sub-cells with enrichment)
-        self.cells = problem.cells
-        self.plane = problem.plane
-        n = len(self.model.nodes)
-        self.dofs = dofs
-        self.u = dofs[:2 * n].reshape(-1, 2)
-        #: (e, 2) coefficients of the enrichment functions (empty without enrichment)
-        self.enriched = dofs[2 * n:].reshape(-1, 2)
-        self.C = C
-        self.timings = timings
+    stress: np.ndarray
+    strain: np.ndarray
+    cells: Any
+    gradient: np.ndarray
+    dofs: np.ndarray
+    enriched: np.ndarray
+    C: np.ndarray
+    timings: dict
+    model: Any
+    plane: str
+
+    stress_at = "cells"
+
+    @classmethod
+    def from_dofs(cls, problem, dofs, C, timings):
+        """The solution of ``problem`` with unknowns ``dofs`` and cell elastic matrices ``C``."""
+        n = len(problem.model.nodes)
         ops = problem.basis.operators[2:]               # du0/dx, du0/dy, du1/dx, du1/dy
-        self.gradient = np.stack([op @ dofs for op in ops], axis=1).reshape(-1, 2, 2)
-        self.strain = engineering_strain(self.gradient)
-        self.stress = np.einsum("kij,kj->ki", C, self.strain)
-
-    def __repr__(self):
-        return (f"<ElasticSolution {len(self.u)} nodes, {len(self.stress)} cells, "
-                f"max |u| {np.abs(self.u).max():.3e}, max von Mises {self.von_mises.max():.3e}>")
-
-    @property
-    def von_mises(self):
-        """``(m,)`` von Mises stress per cell."""
-        return von_mises(self.stress)
+        gradient = np.stack([op @ dofs for op in ops], axis=1).reshape(-1, 2, 2)
+        strain = engineering_strain(gradient)
+        return cls(problem=problem, u=dofs[:2 * n].reshape(-1, 2),
+                   stress=np.einsum("kij,kj->ki", C, strain), strain=strain, cells=problem.cells,
+                   gradient=gradient, dofs=dofs, enriched=dofs[2 * n:].reshape(-1, 2), C=C,
+                   timings=timings, model=problem.model, plane=problem.plane)
 
     def displacement(self, points):
-        """Displacements at points through the shape functions.
-
-        Parameters
-        ----------
-        points : (p, 2) array_like
-
-        Returns
-        -------
-        (p, 2) ndarray
-        """
+        """Displacements ``(p, 2)`` at points ``(p, 2)`` through the shape functions (and
+        the enrichment functions)."""
         phi = self.model.shape_functions(points)
         out = phi @ self.u
         enrichment = self.problem.enrichment
@@ -197,27 +143,22 @@ class ElasticSolution:
         """Strain energy ``1/2 sum_k A_k σ_k · ε_k``."""
         return 0.5 * float(self.cells.area @ (self.stress * self.strain).sum(axis=1))
 
-    def fields(self):
-        """Nodal and cell fields for files and pictures.
+    def nodal_average(self, values):
+        """Cell values ``(m, ...)`` at the nodes: each node's cell (area-weighted over the
+        cells of a node on an interface), ``(n, ...)``."""
+        cells, n = self.cells, len(self.model.nodes)
+        values = np.asarray(values, dtype=float)
+        weight = np.bincount(cells.node, weights=cells.area, minlength=n)
+        flat = values.reshape(len(values), -1)
+        out = np.stack([np.bincount(cells.node, weights=cells.area * col, minlength=n) / weight
+                        for col in flat.T], axis=1)
+        return out.reshape((n,) + values.shape[1:])
 
-        Returns
-        -------
-        point_data : dict of str -> (n, ...) ndarray
-        cell_data : dict of str -> (m, ...) ndarray
-        """
-        return ({"u": self.u},
-                {"stress": self.stress, "strain": self.strain, "von_mises": self.von_mises})
+    def plot_mesh(self):
+        """The nodes, the constrained Delaunay triangles and the domain's diameter."""
+        return self.model.nodes, self.model.triangles, self.model.domain.diameter
 
-    def write(self, path):
-        """Write nodes and cells with ``u``, ``stress``, ``strain`` and
-        ``von_mises`` (``.vtu``, see `cnem.io.write`)."""
+    def write_fields(self, path, point_data, cell_data):
+        """Nodes and integration cells with the fields (`cnem.io.write`)."""
         from .. import io
-        point_data, cell_data = self.fields()
         io.write(self.model, path, point_data=point_data, cell_data=cell_data)
-        return path
-
-    def plot(self, path=None, *, field="von_mises", scale=None, **kwargs):
-        """Off-screen picture of the deformed cells coloured by a field
-        (see `cnem.plot.solution`)."""
-        from .. import plot
-        return plot.solution(self, path, field=field, scale=scale, **kwargs)

@@ -10,7 +10,7 @@ continuum-kinematics-inspired PD (`CPD`, nonlinear, hyper-dual derivatives), sta
 >>> prob = pd.Problem(body, pd.StateBased(1.0, 0.3))
 >>> prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
 >>> prob.add_body_force([1.0, 0.0])
->>> sol = prob.solve_static()
+>>> sol = prob.solve()                 # (solve_static: the former name)
 >>> bool(sol.u[:, 0].max() > 0)
 True
 """
@@ -18,6 +18,8 @@ True
 from .body import Body
 from .cpd import CPD
 from .materials import BondBased, StateBased
-from .problem import DynamicRun, Problem, StaticSolution
+from .problem import Problem
+from .solution import DynamicRun, Relaxation, StaticSolution
 
-__all__ = ["Body", "BondBased", "StateBased", "CPD", "Problem", "StaticSolution", "DynamicRun"]
+__all__ = ["Body", "BondBased", "StateBased", "CPD", "Problem", "StaticSolution", "DynamicRun",
+           "Relaxation"]

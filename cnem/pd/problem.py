@@ -10,56 +10,28 @@ import numpy as np
 import scipy.sparse as sp
 from tqdm.auto import tqdm
 
-from ..assembly.conditions import dirichlet_dofs, per_point
+from ..assembly.conditions import Conditions, per_point
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import SolveError
 from . import _kernels as K
 from .frames import FrameWriter
 from ..material import PLANES
 from .relaxation import relax
+from .solution import DynamicRun, StaticSolution
 
-__all__ = ["Problem", "StaticSolution", "DynamicRun"]
+__all__ = ["Problem"]
 
 log = logging.getLogger(__name__)
 
 
-class StaticSolution:
-    """``u (n, d)``, ``residual_history`` (one list of residual norms per load step)."""
-
-    def __init__(self, problem, u, history):
-        self.problem, self.u, self.residual_history = problem, u, history
-
-    def stress(self):
-        """Stress of every point, ``(n, d, d)`` (see `Problem.stress`; not for CPD)."""
-        return self.problem.stress(self.u)
-
-    def __repr__(self):
-        return (f"<StaticSolution {len(self.u)} points, {len(self.residual_history)} load "
-                f"step(s), max |u| {np.abs(self.u).max():.3e}>")
-
-
-class DynamicRun:
-    """Result of `Problem.run_dynamic`: final ``u``, ``velocity``, ``damage (n,)``,
-    ``times`` of the stored frames, ``frames`` (list of ``(u, damage)``), ``energy``
-    (kinetic + elastic at each stored frame, without breaking), ``broken`` bonds,
-    ``files`` (the VTU file of each frame; empty without ``output``)."""
-
-    def __init__(self, **kw):
-        self.__dict__.update(kw)
-
-    def __repr__(self):
-        return (f"<DynamicRun {len(self.u)} points, t = {self.times[-1]:.3e}, "
-                f"max damage {self.damage.max():.3f}>")
-
-
-class Problem:
+class Problem(Conditions):
     """A peridynamic body with a material, loads and displacement conditions.
 
     Parameters
     ----------
     body : Body
     material : BondBased, StateBased or CPD
-        CPD (nonlinear) supports `solve_static` only; its 2-D energies are defined on
+        CPD (nonlinear) supports `solve` (`solve_static`) only; its 2-D energies are defined on
         the plane directly (``plane`` is not used).
     plane : {"stress", "strain"}
         2-D only.
@@ -85,12 +57,12 @@ class Problem:
         self.dim = body.dim
         self.surface_correction = kind != "cpd" if surface_correction is None else \
             bool(surface_correction)
-        self._dirichlet, self._body = [], []
+        super().__init__()
         self.alive = np.ones(len(body.bond_i), dtype=np.uint8)
         self._operators()
 
     def __repr__(self):
-        return f"<Problem {self.body!r}, {self.material!r}>"
+        return f"<Problem {self.body!r}, {self.material!r}, {self.conditions_repr()}>"
 
     # -- operators ----------------------------------------------------------------------
     def _operators(self):
@@ -125,15 +97,46 @@ class Problem:
         vals = np.concatenate([self.unit, -self.unit], axis=1).reshape(-1)
         return sp.csr_matrix((vals, (rows, cols)), shape=(nb, d * n))
 
-    def _state_operators(self):
+    @cached_property
+    def gradient_weights(self):
+        """``(b, d)`` ``g_b = w_b M_i^-1 xi_b`` of every bond ``b = (i, j)``, with the moment
+        tensors ``M_i = sum_b w_b xi_b xi_b^T`` (``w = beta V_j``): the nonlocal
+        displacement gradient of point ``i`` is ``sum_b (u_j - u_i) g_b^T``, exact for
+        linear fields also where the horizon is cut by a boundary.
+
+        Raises
+        ------
+        ValueError
+            A point whose bonds do not span every direction.
+        """
         b, d, n = self.body, self.dim, len(self.body)
         w = self.weight
-        # moment tensors M_i = sum w xi xi^T and theta_i = sum w (u_j - u_i) . M_i^-1 xi
         M = np.zeros((n, d, d))
         np.add.at(M, b.bond_i, w[:, None, None] * b.xi[:, :, None] * b.xi[:, None, :])
         if (np.linalg.det(M) <= 0).any():
             raise ValueError("a point has too few bonds to span every direction: enlarge the horizon")
-        g = np.einsum("bij,bj->bi", np.linalg.inv(M)[b.bond_i], b.xi) * w[:, None]
+        return np.einsum("bij,bj->bi", np.linalg.inv(M)[b.bond_i], b.xi) * w[:, None]
+
+    def displacement_gradient(self, u):
+        """Nonlocal displacement gradient of every point, ``(n, d, d)``,
+        ``[i, a, c] = du_a/dx_c`` (see `gradient_weights`; all bonds of the family).
+
+        Parameters
+        ----------
+        u : (n, d) array_like
+        """
+        b = self.body
+        u = np.asarray(u, dtype=float).reshape(len(b), self.dim)
+        per = (u[b.bond_j] - u[b.bond_i])[:, :, None] * self.gradient_weights[:, None, :]
+        out = np.zeros((len(b), self.dim, self.dim))
+        np.add.at(out, b.bond_i, per)
+        return out
+
+    def _state_operators(self):
+        b, d, n = self.body, self.dim, len(self.body)
+        w = self.weight
+        # the dilatation theta_i = sum w (u_j - u_i) . M_i^-1 xi: the trace of the gradient
+        g = self.gradient_weights
         rows = np.repeat(b.bond_i, 2 * d)
         cols = np.concatenate([d * b.bond_j[:, None] + np.arange(d),
                                d * b.bond_i[:, None] + np.arange(d)], axis=1).reshape(-1)
@@ -154,7 +157,7 @@ class Problem:
         if self.material.kind == "cpd":
             raise NotImplementedError(
                 f"{what} is available for BondBased and StateBased materials, not for CPD "
-                "(nonlinear, nonlocal measures): use solve_static, its displacements u, or "
+                "(nonlinear, nonlocal measures): use solve, its displacements u, or "
                 "Problem.interactions.evaluate(u) for energy, forces and tangent")
 
     # -- energies -----------------------------------------------------------------------
@@ -285,10 +288,11 @@ class Problem:
         dil = self.T.T @ sp.diags(self.bulk * b.volumes) @ self.T
         return (dil + self.Edev.T @ sp.diags(w) @ self.Edev).tocsr()
 
-    def stress(self, u):
+    def stress_tensor(self, u):
         """Stress of every point from its bonds, ``(n, d, d)`` (``dW_i / d eps`` for a
-        uniform strain: the classical stress in a uniform field)."""
-        self._linear_only("stress")
+        uniform strain: the classical stress in a uniform field). The solutions give
+        it in Voigt form as ``stress``."""
+        self._linear_only("stress_tensor")
         b, d = self.body, self.dim
         x = np.asarray(u, dtype=float).reshape(-1)
         nn = self.unit[:, :, None] * self.unit[:, None, :]
@@ -308,33 +312,38 @@ class Problem:
         np.add.at(out, b.bond_i, per)
         return out
 
-    # -- conditions ---------------------------------------------------------------------
-    def add_dirichlet(self, where, component, value=0.0):
-        """Prescribed displacements at points (same meaning as `cnem.Elasticity.add_dirichlet`)."""
-        self._dirichlet.append(dirichlet_dofs(self.body.points, where, component, value,
-                                              where_to_look="body.points"))
+    # -- conditions (`Conditions`: add_dirichlet, add_body_force) ----------------------
+    points_name = "body.points"
 
-    def add_body_force(self, b):
-        """Force per unit volume: ``b(x) -> (p, d)`` or a constant."""
-        self._body.append(b)
+    @property
+    def condition_points(self):
+        """``(n, d)`` the points that conditions refer to (``body.points``)."""
+        return self.body.points
+
+    def add_traction(self, where, t):
+        """Not for peridynamics: a nonlocal body has no boundary edges to load.
+
+        Raises
+        ------
+        NotImplementedError
+            Always: give the loads as body forces (`add_body_force`, force per unit
+            volume; a traction ``t`` on an edge becomes about ``t / dx`` on the
+            layer of points along it, ``dx`` the spacing).
+        """
+        raise NotImplementedError(
+            "add_traction: peridynamics takes no tractions (a nonlocal body has no "
+            "boundary edges); give the load as a body force with add_body_force, e.g. "
+            "t / dx on the layer of points along the edge (dx the point spacing)")
 
     def load(self):
         """External forces ``(d n,)``: body forces times volumes."""
         f = np.zeros((len(self.body), self.dim))
-        for b in self._body:
-            f += self.body.volumes[:, None] * per_point(b, self.body.points, self.dim, "body force")
+        for b in self.body_forces_at(self.body.points):
+            f += self.body.volumes[:, None] * b
         return f.reshape(-1)
 
-    def _prescribed(self):
-        dofs = np.zeros(0, dtype=np.int64)
-        values = np.zeros(0)
-        for dd, v in self._dirichlet:
-            dofs, values = np.concatenate([dofs, dd]), np.concatenate([values, v])
-        last = len(dofs) - 1 - np.unique(dofs[::-1], return_index=True)[1]
-        return dofs[last], values[last]
-
     # -- statics ------------------------------------------------------------------------
-    #: Most step halvings of the backtracking line search of `solve_static`.
+    #: Most step halvings of the backtracking line search of `solve`.
     LINE_SEARCH_HALVINGS = 10
 
     def _static_system(self):
@@ -349,6 +358,12 @@ class Problem:
 
     def solve_static(self, *, tol=1e-10, steps=1, initial=None, max_iterations=20,
                      line_search=False):
+        """The former name of `solve` (the static Newton solve), kept as an alias:
+        the same parameters and result."""
+        return self.solve(tol=tol, steps=steps, initial=initial, max_iterations=max_iterations,
+                          line_search=line_search)
+
+    def solve(self, *, tol=1e-10, steps=1, initial=None, max_iterations=20, line_search=False):
         """Newton-Raphson with the exact tangent, Dirichlet values and loads ramped in
         ``steps`` equal increments.
 
@@ -393,7 +408,7 @@ class Problem:
             raise ValueError(f"expected steps >= 1 and max_iterations >= 1, received "
                              f"steps={steps}, max_iterations={max_iterations}")
         evaluate, pattern = self._static_system()
-        D, values = self._prescribed()
+        D, values = self.prescribed()
         free = free_rigid_motions(pattern, self.body.points, D)
         if free:
             raise SolveError("the system is singular: the Dirichlet conditions leave free "
@@ -445,7 +460,7 @@ class Problem:
                 r = (f - load)[interior]
                 res.append(float(np.linalg.norm(r)))
             history.append(res)
-        return StaticSolution(self, u.reshape(n, d), history)
+        return StaticSolution(self, u.reshape(n, d), residual_history=history)
 
     @staticmethod
     def _reference(load, reactions, res):
@@ -543,7 +558,7 @@ class Problem:
         rho = self.material.density
         limit = self.material.stretch_limit(d, self.plane, b.horizon)
         state = self._force_state()
-        D, values = self._prescribed()
+        D, values = self.prescribed()
         u = np.zeros((n, d))
         u.reshape(-1)[D] = values
         v = np.zeros((n, d))
@@ -577,7 +592,7 @@ class Problem:
             v.reshape(-1)[D] = 0.0
             if step % every == 0 or step == steps:
                 store(step)
-        return DynamicRun(u=u, velocity=v, damage=self.damage(), times=np.array(times),
+        return DynamicRun(self, u, velocity=v, damage=self.damage(), times=np.array(times),
                           frames=frames, energy=np.array(energy), broken=total_broken,
                           files=files)
 

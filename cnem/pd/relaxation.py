@@ -28,7 +28,7 @@ iterations; the body then settles into its damaged equilibrium.
 >>> prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
 >>> prob.add_dirichlet(lambda p: p[:, 0] > 1 - 1e-9, 0, 1e-3)
 >>> sol = prob.relax(tol=1e-10)
->>> bool(np.abs(sol.u - prob.solve_static().u).max() < 1e-9)
+>>> bool(np.abs(sol.u - prob.solve().u).max() < 1e-9)
 True
 """
 
@@ -42,41 +42,11 @@ from tqdm.auto import tqdm
 
 from ..assembly.linsolve import free_rigid_motions
 from ..errors import SolveError
+from .solution import Relaxation
 
 __all__ = ["relax", "Relaxation"]
 
 log = logging.getLogger(__name__)
-
-
-class Relaxation:
-    """Result of `relax`.
-
-    Attributes
-    ----------
-    u : (n, d) ndarray
-        Equilibrium displacements of the last load step.
-    damage : (n,) ndarray
-        ``Problem.damage()`` at the end.
-    residual_history : list of list of float
-        One list per load step: the residual norm (free dofs) at iteration 0,
-        every ``every`` iterations and at the last iteration.
-    iterations : int
-        Iterations over all load steps.
-    broken : int
-        Bonds broken during the relaxation.
-    """
-
-    def __init__(self, problem, u, damage, history, iterations, broken):
-        self.problem, self.u, self.damage = problem, u, damage
-        self.residual_history, self.iterations, self.broken = history, iterations, broken
-
-    def stress(self):
-        """Stress of every point, ``(n, d, d)`` (see `Problem.stress`)."""
-        return self.problem.stress(self.u)
-
-    def __repr__(self):
-        return (f"<Relaxation {len(self.u)} points, {len(self.residual_history)} load step(s), "
-                f"{self.iterations} iterations, max damage {self.damage.max():.3f}>")
 
 
 def _damping(u, force, previous, velocity, density):
@@ -173,7 +143,7 @@ def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress
                          f"max_steps={max_steps}, steps={steps}, every={every}")
     body, d, n = problem.body, problem.dim, len(problem.body)
     stiffness = problem.stiffness()
-    fixed, values = problem._prescribed()
+    fixed, values = problem.prescribed()
     free_motions = free_rigid_motions(stiffness, body.points, fixed)
     if free_motions:
         raise SolveError("dynamic relaxation cannot settle: the Dirichlet conditions leave free "
@@ -240,4 +210,5 @@ def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress
         history.append(res)
         total += used
     flat[free] = x
-    return Relaxation(problem, u, problem.damage(), history, total, broken)
+    return Relaxation(problem, u, damage=problem.damage(), residual_history=history,
+                      iterations=total, broken=broken)

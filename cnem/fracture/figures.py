@@ -1,0 +1,156 @@
+"""Pictures of a crack-growth run (`CrackPath.plot`): matplotlib, off-screen, PNG.
+
+* `paths`: the geometry, the final von Mises field (at load factor 1) and the
+  crack paths with a dot at every increment's tip;
+* `sif_curves`: K_I, K_II and K_eq of every tip against its crack length;
+* `load_curves`: the critical load factor against crack length and, with a
+  ``measure``, the load-displacement curve of brittle growth.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..plot import nodal_field
+
+__all__ = ["paths", "sif_curves", "load_curves"]
+
+
+def _pyplot():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _unit(u):
+    return f" ({u})" if u else ""
+
+
+def _finish(fig, path):
+    fig.tight_layout()
+    if path is not None:
+        fig.savefig(path, dpi=130)
+    return fig
+
+
+def _outline(ax, domain):
+    for poly in domain.regions:
+        for ring in [poly.exterior, *poly.interiors]:
+            xy = np.asarray(ring.coords)
+            ax.plot(xy[:, 0], xy[:, 1], "k-", lw=1.0)
+
+
+def paths(hist, path=None, *, length_unit="", stress_unit="", title=None, field=True):
+    """Crack paths over the geometry and the final von Mises field.
+
+    Parameters
+    ----------
+    hist : CrackPath
+    path : str or os.PathLike, optional
+        PNG to write.
+    length_unit, stress_unit : str
+        Units for the axes and the colour bar.
+    title : str, optional
+    field : bool
+        Draw the von Mises field of the last solution.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    plt = _pyplot()
+    xmin, ymin, xmax, ymax = hist.domain.bounds
+    aspect = (xmax - xmin) / (ymax - ymin)
+    fig, ax = plt.subplots(figsize=(min(12.0, max(5.0, 5.0 * aspect + 2.2)), 5.5))
+    sol = hist.solution
+    if field and sol is not None:
+        mdl = sol.model
+        vm = nodal_field(sol, "von_mises")
+        top = np.percentile(vm, 99)                    # the tip singularity would wash out the rest
+        art = ax.tripcolor(mdl.nodes[:, 0], mdl.nodes[:, 1], mdl.triangles, vm, shading="gouraud",
+                           cmap="viridis", vmin=0.0, vmax=top)
+        bar = fig.colorbar(art, ax=ax, shrink=0.8, extend="max")
+        bar.set_label(f"von Mises stress at load factor 1{_unit(stress_unit)}")
+    _outline(ax, hist.domain)
+    first = True
+    for crack in hist.cracks:
+        ax.plot(crack[:, 0], crack[:, 1], "-", color="tab:red", lw=1.8,
+                label="crack paths" if first else None)
+        first = False
+    tips = hist.paths()
+    ax.plot(tips[..., 0].ravel(), tips[..., 1].ravel(), "o", ms=3, color="white", mec="black",
+            mew=0.6, label="tip at each increment")
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"x{_unit(length_unit)}")
+    ax.set_ylabel(f"y{_unit(length_unit)}")
+    ax.set_title(title or f"Crack paths, {len(hist.steps)} increments ({hist.criterion})")
+    ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    return _finish(fig, path)
+
+
+def sif_curves(hist, path=None, *, length_unit="", sif_unit="", title=None, reference=None):
+    """K_I, K_II and K_eq of every tip against its crack length.
+
+    Parameters
+    ----------
+    reference : (a, K) tuple of arrays, optional
+        A reference K_I curve to draw (a handbook solution, say).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    length, K, K_eq = hist.array("crack_length"), hist.array("K"), hist.array("K_eq")
+    if reference is not None:
+        ax.plot(reference[0], reference[1], "k-", lw=1.0, label="reference K_I")
+    for i in range(K.shape[1]):
+        tag = f" tip {i}" if K.shape[1] > 1 else ""
+        ax.plot(length[:, i], K[:, i, 0], "o-", ms=3, label=f"K_I{tag}")
+        ax.plot(length[:, i], K[:, i, 1], "s--", ms=3, label=f"K_II{tag}")
+        ax.plot(length[:, i], K_eq[:, i], ":", lw=1.2, label=f"K_eq{tag}")
+    ax.set_xlabel(f"crack length{_unit(length_unit)}")
+    ax.set_ylabel(f"K at load factor 1{_unit(sif_unit)}")
+    ax.set_title(title or f"Stress intensity factors during growth ({hist.criterion})")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return _finish(fig, path)
+
+
+def load_curves(hist, path=None, *, length_unit="", load_unit="", displacement_unit="", title=None):
+    """Critical load factor against crack length and, when ``measure`` was given,
+    the load-displacement curve (``load_factor * measure`` against ``load_factor``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    plt = _pyplot()
+    measure = hist.array("measure")
+    panels = 2 if np.isfinite(measure).any() else 1
+    fig, axes = plt.subplots(1, panels, figsize=(6.0 * panels, 4.5), squeeze=False)
+    length, load = hist.array("crack_length"), hist.array("load_factor")
+    critical = np.nanmin(np.where(np.isfinite(load), load, np.inf), axis=1)
+    critical[~np.isfinite(critical)] = np.nan
+    ax = axes[0, 0]
+    for i in range(load.shape[1]):
+        ax.plot(length[:, i], load[:, i], "o-", ms=3,
+                label=f"tip {i}" if load.shape[1] > 1 else "load factor K_Ic / K_eq")
+    ax.set_xlabel(f"crack length{_unit(length_unit)}")
+    ax.set_ylabel(f"critical load factor{_unit(load_unit)}")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title(title or "Load for growth against crack length")
+    if panels == 2:
+        ax = axes[0, 1]
+        ax.plot(critical * measure, critical, "o-", ms=3, label="brittle growth (K_eq = K_Ic)")
+        ax.plot([0, critical[0] * measure[0]], [0, critical[0]], "k:", lw=1.0,
+                label="elastic loading, initial crack")
+        ax.set_xlabel(f"displacement (measure x load factor){_unit(displacement_unit)}")
+        ax.set_ylabel(f"load factor{_unit(load_unit)}")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        ax.set_title("Load-displacement")
+    return _finish(fig, path)

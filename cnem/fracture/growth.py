@@ -1,0 +1,345 @@
+"""Quasi-static crack growth by linear elastic fracture mechanics: `grow`.
+
+Each increment solves the user's problem on the current model, takes K_I and
+K_II at every growing tip by the interaction integral (`sif`), turns them into
+a kink angle and an equivalent SIF by a criterion (`cnem.fracture.criteria`),
+and appends a straight segment at every tip. The node cloud stays: the new
+crack vertices become nodes, the nodes too close to a new segment are dropped
+(`cnem.fracture.advance`), and the grown domain is discretized again.
+
+>>> import numpy as np, cnem
+>>> dom = cnem.geometry.rectangle(1.0, 2.0, cracks=[[[0.0, 1.0], [0.3, 1.0]]])
+>>> def setup(model):                       # tension on both ends, symmetric about y = 1
+...     prob = cnem.Elasticity(model, (1.0, 0.3), plane="strain")
+...     ends = lambda x, n: np.abs(np.abs(x[:, 1] - 1.0) - 1.0) < 1e-9
+...     prob.add_traction(ends, lambda x, n: n * [0.0, 1.0])
+...     prob.add_dirichlet(lambda p: np.hypot(p[:, 0] - 1.0, p[:, 1]) < 1e-9, None)
+...     prob.add_dirichlet(lambda p: np.hypot(p[:, 0] - 1.0, p[:, 1] - 2.0) < 1e-9, 0)
+...     return prob
+>>> hist = cnem.fracture.grow(dom, cnem.nodes.regular(dom, 0.1), setup, increment=0.1, steps=1,
+...                           progress=False)
+>>> hist.cracks[0][-1].round(6).tolist()        # straight on, mode I
+[0.4, 1.0]
+"""
+
+from __future__ import annotations
+
+import logging
+import warnings
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from ..errors import GeometryError, GrowthError, GrowthWarning
+from ..geometry.cloud import NodeCloud
+from ..geometry.model import discretize
+from ..material import kappa as kolosov
+from ..nodes import irregular
+from . import advance
+from .criteria import CRITERIA, kink
+from .history import CrackPath, GrowthEvent, Step
+from .interaction import sif
+
+__all__ = ["grow"]
+
+log = logging.getLogger(__name__)
+
+#: Events that also raise a `GrowthWarning` (the others are expected ends of growth).
+_WARN = {"crack", "closed", "sharp_kink", "left_domain"}
+
+
+def _rediscretize(old_model, domain, cloud):
+    """The model of the grown domain on its cloud (``old_model``: the model before
+    growing, None at the start; a local update may reuse it)."""
+    return discretize(cloud, progress=False)
+
+
+def _positive(value, name, allow_none=False):
+    if value is None and allow_none:
+        return None
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        v = np.nan
+    if not np.isfinite(v) or v <= 0:
+        raise GrowthError(f"{name}: expected a positive number, received {value!r}")
+    return v
+
+
+def _tip_rows(domain):
+    """``[[crack, end, active], ...]`` for every tip of the domain."""
+    rows = []
+    for tip in domain.tips:
+        for j, c in enumerate(domain.cracks):
+            for end in (0, -1):
+                if np.array_equal(c[end], tip):
+                    rows.append([j, end, True])
+    return rows
+
+
+def _crack_length(crack):
+    return float(np.hypot(*np.diff(crack, axis=0).T).sum())
+
+
+class _Run:
+    """The mutable state of one `grow` call."""
+
+    def __init__(self, domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep):
+        self.domain, self.cloud, self.setup = domain, cloud, setup
+        self.criterion, self.K_Ic, self.max_kink = criterion, K_Ic, max_kink
+        self.measure, self.radius, self.keep = measure, radius, keep
+        self.cracks = [np.array(c, dtype=float) for c in domain.cracks]
+        self.rows = _tip_rows(domain)
+        self.model = None
+        self.steps, self.events = [], []
+
+    def event(self, kind, step, tip, point, message):
+        e = GrowthEvent(kind, step, tip, np.asarray(point, dtype=float).copy(), message)
+        self.events.append(e)
+        log.info("%s", e)
+        if kind in _WARN:
+            warnings.warn(str(e), GrowthWarning, stacklevel=4)
+        return e
+
+    def solve(self):
+        self.model = _rediscretize(self.model, self.domain, self.cloud)
+        sol = self.setup(self.model).solve(progress=False)
+        return sol
+
+    def state(self, sol, step):
+        """K, K_eq, angle, load factor at every active tip (NaN elsewhere)."""
+        t = len(self.rows)
+        tips = np.array([self.cracks[c][e] for c, e, _ in self.rows]).reshape(t, 2)
+        active = np.array([a for *_, a in self.rows], dtype=bool)
+        K, K_eq, angle = np.full((t, 2), np.nan), np.full(t, np.nan), np.full(t, np.nan)
+        for i in np.flatnonzero(active):
+            res = sif(sol, tips[i], radius=self.radius)
+            E, nu = sol.problem.materials[res.region]
+            K[i] = res
+            theta, K_eq[i], at_bound = kink(self.criterion, res[0], res[1],
+                                            kappa=kolosov(nu, sol.plane))
+            angle[i] = theta
+            if at_bound:
+                self.event("sharp_kink", step, i, tips[i],
+                           f"{self.criterion} finds no opening direction for K = {res[0]:.4g}, "
+                           f"{res[1]:.4g}; the crack kinks by {np.degrees(theta):.2f} degrees")
+            elif self.max_kink is not None and abs(theta) > self.max_kink:
+                self.event("sharp_kink", step, i, tips[i],
+                           f"kink {np.degrees(theta):.2f} degrees is sharper than max_kink = "
+                           f"{np.degrees(self.max_kink):.2f} degrees")
+        with np.errstate(divide="ignore", invalid="ignore"):
+            load = np.where(K_eq > 0, self.K_Ic / K_eq, np.nan) if self.K_Ic else np.full(t, np.nan)
+        lengths = np.array([_crack_length(self.cracks[c]) for c, *_ in self.rows]).reshape(t)
+        return dict(tips=tips, active=active, K=K, K_eq=K_eq, angle=angle, load_factor=load,
+                    crack_length=lengths,
+                    measure=float(self.measure(sol)) if self.measure else np.nan)
+
+    def advance(self, state, increments, step, clearance):
+        """Append the new segments; update the domain and the cloud."""
+        segments, spacings = [], []
+        for i in np.flatnonzero(increments > 0):
+            c, end, _ = self.rows[i]
+            crack = self.cracks[c]
+            start = crack[end].copy()
+            d = advance.tip_direction(crack, end)
+            th = state["angle"][i]
+            e = np.array([np.cos(th) * d[0] - np.sin(th) * d[1], np.sin(th) * d[0] + np.cos(th) * d[1]])
+            h = advance.local_spacing(self.cloud, start)
+            reach = clearance * h
+            da = increments[i]
+            hit = advance.first_hit(self.domain, self.cracks, c, end, start, start + da * e, reach)
+            stop = start + da * e
+            if hit.kind in ("boundary", "hole"):
+                stop = hit.point
+                self.rows[i][2] = False
+                if hit.distance < da * (1 - 1e-9):
+                    self.event("left_domain", step, i, start,
+                               f"the increment {da:.4g} would leave the domain: cut at "
+                               f"{hit.distance:.4g} where it meets the {hit.kind}")
+                self.event(hit.kind, step, i, stop, f"tip reached the {hit.kind} at "
+                           f"({stop[0]:.6g}, {stop[1]:.6g}); crack {c} is an edge crack")
+            elif hit.kind == "crack":
+                length = hit.distance - reach
+                self.rows[i][2] = False
+                self.event("crack", step, i, hit.point,
+                           f"tip meets crack {hit.crack} at ({hit.point[0]:.6g}, {hit.point[1]:.6g}) "
+                           f"away from its tips; it stops {reach:.3g} short of it")
+                if length <= reach:
+                    continue
+                stop = start + length * e
+            elif hit.kind == "joined":
+                stop = hit.point
+                self.event("joined", step, i, stop, f"tip joins the tip of crack {hit.crack} at "
+                           f"({stop[0]:.6g}, {stop[1]:.6g})")
+                segments.append((start, stop))
+                spacings.append(h)
+                self._join(i, hit)
+                continue
+            self.cracks[c] = np.vstack([crack, stop]) if end == -1 else np.vstack([stop, crack])
+            segments.append((start, stop))
+            spacings.append(h)
+        if not segments:
+            return False
+        self.domain = advance.rebuilt_domain(self.domain, self.cracks)
+        advance.check_connected(self.domain, step)
+        self.cloud = advance.grown_cloud(self.cloud, self.domain, segments, spacings, clearance)
+        return True
+
+    def _join(self, i, hit):
+        """Crack of tip ``i`` joined to ``hit.crack`` at its end ``hit.end``: one polyline."""
+        c, end, _ = self.rows[i]
+        j = hit.crack
+        a = self.cracks[c] if end == -1 else self.cracks[c][::-1]
+        b = self.cracks[j] if hit.end == 0 else self.cracks[j][::-1]
+        merged = np.vstack([a, b])
+        for row in self.rows:
+            if row[0] == c:
+                if row[1] == end:
+                    row[2] = False
+                row[1] = 0 if row[1] != end else -1
+            elif row[0] == j:
+                if row[1] == hit.end:
+                    row[2] = False
+                row[0], row[1] = c, (-1 if row[1] != hit.end else 0)
+        self.rows[i][2] = False
+        self.cracks[c] = merged
+        del self.cracks[j]
+        for row in self.rows:
+            if row[0] > j:
+                row[0] -= 1
+
+
+def _cycles(paris, prev, now, increments):
+    """Paris-law cycles of one step: da / (C dK^m), trapezoidal between the K_eq at the
+    start and at the end of the step of the tip that grew most (forward Euler if it stopped)."""
+    C, m = paris
+    i = int(np.nanargmax(np.where(increments > 0, increments, np.nan)))
+    rate = lambda k: 1.0 / (C * k ** m)  # noqa: E731
+    k0, k1 = prev["K_eq"][i], now["K_eq"][i]
+    if np.isfinite(k1) and k1 > 0:
+        return 0.5 * increments[i] * (rate(k0) + rate(k1))
+    return increments[i] * rate(k0)
+
+
+def grow(domain, cloud, setup, *, increment, steps, criterion="max_hoop", K_Ic=None, paris=None,
+         exponent=None, max_kink=None, measure=None, radius=None, clearance=0.5, keep=True,
+         progress=True) -> CrackPath:
+    """Grow the cracks of a domain step by step (quasi-static LEFM).
+
+    Parameters
+    ----------
+    domain : Domain
+        With at least one crack tip.
+    cloud : NodeCloud or float
+        Nodes of ``domain``, or a spacing ``h`` (then ``cnem.nodes.irregular(domain, h, seed=0)``).
+    setup : callable
+        ``setup(model) -> Elasticity``: materials, supports and loads on each new model.
+    increment : float
+        Crack extension per step at the fastest tip.
+    steps : int
+        Number of increments.
+    criterion : {"max_hoop", "max_energy_release", "min_sed"}
+        Direction criterion (`cnem.fracture.criteria`).
+    K_Ic : float, optional
+        Fracture toughness: each step's ``load_factor = K_Ic / K_eq`` (proportional loading).
+    paris : (C, m), optional
+        Paris law ``da/dN = C dK_eq^m`` with ``dK`` the K of ``setup``'s load: cycles per step.
+    exponent : float, optional
+        Tip-dependent increments ``da_i = increment (K_eq,i / K_eq,max)^exponent``;
+        default ``m`` of ``paris`` when given, else 0 (every tip grows ``increment``).
+    max_kink : float, optional
+        Kink angle (radians) above which a step is reported (event ``"sharp_kink"``).
+    measure : callable, optional
+        ``measure(solution) -> float`` recorded per step (a load-point displacement,
+        say: times ``load_factor`` it gives the load-displacement curve).
+    radius : float, optional
+        Interaction-integral radius (`sif`; default a few local node spacings).
+    clearance : float
+        Nodes closer than ``clearance`` local spacings to a new segment are dropped,
+        and a tip that ends this close to the boundary is carried on to it.
+    keep : bool
+        Keep every step's solution (`CrackPath.write` needs them).
+    progress : bool
+        A progress bar over the steps.
+
+    Returns
+    -------
+    CrackPath
+
+    Raises
+    ------
+    GrowthError
+        Bad arguments.
+    GeometryError
+        The domain has no tip, or the cracks cut the body apart (with the run so
+        far as the error's ``history``).
+    """
+    if criterion not in CRITERIA:
+        raise GrowthError(f"criterion: expected one of {sorted(CRITERIA)}, received {criterion!r}")
+    if len(domain.tips) == 0:
+        raise GeometryError("grow needs a domain with at least one crack tip (a crack end inside "
+                            f"the body), received {domain!r}")
+    increment = _positive(increment, "increment")
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
+        raise GrowthError(f"steps: expected a non-negative integer, received {steps!r}")
+    K_Ic = _positive(K_Ic, "K_Ic", allow_none=True)
+    if paris is not None:
+        if np.shape(paris) != (2,):
+            raise GrowthError(f"paris: expected (C, m), received {paris!r}")
+        paris = (_positive(paris[0], "paris C"), _positive(paris[1], "paris m"))
+    if exponent is None:
+        exponent = paris[1] if paris is not None else 0.0
+    elif not np.isfinite(exponent) or exponent < 0:
+        raise GrowthError(f"exponent: expected a number >= 0, received {exponent!r}")
+    max_kink = _positive(max_kink, "max_kink", allow_none=True)
+    clearance = _positive(clearance, "clearance")
+    if not isinstance(cloud, NodeCloud):
+        cloud = irregular(domain, _positive(cloud, "cloud (a spacing)"), seed=0)
+    elif cloud.domain is not domain:
+        raise GrowthError("cloud: expected a NodeCloud of `domain` (cloud.domain is domain), "
+                          "received one of another domain; build it with cnem.nodes from `domain`")
+    run = _Run(domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep)
+    bar = tqdm(total=steps, desc="crack growth", unit="step", disable=not progress, leave=False)
+    sol = run.solve()
+    mark = 0                                  # first event of the current step
+    now = run.state(sol, 0)
+    step = 0
+    try:
+        while step < steps:
+            increments = np.zeros(len(run.rows))
+            growing = now["active"] & (now["K"][:, 0] > 0) & (now["K_eq"] > 0)
+            for i in np.flatnonzero(now["active"] & ~growing):
+                run.event("closed", step, i, now["tips"][i], f"K_I = {now['K'][i, 0]:.4g} <= 0: "
+                          "the crack is closed at this tip, which does not grow in this step")
+            if not growing.any():
+                break
+            k_max = now["K_eq"][growing].max()
+            increments[growing] = increment * (now["K_eq"][growing] / k_max) ** exponent
+            grew = run.advance(now, increments, step, clearance)
+            prev, sol_prev, events = now, sol, tuple(run.events[mark:])
+            mark = len(run.events)
+            if grew:
+                sol = run.solve()
+                now = run.state(sol, step + 1)
+            cycles = _cycles(paris, prev, now, increments) if paris else np.nan
+            run.steps.append(Step(**prev, increment=increments, cycles=cycles, events=events,
+                                  solution=sol_prev if keep else None))
+            bar.update()
+            bar.set_postfix(K_eq=f"{k_max:.4g}")
+            step += 1
+            if not grew:
+                break
+    except GeometryError as err:
+        err.history = _history(run, now, sol, mark)
+        raise
+    finally:
+        bar.close()
+    return _history(run, now, sol, mark)
+
+
+def _history(run, now, sol, mark):
+    final = Step(**now, increment=np.zeros(len(run.rows)), events=tuple(run.events[mark:]),
+                 solution=sol if run.keep else None)
+    return CrackPath(steps=run.steps, final=final, cracks=[c.copy() for c in run.cracks],
+                     domain=run.domain, model=run.model, solution=sol, criterion=run.criterion,
+                     events=list(run.events))

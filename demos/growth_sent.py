@@ -1,0 +1,112 @@
+"""Straight mode-I growth of a single edge notch in tension (SENT), against the handbook K_I.
+
+The problem
+-----------
+A strip of width W = 1 and height H = 2 W with an edge crack along its
+mid-height y = H / 2, from a0 / W = 0.2 to a / W = 0.6 by `cnem.fracture.grow`
+(maximum hoop stress, increments of 0.02 W). Uniform tension sigma = 1 on both
+ends, the ends free to rotate (rigid motions held at two corners of the right
+edge, whose reactions vanish), E = 1, nu = 0.3, plane strain, a regular cloud
+(symmetric about the crack line), the default `cnem.fracture.sif` radius and
+no enrichment. The handbook value (Tada, Paris & Irwin; Brown & Srawley, within
+0.5 % for a / W <= 0.6)
+
+    K_I = sigma sqrt(pi a) (1.12 - 0.231 r + 10.55 r^2 - 21.72 r^3 + 30.39 r^4),  r = a / W.
+
+Expected result
+---------------
+* The path stays on the symmetry line: |kink| < 0.1 degrees at every increment
+  (the cloud is symmetric, so K_II is round-off).
+* K_I against the handbook at every increment: the issue asks for 1 %;
+  measured with the defaults (5181 nodes, h = 0.02, radius 6 h = 0.12):
+  1.0-1.9 % low at every increment, so the 1 % target is missed. A finding, not
+  tuned away: plain C-NEM K_I on uniform clouds converges slowly (2.0 % at
+  h = 0.04, 1.5 % at h = 0.02 for a / W = 0.2), and on a cloud graded to
+  h / 8 at the tip the default radius (six tip spacings) gives 2.7 % while a
+  radius of 0.1 gives 0.3-0.9 %.
+* Pictures in ``outdir``: ``sent_path.png`` (path over the von Mises field) and
+  ``sent_sif.png`` (K_I against a with the handbook curve).
+"""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+
+import numpy as np
+
+import cnem
+
+W, H, E, NU, SIGMA = 1.0, 2.0, 1.0, 0.3, 1.0
+
+
+def handbook(a):
+    """K_I of the SENT specimen (Brown & Srawley), ``a`` crack length."""
+    r = np.asarray(a) / W
+    return SIGMA * np.sqrt(np.pi * np.asarray(a)) * (
+        1.12 - 0.231 * r + 10.55 * r ** 2 - 21.72 * r ** 3 + 30.39 * r ** 4)
+
+
+def domain(a0=0.2 * W):
+    return cnem.geometry.rectangle(W, H, cracks=[[[0.0, 0.5 * H], [a0, 0.5 * H]]])
+
+
+def setup(model):
+    """Tension on both ends; rigid motions held at the right edge's corners."""
+    tol = 1e-9 * W
+    prob = cnem.Elasticity(model, (E, NU), plane="strain")
+    prob.add_traction(lambda x, n: np.abs(np.abs(x[:, 1] - 0.5 * H) - 0.5 * H) < tol,
+                      lambda x, n: SIGMA * n * [0.0, 1.0])
+    prob.add_dirichlet(lambda p: np.hypot(p[:, 0] - W, p[:, 1]) < tol, None)
+    prob.add_dirichlet(lambda p: np.hypot(p[:, 0] - W, p[:, 1] - H) < tol, 0)
+    return prob
+
+
+def main(h=0.02, *, a0=0.2, a1=0.6, increment=0.02, outdir="results/growth_sent", plot=True,
+         progress=True):
+    """Grow the crack from ``a0`` to ``a1`` (fractions of W) on a regular cloud of spacing ``h``.
+
+    Returns
+    -------
+    dict
+        ``rows`` (per state: ``a, K_I, K_II, handbook, error, kink_deg``),
+        ``max_error`` (largest |K_I / handbook - 1|), ``max_kink_deg``,
+        ``nodes``, ``files``.
+    """
+    out = pathlib.Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    dom = domain(a0 * W)
+    steps = int(round((a1 - a0) * W / increment))
+    hist = cnem.fracture.grow(dom, cnem.nodes.regular(dom, h * W), setup, increment=increment * W,
+                              steps=steps, progress=progress)
+    a = hist.array("crack_length")[:, 0]
+    K = hist.array("K")[:, 0]
+    kink = np.degrees(hist.array("angle")[:, 0])
+    ref = handbook(a)
+    rows = [dict(a=float(a[k]), K_I=float(K[k, 0]), K_II=float(K[k, 1]), handbook=float(ref[k]),
+                 error=float(K[k, 0] / ref[k] - 1), kink_deg=float(kink[k])) for k in range(len(a))]
+    print(f"{'a/W':>6} {'K_I':>9} {'handbook':>9} {'error %':>8} {'K_II':>10} {'kink deg':>9}")
+    for r in rows:
+        print(f"{r['a'] / W:>6.3f} {r['K_I']:>9.5f} {r['handbook']:>9.5f} {100 * r['error']:>8.3f} "
+              f"{r['K_II']:>10.2e} {r['kink_deg']:>9.2e}")
+    files = []
+    if plot:
+        hist.plot(out / "sent_path.png", kind="paths", length_unit="W", stress_unit="sigma",
+                  title=f"SENT: straight growth a/W = {a0} to {a1} ({len(hist.model.nodes)} nodes)")
+        aa = np.linspace(a0 * W, a1 * W, 100)
+        hist.plot(out / "sent_sif.png", kind="sif", length_unit="W", sif_unit="sigma sqrt(W)",
+                  reference=(aa, handbook(aa)), title="SENT: K_I during growth vs the handbook")
+        files = [out / "sent_path.png", out / "sent_sif.png"]
+    return dict(rows=rows, max_error=max(abs(r["error"]) for r in rows),
+                max_kink_deg=max(abs(r["kink_deg"]) for r in rows),
+                nodes=len(hist.model.nodes), files=[str(f) for f in files], history=hist)
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--h", type=float, default=0.02, help="node spacing (fraction of W)")
+    parser.add_argument("--increment", type=float, default=0.02, help="crack increment / W")
+    parser.add_argument("--no-plot", action="store_true")
+    parser.add_argument("--out", default="results/growth_sent")
+    args = parser.parse_args()
+    main(args.h, increment=args.increment, outdir=args.out, plot=not args.no_plot)

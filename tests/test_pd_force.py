@@ -1,0 +1,86 @@
+"""The fast peridynamic forces (numba PMB kernel, sparse LPS stiffness) against the
+plain double loops of `tests.reference` (formulas of `cnem.pd.materials`)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import cnem.pd as pd
+from reference import lps_force, pmb_force
+
+
+def _irregular_2d(seed=0):
+    """A perturbed lattice of 11 x 8 points with unequal volumes."""
+    rng = np.random.default_rng(seed)
+    h = 0.1
+    g = np.stack(np.meshgrid(np.arange(11) * h, np.arange(8) * h, indexing="ij"), -1)
+    pts = g.reshape(-1, 2) + rng.uniform(-0.2 * h, 0.2 * h, (88, 2))
+    return pts, h * h * rng.uniform(0.8, 1.2, len(pts)), 3.015 * h
+
+
+def _lattice_3d():
+    h = 0.1
+    g = np.stack(np.meshgrid(*[np.arange(5) * h] * 3, indexing="ij"), -1)
+    return g.reshape(-1, 3), np.full(125, h ** 3), 2.015 * h
+
+
+CASES = {"irregular 2-D": _irregular_2d, "3-D lattice": _lattice_3d}
+
+
+def _moduli(E, nu, d, plane):
+    """Bulk (d-dimensional) and shear modulus of the classical law."""
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    if d == 3:
+        return lam + 2 * mu / 3, mu
+    if plane == "stress":
+        lam = 2 * lam * mu / (lam + 2 * mu)
+    return lam + mu, mu
+
+
+def _displacement(points, seed=1):
+    """A linear field plus a random one, small against the spacing."""
+    rng = np.random.default_rng(seed)
+    d = points.shape[1]
+    grad = rng.normal(0.0, 1e-3, (d, d))
+    return points @ grad.T + rng.normal(0.0, 1e-3 * 0.1, points.shape)
+
+
+def _factor(prob):
+    b = prob.body
+    table = {(int(i), int(j)): float(f) for i, j, f in zip(b.bond_i, b.bond_j, prob.factor)}
+    return lambda i, j: table[(i, j)]
+
+
+def _fast_force(prob, u):
+    return prob._internal_force(u, np.inf, prob._force_state())[0]
+
+
+@pytest.mark.parametrize("case", CASES)
+@pytest.mark.parametrize("correction", [False, True], ids=["plain", "corrected"])
+def test_pmb_force_matches_the_double_loop(case, correction):
+    points, volumes, horizon = CASES[case]()
+    d, E = points.shape[1], 2.0
+    prob = pd.Problem(pd.Body(points, volumes, horizon), pd.BondBased(E),
+                      surface_correction=correction)
+    u = _displacement(points)
+    # the micromodulus of the BondBased docstring
+    c = 12 * E / (np.pi * horizon ** 4) if d == 3 else 9 * E / (np.pi * horizon ** 3)
+    expected = pmb_force(points, volumes, horizon, u, c, _factor(prob))
+    found = _fast_force(prob, u)
+    assert np.abs(found - expected).max() <= 1e-12 * np.abs(expected).max()
+
+
+@pytest.mark.parametrize("case", CASES)
+@pytest.mark.parametrize("plane", ["stress", "strain"])
+@pytest.mark.parametrize("correction", [False, True], ids=["plain", "corrected"])
+def test_lps_force_matches_the_double_loop(case, plane, correction):
+    points, volumes, horizon = CASES[case]()
+    d, E, nu = points.shape[1], 2.0, 0.3
+    prob = pd.Problem(pd.Body(points, volumes, horizon), pd.StateBased(E, nu), plane=plane,
+                      surface_correction=correction)
+    u = _displacement(points)
+    bulk, shear = _moduli(E, nu, d, plane)
+    expected = lps_force(points, volumes, horizon, u, bulk, shear, _factor(prob))
+    found = _fast_force(prob, u)
+    assert np.abs(found - expected).max() <= 1e-12 * np.abs(expected).max()
