@@ -14,7 +14,7 @@ import scipy.sparse as sp
 
 from .._parallel import one_thread
 from ..errors import CNEMError
-from .scni import SmoothedGradient, smoothed_gradient
+from .gradients import SmoothedGradient, smoothed_gradient
 
 __all__ = ["updated_gradient", "renumber_rows"]
 

@@ -18,7 +18,7 @@ import scipy.sparse as sp
 
 from ..assembly import CellBasis
 from ..assembly.quadrature import subdivide, tip_cells
-from ..assembly.scni import smoothed_gradient
+from ..assembly.gradients import smoothed_gradient
 from ..assembly.update import renumber_rows, updated_gradient
 from .._parallel import one_thread
 from ..errors import CNEMError
@@ -121,7 +121,7 @@ def updated_operators(old, new, change, form):
 
 def _rows(gradient, index):
     """``B~`` of the cells ``index`` alone."""
-    from ..assembly.scni import SmoothedGradient
+    from ..assembly.gradients import SmoothedGradient
     return SmoothedGradient(gradient.x[index], gradient.y[index], 0)
 
 
