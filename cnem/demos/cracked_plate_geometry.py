@@ -40,7 +40,7 @@ import numpy as np
 import cnem
 import cnem.io
 import cnem.plot
-from cnem.geometry import rectangle
+from cnem.geometry import SegmentKind, rectangle
 
 __all__ = ["main", "cli", "build"]
 
@@ -101,7 +101,7 @@ def main(h=0.1, h_min=0.01, gamma_deg=30.0, growth=0.1, outdir="out", plot=True,
     model = cnem.discretize(cloud, progress=False)
     seconds = time.perf_counter() - t0
 
-    crack_points = np.unique(cloud.segments[cloud.segment_kind == 2])
+    crack_points = np.unique(cloud.segments[cloud.segment_kind == SegmentKind.CRACK])
     exact_area = (2 * HALF_WIDTH) ** 2
     cell_area = float(model.cells.area.sum())
     files = {"vtu": cnem.io.write(model, out / "cracked_plate.vtu")}
