@@ -21,13 +21,13 @@ one side after the other; every run redoes every stage from the node cloud (resp
 nothing), so nothing cached by one run serves the next:
 
 * C-NEM ``model``: ``cnem.discretize(cloud)``;
-* C-NEM ``B~``: the smoothed gradients on a model whose ``_cache`` is cleared but for the
-  triangle-neighbour table ``discretize`` leaves there, so it includes the once-per-model
-  setup it triggers (the circumcircles and their R-tree):
-  ``cnem.assembly.scni.fan_gradient(model)`` (B~ of the cells and of their fan sub-cells,
-  for the default stabilisation), ``smoothed_gradient(model)`` with ``--stabilization 0``;
-* C-NEM ``K``: ``Elasticity(...).stiffness()`` with the gradients already cached: the cell
-  bases, their operators and the assembly of K;
+* C-NEM ``B~``: the smoothed gradients on the fresh model (which holds only the
+  triangle-neighbour table ``discretize`` built), so it includes the once-per-model setup it
+  triggers (the circumcircles and their R-tree): ``gradients.fan()`` of a
+  ``cnem.assembly.SmoothedGradients(model)`` (B~ of the cells and of their fan sub-cells,
+  for the default stabilisation), ``gradients.cells()`` with ``--stabilization 0``;
+* C-NEM ``K``: ``Elasticity(..., gradients=gradients).stiffness()`` with the gradients
+  already kept by ``gradients``: the cell bases, their operators and the assembly of K;
 * skfem ``mesh``, ``basis``, ``K``: ``MeshTri.init_tensor``, ``Basis(...)`` and
   ``asm(linear_elasticity(...), basis)``;
 * ``solve`` (both sides, the very same function): ``skfem.condense`` of the clamped dofs, the
@@ -173,20 +173,19 @@ def lattice_cloud(k):
 def cnem_pipeline(cloud, run):
     """C-NEM from the cloud: model, B~, K, rigid-motion check, solve (timed into ``run``)."""
     import cnem
-    from cnem.assembly import smoothed_gradient
+    from cnem.assembly import SmoothedGradients
     from cnem.assembly.linsolve import free_rigid_motions
-    from cnem.assembly.scni import fan_gradient
 
     model = staged(run, "model", lambda: cnem.discretize(cloud, progress=False))
-    for key in [key for key in model._cache if key != "neighbors"]:    # built by discretize
-        del model._cache[key]
     # the smoothed gradients Elasticity needs: with the stabilisation those of the fan
     # sub-cells too, computed with the cells' (one set of shape-function values)
-    staged(run, "B~", lambda: fan_gradient(model) if CLOUD["stabilization"] > 0
-           else smoothed_gradient(model))
-    grad = smoothed_gradient(model)
-    points = fan_gradient(model)[1].points if CLOUD["stabilization"] > 0 else grad.points
-    prob = cnem.Elasticity(model, (E, NU), plane=PLANE, stabilization=CLOUD["stabilization"])
+    gradients = SmoothedGradients(model)
+    staged(run, "B~", lambda: gradients.fan() if CLOUD["stabilization"] > 0
+           else gradients.cells())
+    grad = gradients.cells()
+    points = gradients.fan()[1].points if CLOUD["stabilization"] > 0 else grad.points
+    prob = cnem.Elasticity(model, (E, NU), plane=PLANE, stabilization=CLOUD["stabilization"],
+                           gradients=gradients)
     K = staged(run, "K", prob.stiffness)
     prob.add_traction(lambda x, nrm: nrm[:, 0] > 0.5, list(TRACTION))
     f, D = prob.load(), clamped_dofs(model.nodes)
@@ -386,9 +385,9 @@ def report(results, warm):
           "(direct <= 2.5M non-zeros, pyamg + CG above; C-NEM: hierarchy on the P1 matrix of its "
           "triangles, built in the stage): Elasticity.solve's path without its "
           "rigid-motion check (timed in the details)")
-    print("B~ = the smoothed gradients on an empty model cache (includes the shape-function "
-          "setup): fan_gradient (cells and their fan sub-cells, one set of points) with the "
-          "stabilisation, smoothed_gradient without; K = Elasticity.stiffness() from them; "
+    print("B~ = the smoothed gradients on a fresh model (includes the shape-function "
+          "setup): SmoothedGradients.fan (cells and their fan sub-cells, one set of points) with "
+          "the stabilisation, .cells() without; K = Elasticity.stiffness() from them; "
           "total = sum of the stages")
     import numba
     print(f"warm-up before timing (numba compile, first calls): both sides once on "

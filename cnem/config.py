@@ -3,7 +3,9 @@
 Tolerances are *relative*: multiply by the domain diameter (lengths) or its
 square (areas) before comparing. Modules read these as ``config.NAME`` when they
 run, so a user may change one for a session (``cnem.config.DIRECT_NNZ = 10**6``);
-where a numba kernel needs a compile-time constant the comment says so.
+where a numba kernel needs a compile-time constant the comment says so
+(``cnem.shape._kernels.MAX_CAVITY`` stays in its kernel module: numba compiles it
+into the kernels as a constant).
 
 >>> from cnem import config
 >>> config.SNAP_TOL < config.CLEARANCE < 1
@@ -14,7 +16,7 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLE
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
-           "FD_STEP", "HYPERDUAL_CHUNK"]
+           "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER"]
 
 # ---------------------------------------------------------------- geometry tolerances
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
@@ -111,3 +113,21 @@ FD_STEP = 1e-4
 #: Real numbers per part handed to the function in one call of
 #: `cnem.hyperdual.derivatives` (bounds its temporaries).
 HYPERDUAL_CHUNK = 2 ** 21
+
+# ---------------------------------------------------------------- shape functions and SCNI
+# (speed and memory only: results do not depend on them)
+
+#: Cells whose boundary quadrature is built and evaluated in one pass of the SCNI
+#: smoothed gradients (`cnem.assembly.passes`): bounds the memory of the points
+#: and their shape functions, and keeps a pass in cache.
+CELLS_PER_PASS = 10_000
+
+#: Room per point for the shape-function rows written chunk by chunk
+#: (`cnem.shape.natural`; doubled when a chunk overflows: points have about 5-6
+#: natural neighbours on average).
+ROW_SLOTS = 8
+
+#: Points the walks of the point location cannot reach, as a fraction of the
+#: triangles, above which they are located with an R-tree of the triangles
+#: (`Model.triangle_tree`, built once) rather than of the circumcircles.
+TRIANGLE_TREE_AFTER = 0.01

@@ -577,6 +577,139 @@ def laplace_reference(model, x, region):
     return {j: v / total for j, v in w.items() if v / total >= 1e-14}
 
 
+# ------------------------------------------------------------ SCNI smoothed gradient
+# C-NEM paper eq. 26-32: b~_I(x_L) = (1 / A_L) ∮_{Γ_L} φ_I(x) n(x) dΓ, cell by cell.
+# Every edge of a cell's boundary (its polygon, and the crack faces that run
+# inside it) is cut where it crosses any circumcircle of the triangulation (all
+# of them tried, roots of a quadratic), since φ is smooth only between those
+# crossings; each piece gets Gauss-Legendre points, φ comes from
+# model.shape_functions, on a crack face from the face's own triangle.
+
+
+def _circumcircles(nodes, triangles):
+    """Centres ``(t, 2)`` and squared radii ``(t,)`` by the textbook formula."""
+    a, b, c = (nodes[triangles[:, k]] for k in range(3))
+    d = 2.0 * (a[:, 0] * (b[:, 1] - c[:, 1]) + b[:, 0] * (c[:, 1] - a[:, 1])
+               + c[:, 0] * (a[:, 1] - b[:, 1]))
+    sa, sb, sc = ((p ** 2).sum(axis=1) for p in (a, b, c))
+    ux = (sa * (b[:, 1] - c[:, 1]) + sb * (c[:, 1] - a[:, 1]) + sc * (a[:, 1] - b[:, 1])) / d
+    uy = (sa * (c[:, 0] - b[:, 0]) + sb * (a[:, 0] - c[:, 0]) + sc * (b[:, 0] - a[:, 0])) / d
+    centre = np.column_stack([ux, uy])
+    return centre, ((a - centre) ** 2).sum(axis=1)
+
+
+def _crossings(a, b, centre, radius2, end_tol=1e-12):
+    """Sorted ``t`` in (0, 1) where ``a + t (b - a)`` crosses a circle (not at the ends)."""
+    d, f = b - a, a - centre
+    qa = d @ d
+    qb = 2.0 * (f @ d)
+    qc = (f ** 2).sum(axis=1) - radius2
+    disc = qb ** 2 - 4.0 * qa * qc
+    hit = disc > 0
+    root = np.sqrt(disc[hit])
+    t = np.concatenate([(-qb[hit] - root) / (2 * qa), (-qb[hit] + root) / (2 * qa)])
+    return np.sort(t[(t > end_tol) & (t < 1.0 - end_tol)])
+
+
+def _crack_face_list(model):
+    """Every crack face as ``(p, q, triangle)``: the segment ``p -> q`` with its own
+    triangle (the one with both ends as vertices) on its left."""
+    from cnem.geometry.pslg import CRACK
+    nodes, tri = model.nodes, model.triangles
+    faces = {}
+    for i, j in model.segments[model.segment_kind == CRACK]:
+        for t in np.flatnonzero((tri == i).any(axis=1) & (tri == j).any(axis=1)):
+            k = [v for v in tri[t] if v not in (i, j)][0]
+            left = orient2d(nodes[i], nodes[j], nodes[k]) > 0
+            faces[int(t)] = (nodes[i], nodes[j]) if left else (nodes[j], nodes[i])
+    return [(p, q, t) for t, (p, q) in faces.items()]
+
+
+def _on_face(a, b, faces, tol):
+    """The triangle of the face the edge ``a -> b`` lies on, running the same way
+    (its triangle then on the cell's side), else -1."""
+    for p, q, t in faces:
+        d = q - p
+        length = np.linalg.norm(d)
+        for x in (a, b):
+            r = x - p
+            if abs(d[0] * r[1] - d[1] * r[0]) > tol * length or not \
+                    -tol <= (r @ d) / length <= length + tol:
+                break
+        else:
+            if (b - a) @ d > 0:
+                return t
+    return -1
+
+
+def _slits(polygon, faces, tol):
+    """The parts of crack faces inside a cell with the cell on both of their sides:
+    ``(a, b, triangle)`` oriented like their face."""
+    out = []
+    for p, q, t in faces:
+        parts = shapely.LineString([p, q]).intersection(polygon)
+        parts = getattr(parts, "geoms", [parts])
+        for part in parts:
+            if not isinstance(part, shapely.LineString) or part.length <= tol:
+                continue
+            xy = np.asarray(part.coords)
+            a, b = xy[0], xy[-1]
+            if (b - a) @ (q - p) < 0:
+                a, b = b, a
+            mid, normal = 0.5 * (a + b), np.array([a[1] - b[1], b[0] - a[0]]) / part.length
+            if polygon.contains(shapely.Point(mid + tol * normal)) and \
+                    polygon.contains(shapely.Point(mid - tol * normal)):
+                out.append((a, b, t))
+    return out
+
+
+def smoothed_gradient(model, gauss=2):
+    """The SCNI smoothed gradients of every shape function on every cell of
+    ``model.cells``, cell by cell from eq. 31-32.
+
+    Parameters
+    ----------
+    model : Model
+        ``n`` nodes, ``m`` cells.
+    gauss : int
+        Gauss points per piece of edge between circumcircle crossings.
+
+    Returns
+    -------
+    gx, gy : (m, n) ndarray
+    """
+    cells, nodes = model.cells, model.nodes
+    centre, radius2 = _circumcircles(nodes, model.triangles)
+    faces = _crack_face_list(model)
+    size = model.domain.diameter
+    s, w = np.polynomial.legendre.leggauss(gauss)
+    s, w = 0.5 * (s + 1.0), 0.5 * w
+    points, hints, weights, owner = [], [], [], []
+    area = np.zeros(len(cells))
+    for c in range(len(cells)):
+        poly = cells.polygon(c)
+        nxt = np.roll(poly, -1, axis=0)
+        area[c] = 0.5 * np.sum(poly[:, 0] * nxt[:, 1] - nxt[:, 0] * poly[:, 1])
+        edges = [(a, b, _on_face(a, b, faces, 1e-9 * size)) for a, b in zip(poly, nxt)]
+        edges += _slits(shapely.Polygon(poly), faces, 1e-6 * np.sqrt(abs(area[c])))
+        for a, b, t in edges:
+            d = b - a
+            normal = np.array([d[1], -d[0]])              # outward, times the length
+            ends = np.concatenate([[0.0], _crossings(a, b, centre, radius2), [1.0]])
+            for t0, t1 in zip(ends[:-1], ends[1:]):
+                x = a + (t0 + (t1 - t0) * s)[:, None] * d
+                points.append(x)
+                hints.append(np.full(gauss, t))
+                weights.append(((t1 - t0) * w)[:, None] * normal)
+                owner.append(np.full(gauss, c))
+    phi = model.shape_functions(np.concatenate(points), triangles=np.concatenate(hints))
+    owner, weights = np.concatenate(owner), np.concatenate(weights)
+    gx, gy = np.zeros((len(cells), len(nodes))), np.zeros((len(cells), len(nodes)))
+    phi = phi.toarray()
+    np.add.at(gx, owner, weights[:, :1] * phi)
+    np.add.at(gy, owner, weights[:, 1:] * phi)
+    return gx / area[:, None], gy / area[:, None]
+
 # ------------------------------------------------------------------ peridynamic forces
 def pd_bonds(points, volumes, horizon, thickness=1.0):
     """Every bond ``(i, j)`` with ``0 < |x_j - x_i| < horizon`` by a double loop, with its

@@ -293,12 +293,6 @@ PROTOCOL = {"SystemExit": "the command line's usage errors",
             "AttributeError": "assignment to an immutable object",
             "AssertionError": "an internal invariant (a bug in cnem, not bad input)"}
 
-#: Bare raises left in files another change is splitting (path, exception): count. Remove an
-#: entry when its file raises `cnem.errors` classes; the test fails on a stale entry.
-PENDING = {("assembly/scni.py", "ValueError"): 1,
-           ("shape/natural.py", "ValueError"): 2,
-           ("shape/natural.py", "NotImplementedError"): 1}
-
 BUILTIN_ERRORS = {name for name, obj in vars(builtins).items()
                   if isinstance(obj, type) and issubclass(obj, BaseException)}
 
@@ -317,20 +311,14 @@ def _raised_builtins(path):
 
 
 def test_every_raise_uses_the_error_family():
-    bad, seen = [], {}
+    bad = []
     for path in sorted(PACKAGE.rglob("*.py")):
         rel = path.relative_to(PACKAGE).as_posix()
         for line, name in _raised_builtins(path):
-            if name in PROTOCOL:
-                continue
-            if (rel, name) in PENDING:
-                seen[rel, name] = seen.get((rel, name), 0) + 1
-                continue
-            bad.append(f"cnem/{rel}:{line}: raise {name}")
+            if name not in PROTOCOL:
+                bad.append(f"cnem/{rel}:{line}: raise {name}")
     assert not bad, ("raise a cnem.errors class (a CNEMError subclass) instead of a builtin:\n"
                      + "\n".join(bad))
-    stale = {key: count for key, count in PENDING.items() if seen.get(key, 0) != count}
-    assert not stale, f"PENDING is out of date (expected count, found {seen}): {stale}"
 
 
 def test_the_scan_sees_bare_raises(tmp_path):

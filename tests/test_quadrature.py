@@ -1,5 +1,5 @@
 """Quadrature on triangles and cell polygons (`cnem.assembly.quadrature`), and the
-graded rule of the cell-boundary quadrature (`cnem.assembly.scni`).
+graded rule of the cell-boundary quadrature (`cnem.assembly.edge_quadrature`).
 
 Checked against exact integrals: polynomials up to the rule's degree, the signed
 areas, and ``∫ 1/r`` over a triangle with a corner at the singular point
@@ -15,7 +15,7 @@ import pytest
 import cases
 import cnem
 from cnem.assembly.quadrature import cell_quadrature, triangle_quadrature
-from cnem.assembly.scni import _graded_rule
+from cnem.assembly.edge_quadrature import graded_rule
 
 
 def _monomial_integral(corners, a, b):
@@ -116,7 +116,7 @@ def test_graded_rule_integrates_sqrt_ends(gauss):
     """``∫_0^1 sqrt(t) t^k`` and ``∫_0^1 sqrt(1 - t) t^k`` exactly with the ends graded."""
     s, w = np.polynomial.legendre.leggauss(gauss)
     s, w = 0.5 * (s + 1.0), 0.5 * w
-    S, W = _graded_rule(s, w, np.array([True, False, False]), np.array([False, True, False]))
+    S, W = graded_rule(s, w, np.array([True, False, False]), np.array([False, True, False]))
     for k in range(gauss - 1):
         exact = 1.0 / (k + 1.5)
         assert abs(W[0] @ (np.sqrt(S[0]) * S[0] ** k) - exact) < 1e-14

@@ -3,19 +3,25 @@
 Checked against what must hold exactly: linear fields have their exact
 gradient in every cell (the integration constraint that makes the patch test
 pass), the cell sums equal the boundary integral of each shape function, the
-quadrature converges as Gauss points are added, and crack faces are seen from
-their own side.
+quadrature converges as Gauss points are added, crack faces are seen from
+their own side, and B~ is the slow cell-by-cell evaluation of eq. 31-32
+(`reference.smoothed_gradient`) to round-off.
 """
 
 from __future__ import annotations
+
+import gc
+import weakref
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 import cases
-from cnem.assembly import cell_edges, smoothed_gradient
-from cnem.assembly.scni import _pieces
+import reference
+from cnem import config
+from cnem.assembly import SmoothedGradients, cell_edges, smoothed_gradient
+from cnem.assembly.edges import circle_pieces
 
 NAMES = cases.NAMES
 
@@ -57,6 +63,22 @@ def test_integration_constraint(name):
     np.testing.assert_allclose(lhs, rhs, atol=1e-11 * h)
 
 
+@pytest.mark.parametrize("name", ["square_irregular", "plate_hole_irregular",
+                                  "three_rectangles_irregular", "kinked_crack_irregular",
+                                  "graded_inclined_crack"])
+def test_smoothed_gradient_is_the_cell_by_cell_reference(name):
+    """B~ equals eq. 31-32 evaluated cell by cell (`reference.smoothed_gradient`: every
+    edge cut at every circumcircle it crosses, crack faces and slits from their own
+    side) to round-off: the distinct edges, the shared points and the passes change
+    nothing but the summation order."""
+    _, _, model = cases.model(name)
+    gx, gy = reference.smoothed_gradient(model)
+    grad = smoothed_gradient(model)
+    scale = max(abs(gx).max(), abs(gy).max())
+    np.testing.assert_allclose(grad.x.toarray(), gx, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(grad.y.toarray(), gy, rtol=0, atol=1e-12 * scale)
+
+
 @pytest.mark.parametrize("name", ["square_irregular", "lshape_regular", "annulus_sector_regular",
                                   "edge_crack_regular", "graded_inclined_crack"])
 def test_quadrature_converges(name):
@@ -78,7 +100,7 @@ def test_edges_are_cut_at_circumcircles():
     every crossing of the cell edges with the circumcircles (checked by brute force)."""
     _, _, model = cases.model("random_points")
     _, a, b = cell_edges(model.cells)
-    edge, t0, t1 = _pieces(model, a, b)
+    edge, t0, t1 = circle_pieces(model, a, b)
     tri = model.triangles
     pick = np.random.default_rng(0).choice(len(a), 60, replace=False)
     for e in pick:
@@ -98,7 +120,7 @@ def test_one_query_per_cell_finds_the_same_pieces(name):
     pieces of one lookup per edge, exactly."""
     _, _, model = cases.model(name)
     cell, a, b = cell_edges(model.cells)
-    for got, ref in zip(_pieces(model, a, b, group=cell), _pieces(model, a, b)):
+    for got, ref in zip(circle_pieces(model, a, b, group=cell), circle_pieces(model, a, b)):
         np.testing.assert_array_equal(got, ref)
 
 
@@ -133,21 +155,30 @@ def test_crack_faces_do_not_see_each_other(name):
     np.testing.assert_allclose((grad.x @ x)[face_cells], 1.0, atol=1e-10 / np.sqrt(cells.area.min()))
 
 
-def test_cached_on_the_model_and_validated():
+def test_kept_by_their_owner_and_validated():
+    """`SmoothedGradients` computes B~ once and hands the same operator to every
+    caller; it is the operator `smoothed_gradient` computes afresh."""
     _, _, model = cases.model("square_regular")
-    assert smoothed_gradient(model) is smoothed_gradient(model)
+    gradients = SmoothedGradients(model)
+    kept = gradients.cells()
+    assert gradients.cells() is kept and gradients.of(model.cells) is kept
+    fresh = smoothed_gradient(model)
+    assert fresh is not kept
+    for a, b in ((fresh.x, kept.x), (fresh.y, kept.y)):
+        np.testing.assert_array_equal(a.toarray(), b.toarray())
     with pytest.raises(ValueError, match="positive number of Gauss points"):
         smoothed_gradient(model, gauss=0)
+    with pytest.raises(ValueError, match="positive number of Gauss points"):
+        SmoothedGradients(model, gauss=0)
 
 
 @pytest.mark.parametrize("name", ["kinked_crack_irregular", "three_rectangles_irregular"])
 def test_passes_over_runs_of_cells_give_the_same_operator(name, monkeypatch):
     """B~ built a few cells at a time (edges between runs integrated twice) is the
     one-pass B~ up to summation order."""
-    from cnem.assembly import scni
     _, _, model = cases.model(name)
     whole = smoothed_gradient(model, cells=model.cells)
-    monkeypatch.setattr(scni, "CELLS_PER_PASS", 7)
+    monkeypatch.setattr(config, "CELLS_PER_PASS", 7)
     runs = smoothed_gradient(model, cells=model.cells)
     for a, b in ((whole.x, runs.x), (whole.y, runs.y)):
         np.testing.assert_allclose(a.toarray(), b.toarray(), atol=1e-13 * abs(a).max())
@@ -161,34 +192,44 @@ def test_passes_over_runs_of_cells_give_the_same_operator(name, monkeypatch):
 def test_fan_gradient_shares_the_cells_points(name, per_pass, cells_cached, monkeypatch):
     """The fan sub-cells' B~ and the cells' B~, computed together from one set of
     points (in one pass or many), equal each computed alone; with the cells' B~
-    already cached only the sub-cells' is computed."""
-    from cnem.assembly import scni
+    already kept only the sub-cells' is computed, and no second copy of it is made."""
+    from cnem.assembly import gradients as owner
     from cnem.assembly.quadrature import subdivide, tip_cells
     _, _, model = cases.model(name)
     alone = smoothed_gradient(model, cells=model.cells)
     sub, _ = subdivide(model.cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
     sub_alone = smoothed_gradient(model, cells=sub)
-    for key in (("scni", 2), ("scni-fan", 2)):             # a cold cache (restored after)
-        monkeypatch.delitem(model._cache, key, raising=False)
-    if cells_cached:
-        monkeypatch.setitem(model._cache, ("scni", 2), alone)
     if per_pass is not None:
-        monkeypatch.setattr(scni, "CELLS_PER_PASS", per_pass)
-    fan_sub, fan = scni.fan_gradient(model)
+        monkeypatch.setattr(config, "CELLS_PER_PASS", per_pass)
+    gradients = SmoothedGradients(model)
+    kept = gradients.cells() if cells_cached else None
+    computed = []                          # the cells' B~ computed on its own
+    monkeypatch.setattr(owner, "smoothed_gradient",
+                        lambda *a, **k: computed.append(1) or smoothed_gradient(*a, **k))
+    with_cells, fan_gradients = [], owner._fan_gradients    # the cells' B~ computed with the fan's
+    monkeypatch.setattr(owner, "_fan_gradients",
+                        lambda *a, **k: with_cells.append(k["with_cells"]) or fan_gradients(*a, **k))
+    fan_sub, fan = gradients.fan()
     np.testing.assert_array_equal(fan_sub.vertices, sub.vertices)
-    together = model._cache[("scni", 2)]
-    assert (together is alone) == cells_cached
-    assert scni.fan_gradient(model)[1] is fan
+    together = gradients.cells()
+    assert computed == [] and with_cells == [not cells_cached]
+    assert (together is kept) == cells_cached
+    assert gradients.fan()[1] is fan
     for a, b in ((alone.x, together.x), (alone.y, together.y),
                  (sub_alone.x, fan.x), (sub_alone.y, fan.y)):
         np.testing.assert_allclose(a.toarray(), b.toarray(), atol=1e-12 * abs(a).max())
     # the spokes add points; the edges shared with the cells do not
     assert alone.points < fan.points < alone.points + sub_alone.points
-    # its last user takes it out of the cache
-    assert scni.fan_gradient(model, release=True)[1] is fan
-    again = scni.fan_gradient(model, release=True)[1]
-    assert again is not fan and ("scni-fan", 2) not in model._cache
+    # its last user takes it: the owner keeps no reference (the cells' B~ it keeps)
+    assert gradients.fan(release=True)[1] is fan
+    again = gradients.fan(release=True)[1]
+    assert again is not fan and gradients.cells() is together and computed == []
+    assert with_cells == [not cells_cached, False]
     np.testing.assert_allclose(again.x.toarray(), fan.x.toarray(), atol=1e-12 * abs(fan.x).max())
+    released = weakref.ref(again)
+    del again
+    gc.collect()
+    assert released() is None
 
 
 def test_runs_are_compact_blocks_whatever_the_order_of_the_nodes(monkeypatch):
@@ -196,12 +237,11 @@ def test_runs_are_compact_blocks_whatever_the_order_of_the_nodes(monkeypatch):
     edges lie between runs (runs of consecutive cells would share about 3/4 of
     them with other runs at four passes); B~ is the one-pass B~."""
     import cnem
-    from cnem.assembly import scni
     dom = cnem.geometry.rectangle(1.0, 1.0)
     pts = np.random.default_rng(3).uniform(0.01, 0.99, (3000, 2))
     model = cnem.discretize(cnem.nodes.from_points(dom, pts), progress=False)
     whole = smoothed_gradient(model, cells=model.cells)
-    monkeypatch.setattr(scni, "CELLS_PER_PASS", len(model.cells) // 4 + 1)
+    monkeypatch.setattr(config, "CELLS_PER_PASS", len(model.cells) // 4 + 1)
     runs = smoothed_gradient(model, cells=model.cells)
     assert whole.points < runs.points < 1.2 * whole.points
     for a, b in ((whole.x, runs.x), (whole.y, runs.y)):
@@ -221,7 +261,8 @@ def test_fan_quadratures_take_the_sub_cells_edges_from_their_cells(name, node_ap
     nodes put the apex on a vertex for boundary nodes, where a spoke is a cell
     edge: it is that edge (cut at the circles), not a spoke."""
     from cnem.assembly.quadrature import subdivide
-    from cnem.assembly.scni import boundary_quadratures, fan_quadratures
+    from cnem.assembly.edge_quadrature import boundary_quadratures
+    from cnem.assembly.fan_quadrature import fan_quadratures
     _, _, model = cases.model(name)
     cells = model.cells
     sub, parent = subdivide(cells, model.nodes, node_apex=np.full(len(cells), node_apex),
@@ -252,7 +293,7 @@ def test_edge_integrals_from_point_rows_or_a_matrix(name):
     """The edge integrals from the kernel's rows (`point_rows`) equal those from the
     shape-function matrix, and the cells' integrals from them equal the direct
     ``to_cells @ W @ Phi``."""
-    from cnem.assembly.scni import boundary_quadrature
+    from cnem.assembly.edge_quadrature import boundary_quadrature
     _, _, model = cases.model(name)
     quad = boundary_quadrature(model)
     phi, order = quad.shape_functions(model)

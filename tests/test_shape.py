@@ -494,14 +494,17 @@ def test_point_rows_and_unordered_rows_of_no_points_and_bad_kinds():
 def test_points_the_walks_miss_are_found_by_either_tree(name, monkeypatch):
     """Unsorted points across cracks and holes, where walks stop: located with the
     circumcircles' R-tree or with one of the triangles, the same shape functions."""
-    from cnem.shape import natural
+    from cnem import config
     _, _, model = cases.model(name)
     pts = interior_points(name, 400, seed=5)
     results, built = [], []
+    asked, triangle_tree = [], type(model).triangle_tree
+    monkeypatch.setattr(type(model), "triangle_tree",
+                        lambda self: asked.append(1) or triangle_tree(self))
     for fraction in (np.inf, 0.0):
-        monkeypatch.setattr(natural, "TRIANGLE_TREE_AFTER", fraction)
-        model._cache.pop("triangle tree", None)
+        monkeypatch.setattr(config, "TRIANGLE_TREE_AFTER", fraction)
+        asked.clear()
         results.append(model.shape_functions(pts).toarray())
-        built.append("triangle tree" in model._cache)
+        built.append(bool(asked))
     np.testing.assert_array_equal(*results)
     assert built == [False, True]            # some walks did stop, and each tree served

@@ -18,7 +18,9 @@ from skfem import condense, solve
 
 from .basis import CellBasis, select_nodes
 from .forms import BilinearForm, Functional, LinearForm, asm
-from .scni import SmoothedGradient, cell_edges, smoothed_gradient
+from .edges import cell_edges
+from .gradients import SmoothedGradient, SmoothedGradients, fan_gradient, smoothed_gradient
 
 __all__ = ["CellBasis", "BilinearForm", "LinearForm", "Functional", "asm", "condense", "solve",
-           "SmoothedGradient", "smoothed_gradient", "cell_edges", "select_nodes"]
+           "SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient",
+           "cell_edges", "select_nodes"]

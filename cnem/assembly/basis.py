@@ -11,7 +11,7 @@ import scipy.sparse as sp
 from skfem.element import DiscreteField
 
 from ..errors import ConditionError, InputError
-from .scni import smoothed_gradient
+from .gradients import smoothed_gradient
 
 if TYPE_CHECKING:
     from typing import Callable, Literal, Sequence
@@ -48,7 +48,9 @@ class CellBasis:
     cells : Cells, optional
         Integration cells (default ``model.cells``; sub-cells for enrichment).
     gradient : SmoothedGradient, optional
-        ``b~`` on ``cells`` when already computed (`cnem.assembly.scni.fan_gradient`).
+        ``b~`` on ``cells`` when already computed (from a
+        `cnem.assembly.gradients.SmoothedGradients`, which keeps it); by default
+        it is computed afresh (`smoothed_gradient`).
     extra : (gx, gy) sparse (m, e), optional
         Smoothed gradients of ``e`` more functions that vanish at every node
         (enrichment); their dofs follow the nodes' (function ``n + i``).

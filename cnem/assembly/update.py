@@ -16,7 +16,7 @@ import scipy.sparse as sp
 
 from .._parallel import one_thread
 from ..errors import CNEMError
-from .scni import SmoothedGradient, smoothed_gradient
+from .gradients import SmoothedGradient, smoothed_gradient
 
 if TYPE_CHECKING:
     from ..geometry.update import ModelUpdate

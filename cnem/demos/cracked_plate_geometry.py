@@ -41,7 +41,7 @@ import numpy as np
 import cnem
 import cnem.io
 import cnem.plot
-from cnem.geometry import rectangle
+from cnem.geometry import SegmentKind, rectangle
 
 if TYPE_CHECKING:
     from typing import Sequence
@@ -109,7 +109,7 @@ def main(h: float = 0.1, h_min: float = 0.01, gamma_deg: float = 30.0, growth: f
     model = cnem.discretize(cloud, progress=False)
     seconds = time.perf_counter() - t0
 
-    crack_points = np.unique(cloud.segments[cloud.segment_kind == 2])
+    crack_points = np.unique(cloud.segments[cloud.segment_kind == SegmentKind.CRACK])
     exact_area = (2 * HALF_WIDTH) ** 2
     cell_area = float(model.cells.area.sum())
     files = {"vtu": cnem.io.write(model, out / "cracked_plate.vtu")}

@@ -24,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .. import config
-from ..assembly.scni import boundary_quadrature
+from ..assembly.edge_quadrature import boundary_quadrature
 from ..errors import FractureError, InputError, check_choice
 from ..geometry.topology import circumcenters
 from .williams import sided_polar

@@ -128,7 +128,8 @@ class Model:
     segment_kind: np.ndarray
     cells: Cells
     timings: dict
-    _cache: dict = field(default_factory=dict, repr=False, compare=False)
+    #: what `neighbors`, `circumcircles` and `triangle_tree` computed, written by them alone
+    _derived: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def domain(self):
@@ -138,23 +139,44 @@ class Model:
     def neighbors(self, *, across_regions=False):
         """The triangle across each edge, ``(t, 3)`` int64: ``nb[t, k]`` faces vertex
         ``k``; -1 on the boundary, at crack faces and (unless ``across_regions``)
-        where the neighbour lies in another region. Cached (`discretize` fills it).
+        where the neighbour lies in another region. Computed once (`discretize`
+        already has it).
         """
-        if "neighbors" not in self._cache:
-            self._cache["neighbors"] = _neighbor_tables(self.triangles, self.triangle_region)
-        return self._cache["neighbors"][1 if across_regions else 0]
+        tables = self._derive("neighbors",
+                              lambda: _neighbor_tables(self.triangles, self.triangle_region))
+        return tables[1 if across_regions else 0]
 
     def circumcircles(self):
         """The circumcircles of the triangles: centres ``(t, 2)``, squared radii
         ``(t,)`` and an R-tree over their boxes (which also holds every triangle:
-        point location). Cached."""
-        if "circumcircles" not in self._cache:
+        point location). Computed on first call, then kept."""
+        def build():
             centre = circumcenters(self.nodes, self.triangles)
             radius2 = ((self.nodes[self.triangles[:, 0]] - centre) ** 2).sum(axis=1)
             radius = np.sqrt(radius2)[:, None]
-            self._cache["circumcircles"] = centre, radius2, RTree(centre - radius,
-                                                                  centre + radius)
-        return self._cache["circumcircles"]
+            return centre, radius2, RTree(centre - radius, centre + radius)
+        return self._derive("circumcircles", build)
+
+    def triangle_tree(self):
+        """An R-tree over the boxes of the triangles: tighter than the circumcircles'
+        (`circumcircles`), worth building to locate many points. Built on first
+        call, then kept.
+
+        Returns
+        -------
+        RTree
+            Entry ``i`` is the bounding box of ``triangles[i]``.
+        """
+        def build():
+            corners = self.nodes[self.triangles]
+            return RTree(corners.min(axis=1), corners.max(axis=1))
+        return self._derive("triangle tree", build)
+
+    def _derive(self, name, build):
+        """``build()``, computed on the first request for ``name`` and kept."""
+        if name not in self._derived:
+            self._derived[name] = build()
+        return self._derived[name]
 
     def node_sides(self):
         """A point on the side of each node: the area-weighted centroid of its cells
@@ -223,9 +245,8 @@ def discretize(cloud, *, progress=None):
     log.info("discretize: %d nodes, %s", len(nodes),
              ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
     cells = Cells(node, cell_region, offsets, vertices)
-    model = Model(cloud, nodes, node_of_point, tri, region, segments, kind, cells, timings)
-    model._cache["neighbors"] = neighbors
-    return model
+    return Model(cloud, nodes, node_of_point, tri, region, segments, kind, cells, timings,
+                 _derived={"neighbors": neighbors})
 
 
 def triangulate(cloud, timings, caller="discretize"):

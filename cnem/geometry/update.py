@@ -301,8 +301,8 @@ def update(model, cloud, *, progress=None):
     reuse = reuse[~redo[owner[reuse]]]
     cells, old_cell = _merge_cells(model.cells.subset(reuse), owner[reuse], fresh, reuse)
     timings["cells"] = time.perf_counter() - t0
-    new = Model(cloud, nodes, node_of_point, tri, region, segments, kind, cells, timings)
-    new._cache["neighbors"] = neighbors
+    new = Model(cloud, nodes, node_of_point, tri, region, segments, kind, cells, timings,
+                _derived={"neighbors": neighbors})
     return ModelUpdate(new, model, old_node, old_cell)
 
 

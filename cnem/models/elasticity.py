@@ -18,10 +18,10 @@ from ..assembly import BilinearForm, CellBasis
 from ..assembly.conditions import Conditions, traction_at
 from ..assembly.basis import spread_component
 from ..assembly.quadrature import cell_quadrature, subdivide, tip_cells
-from ..assembly.scni import fan_gradient
+from ..assembly.gradients import SmoothedGradients
 from ..assembly.triangles import triangle_basis
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
-from ..errors import InputError, SolveError
+from ..errors import GeometryError, InputError, SolveError
 from ..geometry.topology import constraint_edges
 from ..material import lame, parse_materials, stiffness_matrix
 from .solution import ElasticSolution
@@ -67,6 +67,10 @@ class Elasticity(Conditions):
         patch test still holds) and stiffens the low-energy oscillating modes
         that plain SCNI (``a = 0``, the paper's method) leaves almost free, which
         otherwise show as node-to-node oscillations along free crack faces.
+    gradients : SmoothedGradients, optional
+        The model's smoothed gradients at ``gauss``, to share with other
+        problems on the model (what it has computed is not computed again); by
+        default the problem keeps its own (`gradients`).
 
     Examples
     --------
@@ -83,7 +87,7 @@ class Elasticity(Conditions):
 
     def __init__(self, model: Model, materials: tuple[float, float] | Sequence[tuple[float, float]],
                  *, plane: str = "stress", gauss: int = 2, enrich: Enrichment | None = None,
-                 stabilization: float = 1.0):
+                 stabilization: float = 1.0, gradients: SmoothedGradients | None = None):
         from ..fracture.enrichment import Enrichment
         self.model = model
         self.enrichment = Enrichment.from_spec(model, enrich)
@@ -98,6 +102,14 @@ class Elasticity(Conditions):
             raise InputError(f"stabilization: expected a number >= 0, received {stabilization!r}")
         self.plane = plane
         self.gauss = gauss
+        if gradients is None:
+            gradients = SmoothedGradients(model, gauss=gauss)
+        elif gradients.model is not model or gradients.gauss != gauss:
+            raise GeometryError(f"gradients: expected the SmoothedGradients of this model with "
+                                f"gauss={gauss}, received {gradients!r}; build them with "
+                                f"SmoothedGradients(model, gauss={gauss})")
+        #: the owner of the smoothed gradients this problem uses
+        self.gradients = gradients
         super().__init__()
         self._basis = None
         self._K = None
@@ -131,11 +143,11 @@ class Elasticity(Conditions):
         if self._basis is None:
             if self._sub_cells() and self._K is None:
                 # K will need the fan sub-cells' gradients: B~ of the cells comes with them
-                fan_gradient(self.model, gauss=self.gauss)
+                self.gradients.fan()
             extra = (None if self.enrichment is None
                      else self.enrichment.smoothed_gradient(self.gauss, self.cells))
-            self._basis = CellBasis(self.model, vector=True, gauss=self.gauss, extra=extra,
-                                    cells=self.cells)
+            self._basis = CellBasis(self.model, vector=True, extra=extra, cells=self.cells,
+                                    gradient=self.gradients.of(self.cells))
         return self._basis
 
     def update_from(self, old: Elasticity, change: ModelUpdate) -> Elasticity:
@@ -157,8 +169,9 @@ class Elasticity(Conditions):
         """
         from .local_update import updated_operators
         gradient, self._K = updated_operators(old, self, change, elasticity_form)
-        self._basis = CellBasis(self.model, vector=True, gauss=self.gauss, cells=self.cells,
-                                gradient=gradient)
+        self.gradients = SmoothedGradients(self.model, gauss=self.gauss, cells=gradient)
+        self._basis = CellBasis(self.model, vector=True, cells=self.cells,
+                                gradient=self.gradients.cells())
         return self
 
     def cell_materials(self) -> np.ndarray:
@@ -203,7 +216,7 @@ class Elasticity(Conditions):
         ``(1 - a) K_k + a sum_s A_s B~_s^T C B~_s``: no difference operators
         (whose rows would carry both patterns) are formed.
         """
-        sub, grad = fan_gradient(self.model, gauss=self.gauss, release=True)
+        sub, grad = self.gradients.fan(release=True)
         fine = CellBasis(self.model, vector=True, cells=sub, gradient=grad)
         lam, mu = self._lame(weight)
         return elasticity_form.assemble(fine, groups=sub.region, lam=lam, mu=mu)

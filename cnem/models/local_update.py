@@ -20,7 +20,7 @@ import scipy.sparse as sp
 
 from ..assembly import CellBasis
 from ..assembly.quadrature import subdivide, tip_cells
-from ..assembly.scni import smoothed_gradient
+from ..assembly.gradients import smoothed_gradient
 from ..assembly.update import renumber_rows, updated_gradient
 from .._parallel import one_thread
 from ..errors import CNEMError
@@ -131,7 +131,7 @@ def updated_operators(old: Any, new: Any, change: ModelUpdate,
 
 def _rows(gradient, index):
     """``B~`` of the cells ``index`` alone."""
-    from ..assembly.scni import SmoothedGradient
+    from ..assembly.gradients import SmoothedGradient
     return SmoothedGradient(gradient.x[index], gradient.y[index], 0)
 
 

@@ -8,23 +8,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from .. import config
-from ..errors import CNEMError, GeometryError
+from ..errors import CNEMError, GeometryError, UnsupportedError, check_choice
 from .._parallel import work_chunks
-from ..spatial.rtree import RTree
 from . import _kernels as K
 
 __all__ = ["shape_functions", "point_rows", "PointRows", "KINDS"]
 
 KINDS = ("sibson", "laplace")
-
-#: Room per point for the rows written chunk by chunk (doubled when a chunk overflows;
-#: points have about 5-6 natural neighbours on average).
-ROW_SLOTS = 8
-
-#: Points the walks cannot reach, as a fraction of the triangles, above which they
-#: are located with an R-tree of the triangles (built once) rather than of the circles.
-TRIANGLE_TREE_AFTER = 0.01
-
 
 def path_order(pts, bounds, per_tile=4):
     """Order of points along a serpentine path through a square grid of tiles.
@@ -64,20 +54,11 @@ def _locate_sorted(model, spts, tol):
     tri_of = K.locate_walk(model.nodes, model.triangles, nb_all, spts, seeds, nch)
     lost = np.flatnonzero(tri_of < 0)
     if lost.size:
-        many = lost.size > TRIANGLE_TREE_AFTER * len(model.triangles)
-        tree = _triangle_tree(model) if many else model.circumcircles()[2]
+        many = lost.size > config.TRIANGLE_TREE_AFTER * len(model.triangles)
+        tree = model.triangle_tree() if many else model.circumcircles()[2]
         off, idx = tree.query(spts[lost] - tol, spts[lost] + tol)
         tri_of[lost] = K.locate(model.nodes, model.triangles, spts[lost], off, idx, tol)
     return tri_of
-
-
-def _triangle_tree(model):
-    """An R-tree over the boxes of the model's triangles (cached): tighter than the
-    circumcircles', worth building for many points."""
-    if "triangle tree" not in model._cache:
-        corners = model.nodes[model.triangles]
-        model._cache["triangle tree"] = RTree(corners.min(axis=1), corners.max(axis=1))
-    return model._cache["triangle tree"]
 
 
 def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=False,
@@ -87,6 +68,9 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
     Parameters
     ----------
     model : Model
+        Or any triangulation like it: ``nodes``, ``triangles``, ``domain``
+        (``diameter``, ``bounds``) and the methods ``neighbors``,
+        ``circumcircles`` and ``triangle_tree`` of `cnem.geometry.Model`.
     points : (p, 2) array_like
         Points of the closed domain.
     kind : {"sibson", "laplace"}
@@ -116,10 +100,10 @@ def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=Fa
     GeometryError
         Points outside the domain (how many, and the first few).
     """
-    if kind not in KINDS:
-        raise ValueError(f"kind must be one of {KINDS}, received {kind!r}")
+    check_choice("kind", kind, KINDS)
     if gradient and kind != "sibson":
-        raise NotImplementedError("gradients are available for kind='sibson' only")
+        raise UnsupportedError("gradient=True: gradients are available for kind='sibson' "
+                               "only; pass kind='sibson' or gradient=False")
     pts = np.ascontiguousarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise GeometryError(f"points: expected a (p, 2) array, received shape {pts.shape}")
@@ -174,8 +158,7 @@ def point_rows(model, points, *, kind="sibson", triangles=None):
     -------
     PointRows
     """
-    if kind not in KINDS:
-        raise ValueError(f"kind must be one of {KINDS}, received {kind!r}")
+    check_choice("kind", kind, KINDS)
     pts = np.ascontiguousarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2 or not np.isfinite(pts).all():
         raise GeometryError(f"points: expected a (p, 2) array of finite coordinates, received "
@@ -216,7 +199,7 @@ def _coordinates(model, pts, kind, triangles, gradient):
         raise GeometryError(
             f"{outside.size} of {len(pts)} points lie outside {where}, first (index: point) "
             + ", ".join(f"{i}: {pts[i].tolist()}" for i in outside[:5]))
-    slots = ROW_SLOTS
+    slots = config.ROW_SLOTS
     while True:                                # rows in path order, chunk by chunk
         start, size, cols, vals, gx, gy, kinds, full = K.natural(
             model.nodes, model.triangles, nb, spts, tri_of, tol, tol, work_chunks(),

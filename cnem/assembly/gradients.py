@@ -1,0 +1,210 @@
+"""The SCNI smoothed gradient operator ``B~`` (C-NEM paper §4.2, eq. 26-32), and
+`SmoothedGradients`, the owner that computes it once for a model."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import GeometryError
+from .edge_quadrature import boundary_quadratures, check_gauss
+from .fan_quadrature import fan_quadratures
+from .passes import cell_runs, gradients_in_passes
+from .quadrature import subdivide, tip_cells
+
+if TYPE_CHECKING:
+    from ..geometry.model import Cells
+
+__all__ = ["SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient"]
+
+
+class SmoothedGradient:
+    """The operator ``B~`` of eq. 30: smoothed derivatives of every shape function.
+
+    Attributes
+    ----------
+    x, y : scipy.sparse.csr_matrix, shape (m, n)
+        ``x[k, j] = b~_xj(cell k)`` and ``y[k, j] = b~_yj(cell k)``.
+    points : int
+        Number of quadrature points evaluated for it on the cell boundaries (with
+        the other sets of cells computed in the same passes, `fan_gradient`: their
+        shared count).
+    """
+
+    def __init__(self, x, y, points):
+        self.x, self.y, self.points = x, y, points
+
+    def __iter__(self):
+        return iter((self.x, self.y))
+
+    def __repr__(self):
+        m, n = self.x.shape
+        return f"<SmoothedGradient {m} cells x {n} nodes, {self.x.nnz} non-zeros, {self.points} points>"
+
+
+def smoothed_gradient(model, *, gauss: int = 2, cells=None) -> SmoothedGradient:
+    """The smoothed gradient operator ``B~`` of a model's cells, computed afresh
+    (`SmoothedGradients` keeps it for the next users).
+
+    Parameters
+    ----------
+    model : Model
+        ``n`` nodes, ``m`` integration cells.
+    gauss : int
+        Gauss points on each piece of a cell edge between circumcircle
+        crossings. The patch test holds for any value; more points make
+        ``b~`` converge to the exact boundary integrals (see docs/elasticity.md).
+    cells : Cells, optional
+        Integration cells other than ``model.cells``.
+
+    Returns
+    -------
+    SmoothedGradient
+        ``x, y`` sparse ``(m, n)``.
+    """
+    gauss = check_gauss(gauss)
+    every = model.cells if cells is None else cells
+    runs = cell_runs(model, every)
+    (grad,), points = gradients_in_passes(
+        model, [every], lambda sets, _: boundary_quadratures(model, sets, gauss=gauss),
+        None if runs is None else [[run] for run in runs])
+    return SmoothedGradient(*grad, points)
+
+
+def fan_gradient(model, *, gauss: int = 2) -> tuple[Cells, SmoothedGradient]:
+    """Smoothed gradients on the fan sub-cells of the model's cells, computed afresh
+    (`SmoothedGradients.fan` computes them with the cells' and keeps them).
+
+    The sub-cells (`cnem.assembly.quadrature.subdivide`, spokes marked; crack-tip
+    cells fanned from their node) share every edge but their spokes with their
+    cells: only the spokes add points to the cells' (`fan_quadratures`).
+
+    Parameters
+    ----------
+    model : Model
+    gauss : int
+        As in `smoothed_gradient`.
+
+    Returns
+    -------
+    sub : Cells
+        ``s`` fan sub-cells.
+    grad : SmoothedGradient
+        ``x, y`` sparse ``(s, n)``.
+    """
+    _, sub, grad = _fan_gradients(model, check_gauss(gauss), with_cells=False)
+    return sub, grad
+
+
+def _fan_gradients(model, gauss, with_cells):
+    """``(cells' B~ or None, fan sub-cells, their B~)``, the two from one set of
+    points in the same passes (the sub-cells go with their cells' runs)."""
+    cells = model.cells
+    sub, parent = subdivide(cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
+    runs = cell_runs(model, cells)
+    passes = None
+    if runs is not None:
+        run_of = np.empty(len(cells), dtype=np.int64)
+        place = np.empty(len(cells), dtype=np.int64)       # of a cell in its run
+        for r, run in enumerate(runs):
+            run_of[run], place[run] = r, np.arange(len(run))
+        key_of = run_of[parent]
+        sub_order = np.argsort(key_of, kind="stable")
+        cuts = np.searchsorted(key_of[sub_order], np.arange(len(runs) + 1))
+        passes = [[run, sub_order[cuts[r]:cuts[r + 1]]] for r, run in enumerate(runs)]
+
+    def quadratures(sets, index):
+        local = parent if index is None else place[parent[index[1]]]
+        return fan_quadratures(model, *sets, local, gauss=gauss)
+
+    (of_cells, of_sub), points = gradients_in_passes(model, [cells, sub], quadratures, passes,
+                                                     wanted=[with_cells, True])
+    return (None if of_cells is None else SmoothedGradient(*of_cells, points),
+            sub, SmoothedGradient(*of_sub, points))
+
+
+class SmoothedGradients:
+    """The smoothed gradients of one model at one Gauss order, each computed when
+    first asked for and kept: the owner of ``B~`` for everyone who needs it.
+
+    Give one object to every user on the model (`CellBasis` through
+    ``gradient=``, `cnem.Elasticity` through ``gradients=``) and nothing is
+    computed twice: ``B~`` of the cells comes along with the fan sub-cells'
+    (`fan`) from one set of shape-function values, and is kept; the sub-cells'
+    (about six times as large) is handed to its last user and dropped
+    (``release=True``).
+
+    Parameters
+    ----------
+    model : Model
+        ``n`` nodes, ``m`` integration cells.
+    gauss : int
+        Gauss points per piece of cell edge (see `smoothed_gradient`).
+    cells : SmoothedGradient, optional
+        ``B~`` of ``model.cells`` at this Gauss order when it is already known (a
+        local update computes it from the previous model's): kept as `cells`.
+
+    Attributes
+    ----------
+    model : Model
+    gauss : int
+    """
+
+    def __init__(self, model, *, gauss: int = 2, cells: SmoothedGradient | None = None):
+        self.model = model
+        self.gauss = check_gauss(gauss)
+        if cells is not None and cells.x.shape != (len(model.cells.area), len(model.nodes)):
+            raise GeometryError(f"cells: expected the smoothed gradient of this model's "
+                                f"{len(model.cells.area)} cells and {len(model.nodes)} nodes, "
+                                f"received shape {cells.x.shape}")
+        self._cells = cells
+        self._fan = None
+
+    def cells(self) -> SmoothedGradient:
+        """``B~`` of ``model.cells``, ``(m, n)`` (computed on first call, then kept)."""
+        if self._cells is None:
+            self._cells = smoothed_gradient(self.model, gauss=self.gauss)
+        return self._cells
+
+    def of(self, cells) -> SmoothedGradient:
+        """``B~`` of some integration cells: the kept `cells` one for ``model.cells``,
+        computed afresh (and not kept) for others (the sub-cells of an enriched
+        problem, say)."""
+        if cells is self.model.cells:
+            return self.cells()
+        return smoothed_gradient(self.model, gauss=self.gauss, cells=cells)
+
+    def fan(self, *, release: bool = False) -> tuple[Cells, SmoothedGradient]:
+        """Smoothed gradients on the fan sub-cells of the model's cells (`fan_gradient`),
+        computed on first call together with the cells' `cells` when those are not
+        there yet (kept too), from one set of points.
+
+        Parameters
+        ----------
+        release : bool
+            Hand the result over and keep no reference to it (its last user: about
+            as large as ``B~`` six times over, so a large model does not keep it
+            alive); a later call computes it again.
+
+        Returns
+        -------
+        sub, grad : Cells, SmoothedGradient
+            As `fan_gradient` returns them.
+        """
+        if self._fan is None:
+            of_cells, sub, grad = _fan_gradients(self.model, self.gauss,
+                                                 with_cells=self._cells is None)
+            if of_cells is not None:
+                self._cells = of_cells
+            self._fan = sub, grad
+        fan = self._fan
+        if release:
+            self._fan = None
+        return fan
+
+    def __repr__(self):
+        kept = [name for name, value in (("cells", self._cells), ("fan", self._fan))
+                if value is not None]
+        return (f"<SmoothedGradients gauss {self.gauss} of a {len(self.model.nodes)}-node model, "
+                f"kept: {', '.join(kept) or 'none'}>")
