@@ -41,7 +41,7 @@ import meshio
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import CNEMError
+from .errors import FormatError
 from .geometry.model import Cells
 
 if TYPE_CHECKING:
@@ -56,10 +56,6 @@ SUFFIXES = {".vtu": "vtu"}
 
 #: Cell-data names `write` reserves for itself.
 RESERVED = ("region", "node", "area", "cell")
-
-
-class FormatError(CNEMError, ValueError):
-    """A file name or a file's contents that `cnem.io` cannot handle."""
 
 
 def _format(path):

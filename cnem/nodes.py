@@ -21,19 +21,15 @@ import shapely
 from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
+from . import config
 from .errors import GeometryError
 from .geometry.cloud import NodeCloud
-from .geometry.pslg import segment_projection
+from .geometry.pslg import SegmentKind, segment_projection
 
 if TYPE_CHECKING:
     from .geometry.domain import Domain
 
 __all__ = ["regular", "irregular", "graded", "from_points", "NodeCloud"]
-
-#: Interior nodes closer than this fraction of the local spacing to a
-#: boundary, interface or crack are dropped (the boundary nodes stand there).
-CLEARANCE = 0.5
-
 
 def _check_spacing(dom, h, name="h"):
     h = float(h)
@@ -60,7 +56,7 @@ def _tip_to_tip(dom):
     if len(dom.tips) == 0:
         return np.zeros(len(edges), dtype=bool)
     is_tip = cKDTree(dom.tips).query(v)[0] <= dom.tolerance
-    return (kinds == 2) & is_tip[edges[:, 0]] & is_tip[edges[:, 1]]
+    return (kinds == SegmentKind.CRACK) & is_tip[edges[:, 0]] & is_tip[edges[:, 1]]
 
 
 def _boundary_nodes(dom, spacing_of, jitter=None):
@@ -145,7 +141,7 @@ def regular(domain: Domain, h: float) -> NodeCloud:
     h = _check_spacing(domain, h)
     spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
     lattice = _lattice(domain, h)
-    interior = _keep_interior(domain, lattice, CLEARANCE * h)
+    interior = _keep_interior(domain, lattice, config.CLEARANCE * h)
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
 
 
@@ -164,7 +160,7 @@ def irregular(domain: Domain, h: float, *, seed: int = 0) -> NodeCloud:
     spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
     lattice = _lattice(domain, h, offset=0.5 * h)
     lattice = lattice + rng.uniform(-0.35 * h, 0.35 * h, lattice.shape)
-    interior = _keep_interior(domain, lattice, CLEARANCE * h)
+    interior = _keep_interior(domain, lattice, config.CLEARANCE * h)
     boundary = _boundary_nodes(domain, spacing_of, jitter=rng)
     return _assemble(domain, boundary, interior, spacing_of)
 
@@ -219,7 +215,7 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
     if seed is not None:
         rng = np.random.default_rng(seed)
         interior = interior + rng.uniform(-0.25, 0.25, interior.shape) * spacing_of(interior)[:, None]
-    interior = _keep_interior(domain, interior, CLEARANCE * spacing_of(interior))
+    interior = _keep_interior(domain, interior, config.CLEARANCE * spacing_of(interior))
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
 
 
