@@ -163,7 +163,7 @@ class Model:
             return centre, radius2, RTree(centre - radius, centre + radius)
         return self._derive("circumcircles", build)
 
-    def triangle_tree(self):
+    def triangle_tree(self) -> RTree:
         """An R-tree over the boxes of the triangles: tighter than the circumcircles'
         (`circumcircles`), worth building to locate many points. Built on first
         call, then kept.
