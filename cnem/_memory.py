@@ -27,7 +27,7 @@ def _malloc_trim():
         return None
 
 
-def release_free_memory():
+def release_free_memory() -> bool:
     """Return the free space of the C heaps to the operating system (glibc only).
 
     Returns

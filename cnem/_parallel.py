@@ -3,6 +3,7 @@ functions and the assembly."""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from contextlib import contextmanager
 
 import numba
@@ -16,7 +17,7 @@ def work_chunks() -> int:
 
 
 @contextmanager
-def one_thread():
+def one_thread() -> Iterator[None]:
     """Run the parallel kernels called inside on the calling thread alone.
 
     For small work (a local update's few cells): a parallel region then waits

@@ -41,6 +41,11 @@ OptionError True
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from typing import TypeVar
+
+_Value = TypeVar("_Value")
+
 __all__ = ["CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError",
            "FormError", "ConditionError", "SpatialError", "FractureError", "GrowthError",
            "FormatError", "HyperDualError", "LimitError", "UnsupportedError", "SolveError",
@@ -129,7 +134,8 @@ class PlotInputError(PlotError, InputError):
     """A field name, field values or view bounds that `cnem.plot` cannot draw."""
 
 
-def check_choice(name: str, value, choices, *, error: type[InputError] = OptionError):
+def check_choice(name: str, value: _Value, choices: Iterable[object], *,
+                 error: type[InputError] = OptionError) -> _Value:
     """``value`` if it is one of ``choices``, else ``error`` naming the choices.
 
     Parameters

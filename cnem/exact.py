@@ -8,7 +8,10 @@ True
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .errors import MaterialError
 from .material import effective_modulus, lame
@@ -36,7 +39,8 @@ class LayeredCylinder:
     center : (2,) array_like
     """
 
-    def __init__(self, radii, materials, *, pressure=1.0, plane="stress", center=(0.0, 0.0)):
+    def __init__(self, radii: ArrayLike, materials: ArrayLike, *, pressure: float = 1.0,
+                 plane: Literal["stress", "strain"] = "stress", center: ArrayLike = (0.0, 0.0)) -> None:
         self.radii = np.asarray(radii, dtype=float)
         mats = np.asarray(materials, dtype=float).reshape(-1, 2)
         if len(mats) != len(self.radii) - 1 or not (np.diff(self.radii) > 0).all():
@@ -64,19 +68,19 @@ class LayeredCylinder:
         coef = np.linalg.solve(A, rhs).reshape(k, 2)
         self.a, self.b = coef[:, 0], coef[:, 1]
 
-    def layer(self, r):
+    def layer(self, r: ArrayLike) -> np.ndarray:
         """Layer index of radii (the inner layer at an interface)."""
         return np.clip(np.searchsorted(self.radii, r, side="left") - 1, 0, len(self.a) - 1)
 
-    def radial_displacement(self, r):
+    def radial_displacement(self, r: ArrayLike) -> np.ndarray:
         i = self.layer(r)
         return self.a[i] * r + self.b[i] / r
 
-    def radial_stress(self, r):
+    def radial_stress(self, r: ArrayLike) -> np.ndarray:
         i = self.layer(r)
         return 2.0 * (self.lam[i] + self.mu[i]) * self.a[i] - 2.0 * self.mu[i] * self.b[i] / r ** 2
 
-    def hoop_stress(self, r):
+    def hoop_stress(self, r: ArrayLike) -> np.ndarray:
         i = self.layer(r)
         return 2.0 * (self.lam[i] + self.mu[i]) * self.a[i] + 2.0 * self.mu[i] * self.b[i] / r ** 2
 
@@ -85,13 +89,13 @@ class LayeredCylinder:
         r = np.hypot(rel[:, 0], rel[:, 1])
         return r, rel[:, 0] / r, rel[:, 1] / r
 
-    def displacement(self, points):
+    def displacement(self, points: ArrayLike) -> np.ndarray:
         """``(p, 2)`` Cartesian displacements."""
         r, c, s = self._polar(points)
         ur = self.radial_displacement(r)
         return np.column_stack([ur * c, ur * s])
 
-    def stress(self, points, *, layer=None):
+    def stress(self, points: ArrayLike, *, layer: ArrayLike | None = None) -> np.ndarray:
         """``(p, 3)`` ``[sxx, syy, sxy]``; ``layer`` forces the layer (for cells on an interface)."""
         r, c, s = self._polar(points)
         i = self.layer(r) if layer is None else np.asarray(layer)
@@ -102,7 +106,7 @@ class LayeredCylinder:
                                 (srr - stt) * s * c])
 
 
-def rayleigh_speed(E: float, nu: float, density: float, plane: str = "stress") -> float:
+def rayleigh_speed(E: float, nu: float, density: float, plane: Literal["stress", "strain"] = "stress") -> float:
     """Rayleigh (surface) wave speed of an isotropic elastic solid in 2-D.
 
     Parameters
@@ -153,23 +157,24 @@ class CentralCrack:
         Angle (radians) between the load and the crack's normal (0: pure mode I).
     """
 
-    def __init__(self, half_length: float, sigma: float = 1.0, gamma: float = 0.0):
+    def __init__(self, half_length: float, sigma: float = 1.0, gamma: float = 0.0) -> None:
         self.a, self.sigma, self.gamma = float(half_length), float(sigma), float(gamma)
         self.normal = self.sigma * np.cos(self.gamma) ** 2
         self.shear = self.sigma * np.sin(self.gamma) * np.cos(self.gamma)
 
-    def sif(self):
+    def sif(self) -> tuple[float, float]:
         """``(K_I, K_II)``."""
         k0 = self.sigma * np.sqrt(np.pi * self.a)
         return k0 * np.cos(self.gamma) ** 2, k0 * np.sin(self.gamma) * np.cos(self.gamma)
 
-    def opening(self, x, E: float, nu: float = 0.0, plane: str = "stress"):
+    def opening(self, x: ArrayLike, E: float, nu: float = 0.0,
+                plane: Literal["stress", "strain"] = "stress") -> np.ndarray:
         """Normal opening ``(p,)`` of the faces at ``x`` (crack axes; 0 outside the crack)."""
         x = np.asarray(x, dtype=float)
         return 4 * self.normal / effective_modulus(E, nu, plane) * \
             np.sqrt(np.clip(self.a * self.a - x * x, 0.0, None))
 
-    def normal_stress_ahead(self, r):
+    def normal_stress_ahead(self, r: ArrayLike) -> np.ndarray:
         """Normal stress ``(p,)`` on the crack line at distance ``r > 0`` ahead of a tip."""
         r = np.asarray(r, dtype=float)
         return self.normal * (self.a + r) / np.sqrt(r * (2 * self.a + r))

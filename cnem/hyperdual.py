@@ -20,7 +20,10 @@ second derivatives, free of the truncation and cancellation errors of finite dif
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import config
 from .errors import HyperDualError
@@ -63,7 +66,8 @@ class HyperDual:
     __array_ufunc__ = None        # ndarray <op> HyperDual defers to the reflected method here
     __hash__ = None
 
-    def __init__(self, re, e1=0.0, e2=0.0, e12=0.0):
+    def __init__(self, re: ArrayLike, e1: ArrayLike = 0.0, e2: ArrayLike = 0.0,
+                 e12: ArrayLike = 0.0) -> None:
         parts = [np.asarray(p, dtype=np.float64) for p in (re, e1, e2, e12)]
         shape = _broadcast([p.shape for p in parts], "HyperDual(re, e1, e2, e12)")
         for name, p in zip(_PARTS, parts):
@@ -73,12 +77,12 @@ class HyperDual:
         raise AttributeError("HyperDual is immutable; build a new one with HyperDual(re, e1, ...)")
 
     @property
-    def shape(self):
+    def shape(self) -> tuple[int, ...]:
         """tuple : Shape of every part."""
         return self.re.shape
 
     @property
-    def ndim(self):
+    def ndim(self) -> int:
         """int : Number of dimensions."""
         return self.re.ndim
 
@@ -91,11 +95,11 @@ class HyperDual:
     def __repr__(self):
         return "HyperDual(" + ", ".join(f"{p}={getattr(self, p)!r}" for p in _PARTS) + ")"
 
-    def sum(self, axis=None):
+    def sum(self, axis: int | tuple[int, ...] | None = None) -> HyperDual:
         """Sum over ``axis`` (all axes when None), each part separately."""
         return HyperDual(*(getattr(self, p).sum(axis=axis) for p in _PARTS))
 
-    def reshape(self, *shape):
+    def reshape(self, *shape: int | tuple[int, ...]) -> HyperDual:
         """Same numbers in a new shape (as ``ndarray.reshape``)."""
         return HyperDual(*(getattr(self, p).reshape(*shape) for p in _PARTS))
 
@@ -189,7 +193,7 @@ class HyperDual:
 
 def _elementwise(name, real, rule):
     """A function of one argument: ``real`` on plain input, chain rule ``rule(a)`` on HyperDual."""
-    def func(x):
+    def func(x: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
         if isinstance(x, HyperDual):
             return x._chain(*rule(x.re))
         return real(np.asarray(x, dtype=np.float64))
@@ -244,7 +248,7 @@ cosh = _elementwise("cosh", np.cosh, lambda a: (np.cosh(a), np.sinh(a), np.cosh(
 tanh = _elementwise("tanh", np.tanh, _tanh_rule)
 
 
-def power(x, p):
+def power(x: HyperDual | ArrayLike, p: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
     """``x ** p`` for HyperDual or real ``x`` and real or HyperDual ``p`` (HyperDual: x > 0)."""
     if isinstance(x, HyperDual):
         return x ** p
@@ -270,18 +274,18 @@ def _stack_any(items):
     return np.stack(np.broadcast_arrays(*items), axis=-1)
 
 
-def dot(a, b):
+def dot(a: HyperDual | ArrayLike, b: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
     """Dot product over the last axis: ``(..., d), (..., d) -> (...)``; either may be real."""
     a, b = _vectors(a, b, "hd.dot")
     return (a * b).sum(axis=-1)
 
 
-def norm(a):
+def norm(a: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
     """Euclidean norm over the last axis: ``(..., d) -> (...)``."""
     return sqrt(dot(a, a))
 
 
-def cross(a, b):
+def cross(a: HyperDual | ArrayLike, b: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
     """Cross product over the last axis.
 
     Parameters
@@ -304,7 +308,7 @@ def cross(a, b):
                          f"{d} (shapes {a.shape} and {b.shape}); pass 2-D or 3-D vectors")
 
 
-def stack(items, axis=-1):
+def stack(items: Sequence[HyperDual | ArrayLike], axis: int = -1) -> HyperDual:
     """Stack HyperDuals (or reals) of broadcast-compatible shapes along a new ``axis``."""
     items = [v if isinstance(v, HyperDual) else HyperDual(v) for v in items]
     shape = _broadcast([v.shape for v in items], "hd.stack")
@@ -312,7 +316,7 @@ def stack(items, axis=-1):
                        for p in _PARTS))
 
 
-def concatenate(items, axis=-1):
+def concatenate(items: Sequence[HyperDual | ArrayLike], axis: int = -1) -> HyperDual:
     """Join HyperDuals (or reals) along the existing ``axis`` (default the last, components)."""
     items = [v if isinstance(v, HyperDual) else HyperDual(v) for v in items]
     try:
@@ -332,7 +336,8 @@ def _check_output(out, shape, what, hint=""):
             f"index components as y[..., j]{hint}")
 
 
-def derivatives(f, x, *, batch=True):
+def derivatives(f: Callable[[HyperDual], HyperDual], x: ArrayLike, *,
+                batch: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Value, gradient and Hessian of a scalar function of ``k`` variables at ``m`` points.
 
     Seeds ``eps1`` along variable p and ``eps2`` along q for every pair p <= q (eq. 30):
@@ -386,7 +391,8 @@ def derivatives(f, x, *, batch=True):
     return value, grad, hess
 
 
-def derivative(f, x):
+def derivative(f: Callable[[HyperDual], HyperDual],
+               x: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Value, first and second derivative of an elementwise scalar function (eq. 27).
 
     Parameters

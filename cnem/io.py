@@ -31,14 +31,21 @@ point data would not come back as written.
 from __future__ import annotations
 
 import logging
+import os
 import pathlib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import meshio
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .errors import FormatError
 from .geometry.model import Cells
+
+if TYPE_CHECKING:
+    from .geometry.model import Model
 
 __all__ = ["write", "write_nodes", "write_points", "read", "CellMesh", "FormatError", "SUFFIXES"]
 
@@ -122,7 +129,8 @@ def _checked(value, count, name):
     return arr, fill
 
 
-def write(model, path, *, point_data=None, cell_data=None):
+def write(model: Model, path: str | os.PathLike, *, point_data: Mapping[str, ArrayLike] | None = None,
+          cell_data: Mapping[str, ArrayLike] | None = None) -> pathlib.Path:
     """Write the nodes and integration cells of a model to a ``.vtu`` file.
 
     Parameters
@@ -194,7 +202,8 @@ def write(model, path, *, point_data=None, cell_data=None):
     return path
 
 
-def write_nodes(model, path, *, point_data=None):
+def write_nodes(model: Model, path: str | os.PathLike, *,
+                point_data: Mapping[str, ArrayLike] | None = None) -> pathlib.Path:
     """Write the nodes, the constrained Delaunay triangles and the constraint segments.
 
     Parameters
@@ -238,7 +247,9 @@ def write_nodes(model, path, *, point_data=None):
     return path
 
 
-def write_points(points, path, *, triangles=None, point_data=None, cell_data=None):
+def write_points(points: ArrayLike, path: str | os.PathLike, *, triangles: ArrayLike | None = None,
+                 point_data: Mapping[str, ArrayLike] | None = None,
+                 cell_data: Mapping[str, ArrayLike] | None = None) -> pathlib.Path:
     """Write points (2-D or 3-D), as ``vertex`` cells or with triangles on them.
 
     Parameters
@@ -314,12 +325,12 @@ class CellMesh:
     def __len__(self):
         return len(self.node)
 
-    def polygon(self, i):
+    def polygon(self, i: int) -> np.ndarray:
         """Vertices of cell ``i``, ``(k, 2)``, counter-clockwise."""
         return self.vertices[self.offsets[i]:self.offsets[i + 1]]
 
     @property
-    def cells(self):
+    def cells(self) -> Cells:
         """The cells as a `cnem.geometry.Cells` (areas recomputed from the vertices)."""
         return Cells(self.node, self.region, self.offsets, self.vertices)
 
@@ -330,7 +341,7 @@ class CellMesh:
                 + (f", data: {', '.join(extra)}" if extra else "") + ">")
 
 
-def read(path):
+def read(path: str | os.PathLike) -> CellMesh:
     """Read nodes and integration cells from a file written by `write`.
 
     Parameters

@@ -6,7 +6,10 @@ planes, the Lamé parameters, the matrix ``C``, Kolosov's constant and the effec
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .errors import MaterialError, check_choice
 
@@ -16,7 +19,7 @@ __all__ = ["PLANES", "parse_materials", "lame", "stiffness_matrix", "kappa", "ef
 PLANES = ("stress", "strain")
 
 
-def parse_materials(materials, nregions):
+def parse_materials(materials: ArrayLike, nregions: int) -> np.ndarray:
     """``(r, 2)`` array of ``(E, nu)`` per region from one pair or a list of pairs."""
     try:
         arr = np.asarray(materials, dtype=float)
@@ -38,7 +41,8 @@ def parse_materials(materials, nregions):
     return arr
 
 
-def lame(E, nu, plane):
+def lame(E: ArrayLike, nu: ArrayLike,
+         plane: Literal["stress", "strain"]) -> tuple[np.ndarray, np.ndarray]:
     """Lamé parameters of the 2-D law: ``sigma = 2 mu eps + lam tr(eps) I``.
 
     In plane stress ``lam`` is ``lambda* = 2 lambda mu / (lambda + 2 mu)``.
@@ -56,7 +60,7 @@ def lame(E, nu, plane):
     return lam, mu
 
 
-def stiffness_matrix(E, nu, plane):
+def stiffness_matrix(E: ArrayLike, nu: ArrayLike, plane: Literal["stress", "strain"]) -> np.ndarray:
     """The matrix ``C`` of eq. 24 (strain) or 25 (stress), Voigt ``[xx, yy, xy]``
     with engineering shear strain.
 
@@ -72,13 +76,14 @@ def stiffness_matrix(E, nu, plane):
     return C
 
 
-def kappa(nu, plane):
+def kappa(nu: float | np.ndarray, plane: Literal["stress", "strain"]) -> float | np.ndarray:
     """Kolosov's constant: ``3 - 4 nu`` (plane strain) or ``(3 - nu) / (1 + nu)`` (plane stress)."""
     check_choice("plane", plane, PLANES)
     return 3.0 - 4.0 * nu if plane == "strain" else (3.0 - nu) / (1.0 + nu)
 
 
-def effective_modulus(E, nu, plane):
+def effective_modulus(E: float | np.ndarray, nu: float | np.ndarray,
+                      plane: Literal["stress", "strain"]) -> float | np.ndarray:
     """``E' = E`` (plane stress) or ``E / (1 - nu^2)`` (plane strain): ``G = K^2 / E'``."""
     kappa(nu, plane)
     return E if plane == "stress" else E / (1.0 - nu * nu)

@@ -14,14 +14,20 @@ the crack can open).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import shapely
+from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from . import config
 from .errors import GeometryError
 from .geometry.cloud import NodeCloud
 from .geometry.pslg import SegmentKind, segment_projection
+
+if TYPE_CHECKING:
+    from .geometry.domain import Domain
 
 __all__ = ["regular", "irregular", "graded", "from_points", "NodeCloud"]
 
@@ -119,7 +125,7 @@ def _assemble(dom, boundary, interior, spacing_of):
     return NodeCloud(dom, points, segs.astype(np.int64), kinds, spacing_of(points))
 
 
-def regular(domain, h):
+def regular(domain: Domain, h: float) -> NodeCloud:
     """Square lattice of spacing ``h`` plus boundary nodes every ~h.
 
     Parameters
@@ -139,7 +145,7 @@ def regular(domain, h):
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
 
 
-def irregular(domain, h, *, seed=0):
+def irregular(domain: Domain, h: float, *, seed: int = 0) -> NodeCloud:
     """Randomly perturbed lattice of mean spacing ``h`` (reproducible with ``seed``).
 
     Interior nodes are moved by up to 0.35 h in each direction and boundary
@@ -159,7 +165,8 @@ def irregular(domain, h, *, seed=0):
     return _assemble(domain, boundary, interior, spacing_of)
 
 
-def graded(domain, h, *, near, h_min, growth=0.3, seed=None):
+def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: float = 0.3,
+           seed: int | None = None) -> NodeCloud:
     """Nodes whose spacing shrinks from ``h`` to ``h_min`` towards given points.
 
     The local spacing is ``s(x) = min(h, h_min + growth * d(x))`` with ``d`` the
@@ -212,7 +219,7 @@ def graded(domain, h, *, near, h_min, growth=0.3, seed=None):
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
 
 
-def from_points(domain, points):
+def from_points(domain: Domain, points: ArrayLike) -> NodeCloud:
     """The user's own nodes, with missing corners and crack vertices added.
 
     Points within ``domain.tolerance`` of a boundary, interface or crack are

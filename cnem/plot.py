@@ -15,13 +15,21 @@ with the command that installs it (``pip install "cnem[plot]"``).
 from __future__ import annotations
 
 import logging
+import os
 import pathlib
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .errors import PlotDependencyError, PlotError, PlotInputError
 from .geometry.pslg import SegmentKind
 from .io import cell_topology
+
+if TYPE_CHECKING:
+    import pyvista
+
+    from .geometry.model import Model
 
 __all__ = ["model", "solution", "cells_polydata", "region_color", "PlotError", "REGION_COLORS",
            "SOLUTION_FIELDS"]
@@ -58,7 +66,7 @@ def _pyvista():
     return pyvista
 
 
-def region_color(region):
+def region_color(region: ArrayLike) -> np.ndarray:
     """RGB colour (0-255) of each region, ``(r, 3)`` uint8 for ``(r,)`` region indices."""
     return REGION_COLORS[np.asarray(region, dtype=np.int64) % len(REGION_COLORS)]
 
@@ -77,7 +85,7 @@ def _lines(pv, points2d, pairs, z):
     return pv.PolyData(_lift(points2d, z), lines=lines)
 
 
-def cells_polydata(model):
+def cells_polydata(model: Model) -> pyvista.PolyData:
     """The integration cells as a pyvista ``PolyData`` (one polygon per cell).
 
     Parameters
@@ -112,8 +120,11 @@ def _triangle_edges(triangles):
     return np.unique(np.sort(e, axis=1), axis=0)
 
 
-def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks=True,
-          window_size=(1200, 1200), bounds=None, node_size=None):
+def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles: bool = True,
+          show_nodes: bool = True, show_cracks: bool = True,
+          window_size: tuple[int, int] = (1200, 1200),
+          bounds: tuple[float, float, float, float] | None = None,
+          node_size: float | None = None) -> pyvista.Plotter:
     """Top view of a model: constrained Voronoi cells, Delaunay triangles, nodes, cracks.
 
     Cells are filled with their region's colour (`REGION_COLORS`, unlit so the
@@ -276,8 +287,10 @@ def nodal_field(sol, field):
     return sol.nodal_average(per_place)
 
 
-def solution(sol, path=None, *, field="von_mises", scale=None, window_size=(1200, 1200),
-             show_edges=False, cmap="viridis", title=None):
+def solution(sol: Any, path: str | os.PathLike | None = None, *, field: str | np.ndarray = "von_mises",
+             scale: float | None = None, window_size: tuple[int, int] = (1200, 1200),
+             show_edges: bool = False, cmap: str = "viridis",
+             title: str | None = None) -> pyvista.Plotter:
     """The deformed body coloured by a field (off-screen).
 
     The solution's triangles (``sol.plot_mesh()``: C-NEM's constrained Delaunay

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
+from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
@@ -236,7 +237,10 @@ class _ExactCells:
         return ring
 
 
-def voronoi_cells(nodes, triangles, region, *, progress=None, neighbors=None, only=None):
+def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
+                  progress: bool | None = None, neighbors: np.ndarray | None = None,
+                  only: ArrayLike | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Constrained Voronoi cells of a (crack-split) constrained Delaunay triangulation.
 
     Parameters

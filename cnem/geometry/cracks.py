@@ -39,7 +39,8 @@ def _fan_groups(v, fan, triangles, crack_neighbors):
     return sorted(groups, key=min)
 
 
-def split_cracks(points, triangles, segments, kind):
+def split_cracks(points: np.ndarray, triangles: np.ndarray, segments: np.ndarray, kind: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Duplicate crack nodes so that each crack face has its own nodes.
 
     Parameters

@@ -8,15 +8,18 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import shapely
 from shapely.geometry import LineString, MultiPolygon, Polygon
 from shapely.geometry.polygon import orient
 from shapely.validation import explain_validity
+from numpy.typing import ArrayLike
 
 from .. import config
 from ..errors import GeometryError
-from .pslg import CRACK, build_pslg, ring_coordinates
+from .pslg import CRACK, PSLG, build_pslg, ring_coordinates
 
 __all__ = ["Domain"]
 
@@ -109,7 +112,8 @@ class Domain:
         the domain or crossing each other, zero-length segments.
     """
 
-    def __init__(self, regions, cracks=()):
+    def __init__(self, regions: ArrayLike | Polygon | Sequence[ArrayLike | tuple | Polygon],
+                 cracks: Sequence[ArrayLike] = ()) -> None:
         if isinstance(regions, MultiPolygon):
             regions = list(regions.geoms)
         elif _is_single_polygon(regions):
@@ -218,51 +222,51 @@ class Domain:
 
     # -------------------------------------------------------------- properties
     @property
-    def regions(self):
+    def regions(self) -> tuple[Polygon, ...]:
         """tuple of shapely.Polygon: the material regions, counter-clockwise."""
         return self._regions
 
     @property
-    def cracks(self):
+    def cracks(self) -> tuple[np.ndarray, ...]:
         """tuple of (k, 2) ndarray: the crack polylines."""
         return self._cracks
 
     @property
-    def polygon(self):
+    def polygon(self) -> shapely.Geometry:
         """shapely geometry: union of all regions (cracks not cut)."""
         return self._union
 
     @property
-    def pslg(self):
+    def pslg(self) -> PSLG:
         """PSLG: vertices and constraint edges (boundaries, interfaces, cracks)."""
         return self._pslg
 
     @property
-    def area(self):
+    def area(self) -> float:
         """float: total area of the regions."""
         return float(sum(p.area for p in self._regions))
 
     @property
-    def bounds(self):
+    def bounds(self) -> tuple[float, float, float, float]:
         """(4,) tuple ``(xmin, ymin, xmax, ymax)``."""
         return tuple(float(b) for b in self._union.bounds)
 
     @property
-    def diameter(self):
+    def diameter(self) -> float:
         """float: length of the bounding-box diagonal."""
         return self._diameter
 
     @property
-    def tolerance(self):
+    def tolerance(self) -> float:
         """float: absolute snapping tolerance ``SNAP_TOL * diameter``."""
         return self._tol
 
     @property
-    def tips(self):
+    def tips(self) -> np.ndarray:
         """(t, 2) ndarray: crack ends that lie inside the domain."""
         return self._tips
 
-    def tip_frame(self, tip):
+    def tip_frame(self, tip: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """The crack tip nearest to a point, and the crack's direction there.
 
         Parameters
@@ -292,7 +296,7 @@ class Domain:
                     return at.copy(), d / np.hypot(*d)
         raise AssertionError("a tip that is no crack end")      # pragma: no cover
 
-    def contains(self, points):
+    def contains(self, points: ArrayLike) -> np.ndarray:
         """Whether points lie in the closed domain.
 
         Parameters
@@ -305,7 +309,7 @@ class Domain:
         """
         return self.region_of(points) >= 0
 
-    def region_of(self, points):
+    def region_of(self, points: ArrayLike) -> np.ndarray:
         """Index of the region (closure) containing each point, -1 outside.
 
         Parameters

@@ -5,8 +5,11 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike
 
 from ..errors import GeometryError
 from ._kernels import polygon_moments
@@ -18,6 +21,9 @@ from ..spatial.rtree import RTree
 from .topology import circumcenters, cut_between_regions, triangle_neighbors
 
 from .triangulation import constrained_delaunay
+
+if TYPE_CHECKING:
+    from .domain import Domain
 
 __all__ = ["Cells", "Model", "discretize"]
 
@@ -72,7 +78,7 @@ class Cells:
     def __len__(self):
         return len(self.node)
 
-    def subset(self, index):
+    def subset(self, index: ArrayLike) -> Cells:
         """The cells ``index`` (in that order) as a `Cells` of their own."""
         index = np.asarray(index, dtype=np.int64)
         counts = np.diff(self.offsets)[index]
@@ -84,11 +90,11 @@ class Cells:
                      None if self.edge_source is None else self.edge_source[verts],
                      self.area[index])
 
-    def polygon(self, i):
+    def polygon(self, i: int) -> np.ndarray:
         """Vertices of cell ``i``, ``(k, 2)``, counter-clockwise."""
         return self.vertices[self.offsets[i]:self.offsets[i + 1]]
 
-    def centroid(self):
+    def centroid(self) -> np.ndarray:
         """Centroids of all cells, ``(m, 2)``."""
         return self._moments()[1]
 
@@ -132,11 +138,11 @@ class Model:
     _derived: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
-    def domain(self):
+    def domain(self) -> Domain:
         """Domain: the body this model discretises."""
         return self.cloud.domain
 
-    def neighbors(self, *, across_regions=False):
+    def neighbors(self, *, across_regions: bool = False) -> np.ndarray:
         """The triangle across each edge, ``(t, 3)`` int64: ``nb[t, k]`` faces vertex
         ``k``; -1 on the boundary, at crack faces and (unless ``across_regions``)
         where the neighbour lies in another region. Computed once (`discretize`
@@ -146,7 +152,7 @@ class Model:
                               lambda: _neighbor_tables(self.triangles, self.triangle_region))
         return tables[1 if across_regions else 0]
 
-    def circumcircles(self):
+    def circumcircles(self) -> tuple[np.ndarray, np.ndarray, RTree]:
         """The circumcircles of the triangles: centres ``(t, 2)``, squared radii
         ``(t,)`` and an R-tree over their boxes (which also holds every triangle:
         point location). Computed on first call, then kept."""
@@ -157,7 +163,7 @@ class Model:
             return centre, radius2, RTree(centre - radius, centre + radius)
         return self._derive("circumcircles", build)
 
-    def triangle_tree(self):
+    def triangle_tree(self) -> RTree:
         """An R-tree over the boxes of the triangles: tighter than the circumcircles'
         (`circumcircles`), worth building to locate many points. Built on first
         call, then kept.
@@ -178,7 +184,7 @@ class Model:
             self._derived[name] = build()
         return self._derived[name]
 
-    def node_sides(self):
+    def node_sides(self) -> np.ndarray:
         """A point on the side of each node: the area-weighted centroid of its cells
         (for the two copies of a crack-face node, a point on each one's face).
 
@@ -192,8 +198,11 @@ class Model:
         return np.column_stack([np.bincount(cells.node, weights=cells.area * c, minlength=n)
                                 for c in cells.centroid().T]) / weight[:, None]
 
-    def shape_functions(self, points, *, kind="sibson", triangles=None, gradient=False,
-                        in_order=True):
+    def shape_functions(self, points: ArrayLike, *, kind: Literal["sibson", "laplace"] = "sibson",
+                        triangles: ArrayLike | None = None, gradient: bool = False,
+                        in_order: bool = True
+                        ) -> (sp.csr_matrix | tuple[sp.csr_matrix, np.ndarray]
+                              | tuple[sp.csr_matrix, sp.csr_matrix, sp.csr_matrix]):
         """Constrained natural-neighbour coordinates, see `cnem.shape.shape_functions`.
 
         Returns
@@ -212,7 +221,7 @@ class Model:
                 f"({len(dom.tips)} tip{'s' * (len(dom.tips) != 1)})>")
 
 
-def discretize(cloud, *, progress=None):
+def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:
     """Constrained Delaunay triangulation, crack opening and constrained Voronoi cells.
 
     Parameters

@@ -12,6 +12,7 @@ import enum
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
@@ -74,7 +75,8 @@ def _merge_vertices(points, tol):
     return points[first[order]], rank[label]
 
 
-def segment_projection(points, a, b):
+def segment_projection(points: ArrayLike, a: ArrayLike,
+                       b: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Position along and distance from segments of points.
 
     Parameters
@@ -111,7 +113,8 @@ def _split_edge(a, b, vertices, tree, tol):
     return cand[keep][order]
 
 
-def build_pslg(polylines, kinds_hint, tol, extra_vertices=None):
+def build_pslg(polylines: list[tuple[np.ndarray, bool]], kinds_hint: list[int], tol: float,
+               extra_vertices: np.ndarray | None = None) -> PSLG:
     """Build a PSLG from rings and crack polylines.
 
     Parameters

@@ -12,6 +12,7 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import sparse
 from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
@@ -29,7 +30,8 @@ def _spacing(points):
     return float(np.median(distance[:, k]))
 
 
-def ridge_path(points, field, start, *, threshold=0.5, spacing=None, step=None) -> np.ndarray:
+def ridge_path(points: ArrayLike, field: ArrayLike, start: ArrayLike, *, threshold: float = 0.5,
+               spacing: float | None = None, step: float | None = None) -> np.ndarray:
     """The polyline along the ridge of ``field >= threshold`` from ``start`` to its far end.
 
     The points where ``field >= threshold`` are linked to those within 1.5

@@ -9,7 +9,10 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import GeometryError
 from .domain import Domain
@@ -23,7 +26,8 @@ def _positive(name, value):
     return float(value)
 
 
-def arc(center, radius, start, stop, spacing, *, pieces=None):
+def arc(center: ArrayLike, radius: float, start: float, stop: float, spacing: float, *,
+        pieces: int | None = None) -> np.ndarray:
     """Points on a circular arc, ends included, about ``spacing`` apart.
 
     Parameters
@@ -49,7 +53,8 @@ def arc(center, radius, start, stop, spacing, *, pieces=None):
     return np.asarray(center, float) + radius * np.column_stack([np.cos(t), np.sin(t)])
 
 
-def rectangle(width=1.0, height=1.0, *, origin=(0.0, 0.0), cracks=()):
+def rectangle(width: float = 1.0, height: float = 1.0, *, origin: ArrayLike = (0.0, 0.0),
+              cracks: Sequence[ArrayLike] = ()) -> Domain:
     """Axis-aligned rectangle ``[x0, x0 + width] x [y0, y0 + height]``.
 
     Returns
@@ -62,8 +67,9 @@ def rectangle(width=1.0, height=1.0, *, origin=(0.0, 0.0), cracks=()):
     return Domain([shell], cracks=cracks)
 
 
-def plate_with_hole(width=1.0, height=1.0, radius=0.2, *, center=None, spacing=None,
-                    cracks=()):
+def plate_with_hole(width: float = 1.0, height: float = 1.0, radius: float = 0.2, *,
+                    center: ArrayLike | None = None, spacing: float | None = None,
+                    cracks: Sequence[ArrayLike] = ()) -> Domain:
     """Rectangle ``[0, width] x [0, height]`` with a circular hole.
 
     Parameters
@@ -83,7 +89,9 @@ def plate_with_hole(width=1.0, height=1.0, radius=0.2, *, center=None, spacing=N
     return Domain([(shell, [ring[::-1]])], cracks=cracks)
 
 
-def annulus(radii, *, angles=None, center=(0.0, 0.0), spacing=None, segments=None, cracks=()):
+def annulus(radii: Sequence[float], *, angles: Sequence[float] | None = None,
+            center: ArrayLike = (0.0, 0.0), spacing: float | None = None,
+            segments: int | None = None, cracks: Sequence[ArrayLike] = ()) -> Domain:
     """Concentric annular regions (a multi-material cylinder section).
 
     Parameters
@@ -118,7 +126,7 @@ def annulus(radii, *, angles=None, center=(0.0, 0.0), spacing=None, segments=Non
     return Domain(regions, cracks=cracks)
 
 
-def l_shape(size=1.0, cut=0.5, *, cracks=()):
+def l_shape(size: float = 1.0, cut: float = 0.5, *, cracks: Sequence[ArrayLike] = ()) -> Domain:
     """Square ``[0, size]^2`` without its top-right ``cut x cut`` corner."""
     s, c = _positive("size", size), _positive("cut", cut)
     if c >= s:

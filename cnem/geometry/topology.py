@@ -8,7 +8,7 @@ __all__ = ["triangle_neighbors", "cut_between_regions", "vertex_triangles", "cir
            "constraint_edges"]
 
 
-def triangle_neighbors(triangles, region=None):
+def triangle_neighbors(triangles: np.ndarray, region: np.ndarray | None = None) -> np.ndarray:
     """Neighbour across each edge; edges between regions count as boundaries.
 
     Parameters
@@ -36,7 +36,7 @@ def triangle_neighbors(triangles, region=None):
     return nb if region is None else cut_between_regions(nb, region)
 
 
-def cut_between_regions(nb, region):
+def cut_between_regions(nb: np.ndarray, region: np.ndarray) -> np.ndarray:
     """Neighbours ``(t, 3)`` with -1 where the neighbour lies in another region (a copy)."""
     nb = nb.copy()
     other = nb >= 0
@@ -46,7 +46,7 @@ def cut_between_regions(nb, region):
     return nb
 
 
-def vertex_triangles(triangles, n):
+def vertex_triangles(triangles: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """CSR of the triangles around each vertex.
 
     Returns
@@ -62,7 +62,7 @@ def vertex_triangles(triangles, n):
     return offsets, (order // 3).astype(np.int64)
 
 
-def circumcenters(points, triangles):
+def circumcenters(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     """Circumcentres of triangles, computed relative to the first vertex.
 
     Returns
@@ -79,7 +79,7 @@ def circumcenters(points, triangles):
     return a + np.column_stack([ux, uy])
 
 
-def constraint_edges(triangles, nb):
+def constraint_edges(triangles: np.ndarray, nb: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Edges with no neighbour (boundary, crack face, or interface side).
 
     Returns

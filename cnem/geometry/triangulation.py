@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import triangle
 
 from ..errors import GeometryError
 from .pslg import segment_projection
+
+if TYPE_CHECKING:
+    from .cloud import NodeCloud
 
 __all__ = ["constrained_delaunay"]
 
@@ -30,7 +35,7 @@ def _steiner_error(points, segments, extra, tol):
         + "; ".join(msgs) + "; boundaries, interfaces and cracks may only meet at shared vertices")
 
 
-def constrained_delaunay(cloud):
+def constrained_delaunay(cloud: NodeCloud) -> tuple[np.ndarray, np.ndarray]:
     """Triangulate a `NodeCloud` respecting all its segments.
 
     Parameters

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -45,6 +46,9 @@ from ..errors import GeometryError
 from .cells import voronoi_cells
 from .model import Cells, Model, triangulate
 from .topology import circumcenters
+
+if TYPE_CHECKING:
+    from .cloud import NodeCloud
 
 __all__ = ["ModelUpdate", "update"]
 
@@ -72,18 +76,18 @@ class ModelUpdate:
     old_cell: np.ndarray
 
     @property
-    def changed_cells(self):
+    def changed_cells(self) -> np.ndarray:
         """New cells that were recomputed, ``(c,)`` int64."""
         return np.flatnonzero(self.old_cell < 0)
 
     @property
-    def dropped_cells(self):
+    def dropped_cells(self) -> np.ndarray:
         """Old cells that no new cell copies, ``(d,)`` int64."""
         kept = np.zeros(len(self.old.cells), dtype=bool)
         kept[self.old_cell[self.old_cell >= 0]] = True
         return np.flatnonzero(~kept)
 
-    def new_node(self):
+    def new_node(self) -> np.ndarray:
         """The new node of each old node, ``(n_old,)`` int64, -1 where none."""
         out = np.full(len(self.old.nodes), -1, dtype=np.int64)
         have = self.old_node >= 0
@@ -232,7 +236,7 @@ def _boxes_meet(boxes, targets, pad):
     return hit
 
 
-def update(model, cloud, *, progress=None):
+def update(model: Model, cloud: NodeCloud, *, progress: bool | None = None) -> ModelUpdate:
     """The model of a changed node cloud, recomputing only the cells the change reaches.
 
     Parameters

@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, Literal, NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import ArrayLike
 
 from .. import config
 from ..errors import CNEMError, GeometryError, UnsupportedError, check_choice
@@ -61,8 +62,11 @@ def _locate_sorted(model, spts, tol):
     return tri_of
 
 
-def shape_functions(model, points, *, kind="sibson", triangles=None, gradient=False,
-                    in_order=True):
+def shape_functions(model: Any, points: ArrayLike, *, kind: Literal["sibson", "laplace"] = "sibson",
+                    triangles: ArrayLike | None = None, gradient: bool = False,
+                    in_order: bool = True
+                    ) -> (sp.csr_matrix | tuple[sp.csr_matrix, np.ndarray]
+                          | tuple[sp.csr_matrix, sp.csr_matrix, sp.csr_matrix]):
     """Constrained natural-neighbour coordinates of points.
 
     Parameters
@@ -149,7 +153,8 @@ class PointRows(NamedTuple):
     nodes: int
 
 
-def point_rows(model, points, *, kind="sibson", triangles=None):
+def point_rows(model: Any, points: ArrayLike, *, kind: Literal["sibson", "laplace"] = "sibson",
+               triangles: ArrayLike | None = None) -> PointRows:
     """`shape_functions` of many points left in the layout the kernel writes them,
     for consumers that read the rows one by one (points and keywords as in
     `shape_functions`).

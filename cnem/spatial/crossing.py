@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import SpatialError
 from . import _family_kernels as K
@@ -25,7 +26,7 @@ def _far_ends(seg):
     return far.reshape(-1, 2, 2)
 
 
-def remove_crossing(family, points, segments):
+def remove_crossing(family: Family, points: ArrayLike, segments: ArrayLike) -> Family:
     """Drop every bond ``(i, j)`` whose straight segment crosses a segment.
 
     A bond crosses when the interiors cross, or when it passes through an

@@ -16,9 +16,11 @@ reference (``"brute"``, small clouds only).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numba
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from .. import config
@@ -58,15 +60,15 @@ class Family:
         return len(self.offsets) - 1
 
     @property
-    def counts(self):
+    def counts(self) -> np.ndarray:
         """(n,) int64 ndarray: family sizes."""
         return np.diff(self.offsets)
 
-    def row(self, i):
+    def row(self, i: int) -> np.ndarray:
         """Family members of point ``i``."""
         return self.indices[self.offsets[i]:self.offsets[i + 1]]
 
-    def pairs(self):
+    def pairs(self) -> np.ndarray:
         """All bonds as ``(k, 2)`` int64 ``(i, j)`` pairs."""
         rows = np.repeat(np.arange(len(self), dtype=np.int64), self.counts)
         return np.column_stack([rows, self.indices.astype(np.int64)])
@@ -153,7 +155,9 @@ def choose_method(horizon):
     return "cells"
 
 
-def family_search(points, horizon, *, period=None, method="auto"):
+def family_search(points: ArrayLike, horizon: float | ArrayLike, *,
+                  period: ArrayLike | None = None,
+                  method: Literal["auto", "rtree", "cells", "kdtree", "brute"] = "auto") -> Family:
     """Family of each point: every ``j`` with ``0 < |x_j - x_i| < horizon_i``.
 
     Parameters

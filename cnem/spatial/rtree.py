@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .. import config
 from .._parallel import work_chunks
@@ -20,7 +21,7 @@ from . import _rtree_kernels as K
 __all__ = ["RTree", "check_period", "as_points"]
 
 
-def as_points(points, name="points"):
+def as_points(points: ArrayLike, name: str = "points") -> np.ndarray:
     """Validate a ``(n, d)`` float64 C-contiguous array with d = 2 or 3."""
     arr = np.ascontiguousarray(points, dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] not in (2, 3):
@@ -32,7 +33,7 @@ def as_points(points, name="points"):
     return arr
 
 
-def check_period(period, dim, *points):
+def check_period(period: ArrayLike | None, dim: int, *points: np.ndarray) -> np.ndarray:
     """Period as a ``(d,)`` array (``inf`` where not periodic); points must lie in ``[0, L)``."""
     if period is None:
         return np.full(dim, np.inf)
@@ -85,7 +86,7 @@ class RTree:
     compare wrapped centre distances (Algorithms 3-5). All queries are exact.
     """
 
-    def __init__(self, lo, hi, *, period=None):
+    def __init__(self, lo: ArrayLike, hi: ArrayLike, *, period: ArrayLike | None = None) -> None:
         self._corners = None
         lo, hi = as_points(lo, "lo"), as_points(hi, "hi")
         if lo.shape != hi.shape:
@@ -98,7 +99,7 @@ class RTree:
         self._build(0.5 * (lo + hi), 0.5 * (hi - lo), period)
 
     @classmethod
-    def from_points(cls, points, *, period=None):
+    def from_points(cls, points: ArrayLike, *, period: ArrayLike | None = None) -> RTree:
         """A tree over points (zero-size boxes).
 
         Parameters
@@ -171,11 +172,11 @@ class RTree:
         return pts
 
     @property
-    def periodic(self):
+    def periodic(self) -> bool:
         """bool: whether the tree has periodic boundaries."""
         return bool(np.isfinite(self.period).all())
 
-    def query(self, qlo, qhi):
+    def query(self, qlo: ArrayLike, qhi: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Boxes intersecting each query box (closed boxes).
 
         Parameters
@@ -201,7 +202,8 @@ class RTree:
         return self._query(qcen, 0.5 * (qhi - qlo), np.zeros(len(qlo)), K.INTERSECT,
                            qlo=qlo, qhi=qhi)
 
-    def query_ball(self, points, r, *, strict=False, exclude_self=False):
+    def query_ball(self, points: ArrayLike, r: float | ArrayLike, *, strict: bool = False,
+                   exclude_self: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Boxes within distance ``r`` of each point.
 
         Parameters
@@ -227,7 +229,7 @@ class RTree:
         kind = K.BALL_OPEN if strict else K.BALL_CLOSED
         return self._query(pts, np.zeros_like(pts), radius, kind, exclude_self)
 
-    def nearest(self, points):
+    def nearest(self, points: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Nearest box to each point.
 
         Returns
@@ -242,13 +244,13 @@ class RTree:
         return K.nearest(self.centre, self.half, self.first, self.count, self.size, self.depth,
                          self.fanout, self.order, pts, self.period, work_chunks())
 
-    def node_boxes(self, level):
+    def node_boxes(self, level: int) -> tuple[np.ndarray, np.ndarray]:
         """Centre and half-width of the nodes at ``level`` (0: the boxes, sorted)."""
         a, b = self.level_start[level], self.level_start[level + 1]
         return self.centre[a:b], self.half[a:b]
 
     @property
-    def depth(self):
+    def depth(self) -> int:
         """int: number of levels above the boxes."""
         return 0 if self.size == 0 else len(self.level_start) - 2
 
