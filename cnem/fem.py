@@ -264,7 +264,7 @@ class P1Elasticity(Conditions):
                 f"{self.conditions_repr()}>")
 
     @property
-    def nodes(self):
+    def nodes(self) -> np.ndarray:
         """``(n, 2)`` node coordinates (crack nodes once per face)."""
         return self.mesh.p.T
 
@@ -273,7 +273,7 @@ class P1Elasticity(Conditions):
     edges_name = "boundary facet"
 
     @property
-    def condition_points(self):
+    def condition_points(self) -> np.ndarray:
         """``(n, 2)`` the nodes that conditions refer to (`nodes`)."""
         return self.nodes
 
@@ -424,7 +424,8 @@ class P1Solution(Solution):
     stress_at = "triangles"
 
     @classmethod
-    def from_dofs(cls, problem, x, timings):
+    def from_dofs(cls, problem: P1Elasticity, x: np.ndarray,
+                  timings: dict[str, float]) -> P1Solution:
         """The solution of ``problem`` with the interleaved nodal unknowns ``x (2 n,)``."""
         eps = sym_grad(problem.basis.interpolate(x))[:, :, :, 0]          # (2, 2, t)
         strain = np.column_stack([eps[0, 0], eps[1, 1], 2.0 * eps[0, 1]])

@@ -96,7 +96,9 @@ class CellBasis:
         self._built = None                  # the operators as built from _node_ops
 
     @classmethod
-    def from_operators(cls, model, value, gx, gy, weights, points, *, vector=False):
+    def from_operators(cls, model: Model, value: sp.spmatrix, gx: sp.spmatrix, gy: sp.spmatrix,
+                       weights: np.ndarray, points: np.ndarray, *,
+                       vector: bool = False) -> CellBasis:
         """A basis over other integration points, from the scalar operators of the
         functions there (linear triangles, say: `cnem.assembly.triangles`).
 
@@ -128,7 +130,7 @@ class CellBasis:
         return f"<CellBasis {kind}, {self.N} dofs, {len(self.dx)} cells>"
 
     @cached_property
-    def operators(self):
+    def operators(self) -> list[sp.spmatrix]:
         """Sparse operators from the dofs to the field descriptors at the cells.
 
         Returns

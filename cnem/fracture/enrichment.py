@@ -18,7 +18,7 @@ strain per cell would leave the extra dofs without stiffness).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -93,7 +93,7 @@ class Enrichment:
             self._at_nodes[mine] = self.evaluate(model.nodes[self.nodes[mine]], t, sides[mine])
 
     @classmethod
-    def from_spec(cls, model, spec):
+    def from_spec(cls, model: Model, spec: Any) -> Enrichment | None:
         """An `Enrichment` from ``None``, an `Enrichment`, or
         ``dict(tips=..., radius=..., functions=...)``."""
         if spec is None or isinstance(spec, cls):

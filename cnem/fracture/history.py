@@ -105,7 +105,7 @@ class Step:
     solution: object = None
 
     @property
-    def critical_load_factor(self):
+    def critical_load_factor(self) -> float:
         """float: the smallest load factor over the active tips (NaN if none)."""
         lf = self.load_factor[self.active]
         return float(np.nanmin(lf)) if lf.size and np.isfinite(lf).any() else np.nan
@@ -166,7 +166,7 @@ class CrackPath:
         return np.stack([np.asarray(getattr(s, name)) for s in self._all()])
 
     @property
-    def cycles(self):
+    def cycles(self) -> np.ndarray:
         """(steps + 1,) ndarray: cumulative load cycles at each state (0 at the start;
         NaN throughout without a Paris law)."""
         c = np.array([s.cycles for s in self.steps], dtype=float)

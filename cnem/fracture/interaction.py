@@ -38,11 +38,11 @@ class SIFResult(tuple):
         return obj
 
     @property
-    def KI(self):
+    def KI(self) -> float:
         return self[0]
 
     @property
-    def KII(self):
+    def KII(self) -> float:
         return self[1]
 
 

@@ -123,7 +123,7 @@ class Elasticity(Conditions):
     points_name = "model.nodes"
 
     @property
-    def condition_points(self):
+    def condition_points(self) -> np.ndarray:
         """``(n, 2)`` the nodes that conditions refer to (``model.nodes``)."""
         return self.model.nodes
 
@@ -138,7 +138,7 @@ class Elasticity(Conditions):
 
     # -- assembly -----------------------------------------------------------------------
     @property
-    def basis(self):
+    def basis(self) -> CellBasis:
         """The vector `CellBasis` (built on first use)."""
         if self._basis is None:
             if self._sub_cells() and self._K is None:

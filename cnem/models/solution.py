@@ -57,7 +57,8 @@ class ElasticSolution(Solution):
     stress_at = "cells"
 
     @classmethod
-    def from_dofs(cls, problem, dofs, C, timings):
+    def from_dofs(cls, problem: Any, dofs: np.ndarray, C: np.ndarray,
+                  timings: dict[str, float]) -> ElasticSolution:
         """The solution of ``problem`` with unknowns ``dofs`` and cell elastic matrices ``C``."""
         n = len(problem.model.nodes)
         ops = problem.basis.operators[2:]               # du0/dx, du0/dy, du1/dx, du1/dy

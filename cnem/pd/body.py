@@ -11,6 +11,9 @@ from ..spatial import family_search, remove_crossing
 from ._kernels import bond_geometry
 
 if TYPE_CHECKING:
+    from ..geometry.cloud import NodeCloud
+
+if TYPE_CHECKING:
     from typing import Sequence
     from numpy.typing import ArrayLike
 
@@ -120,7 +123,8 @@ class Body:
                       spacing, horizon, self.xi, self.length, self.beta)
 
     @classmethod
-    def from_cloud(cls, cloud, horizon_factor=3.0, *, thickness=1.0):
+    def from_cloud(cls, cloud: NodeCloud, horizon_factor: float = 3.0, *,
+                   thickness: float = 1.0) -> Body:
         """The nodes of a C-NEM node cloud, with their integration-cell areas as volumes.
 
         Points on a crack face become two points, one per face (as in

@@ -92,12 +92,12 @@ class Problem(Conditions):
         self.factor = self._correction() if self.surface_correction else np.ones(len(b.bond_i))
 
     @cached_property
-    def unit(self):
+    def unit(self) -> np.ndarray:
         """``(b, d)`` unit bond directions."""
         return self.body.xi / self.body.length[:, None]
 
     @cached_property
-    def A(self):
+    def A(self) -> sp.csr_matrix:
         """Extension operator ``e = A u``, sparse ``(b, d n)``."""
         b, d, n = self.body, self.dim, len(self.body)
         nb = len(b.bond_i)
@@ -108,7 +108,7 @@ class Problem(Conditions):
         return sp.csr_matrix((vals, (rows, cols)), shape=(nb, d * n))
 
     @cached_property
-    def gradient_weights(self):
+    def gradient_weights(self) -> np.ndarray:
         """``(b, d)`` ``g_b = w_b M_i^-1 xi_b`` of every bond ``b = (i, j)``, with the moment
         tensors ``M_i = sum_b w_b xi_b xi_b^T`` (``w = beta V_j``): the nonlocal
         displacement gradient of point ``i`` is ``sum_b (u_j - u_i) g_b^T``, exact for
@@ -328,7 +328,7 @@ class Problem(Conditions):
     points_name = "body.points"
 
     @property
-    def condition_points(self):
+    def condition_points(self) -> np.ndarray:
         """``(n, d)`` the points that conditions refer to (``body.points``)."""
         return self.body.points
 

@@ -44,12 +44,12 @@ class PointSolution(Solution):
         return self.problem.stress_tensor(self.u)
 
     @cached_property
-    def stress(self):
+    def stress(self) -> np.ndarray:
         """``(n, 3)`` or ``(n, 6)`` Voigt stress of every point (not for CPD)."""
         return voigt(self.stress_tensor())
 
     @cached_property
-    def strain(self):
+    def strain(self) -> np.ndarray:
         """``(n, 3)`` or ``(n, 6)`` engineering strain of every point."""
         return engineering_strain(self.problem.displacement_gradient(self.u))
 

@@ -113,7 +113,7 @@ class Body:
         return offsets, members
 
     @property
-    def n_owned(self):
+    def n_owned(self) -> int:
         """Points owned by this rank."""
         return len(self.owned)
 

@@ -99,6 +99,6 @@ class Halo:
         return values
 
     @property
-    def neighbours(self):
+    def neighbours(self) -> list[int]:
         """Ranks this one exchanges with."""
         return sorted(set(self.sends) | set(self.receives))

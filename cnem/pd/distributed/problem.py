@@ -107,13 +107,13 @@ class Problem(Conditions):
         return f"<distributed Problem {self.body!r}, {self.material!r}>"
 
     @property
-    def root(self):
+    def root(self) -> bool:
         """Whether this is rank 0."""
         return self.comm.rank == 0
 
     # -- conditions (global predicates, kept at the owned points) -----------------------
     @property
-    def condition_points(self):
+    def condition_points(self) -> np.ndarray:
         """All points of the body (every rank): what Dirichlet predicates see."""
         return self.body.global_points
 
