@@ -174,11 +174,12 @@ def test_tip_into_the_far_edge_splits_the_body_with_the_pieces_named():
 
 
 # ---------------------------------------------------------------------- events
-def uniaxial_setup(sigma):
-    """Unit square, traction sigma along y on top and bottom, rigid motions held."""
+def uniaxial_setup(sigma, **options):
+    """Unit square, traction sigma along y on top and bottom, rigid motions held
+    (``options``: more arguments of the problem)."""
     def setup(model):
         tol = 1e-9
-        prob = cnem.Elasticity(model, (E, NU), plane="strain")
+        prob = cnem.Elasticity(model, (E, NU), plane="strain", **options)
         prob.add_traction(lambda x, n: np.abs(np.abs(x[:, 1] - 0.5) - 0.5) < tol,
                           lambda x, n: sigma * n * [0.0, 1.0])
         prob.add_dirichlet(lambda p: np.hypot(*p.T) < tol, None)
@@ -287,18 +288,8 @@ def test_local_update_grows_the_same_path_as_full_rebuilds(crack, caplog):
 
 def test_enriched_problem_falls_back_to_full_rebuilds_and_says_so(caplog):
     dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.45], [0.3, 0.55]]])
-
-    def setup(model):
-        tol = 1e-9
-        prob = cnem.Elasticity(model, (E, NU), plane="strain", enrich=dict(radius=0.12))
-        prob.add_traction(lambda x, n: np.abs(np.abs(x[:, 1] - 0.5) - 0.5) < tol,
-                          lambda x, n: n * [0.0, 1.0])
-        prob.add_dirichlet(lambda p: np.hypot(*p.T) < tol, None)
-        prob.add_dirichlet(lambda p: np.hypot(p[:, 0] - 1.0, p[:, 1]) < tol, 1)
-        return prob
-
     with caplog.at_level("INFO", logger="cnem.fracture.growth"):
-        local, full = grown_pair(dom, setup, steps=2)
+        local, full = grown_pair(dom, uniaxial_setup(1.0, enrich=dict(radius=0.12)), steps=2)
     said = [r for r in caplog.records if "refuses the local update" in r.getMessage()]
     assert len(said) == 1 and "enrich" in said[0].getMessage()
     assert_same_runs(local, full)
