@@ -266,8 +266,8 @@ def ok(r):
 
 def solver(nnz):
     """The method `solve_spd` picks for a matrix with ``nnz`` non-zeros."""
-    from cnem.assembly.linsolve import DIRECT_NNZ
-    return "direct" if nnz <= DIRECT_NNZ else "amg"
+    from cnem import config
+    return "direct" if nnz <= config.DIRECT_NNZ else "amg"
 
 
 def memory_need(side, n, done):

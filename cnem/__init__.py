@@ -32,7 +32,11 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import CNEMError, GeometryError, SolveError
+from .errors import (CNEMError, ConditionError, FormatError, FormError, FractureError,
+                     GeometryError, GrowthError, GrowthWarning, HyperDualError, InputError,
+                     LimitError, MaterialError, MissingExtraError, OptionError,
+                     PlotDependencyError, PlotError, PlotInputError, SolveError, SpatialError,
+                     UnsupportedError)
 
 __version__ = "0.1.0"
 
@@ -48,7 +52,11 @@ _NAMES = {"Domain": "geometry", "NodeCloud": "geometry", "Model": "geometry",
 __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
            "nodes", "geometry", "assembly", "models", "exact", "fracture", "io", "plot", "shape",
            "spatial", "hyperdual", "pd", "fem", "material",
-           "CNEMError", "GeometryError", "SolveError", "__version__"]
+           "CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError", "FormError",
+           "ConditionError", "SpatialError", "FractureError", "GrowthError", "FormatError",
+           "HyperDualError", "GrowthWarning", "MissingExtraError",
+           "LimitError", "UnsupportedError", "SolveError", "PlotError", "PlotDependencyError",
+           "PlotInputError", "__version__"]
 
 
 def __getattr__(name: str):

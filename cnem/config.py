@@ -1,11 +1,22 @@
-"""Tolerances used across cnem, kept in one place.
+"""Tolerances and tuning constants used across cnem, kept in one place.
 
-All tolerances are *relative*: multiply by the domain diameter (lengths) or
-its square (areas) before comparing.
+Tolerances are *relative*: multiply by the domain diameter (lengths) or its
+square (areas) before comparing. Modules read these as ``config.NAME`` when they
+run, so a user may change one for a session (``cnem.config.DIRECT_NNZ = 10**6``);
+where a numba kernel needs a compile-time constant the comment says so.
+
+>>> from cnem import config
+>>> config.SNAP_TOL < config.CLEARANCE < 1
+True
 """
 
-__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL"]
+__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLEARANCE", "FANOUT",
+           "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
+           "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
+           "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
+           "FD_STEP", "HYPERDUAL_CHUNK"]
 
+# ---------------------------------------------------------------- geometry tolerances
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
 #: are snapped onto it; vertices closer than this are the same vertex.
 SNAP_TOL = 1e-9
@@ -23,3 +34,80 @@ GRID_TOL = 1e-13
 #: Relative distance (times the domain diameter) under which a query point is
 #: taken to be at a node or on a constraint edge in the shape functions.
 SHAPE_TOL = 1e-12
+
+# ---------------------------------------------------------------- node generation
+#: Interior nodes closer than this fraction of the local spacing to a boundary,
+#: interface or crack are dropped (the boundary nodes stand there); `cnem.nodes`.
+CLEARANCE = 0.5
+
+# ---------------------------------------------------------------- spatial search
+#: Children per R-tree node (and boxes per leaf); a tree keeps the value it was
+#: built with, so changing it affects trees built afterwards; `cnem.spatial.RTree`.
+FANOUT = 16
+
+#: Largest cloud `cnem.spatial.family_search(method="brute")` accepts (it tests
+#: all n^2 pairs).
+BRUTE_LIMIT = 20_000
+
+#: Cells per horizon along each axis of the family search's cell list
+#: (one horizon per point).
+CELLS_PER_HORIZON = 2
+
+#: Columns per horizon along the two binned axes of the family search (one
+#: horizon for all points).
+COLUMNS_PER_HORIZON = 3
+
+#: `cnem.fem.mesh_domain` with a node target stops once the node count is within this
+#: relative distance of the target ...
+MESH_NODES_STOP = 0.02
+
+#: ... or after this many meshes (a secant on log count against log max_area) ...
+MESH_NODES_TRIES = 6
+
+#: ... and warns when the best is further than this from the target (the coarsest
+#: mesh is taken when it is this close).
+MESH_NODES_RTOL = 0.05
+
+# ---------------------------------------------------------------- linear solves
+#: Above this many matrix non-zeros `cnem.assembly.linsolve.solve_spd` uses
+#: pyamg-preconditioned CG: about 200k unknowns of linear triangles (12 non-zeros
+#: per row), about 40k unknowns of an SCNI stiffness (~65 per row), whose sparse
+#: factors fill in much faster (at 200k unknowns: 74 s direct against 7 s for
+#: smoothed aggregation + CG, 36 iterations).
+DIRECT_NNZ = 2_500_000
+
+#: Largest relative tolerance of the inner linear solve of a Newton step in
+#: `cnem.pd.Problem.solve_static` (inexact Newton: ``min(NEWTON_FORCING, |R| / ref)``).
+NEWTON_FORCING = 1e-3
+
+#: Smallest relative tolerance asked of that inner linear solve (and of the one
+#: solve of a linear problem).
+NEWTON_INNER_FLOOR = 1e-12
+
+# ---------------------------------------------------------------- fracture
+#: Fewest Gauss points per cell-edge piece in the smoothing of the enrichment
+#: functions (they vary like sqrt(r) about the tip, not like a rational
+#: function); `cnem.fracture.enrichment`.
+MIN_GAUSS = 4
+
+# ---------------------------------------------------------------- peridynamics
+#: CPD interactions evaluated together (bounds the temporaries: ~0.3 KB per 2-D pair).
+CPD_CHUNK = 1 << 18
+
+#: CPD pairs (triplets) whose reference area (volume) is below this fraction of
+#: the product of their bond lengths are degenerate (collinear / coplanar): their
+#: stretch is undefined and their reference measure, the energy's weight,
+#: vanishes; they are left out.
+CPD_DEGENERATE = 1e-8
+
+#: Most CPD pairs or triplets a body may hold (about 64 bytes each are stored);
+#: above it `cnem.errors.LimitError`.
+MAX_INTERACTIONS = 50_000_000
+
+#: Relative step of the CPD finite differences (``derivatives="fd"``).
+FD_STEP = 1e-4
+
+# ---------------------------------------------------------------- hyper-dual numbers
+#: Real numbers per part handed to the function in one call of
+#: `cnem.hyperdual.derivatives` (bounds its temporaries).
+HYPERDUAL_CHUNK = 2 ** 21

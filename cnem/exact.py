@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .errors import MaterialError
 from .material import effective_modulus, lame
 
 __all__ = ["LayeredCylinder", "CentralCrack", "rayleigh_speed"]
@@ -39,8 +40,9 @@ class LayeredCylinder:
         self.radii = np.asarray(radii, dtype=float)
         mats = np.asarray(materials, dtype=float).reshape(-1, 2)
         if len(mats) != len(self.radii) - 1 or not (np.diff(self.radii) > 0).all():
-            raise ValueError(f"expected increasing radii and one material per layer, received "
-                             f"{len(self.radii)} radii and {len(mats)} materials")
+            raise MaterialError(f"expected increasing radii and one material per layer, received "
+                                f"{len(self.radii)} radii and {len(mats)} materials; give "
+                                f"len(radii) - 1 (E, nu) pairs")
         self.lam, self.mu = lame(mats[:, 0], mats[:, 1], plane)
         self.center = np.asarray(center, dtype=float)
         k = len(mats)

@@ -35,7 +35,8 @@ from skfem.models.elasticity import linear_elasticity
 
 from .assembly.quadrature import triangle_quadrature
 from .assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
-from .errors import GeometryError, SolveError
+from . import config
+from .errors import GeometryError, InputError, SolveError
 from .geometry.cracks import split_cracks
 from .geometry.pslg import BOUNDARY, CRACK
 from .assembly.conditions import Conditions, per_point, traction_at
@@ -48,9 +49,6 @@ log = logging.getLogger(__name__)
 
 #: Segment markers handed to `triangle` are ``kind + _MARK`` (0 and 1 are its own).
 _MARK = 2
-#: `mesh_domain` with a node target: stop within `_NODES_STOP` (relative) after at
-#: most `_NODES_TRIES` meshes, warn beyond `_NODES_RTOL`.
-_NODES_STOP, _NODES_RTOL, _NODES_TRIES = 0.02, 0.05, 6
 
 
 # ---------------------------------------------------------------------- meshing
@@ -138,20 +136,20 @@ def mesh_domain(domain, *, nodes=None, max_area=None, quality=30.0):
 
     Raises
     ------
-    ValueError
+    InputError
         Both ``nodes`` and ``max_area`` given, non-positive values, a quality
         above 34 degrees, or a target node count below the coarsest mesh.
     GeometryError
         If a crack cannot be opened.
     """
     if nodes is not None and max_area is not None:
-        raise ValueError(f"give either nodes or max_area, received nodes={nodes!r} and "
-                         f"max_area={max_area!r}")
+        raise InputError(f"give either nodes or max_area, received nodes={nodes!r} and "
+                         f"max_area={max_area!r}; drop one of them")
     if not 0.0 < float(quality) <= 34.0:
-        raise ValueError(f"quality: expected a minimum angle in (0, 34] degrees, received "
+        raise InputError(f"quality: expected a minimum angle in (0, 34] degrees, received "
                          f"{quality!r} (triangle may not terminate above 34)")
     if max_area is not None and not float(max_area) > 0.0:
-        raise ValueError(f"max_area: expected a positive number, received {max_area!r}")
+        raise InputError(f"max_area: expected a positive number, received {max_area!r}")
     data = _pslg_input(domain)
     if nodes is None:
         out = _triangulate(data, quality, max_area)
@@ -173,24 +171,24 @@ def mesh_domain(domain, *, nodes=None, max_area=None, quality=30.0):
 
 
 def _mesh_for_nodes(data, area, target, quality):
-    """Mesh whose node count is within `_NODES_STOP` of ``target`` if possible
+    """Mesh whose node count is within `cnem.config.MESH_NODES_STOP` of ``target`` if possible
     (secant on ``log count`` against ``log max_area``)."""
     if target < 3:
-        raise ValueError(f"nodes: expected a target node count >= 3, received {target}")
+        raise InputError(f"nodes: expected a target node count >= 3, received {target}")
     coarsest = _triangulate(data, quality, None)
-    if len(coarsest["vertices"]) >= (1.0 - _NODES_RTOL) * target:
-        if len(coarsest["vertices"]) <= (1.0 + _NODES_RTOL) * target:
+    if len(coarsest["vertices"]) >= (1.0 - config.MESH_NODES_RTOL) * target:
+        if len(coarsest["vertices"]) <= (1.0 + config.MESH_NODES_RTOL) * target:
             return coarsest
-        raise ValueError(f"nodes: the coarsest quality-{quality:g} mesh of this domain already "
+        raise InputError(f"nodes: the coarsest quality-{quality:g} mesh of this domain already "
                          f"has {len(coarsest['vertices'])} nodes, more than the target {target}; "
                          "ask for more nodes or a coarser domain description")
     tries = []
     max_area = 2.0 * area / target
-    for _ in range(_NODES_TRIES):
+    for _ in range(config.MESH_NODES_TRIES):
         out = _triangulate(data, quality, max_area)
         count = len(out["vertices"])
         tries.append((abs(count / target - 1.0), count, max_area, out))
-        if abs(count / target - 1.0) <= _NODES_STOP:
+        if abs(count / target - 1.0) <= config.MESH_NODES_STOP:
             break
         slope = -1.0
         if len(tries) >= 2 and tries[-1][2] != tries[-2][2] and tries[-1][1] != tries[-2][1]:
@@ -199,7 +197,7 @@ def _mesh_for_nodes(data, area, target, quality):
             slope = min(max(slope, -2.0), -0.5)
         max_area *= (target / count) ** (1.0 / slope)
     best = min(tries, key=lambda item: item[0])
-    if best[0] > _NODES_RTOL:
+    if best[0] > config.MESH_NODES_RTOL:
         log.warning("mesh_domain: %d nodes for a target of %d (max area %.3g)",
                     best[1], target, best[2])
     log.info("mesh_domain: %d nodes (target %d) after %d meshes", best[1], target, len(tries))

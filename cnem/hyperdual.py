@@ -22,18 +22,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import CNEMError
+from . import config
+from .errors import HyperDualError
 
 __all__ = ["HyperDual", "HyperDualError", "sqrt", "exp", "log", "sin", "cos", "tan", "arcsin",
            "arccos", "arctan", "sinh", "cosh", "tanh", "power", "dot", "cross", "norm", "stack",
            "concatenate", "derivatives", "derivative"]
 
 _PARTS = ("re", "e1", "e2", "e12")
-_CHUNK = 2 ** 21     # real numbers per part handed to f in one call of `derivatives`
-
-
-class HyperDualError(CNEMError, ValueError):
-    """Invalid hyper-dual input: shapes that do not broadcast, wrong vector lengths or outputs."""
 
 
 def _broadcast(shapes, what):
@@ -370,7 +366,7 @@ def derivatives(f, x, *, batch=True):
     first, second = np.triu_indices(k)
     eye = np.eye(k)
     value, grad, hess = np.empty(m), np.empty((m, k)), np.empty((m, k, k))
-    step = max(1, _CHUNK // max(m * k, 1)) if batch else 1
+    step = max(1, config.HYPERDUAL_CHUNK // max(m * k, 1)) if batch else 1
     for start in range(0, len(first), step):
         p, q = first[start:start + step], second[start:start + step]
         if batch:

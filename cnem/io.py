@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import meshio
 import numpy as np
 
-from .errors import CNEMError
+from .errors import FormatError
 from .geometry.model import Cells
 
 __all__ = ["write", "write_nodes", "write_points", "read", "CellMesh", "FormatError", "SUFFIXES"]
@@ -49,10 +49,6 @@ SUFFIXES = {".vtu": "vtu"}
 
 #: Cell-data names `write` reserves for itself.
 RESERVED = ("region", "node", "area", "cell")
-
-
-class FormatError(CNEMError, ValueError):
-    """A file name or a file's contents that `cnem.io` cannot handle."""
 
 
 def _format(path):

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .errors import MaterialError, check_choice
+
 __all__ = ["PLANES", "parse_materials", "lame", "stiffness_matrix", "kappa", "effective_modulus"]
 
 #: The 2-D idealisations: plane stress or plane strain.
@@ -19,18 +21,20 @@ def parse_materials(materials, nregions):
     try:
         arr = np.asarray(materials, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"materials: expected an (E, nu) pair or a list of {nregions} pairs, "
-                         f"received {materials!r}") from None
+        raise MaterialError(f"materials: expected an (E, nu) pair or a list of {nregions} pairs, "
+                            f"received {materials!r}") from None
     if arr.shape == (2,):
         arr = np.tile(arr, (nregions, 1))
     if arr.shape != (nregions, 2):
-        raise ValueError(f"materials: expected an (E, nu) pair or one pair per region "
-                         f"({nregions} regions), received shape {arr.shape}")
+        raise MaterialError(f"materials: expected an (E, nu) pair or one pair per region "
+                            f"({nregions} regions), received shape {arr.shape}")
     E, nu = arr[:, 0], arr[:, 1]
     if not (np.isfinite(arr).all() and (E > 0).all()):
-        raise ValueError(f"materials: Young's moduli must be positive and finite, received {E.tolist()}")
+        raise MaterialError(f"materials: Young's moduli must be positive and finite, received "
+                            f"{E.tolist()}")
     if not ((nu > -1.0) & (nu < 0.5)).all():
-        raise ValueError(f"materials: Poisson ratios must lie in (-1, 0.5), received {nu.tolist()}")
+        raise MaterialError(f"materials: Poisson ratios must lie in (-1, 0.5), received "
+                            f"{nu.tolist()}")
     return arr
 
 
@@ -43,8 +47,7 @@ def lame(E, nu, plane):
     -------
     lam, mu : ndarray
     """
-    if plane not in PLANES:
-        raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
+    check_choice("plane", plane, PLANES)
     E, nu = np.asarray(E, dtype=float), np.asarray(nu, dtype=float)
     mu = E / (2.0 * (1.0 + nu))
     lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
@@ -71,8 +74,7 @@ def stiffness_matrix(E, nu, plane):
 
 def kappa(nu, plane):
     """Kolosov's constant: ``3 - 4 nu`` (plane strain) or ``(3 - nu) / (1 + nu)`` (plane stress)."""
-    if plane not in PLANES:
-        raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
+    check_choice("plane", plane, PLANES)
     return 3.0 - 4.0 * nu if plane == "strain" else (3.0 - nu) / (1.0 + nu)
 
 

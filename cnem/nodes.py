@@ -18,16 +18,12 @@ import numpy as np
 import shapely
 from scipy.spatial import cKDTree
 
+from . import config
 from .errors import GeometryError
 from .geometry.cloud import NodeCloud
-from .geometry.pslg import segment_projection
+from .geometry.pslg import SegmentKind, segment_projection
 
 __all__ = ["regular", "irregular", "graded", "from_points", "NodeCloud"]
-
-#: Interior nodes closer than this fraction of the local spacing to a
-#: boundary, interface or crack are dropped (the boundary nodes stand there).
-CLEARANCE = 0.5
-
 
 def _check_spacing(dom, h, name="h"):
     h = float(h)
@@ -54,7 +50,7 @@ def _tip_to_tip(dom):
     if len(dom.tips) == 0:
         return np.zeros(len(edges), dtype=bool)
     is_tip = cKDTree(dom.tips).query(v)[0] <= dom.tolerance
-    return (kinds == 2) & is_tip[edges[:, 0]] & is_tip[edges[:, 1]]
+    return (kinds == SegmentKind.CRACK) & is_tip[edges[:, 0]] & is_tip[edges[:, 1]]
 
 
 def _boundary_nodes(dom, spacing_of, jitter=None):
@@ -139,7 +135,7 @@ def regular(domain, h):
     h = _check_spacing(domain, h)
     spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
     lattice = _lattice(domain, h)
-    interior = _keep_interior(domain, lattice, CLEARANCE * h)
+    interior = _keep_interior(domain, lattice, config.CLEARANCE * h)
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
 
 
@@ -158,7 +154,7 @@ def irregular(domain, h, *, seed=0):
     spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
     lattice = _lattice(domain, h, offset=0.5 * h)
     lattice = lattice + rng.uniform(-0.35 * h, 0.35 * h, lattice.shape)
-    interior = _keep_interior(domain, lattice, CLEARANCE * h)
+    interior = _keep_interior(domain, lattice, config.CLEARANCE * h)
     boundary = _boundary_nodes(domain, spacing_of, jitter=rng)
     return _assemble(domain, boundary, interior, spacing_of)
 
@@ -212,7 +208,7 @@ def graded(domain, h, *, near, h_min, growth=0.3, seed=None):
     if seed is not None:
         rng = np.random.default_rng(seed)
         interior = interior + rng.uniform(-0.25, 0.25, interior.shape) * spacing_of(interior)[:, None]
-    interior = _keep_interior(domain, interior, CLEARANCE * spacing_of(interior))
+    interior = _keep_interior(domain, interior, config.CLEARANCE * spacing_of(interior))
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
 
 

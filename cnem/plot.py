@@ -19,7 +19,8 @@ import pathlib
 
 import numpy as np
 
-from .errors import CNEMError
+from .errors import PlotDependencyError, PlotError, PlotInputError
+from .geometry.pslg import SegmentKind
 from .io import cell_topology
 
 __all__ = ["model", "solution", "cells_polydata", "region_color", "PlotError", "REGION_COLORS",
@@ -46,16 +47,12 @@ REGION_COLORS = np.array([
 INSTALL_HINT = 'install the plotting extra: pip install "cnem[plot]"'
 
 
-class PlotError(CNEMError, RuntimeError):
-    """pyvista is missing or cannot render off-screen."""
-
-
 def _pyvista():
     """pyvista, set to render off-screen, or a `PlotError` saying how to get it."""
     try:
         import pyvista
     except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise PlotError(f"cnem.plot needs pyvista, which cannot be imported ({exc}); "
+        raise PlotDependencyError(f"cnem.plot needs pyvista, which cannot be imported ({exc}); "
                         f"{INSTALL_HINT}") from exc
     pyvista.OFF_SCREEN = True
     return pyvista
@@ -131,7 +128,7 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
         Write a PNG there (parent folders are created).
     show_triangles, show_nodes, show_cracks : bool
         Draw the constrained Delaunay triangles, the nodes, the crack faces
-        (segments with ``segment_kind == 2``).
+        (segments with ``segment_kind == SegmentKind.CRACK``).
     window_size : (2,) int
         Picture size in pixels, ``(width, height)``.
     bounds : (4,) float, optional
@@ -147,8 +144,10 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
 
     Raises
     ------
-    PlotError
-        pyvista missing, or the picture cannot be rendered.
+    PlotDependencyError
+        pyvista missing, or the picture cannot be rendered (an `ImportError`).
+    PlotInputError
+        empty ``bounds`` (a `ValueError`).
     """
     pv = _pyvista()
     mdl = model
@@ -158,8 +157,8 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
         bounds = (xmin, ymin, xmax, ymax)
     bx0, by0, bx1, by1 = map(float, bounds)
     if not (bx1 > bx0 and by1 > by0):
-        raise PlotError(f"bounds must be (xmin, ymin, xmax, ymax) with xmin < xmax and "
-                        f"ymin < ymax, received {tuple(bounds)}")
+        raise PlotInputError(f"bounds must be (xmin, ymin, xmax, ymax) with xmin < xmax and "
+                             f"ymin < ymax, received {tuple(bounds)}; give a non-empty view")
     width, height = map(int, window_size)
     lift = 1e-4 * dom.diameter        # draw lines above the cells (parallel view: no shift)
     pl = _plotter(pv, width, height)
@@ -173,7 +172,7 @@ def model(model, path=None, *, show_triangles=True, show_nodes=True, show_cracks
                     color=(0.55, 0.55, 0.55), line_width=max(0.5, 0.5 * width / 1200),
                     lighting=False)
     if show_cracks:
-        crack = np.asarray(mdl.segments)[np.asarray(mdl.segment_kind) == 2]
+        crack = np.asarray(mdl.segments)[np.asarray(mdl.segment_kind) == SegmentKind.CRACK]
         if len(crack):
             pl.add_mesh(_lines(pv, mdl.nodes, crack, 2 * lift), color="red",
                         line_width=max(3.0, 4.0 * width / 1200), lighting=False)
@@ -196,9 +195,9 @@ def _plotter(pv, width, height):
     try:
         pl = pv.Plotter(off_screen=True, window_size=(width, height))
     except Exception as exc:  # pragma: no cover - depends on the environment
-        raise PlotError(f"pyvista cannot open an off-screen window ({exc}); {INSTALL_HINT} "
-                        f"and make sure VTK has an off-screen backend (OSMesa/EGL) or a display"
-                        ) from exc
+        raise PlotDependencyError(f"pyvista cannot open an off-screen window ({exc}); "
+                                  f"{INSTALL_HINT} and make sure VTK has an off-screen backend "
+                                  f"(OSMesa/EGL) or a display") from exc
     pl.set_background("white")
     return pl
 
@@ -226,8 +225,9 @@ def _save(pl, path, what):
             pl.screenshot(str(path))
         except Exception as exc:  # pragma: no cover - depends on the environment
             pl.close()
-            raise PlotError(f"pyvista could not render {str(path)!r} off-screen ({exc}); "
-                            f"{INSTALL_HINT}, with a VTK that renders off-screen") from exc
+            raise PlotDependencyError(f"pyvista could not render {str(path)!r} off-screen "
+                                      f"({exc}); {INSTALL_HINT}, with a VTK that renders "
+                                      f"off-screen") from exc
         log.info("cnem.plot.%s: wrote %s", what, path)
     return pl
 
@@ -259,11 +259,13 @@ def nodal_field(sol, field):
         if values.shape == (n,):
             return values
         if values.shape != (k,):
-            raise PlotError(f"field: expected a name in {SOLUTION_FIELDS}, or values at the "
-                            f"{n} nodes or the {k} {sol.stress_at}, received shape {values.shape}")
+            raise PlotInputError(f"field: expected a name in {SOLUTION_FIELDS}, or values at "
+                                 f"the {n} nodes or the {k} {sol.stress_at}, received shape "
+                                 f"{values.shape}; pass {n} or {k} values")
         per_place = values
     elif field not in SOLUTION_FIELDS:
-        raise PlotError(f"field must be one of {SOLUTION_FIELDS}, received {field!r}")
+        raise PlotInputError(f"field must be one of {SOLUTION_FIELDS} or an array of values, "
+                             f"received {field!r}; pick one of those names")
     elif field in ("ux", "uy", "|u|"):
         return {"ux": sol.u[:, 0], "uy": sol.u[:, 1], "|u|": np.linalg.norm(sol.u, axis=1)}[field]
     else:

@@ -230,7 +230,7 @@ def test_derivatives_chunks_the_pairs(monkeypatch):
 
     whole = hd.derivatives(f, z)
     assert calls == [(10, 10, 4)]                       # all 10 pairs in one call
-    monkeypatch.setattr(hd, "_CHUNK", 3 * 10 * 4)
+    monkeypatch.setattr(cnem.config, "HYPERDUAL_CHUNK", 3 * 10 * 4)
     calls.clear()
     chunked = hd.derivatives(f, z)
     assert calls == [(3, 10, 4)] * 3 + [(1, 10, 4)]

@@ -9,6 +9,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem.element import DiscreteField
 
+from ..errors import ConditionError, InputError
 from .scni import smoothed_gradient
 
 __all__ = ["CellBasis", "spread_component"]
@@ -188,7 +189,8 @@ class CellBasis:
         """
         u = np.asarray(u, dtype=float)
         if u.shape != (self.N,):
-            raise ValueError(f"u: expected {self.N} dof values, received shape {u.shape}")
+            raise InputError(f"u: expected {self.N} dof values, received shape {u.shape}; "
+                             f"pass one value per dof of this basis")
         return self._field(np.array([op @ u for op in self.operators]), self.vector)
 
     def get_dofs(self, where, component=None):
@@ -207,12 +209,13 @@ class CellBasis:
         nodes = select_nodes(self.model.nodes, where)
         if not self.vector:
             if component not in (None, 0):
-                raise ValueError(f"component: a scalar basis has component 0 only, received {component!r}")
+                raise ConditionError(f"component: a scalar basis has component 0 only, "
+                                     f"received {component!r}; pass None or 0")
             return nodes
         if component is None:
             return np.sort(np.concatenate([2 * nodes, 2 * nodes + 1]))
         if component not in (0, 1):
-            raise ValueError(f"component: expected 0, 1 or None, received {component!r}")
+            raise ConditionError(f"component: expected 0, 1 or None (both), received {component!r}")
         return 2 * nodes + component
 
 
@@ -232,19 +235,21 @@ def select_nodes(nodes, where):
     if callable(where):
         mask = np.asarray(where(nodes))
         if mask.shape != (n,) or mask.dtype != bool:
-            raise ValueError(f"where(nodes) must return a (n,) bool array for the {n} nodes, "
-                             f"received dtype {mask.dtype} shape {mask.shape}")
+            raise ConditionError(f"where(nodes) must return a (n,) bool array for the {n} nodes, "
+                                 f"received dtype {mask.dtype} shape {mask.shape}; return a "
+                                 f"comparison such as p[:, 0] < 1e-9")
         return np.flatnonzero(mask)
     arr = np.asarray(where)
     if arr.dtype == bool:
         if arr.shape != (n,):
-            raise ValueError(f"where: a boolean mask needs one entry per node ({n}), "
-                             f"received shape {arr.shape}")
+            raise ConditionError(f"where: a boolean mask needs one entry per node ({n}), "
+                                 f"received shape {arr.shape}")
         return np.flatnonzero(arr)
     if arr.size and not np.issubdtype(arr.dtype, np.integer):
-        raise ValueError(f"where: expected a callable, a boolean mask or node indices, "
-                         f"received an array of dtype {arr.dtype}")
+        raise ConditionError(f"where: expected a callable, a boolean mask or node indices, "
+                             f"received an array of dtype {arr.dtype}")
     idx = np.unique(arr.astype(np.int64).reshape(-1))
     if idx.size and (idx[0] < 0 or idx[-1] >= n):
-        raise ValueError(f"where: node indices must lie in [0, {n}), received [{idx[0]}, {idx[-1]}]")
+        raise ConditionError(f"where: node indices must lie in [0, {n}), received "
+                             f"[{idx[0]}, {idx[-1]}]; index the model's nodes")
     return idx

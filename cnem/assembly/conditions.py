@@ -25,6 +25,7 @@ from typing import Any, Callable, Union
 
 import numpy as np
 
+from ..errors import ConditionError, UnsupportedError
 from .basis import select_nodes
 
 __all__ = ["Conditions", "Traction", "per_point", "traction_at", "dirichlet_dofs"]
@@ -38,7 +39,7 @@ def per_point(value, points, width, what):
 
     Raises
     ------
-    ValueError
+    ConditionError
         Values of the wrong shape, or not finite (``what`` names them).
     """
     arr = np.asarray(value(points) if callable(value) else value, dtype=float)
@@ -47,10 +48,12 @@ def per_point(value, points, width, what):
     try:
         arr = np.broadcast_to(arr, (len(points), width))
     except ValueError:
-        raise ValueError(f"{what}: expected a number or one value per point, shape "
-                         f"({len(points)}, {width}), received shape {arr.shape}") from None
+        raise ConditionError(f"{what}: expected a number or one value per point, shape "
+                             f"({len(points)}, {width}), received shape {arr.shape}; return one "
+                             f"row per point") from None
     if not np.isfinite(arr).all():
-        raise ValueError(f"{what}: values must be finite, received NaN or inf")
+        raise ConditionError(f"{what}: expected finite values, received NaN or inf; check "
+                             f"the value or function given")
     return arr
 
 
@@ -80,10 +83,11 @@ def dirichlet_dofs(points, where, component, value, *, where_to_look="the nodes"
     """
     d = points.shape[1]
     if component is not None and component not in range(d):
-        raise ValueError(f"component: expected None or 0..{d - 1}, received {component!r}")
+        raise ConditionError(f"component: expected None (all) or 0..{d - 1}, received "
+                             f"{component!r}")
     nodes = select_nodes(points, where)
     if nodes.size == 0:
-        raise ValueError(f"add_dirichlet: `where` selects no node; check the predicate against "
+        raise ConditionError(f"add_dirichlet: `where` selects no node; check the predicate against "
                          f"{where_to_look} (boundary nodes lie exactly on the boundary)")
     comps = np.arange(d) if component is None else np.array([component])
     vals = per_point(value, points[nodes], len(comps), "add_dirichlet value")
@@ -170,7 +174,8 @@ class Conditions:
         normal : (e, 2) ndarray
             Outward unit normals.
         """
-        raise NotImplementedError(f"{type(self).__name__} has no boundary edges")
+        raise UnsupportedError(f"{type(self).__name__} has no boundary edges; give loads as "
+                               f"body forces (add_body_force)")
 
     def add_traction(self, where: Where, t: Any) -> None:
         """Tractions on the boundary edges (outer boundary, holes, crack faces).
@@ -190,10 +195,10 @@ class Conditions:
         mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
         pick = np.asarray(where(mid, normal)) if callable(where) else np.asarray(where)
         if pick.shape != (len(edges),) or pick.dtype != bool:
-            raise ValueError(f"add_traction: where(x, nrm) must return a ({len(edges)},) bool "
-                             f"array, received dtype {pick.dtype} shape {pick.shape}")
+            raise ConditionError(f"add_traction: where(x, nrm) must return a ({len(edges)},) bool "
+                                 f"array, received dtype {pick.dtype} shape {pick.shape}")
         if not pick.any():
-            raise ValueError(f"add_traction: `where` selects no {self.edges_name}; check the "
+            raise ConditionError(f"add_traction: `where` selects no {self.edges_name}; check the "
                              "predicate against the midpoints and outward normals of "
                              "boundary_edges()")
         index = np.flatnonzero(pick)

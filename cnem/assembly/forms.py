@@ -18,6 +18,7 @@ import scipy.sparse as sp
 from skfem.assembly.form.form import FormExtraParams
 
 from .._parallel import work_chunks
+from ..errors import FormError
 from . import _sparse_kernels as SK
 
 __all__ = ["BilinearForm", "LinearForm", "Functional", "asm"]
@@ -36,17 +37,19 @@ def _check_groups(groups, m, kwargs):
     groups = np.asarray(groups)
     if groups.shape != (m,) or not np.issubdtype(groups.dtype, np.integer) or \
             (m and groups.min() < 0):
-        raise ValueError(f"groups: expected ({m},) non-negative integers, one per cell, "
-                         f"received dtype {groups.dtype} shape {groups.shape}")
+        raise FormError(f"groups: expected ({m},) non-negative integers, one per cell, "
+                        f"received dtype {groups.dtype} shape {groups.shape}; pass a group "
+                        f"index for every cell")
     shapes = {name: np.shape(value) for name, value in kwargs.items()}
     lengths = {shape[0] for shape in shapes.values() if len(shape) == 1}
     if any(len(shape) > 1 for shape in shapes.values()) or len(lengths) > 1:
-        raise ValueError(f"with groups, the keywords must hold one value per group (the same "
-                         f"number for all) or a scalar, received shapes {shapes}")
+        raise FormError(f"with groups, the keywords must hold one value per group (the same "
+                        f"number for all) or a scalar, received shapes {shapes}; give 1-D "
+                        f"arrays of one length")
     count = lengths.pop() if lengths else (int(groups.max()) + 1 if m else 0)
     if m and groups.max() >= count:
-        raise ValueError(f"groups: index {int(groups.max())} but the keywords hold {count} "
-                         "values, one per group")
+        raise FormError(f"groups: index {int(groups.max())} but the keywords hold {count} "
+                        "values, one per group; expected indices below the number of values")
     return groups.astype(np.int64, copy=False), count
 
 
@@ -56,8 +59,8 @@ def _coefficients(values, m, what):
     try:
         return np.broadcast_to(arr, (m,))
     except ValueError:
-        raise ValueError(f"{what} must return one value per cell ({m},) or a scalar, "
-                         f"received shape {arr.shape}") from None
+        raise FormError(f"{what} must return one value per cell ({m},) or a scalar, "
+                        f"received shape {arr.shape}; reduce over the other axes") from None
 
 
 class _Form:
@@ -109,7 +112,8 @@ class BilinearForm(_Form):
         units = basis.unit_fields()
         zero = basis.zero_field()
         if np.any(np.asarray(self.form(zero, zero, w)) != 0.0):
-            raise ValueError(f"form {self.__name__} is not bilinear: it is non-zero for u = v = 0")
+            raise FormError(f"form {self.__name__} is not bilinear: expected zero for u = v = 0, "
+                            f"received a non-zero value; drop the terms without u or v")
         for a, ua in enumerate(units):
             for b, vb in enumerate(units):
                 value = _coefficients(self.form(ua, vb, w), m, f"form {self.__name__}")

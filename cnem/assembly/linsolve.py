@@ -10,17 +10,12 @@ import scipy.sparse as sp
 import scipy.sparse.csgraph as csgraph
 import scipy.sparse.linalg as spla
 
-from ..errors import SolveError
+from .. import config
+from ..errors import InputError, SolveError, check_choice
 
-__all__ = ["rigid_modes", "free_rigid_motions", "solve_spd", "DIRECT_NNZ"]
+__all__ = ["rigid_modes", "free_rigid_motions", "solve_spd"]
 
 log = logging.getLogger(__name__)
-
-#: Above this many matrix non-zeros `solve_spd` uses pyamg-preconditioned CG: about
-#: 200k unknowns of linear triangles (12 non-zeros per row), about 40k unknowns of an
-#: SCNI stiffness (~65 per row), whose sparse factors fill in much faster (at 200k
-#: unknowns: 74 s direct against 7 s for smoothed aggregation + CG, 36 iterations).
-DIRECT_NNZ = 2_500_000
 
 
 def rigid_modes(points):
@@ -41,8 +36,8 @@ def rigid_modes(points):
     """
     n, d = np.shape(points)
     if d not in (2, 3):
-        raise ValueError(f"points: expected an (n, 2) or (n, 3) array, received shape "
-                         f"{np.shape(points)}")
+        raise InputError(f"points: expected an (n, 2) or (n, 3) array, received shape "
+                         f"{np.shape(points)}; pass the node coordinates")
     rel = points - points.mean(axis=0)
     if d == 2:
         rel = np.column_stack([rel, np.zeros(n)])
@@ -184,7 +179,7 @@ def solve_spd(A, b, *, modes=None, tol=1e-10, method="auto", preconditioner=None
     tol : float
         Relative residual for the iterative solver.
     method : {"auto", "direct", "amg"}
-        ``"auto"``: direct up to `DIRECT_NNZ` non-zeros, pyamg + CG above.
+        ``"auto"``: direct up to `cnem.config.DIRECT_NNZ` non-zeros, pyamg + CG above.
     preconditioner : sparse (N, N) or callable returning one, optional
         A sparser SPD matrix spectrally close to ``A`` (the P1 stiffness of the
         same nodes, `cnem.assembly.triangles`): the smoothed-aggregation
@@ -202,17 +197,16 @@ def solve_spd(A, b, *, modes=None, tol=1e-10, method="auto", preconditioner=None
     (N,) ndarray
     """
     if method == "auto":
-        method = "direct" if A.nnz <= DIRECT_NNZ else "amg"
+        method = "direct" if A.nnz <= config.DIRECT_NNZ else "amg"
     if method == "direct":
         return spla.spsolve(A.tocsc(), b)
-    if method != "amg":
-        raise ValueError(f"method: expected 'auto', 'direct' or 'amg', received {method!r}")
+    check_choice("method", method, ("auto", "direct", "amg"))
     if callable(preconditioner):
         preconditioner = preconditioner()
     if preconditioner is not None:
         if preconditioner.shape != A.shape:
-            raise ValueError(f"preconditioner: expected shape {A.shape} like the matrix, "
-                             f"received {preconditioner.shape}")
+            raise InputError(f"preconditioner: expected shape {A.shape} like the matrix, "
+                             f"received {preconditioner.shape}; build it on the same dofs")
         x, rel, its = _amg_cg(A, b, preconditioner, modes, tol, smooth_with_matrix)
         if rel <= 10 * tol:
             return x

@@ -6,6 +6,7 @@ import numpy as np
 from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
+from ..errors import InputError
 from . import _fan_kernels as FK
 
 __all__ = ["cell_triangles", "triangle_quadrature", "cell_quadrature", "subdivide", "tip_cells"]
@@ -58,8 +59,8 @@ def _cell_flags(flags, m, name):
         return np.zeros(m, dtype=bool)
     arr = np.asarray(flags, dtype=bool)
     if arr.shape != (m,):
-        raise ValueError(f"{name}: expected one flag per cell, shape ({m},), "
-                         f"received shape {arr.shape}")
+        raise InputError(f"{name}: expected one flag per cell, shape ({m},), "
+                         f"received shape {arr.shape}; pass a bool array over the cells")
     return arr
 
 

@@ -26,6 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import InputError
+
 __all__ = ["Solution", "von_mises", "engineering_strain", "voigt", "energy_error_density"]
 
 #: The tensor entries of the Voigt order, by dimension.
@@ -82,8 +84,8 @@ def energy_error_density(points, region, stress, C, exact_stress):
         exact = exact_stress(points)
     exact = np.asarray(exact, dtype=float)
     if exact.shape != (len(points), 3):
-        raise ValueError(f"exact_stress must return ({len(points)}, 3) values "
-                         f"[sxx, syy, sxy], received shape {exact.shape}")
+        raise InputError(f"exact_stress must return ({len(points)}, 3) values "
+                         f"[sxx, syy, sxy], received shape {exact.shape}; return one row per point")
     diff = stress - exact
     return np.einsum("qi,qij,qj->q", diff, np.linalg.inv(C), diff)
 

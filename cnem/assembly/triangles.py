@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import GeometryError
 from .basis import CellBasis
 
 __all__ = ["triangle_basis"]
@@ -42,8 +43,9 @@ def triangle_basis(model, *, vector=False):
     e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
     twice = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
     if not (twice > 0).all():
-        raise ValueError(f"triangle_basis: {int((twice <= 0).sum())} of {len(tri)} triangles "
-                         "are degenerate or clockwise")
+        raise GeometryError(f"triangle_basis: {int((twice <= 0).sum())} of {len(tri)} triangles "
+                            "are degenerate or clockwise; expected counter-clockwise triangles of "
+                            "positive area: move the collinear nodes")
     dx = -opposite[:, :, 1] / twice[:, None]
     dy = opposite[:, :, 0] / twice[:, None]
     t, n = len(tri), len(model.nodes)

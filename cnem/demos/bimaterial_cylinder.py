@@ -48,6 +48,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import cnem
+from cnem.errors import InputError
 from cnem.exact import LayeredCylinder
 
 __all__ = ["main", "cli", "run", "rate", "build", "exact_solution", "GRIDS", "TABLE_I"]
@@ -70,7 +71,7 @@ def grid_for(nodes):
     radial one. This rule gives the paper's lattices 7x21 = 147, 9x35 = 315 and
     23x81 = 1863 (and 15x46 = 690 for its 687-node cloud)."""
     if nodes < 9:
-        raise ValueError(f"nodes: need at least 9 nodes (3 x 3), received {nodes}")
+        raise InputError(f"nodes: need at least 9 nodes (3 x 3), received {nodes}")
     best = None
     for nr in range(3, int(np.sqrt(nodes)) + 2, 2):
         na = max(3, int(round(nodes / nr)))
@@ -94,7 +95,7 @@ def build(n_radial, n_angular, *, irregular=False, seed=0):
     cloud : cnem.NodeCloud
     """
     if n_radial < 3 or n_angular < 3:
-        raise ValueError(f"need at least 3 radii and 3 angles, received {n_radial} x {n_angular}")
+        raise InputError(f"need at least 3 radii and 3 angles, received {n_radial} x {n_angular}")
     dom = cnem.geometry.annulus(RADII, angles=(0.0, np.pi / 2), segments=n_angular - 1)
     r = np.linspace(RADII[0], RADII[-1], n_radial)
     r[np.argmin(np.abs(r - RADII[1]))] = RADII[1]          # a ring of nodes on the interface

@@ -67,6 +67,7 @@ from __future__ import annotations
 import argparse
 
 from cnem.demos.cpd import stretch, structures
+from cnem.errors import OptionError
 
 __all__ = ["main", "cli", "EXAMPLES", "QUICK"]
 
@@ -96,7 +97,7 @@ def main(examples=EXAMPLES, *, quick=False, outdir="results/cpd", plot=True):
     """
     unknown = [e for e in examples if e not in EXAMPLES]
     if unknown:
-        raise ValueError(f"examples: expected names from {EXAMPLES}, received {unknown}")
+        raise OptionError(f"examples: expected names from {EXAMPLES}, received {unknown}")
     return {e: RUN[e](**(QUICK[e] if quick else {}), outdir=outdir, plot=plot) for e in examples}
 
 

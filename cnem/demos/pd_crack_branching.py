@@ -78,6 +78,7 @@ import time
 import numpy as np
 
 import cnem.pd as pd
+from cnem.errors import InputError
 from cnem.exact import rayleigh_speed
 from cnem.pd import cracks
 
@@ -123,10 +124,10 @@ def plate(h):
     """
     h = float(h)
     if not np.isfinite(h) or h <= 0:
-        raise ValueError(f"h: expected a positive grid spacing in metres, received {h}")
+        raise InputError(f"h: expected a positive grid spacing in metres, received {h}")
     nx, ny = LENGTH / h, HEIGHT / h
     if abs(nx - round(nx)) > 1e-6 or abs(ny - round(ny)) > 1e-6 or round(ny) % 2:
-        raise ValueError(f"h = {h * 1e3:g} mm: expected a spacing that divides {LENGTH * 1e3:g} mm "
+        raise InputError(f"h = {h * 1e3:g} mm: expected a spacing that divides {LENGTH * 1e3:g} mm "
                          f"and {HEIGHT * 1e3:g} mm into whole cells with an even number of rows, "
                          f"e.g. 1, 0.5, 0.25 or 0.2 mm")
     nx, ny = round(nx), round(ny)
@@ -157,18 +158,18 @@ def build(h, m, material="soda-lime", stress=None):
         Grid points along x and y.
     """
     if material not in MATERIALS:
-        raise ValueError(f"material: expected one of {', '.join(MATERIALS)}, received {material!r}")
+        raise InputError(f"material: expected one of {', '.join(MATERIALS)}, received {material!r}")
     m = float(m)
     if not 2.0 <= m <= 10.0:
-        raise ValueError(f"m: expected a horizon of 2 to 10 grid spacings, received {m}")
+        raise InputError(f"m: expected a horizon of 2 to 10 grid spacings, received {m}")
     mat = MATERIALS[material]
     stress = mat["stress"] if stress is None else float(stress)
     if not np.isfinite(stress) or stress <= 0:
-        raise ValueError(f"stress: expected a positive traction in Pa, received {stress}")
+        raise InputError(f"stress: expected a positive traction in Pa, received {stress}")
     points, shape = plate(h)
     horizon = m * h
     if horizon > 0.25 * HEIGHT:
-        raise ValueError(f"delta = m h = {horizon * 1e3:g} mm: expected a horizon of at most a "
+        raise InputError(f"delta = m h = {horizon * 1e3:g} mm: expected a horizon of at most a "
                          f"quarter of the plate height ({0.25 * HEIGHT * 1e3:g} mm); refine h")
     # the crack line starts left of the plate: no bond passes around its end at the mouth
     body = pd.Body(points, h * h * THICKNESS, horizon, thickness=THICKNESS,
@@ -334,9 +335,9 @@ def main(h=0.25e-3, m=4.0, t_end=46e-6, *, material="soda-lime", stress=None, fr
     """
     t_end, frame_every = float(t_end), float(frame_every)
     if not np.isfinite(t_end) or t_end <= 0:
-        raise ValueError(f"t_end: expected a positive time in seconds, received {t_end}")
+        raise InputError(f"t_end: expected a positive time in seconds, received {t_end}")
     if not 0 < frame_every <= t_end:
-        raise ValueError(f"frame_every: expected a time in (0, t_end = {t_end:g}] s, received "
+        raise InputError(f"frame_every: expected a time in (0, t_end = {t_end:g}] s, received "
                          f"{frame_every}")
     start = time.perf_counter()
     problem, shape = build(h, m, material, stress)

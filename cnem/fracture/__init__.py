@@ -6,7 +6,8 @@
 >>> model = cnem.discretize(cnem.nodes.regular(dom, 0.1))
 >>> prob = cnem.Elasticity(model, (1.0, 0.3), plane="strain")
 >>> exact = nodal_williams(model, (0.0, 0.0), 1.0, 0.0, 1.0, 0.3, "strain")   # mode I, K_I = 1
->>> boundary = np.unique(model.segments[model.segment_kind != 1])
+>>> from cnem.geometry import SegmentKind
+>>> boundary = np.unique(model.segments[model.segment_kind != SegmentKind.INTERFACE])
 >>> prob.add_dirichlet(boundary, None, lambda p: exact[boundary])
 >>> KI, KII = sif(prob.solve(progress=False), (0.0, 0.0), radius=0.6)
 >>> bool(abs(KI - 1.0) < 0.02 and abs(KII) < 0.02)

@@ -21,7 +21,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from .. import config
 from ..assembly.scni import boundary_quadrature
+from ..errors import FractureError, InputError, check_choice
 from ..geometry.topology import circumcenters
 from .williams import sided_polar
 
@@ -29,10 +31,6 @@ __all__ = ["Enrichment", "FUNCTIONS"]
 
 #: Enrichment function sets and their sizes.
 FUNCTIONS = {"sqrt": 1, "branch": 4}
-
-#: Fewest Gauss points per cell-edge piece in the smoothing of the enrichment
-#: functions (they vary like sqrt(r) about the tip, not like a rational function).
-MIN_GAUSS = 4
 
 
 class Enrichment:
@@ -62,25 +60,23 @@ class Enrichment:
     """
 
     def __init__(self, model, tips, radius, *, functions="sqrt"):
-        if functions not in FUNCTIONS:
-            raise ValueError(f"enrich functions: expected one of {tuple(FUNCTIONS)}, "
-                             f"received {functions!r}")
+        check_choice("enrich functions", functions, FUNCTIONS)
         self.functions, self.size = functions, FUNCTIONS[functions]
         pts = np.atleast_2d(np.asarray(tips, dtype=float))
         if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) == 0:
-            raise ValueError(f"enrich tips: expected points (t, 2), received shape {pts.shape}")
+            raise FractureError(f"enrich tips: expected points (t, 2), received shape {pts.shape}")
         frames = [model.domain.tip_frame(p) for p in pts]
         self.tips = np.array([f[0] for f in frames])
         self.directions = np.array([f[1] for f in frames])
         radius = float(radius)
         if not np.isfinite(radius) or radius <= 0:
-            raise ValueError(f"enrich radius: expected a positive number, received {radius}")
+            raise FractureError(f"enrich radius: expected a positive number, received {radius}")
         self.model, self.radius = model, radius
         dist = np.hypot(*(model.nodes[:, None, :] - self.tips[None]).transpose(2, 0, 1))
         self.nodes = np.flatnonzero(dist.min(axis=1) < radius)
         if self.nodes.size == 0:
-            raise ValueError(f"enrich radius {radius:g} holds no node about the tips "
-                             f"{self.tips.tolist()}; choose a larger radius")
+            raise FractureError(f"enrich radius {radius:g} holds no node about the tips "
+                                f"{self.tips.tolist()}; choose a larger radius")
         self.tip_of = dist.argmin(axis=1)[self.nodes]
         # F_k at the nodes, each on its own crack face
         self._at_nodes = np.zeros((len(self.nodes), self.size))
@@ -99,8 +95,8 @@ class Enrichment:
                 and "radius" in spec:
             return cls(model, spec.get("tips", model.domain.tips), spec["radius"],
                        functions=spec.get("functions", "sqrt"))
-        raise ValueError(f"enrich: expected dict(tips=..., radius=..., functions=...) or an "
-                         f"Enrichment, received {spec!r}")
+        raise FractureError(f"enrich: expected dict(tips=..., radius=..., functions=...) or an "
+                            f"Enrichment, received {spec!r}")
 
     def __len__(self):
         """Number of enrichment functions (enriched nodes times `size`)."""
@@ -180,8 +176,8 @@ class Enrichment:
             # dphi has phi's pattern: its entries line up with sub's
             d = dphi.tocsc()[:, self.nodes].tocoo()
             if not (np.array_equal(d.row, sub.row) and np.array_equal(d.col, sub.col)):
-                raise ValueError("gradient: expected shape-function gradients with the "
-                                 "sparsity pattern of phi (from one shape_functions call)")
+                raise InputError("gradient: expected shape-function gradients with the "
+                                 "sparsity pattern of phi; take both from one shape_functions call")
             out.append(matrix(d.data[:, None] * shifted + sub.data[:, None] * dF[:, :, axis]))
         return tuple(out)
 
@@ -210,13 +206,13 @@ class Enrichment:
 
     def smoothed_gradient(self, gauss=2, cells=None):
         """SCNI smoothed gradients of the enrichment functions, with at least
-        `MIN_GAUSS` points per piece of cell edge, graded towards the tips.
+        `cnem.config.MIN_GAUSS` points per piece of cell edge, graded towards the tips.
 
         Returns
         -------
         gx, gy : scipy.sparse.csr_matrix, shape (m, len(self))
         """
-        quad = boundary_quadrature(self.model, gauss=max(gauss, MIN_GAUSS), cells=cells,
+        quad = boundary_quadrature(self.model, gauss=max(gauss, config.MIN_GAUSS), cells=cells,
                                    singular=self.tips)
         select = np.flatnonzero(self.in_support(quad.points))
         points, hint = quad.points[select], quad.hint[select]

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..assembly.quadrature import cell_quadrature
+from ..errors import FractureError
 from ..material import effective_modulus
 from .williams import williams
 
@@ -72,7 +73,7 @@ def sif(sol, tip, *, radius=None, order=4):
 
     Raises
     ------
-    ValueError
+    FractureError
         No tip; a disc that reaches into another material (the interaction
         integral needs one material), leaves no cell, or is not a positive number.
     """
@@ -82,19 +83,21 @@ def sif(sol, tip, *, radius=None, order=4):
         radius = 6.0 * _local_spacing(model, at)
     radius = float(radius)
     if not np.isfinite(radius) or radius <= 0:
-        raise ValueError(f"radius: expected a positive number, received {radius}")
+        raise FractureError(f"radius: expected a positive number, received {radius}; leave it "
+                            f"None for a few node spacings")
     cell, points, weights = cell_quadrature(sol.cells, model.nodes, order)
     rot = np.array([[d[0], d[1]], [-d[1], d[0]]])            # global -> crack-tip frame
     local = (points - at) @ rot.T
     r = np.hypot(local[:, 0], local[:, 1])
     near = r < radius
     if not near.any():
-        raise ValueError(f"radius {radius:g} holds no integration point about the tip {at.tolist()}")
+        raise FractureError(f"radius {radius:g} holds no integration point about the tip "
+                            f"{at.tolist()}; expected at least one: choose a larger radius")
     regions = np.unique(sol.cells.region[cell[near]])
     if len(regions) > 1:
-        raise ValueError(f"the disc of radius {radius:g} about the tip {at.tolist()} reaches "
-                         f"into regions {regions.tolist()}; the interaction integral needs one "
-                         "material: choose a smaller radius")
+        raise FractureError(f"the disc of radius {radius:g} about the tip {at.tolist()} reaches "
+                            f"into regions {regions.tolist()}; the interaction integral needs one "
+                            "material: choose a smaller radius")
     cell, local, r, w = cell[near], local[near], r[near], weights[near]
     theta = np.arctan2(local[:, 1], local[:, 0])
     E, nu = sol.problem.materials[regions[0]]

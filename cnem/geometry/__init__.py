@@ -11,8 +11,8 @@ True
 from .cloud import NodeCloud
 from .domain import Domain
 from .model import Cells, Model, discretize
-from .pslg import PSLG
+from .pslg import PSLG, SegmentKind
 from .shapes import annulus, arc, l_shape, plate_with_hole, rectangle
 
-__all__ = ["Domain", "NodeCloud", "Model", "Cells", "PSLG", "discretize",
+__all__ = ["Domain", "NodeCloud", "Model", "Cells", "PSLG", "SegmentKind", "discretize",
            "rectangle", "plate_with_hole", "annulus", "l_shape", "arc"]

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .pslg import KIND_NAMES
+from .pslg import SegmentKind
 
 __all__ = ["NodeCloud"]
 
@@ -25,7 +25,7 @@ class NodeCloud:
         Constraint segments as index pairs into ``points``; no node lies
         inside a segment.
     segment_kind : (s,) int8 ndarray
-        0 boundary, 1 interface, 2 crack.
+        `SegmentKind` of each segment: 0 boundary, 1 interface, 2 crack.
     spacing : (n0,) ndarray
         Nominal local node spacing at each node.
     """
@@ -40,6 +40,6 @@ class NodeCloud:
         return len(self.points)
 
     def __repr__(self):
-        counts = ", ".join(f"{np.count_nonzero(self.segment_kind == k)} {name}"
-                           for k, name in enumerate(KIND_NAMES))
+        counts = ", ".join(f"{np.count_nonzero(self.segment_kind == k)} {k.name.lower()}"
+                           for k in SegmentKind)
         return f"<NodeCloud {len(self.points)} nodes, segments: {counts}>"

@@ -279,10 +279,11 @@ class Domain:
         """
         tips = self.tips
         if len(tips) == 0:
-            raise ValueError("the domain has no crack tip (crack ends inside the body)")
+            raise GeometryError("the domain has no crack tip (a crack end inside the body): its "
+                                "cracks, if any, end on the boundary; give a crack that ends inside")
         tip = np.asarray(tip, dtype=float).reshape(-1)
         if tip.shape != (2,):
-            raise ValueError(f"tip: expected a point (2,), received shape {tip.shape}")
+            raise GeometryError(f"tip: expected a point (2,), received shape {tip.shape}")
         at = tips[np.argmin(np.hypot(*(tips - tip).T))]
         for crack in self.cracks:
             for end, before in ((crack[-1], crack[-2]), (crack[0], crack[1])):

@@ -113,7 +113,7 @@ class Model:
     segments : (s, 2) int64 ndarray
         Constraint segments after splitting (each crack segment once per face).
     segment_kind : (s,) int8 ndarray
-        0 boundary, 1 interface, 2 crack face.
+        `SegmentKind` of each segment: 0 boundary, 1 interface, 2 crack face.
     cells : Cells
     timings : dict
         Seconds spent in each stage.

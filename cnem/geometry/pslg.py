@@ -8,6 +8,7 @@ and crack ends that touch a boundary split that boundary edge.
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,11 +18,21 @@ from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
 
-__all__ = ["PSLG", "BOUNDARY", "INTERFACE", "CRACK", "build_pslg", "segment_projection"]
+__all__ = ["PSLG", "SegmentKind", "BOUNDARY", "INTERFACE", "CRACK", "build_pslg",
+           "segment_projection"]
 
-#: Edge kinds.
-BOUNDARY, INTERFACE, CRACK = 0, 1, 2
-KIND_NAMES = ("boundary", "interface", "crack")
+
+class SegmentKind(enum.IntEnum):
+    """Kind of a constraint edge or segment, stored as int8 in ``PSLG.kind``,
+    ``NodeCloud.segment_kind`` and ``Model.segment_kind``; compare arrays with the
+    names (``model.segment_kind == SegmentKind.CRACK``)."""
+
+    BOUNDARY = 0        #: one region on one side (outer boundary or a hole)
+    INTERFACE = 1       #: a region on each side (a material interface)
+    CRACK = 2           #: a crack (in a Model: one segment per crack face)
+
+
+BOUNDARY, INTERFACE, CRACK = SegmentKind.BOUNDARY, SegmentKind.INTERFACE, SegmentKind.CRACK
 
 
 @dataclass(frozen=True)
@@ -34,8 +45,8 @@ class PSLG:
     edges : (e, 2) int64 ndarray
         Vertex index pairs, each straight edge once.
     kind : (e,) int8 ndarray
-        ``BOUNDARY`` (one region on one side), ``INTERFACE`` (two regions)
-        or ``CRACK``.
+        `SegmentKind` values: ``BOUNDARY`` (one region on one side), ``INTERFACE``
+        (two regions) or ``CRACK``.
     """
 
     vertices: np.ndarray

@@ -20,7 +20,7 @@ from ..assembly.quadrature import cell_quadrature, subdivide, tip_cells
 from ..assembly.scni import fan_gradient
 from ..assembly.triangles import triangle_basis
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
-from ..errors import SolveError
+from ..errors import InputError, SolveError
 from ..geometry.topology import constraint_edges
 from ..material import lame, parse_materials, stiffness_matrix
 from .solution import ElasticSolution
@@ -87,7 +87,7 @@ class Elasticity(Conditions):
         lame(1.0, 0.0, plane)                       # validates `plane`
         self.stabilization = float(stabilization)
         if not (np.isfinite(self.stabilization) and self.stabilization >= 0):
-            raise ValueError(f"stabilization: expected a number >= 0, received {stabilization!r}")
+            raise InputError(f"stabilization: expected a number >= 0, received {stabilization!r}")
         self.plane = plane
         self.gauss = gauss
         super().__init__()

@@ -9,6 +9,7 @@ import numpy as np
 
 from ..assembly.quadrature import cell_quadrature
 from ..assembly.solution import Solution, energy_error_density, engineering_strain, von_mises
+from ..errors import check_choice
 
 __all__ = ["ElasticSolution", "von_mises", "energy_error_density"]
 
@@ -126,8 +127,7 @@ class ElasticSolution(Solution):
         -------
         float
         """
-        if strain not in ("smoothed", "pointwise"):
-            raise ValueError(f"strain: expected 'smoothed' or 'pointwise', received {strain!r}")
+        check_choice("strain", strain, ("smoothed", "pointwise"))
         cell, points, weights = cell_quadrature(self.cells, self.model.nodes, order,
                                                 singular=self.model.domain.tips)
         if strain == "smoothed":

@@ -22,18 +22,12 @@ from itertools import combinations
 import numpy as np
 import scipy.sparse as sp
 
+from .. import config
+from ..errors import InputError, LimitError, MaterialError
 from ._cpd_kernels import add_rows, scatter_hessian
 
-__all__ = ["Interactions", "CHUNK", "DEGENERATE", "MAX_INTERACTIONS"]
+__all__ = ["Interactions"]
 
-#: Interactions evaluated together (bounds the temporaries: ~0.3 KB per 2-D pair).
-CHUNK = 1 << 18
-#: Pairs (triplets) whose reference area (volume) is below this fraction of the product of
-#: their bond lengths are degenerate (collinear / coplanar): their stretch is undefined and
-#: their reference measure, the energy's weight, vanishes; they are left out.
-DEGENERATE = 1e-8
-#: Most pairs or triplets a body may hold (about 64 bytes each are stored).
-MAX_INTERACTIONS = 50_000_000
 
 _ROT = np.array([[0.0, 1.0], [-1.0, 0.0]])     # d2a / dxi_p dxi_q of the 2-D area
 
@@ -99,16 +93,17 @@ def _size(g):
 
 
 def _chunks(m):
-    """Slices of at most `CHUNK` interactions."""
-    return [slice(s, min(s + CHUNK, m)) for s in range(0, m, CHUNK)]
+    """Slices of at most `cnem.config.CPD_CHUNK` interactions."""
+    chunk = config.CPD_CHUNK
+    return [slice(s, min(s + chunk, m)) for s in range(0, m, chunk)]
 
 
 def _check_count(count, what):
-    """A clear error before lists of more than `MAX_INTERACTIONS` are built."""
-    if count > MAX_INTERACTIONS:
-        raise ValueError(f"CPD: {count} {what} exceed the limit of {MAX_INTERACTIONS} "
-                         f"(cnem.pd._cpd_assembly.MAX_INTERACTIONS, ~64 bytes each); use a "
-                         f"smaller horizon or fewer points")
+    """A clear error before lists of more than `cnem.config.MAX_INTERACTIONS` are built."""
+    if count > config.MAX_INTERACTIONS:
+        raise LimitError(f"CPD: expected at most {config.MAX_INTERACTIONS} {what} "
+                         f"(cnem.config.MAX_INTERACTIONS, ~64 bytes each), received {count}; "
+                         f"use a smaller horizon or fewer points, or raise the limit")
 
 
 class Interactions:
@@ -180,7 +175,7 @@ class Interactions:
 
     def _regular(self, idx):
         """Mask of the non-degenerate pairs or triplets."""
-        return _size(self._measure(idx)) > DEGENERATE * np.prod(self.body.length[idx], axis=1)
+        return _size(self._measure(idx)) > config.CPD_DEGENERATE * np.prod(self.body.length[idx], axis=1)
 
     def _pattern(self, n, bi, bj):
         """Block pattern (BSR ``indptr``, ``indices``) and the block of each contribution:
@@ -218,8 +213,8 @@ class Interactions:
         n, d, nb = len(body), body.dim, len(body.bond_i)
         u = np.asarray(u, dtype=float)
         if u.size != n * d:
-            raise ValueError(f"u: expected {n * d} displacements (shape ({n}, {d})), "
-                             f"received shape {u.shape}")
+            raise InputError(f"u: expected {n * d} displacements (shape ({n}, {d})), "
+                             f"received shape {u.shape}; pass one vector per point")
         u = u.reshape(n, d)
         y = body.xi + u[body.bond_j] - u[body.bond_i]                 # deformed bonds
         sums = {"energy": 0.0, "grad": np.zeros((nb, d))}
@@ -279,9 +274,9 @@ class Interactions:
         needs = (material.C2 > 0 or material.C3 > 0, material.C3 > 0)
         have = (self.material.C2 > 0 or self.material.C3 > 0, self.material.C3 > 0)
         if needs != have:
-            raise ValueError(f"material: expected one with the same kinds of interactions "
-                             f"(C2 or C3 > 0: {have[0]}, C3 > 0: {have[1]}), received "
-                             f"{material!r}; build new ones with material.interactions(body)")
+            raise MaterialError(f"material: expected one with the same kinds of interactions "
+                                f"(C2 or C3 > 0: {have[0]}, C3 > 0: {have[1]}), received "
+                                f"{material!r}; build new ones with material.interactions(body)")
         other = copy.copy(self)
         other.material = material
         return other

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from ..spatial import family_search, remove_crossing
 from ._kernels import bond_geometry
 
@@ -27,24 +28,26 @@ def checked_input(points, volumes, horizon, thickness):
 
     Raises
     ------
-    ValueError
+    InputError
         Not a non-empty ``(n, 2)`` or ``(n, 3)`` array, or non-positive volumes, horizon
         or thickness.
     """
     pts = np.ascontiguousarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] not in (2, 3) or len(pts) == 0:
-        raise ValueError(f"points: expected a non-empty (n, 2) or (n, 3) array, received "
+        raise InputError(f"points: expected a non-empty (n, 2) or (n, 3) array, received "
                          f"shape {pts.shape}")
     n, d = pts.shape
     vol = np.broadcast_to(np.asarray(volumes, dtype=float), (n,)).copy()
     if not (np.isfinite(vol).all() and (vol > 0).all()):
-        raise ValueError("volumes: expected positive finite volumes, one per point")
+        raise InputError(f"volumes: expected positive finite volumes, a number or one per "
+                         f"point, received min {vol.min()!r}")
     horizon = float(horizon)
     if not np.isfinite(horizon) or horizon <= 0:
-        raise ValueError(f"horizon: expected a positive number, received {horizon}")
+        raise InputError(f"horizon: expected a positive number, received {horizon}; "
+                         f"typically three node spacings")
     thick = float(thickness) if d == 2 else 1.0
     if thick <= 0:
-        raise ValueError(f"thickness: expected a positive number, received {thickness}")
+        raise InputError(f"thickness: expected a positive number, received {thickness}")
     return pts, vol, horizon, thick
 
 

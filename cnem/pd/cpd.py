@@ -41,15 +41,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import config
 from .. import hyperdual as hd
+from ..errors import MaterialError, check_choice
 from ._cpd_assembly import Interactions
 
-__all__ = ["CPD", "Interactions", "seth_hill", "DERIVATIVES", "FD_STEP"]
+__all__ = ["CPD", "Interactions", "seth_hill", "DERIVATIVES"]
 
 #: How the derivatives of the interaction energies are computed.
 DERIVATIVES = ("hyperdual", "analytic", "fd")
-#: Relative step of the finite differences (``derivatives="fd"``).
-FD_STEP = 1e-4
 
 
 def seth_hill(exponent):
@@ -96,7 +96,7 @@ class CPD:
         derivative at ``lam = 1`` for a stress-free reference state.
     derivatives : {"hyperdual", "analytic", "fd"}
         Hyper-dual numbers (any energy), hand-written derivatives (Seth-Hill only) or
-        central finite differences of relative step `FD_STEP` (approximate).
+        central finite differences of relative step `cnem.config.FD_STEP` (approximate).
 
     Notes
     -----
@@ -109,27 +109,25 @@ class CPD:
                  derivatives="hyperdual"):
         C = [float(C1), float(C2), float(C3)]
         if not (np.isfinite(C).all() and C[0] > 0 and C[1] >= 0 and C[2] >= 0):
-            raise ValueError(f"CPD: expected C1 > 0, C2 >= 0, C3 >= 0 (finite), received "
-                             f"C1={C1}, C2={C2}, C3={C3}")
+            raise MaterialError(f"CPD: expected C1 > 0, C2 >= 0, C3 >= 0 (finite), received "
+                                f"C1={C1}, C2={C2}, C3={C3}")
         self.C1, self.C2, self.C3 = C
         self.exponent = float(exponent)
         if not np.isfinite(self.exponent):
-            raise ValueError(f"exponent: expected a finite number, received {exponent}")
-        if derivatives not in DERIVATIVES:
-            raise ValueError(f"derivatives: expected one of {DERIVATIVES}, received "
-                             f"{derivatives!r}")
+            raise MaterialError(f"exponent: expected a finite number, received {exponent}")
+        check_choice("derivatives", derivatives, DERIVATIVES)
         self.derivatives = derivatives
         given = (psi1, psi2, psi3)
         for k, (psi, c) in enumerate(zip(given, C), start=1):
             if psi is not None and not callable(psi):
-                raise ValueError(f"psi{k}: expected a function of the stretch, received "
-                                 f"{type(psi).__name__}")
+                raise MaterialError(f"psi{k}: expected a function of the stretch, received "
+                                    f"{type(psi).__name__}")
             if psi is not None and c == 0:
-                raise ValueError(f"psi{k} is given but C{k} = 0, so it would never be used; "
-                                 f"give C{k} > 0 or drop psi{k}")
+                raise MaterialError(f"psi{k} is given but C{k} = 0, so it would never be used; "
+                                    f"give C{k} > 0 or drop psi{k}")
         if derivatives == "analytic" and any(p is not None for p in given):
-            raise ValueError("derivatives='analytic' is written for the Seth-Hill energies "
-                             "only; with user energies psi1/psi2/psi3 use 'hyperdual'")
+            raise MaterialError("derivatives='analytic' is written for the Seth-Hill energies "
+                                "only; with user energies psi1/psi2/psi3 use 'hyperdual'")
         default = seth_hill(self.exponent)
         self.psi = tuple(default if p is None else p for p in given)
         self.user = tuple(p is not None for p in given)
@@ -145,13 +143,14 @@ class CPD:
 
         Raises
         ------
-        ValueError
-            C3 > 0 on a 2-D body, or more pairs or triplets than
-            `cnem.pd._cpd_assembly.MAX_INTERACTIONS`.
+        MaterialError
+            C3 > 0 on a 2-D body.
+        LimitError
+            More pairs or triplets than `cnem.config.MAX_INTERACTIONS`.
         """
         if body.dim == 2 and self.C3 != 0:
-            raise ValueError(f"C3 = {self.C3:g}: three-neighbour (volume) interactions exist "
-                             f"in 3-D only; for a 2-D body set C3=0")
+            raise MaterialError(f"C3 = {self.C3:g}: three-neighbour (volume) interactions exist "
+                                f"in 3-D only; for a 2-D body set C3=0")
         return Interactions(body, self)
 
     def measure_derivatives(self, order, g, ref):
@@ -189,7 +188,7 @@ class CPD:
                                     hd.derivative(energy, g[:, 0]))
         else:
             value, first, second = _finite_differences(energy, g if vector else g[:, 0],
-                                                       FD_STEP * np.abs(ref))
+                                                       config.FD_STEP * np.abs(ref))
         return value, first.reshape(g.shape), second.reshape(len(g), g.shape[1], -1)
 
     def __repr__(self):

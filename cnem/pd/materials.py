@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import MaterialError
+
 __all__ = ["BondBased", "StateBased"]
 
 
 def _positive(name, value):
     value = float(value)
     if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"{name}: expected a positive number, received {value}")
+        raise MaterialError(f"{name}: expected a positive number, received {value}")
     return value
 
 
@@ -93,7 +95,7 @@ class StateBased:
         self.E = _positive("E", E)
         nu = float(nu)
         if not -1.0 < nu < 0.5:
-            raise ValueError(f"nu: expected a Poisson ratio in (-1, 0.5), received {nu}")
+            raise MaterialError(f"nu: expected a Poisson ratio in (-1, 0.5), received {nu}")
         self.nu = nu
         self.critical_stretch = None if critical_stretch is None else _positive(
             "critical_stretch", critical_stretch)

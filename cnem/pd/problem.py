@@ -12,7 +12,8 @@ from tqdm.auto import tqdm
 
 from ..assembly.conditions import Conditions, per_point
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
-from ..errors import SolveError
+from .. import config
+from ..errors import InputError, MaterialError, SolveError, UnsupportedError, check_choice
 from . import _kernels as K
 from .frames import FrameWriter
 from ..material import PLANES
@@ -44,15 +45,14 @@ class Problem(Conditions):
     """
 
     def __init__(self, body, material, *, plane="stress", surface_correction=None):
-        if plane not in PLANES:
-            raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
+        check_choice("plane", plane, PLANES)
         kind = getattr(material, "kind", None)
         if kind not in ("bond", "state", "cpd"):
-            raise ValueError(f"material: expected cnem.pd.BondBased, StateBased or CPD, "
-                             f"received {type(material).__name__}")
+            raise MaterialError(f"material: expected cnem.pd.BondBased, StateBased or CPD, "
+                                f"received {type(material).__name__}")
         if kind == "cpd" and surface_correction:
-            raise ValueError("surface_correction=True: the surface correction does not apply "
-                             "to CPD (its energies use the plain volumes); leave it unset")
+            raise MaterialError("surface_correction=True: the surface correction does not apply "
+                                "to CPD (its energies use the plain volumes); leave it unset")
         self.body, self.material, self.plane = body, material, plane
         self.dim = body.dim
         self.surface_correction = kind != "cpd" if surface_correction is None else \
@@ -114,7 +114,9 @@ class Problem(Conditions):
         M = np.zeros((n, d, d))
         np.add.at(M, b.bond_i, w[:, None, None] * b.xi[:, :, None] * b.xi[:, None, :])
         if (np.linalg.det(M) <= 0).any():
-            raise ValueError("a point has too few bonds to span every direction: enlarge the horizon")
+            raise InputError(f"expected bonds spanning every direction at each point, received "
+                             f"{int((np.linalg.det(M) <= 0).sum())} points with too few bonds; "
+                             f"enlarge the horizon")
         return np.einsum("bij,bj->bi", np.linalg.inv(M)[b.bond_i], b.xi) * w[:, None]
 
     def displacement_gradient(self, u):
@@ -155,7 +157,7 @@ class Problem(Conditions):
     def _linear_only(self, what):
         """Refuse CPD in the methods of the linear (bond- and state-based) models."""
         if self.material.kind == "cpd":
-            raise NotImplementedError(
+            raise UnsupportedError(
                 f"{what} is available for BondBased and StateBased materials, not for CPD "
                 "(nonlinear, nonlocal measures): use solve, its displacements u, or "
                 "Problem.interactions.evaluate(u) for energy, forces and tangent")
@@ -325,12 +327,12 @@ class Problem(Conditions):
 
         Raises
         ------
-        NotImplementedError
-            Always: give the loads as body forces (`add_body_force`, force per unit
+        UnsupportedError
+            Always (a `NotImplementedError`): give the loads as body forces (`add_body_force`, force per unit
             volume; a traction ``t`` on an edge becomes about ``t / dx`` on the
             layer of points along it, ``dx`` the spacing).
         """
-        raise NotImplementedError(
+        raise UnsupportedError(
             "add_traction: peridynamics takes no tractions (a nonlocal body has no "
             "boundary edges); give the load as a body force with add_body_force, e.g. "
             "t / dx on the layer of points along the edge (dx the point spacing)")
@@ -375,7 +377,7 @@ class Problem(Conditions):
         times the largest of the norms of its load, of the reactions at the prescribed
         dofs and of that first entry.
         Nonlinear materials (CPD) solve each correction to a relative tolerance
-        ``min(1e-3, |R| / reference)`` (inexact Newton, still quadratic).
+        ``min(NEWTON_FORCING, |R| / reference)`` (`cnem.config`; inexact Newton, still quadratic).
 
         Parameters
         ----------
@@ -405,7 +407,7 @@ class Problem(Conditions):
         d, n = self.dim, len(self.body)
         steps, max_iterations = int(steps), int(max_iterations)
         if steps < 1 or max_iterations < 1:
-            raise ValueError(f"expected steps >= 1 and max_iterations >= 1, received "
+            raise InputError(f"expected steps >= 1 and max_iterations >= 1, received "
                              f"steps={steps}, max_iterations={max_iterations}")
         evaluate, pattern = self._static_system()
         D, values = self.prescribed()
@@ -448,7 +450,9 @@ class Problem(Conditions):
                         f"{res[-1]:.3e} (wanted {tol * ref:.3e}) after {len(res) - 1} "
                         f"iteration(s); try more load steps, line_search=True or a larger "
                         f"max_iterations")
-                rtol = min(tol, 1e-12) if linear else min(1e-3, max(res[-1] / ref, 1e-12))
+                floor = config.NEWTON_INNER_FLOOR
+                rtol = min(tol, floor) if linear else min(config.NEWTON_FORCING,
+                                                          max(res[-1] / ref, floor))
                 try:
                     du = solve_spd(blocks(Kt)[0], r, modes=modes, tol=rtol)
                 except SolveError as exc:
@@ -553,7 +557,7 @@ class Problem(Conditions):
         b, d, n = self.body, self.dim, len(self.body)
         dt, steps = float(dt), int(steps)
         if not dt > 0 or steps < 1:
-            raise ValueError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
+            raise InputError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
         every = max(1, steps // 10) if every is None else int(every)
         rho = self.material.density
         limit = self.material.stretch_limit(d, self.plane, b.horizon)

@@ -12,6 +12,7 @@ from functools import cached_property
 
 import numpy as np
 
+from ..errors import GeometryError
 from ..assembly.solution import Solution, engineering_strain, voigt
 
 __all__ = ["PointSolution", "StaticSolution", "DynamicRun", "Relaxation"]
@@ -90,9 +91,9 @@ class PointSolution(Solution):
         out = LinearNDInterpolator(body.points, self.u)(pts)
         outside = np.isnan(out).any(axis=1)
         if outside.any():
-            raise ValueError(f"displacement: {int(outside.sum())} of {len(pts)} points lie "
-                             f"outside the convex hull of the body's points, the first at "
-                             f"{pts[outside][0].tolist()}; give points inside the body")
+            raise GeometryError(f"displacement: {int(outside.sum())} of {len(pts)} points lie "
+                                f"outside the convex hull of the body's points, the first at "
+                                f"{pts[outside][0].tolist()}; give points inside the body")
         return out
 
     def nodal_average(self, values):

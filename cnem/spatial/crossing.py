@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import SpatialError
 from . import _family_kernels as K
 from .family import Family
 from .rtree import RTree
@@ -52,16 +53,17 @@ def remove_crossing(family, points, segments):
     if seg.ndim == 2 and seg.shape[1] == 4:
         seg = seg.reshape(-1, 2, 2)
     if seg.ndim != 3 or seg.shape[1:] != (2, 2):
-        raise ValueError(f"segments: expected an (s, 2, 2) array of end points, received "
-                         f"shape {seg.shape}")
+        raise SpatialError(f"segments: expected an (s, 2, 2) array of end points, received "
+                           f"shape {seg.shape}; pass one pair of points per segment")
     far = _far_ends(seg)
     seg = np.ascontiguousarray(seg.reshape(-1, 4))
     if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) != len(family):
-        raise ValueError(f"points: expected ({len(family)}, 2) 2-D points of the family, "
-                         f"received shape {pts.shape}")
+        raise SpatialError(f"points: expected ({len(family)}, 2) 2-D points of the family, "
+                           f"received shape {pts.shape}; pass the points it was searched on")
     if np.isfinite(family.period).any():
-        raise ValueError("remove_crossing does not support periodic families: a bond's "
-                         "segment is ambiguous across the cell boundary")
+        raise SpatialError("remove_crossing: expected a family without period, received a "
+                           "periodic one (a bond's segment is ambiguous across the cell "
+                           "boundary); search the family without period= to cut bonds")
     if len(seg) == 0 or len(family.indices) == 0:
         return family
     lo = np.minimum(seg[:, :2], seg[:, 2:])

@@ -21,23 +21,17 @@ import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .. import config
+from ..errors import LimitError, SpatialError, check_choice
 from . import _family_kernels as K
 from . import _pair_kernels as P
 from .._parallel import work_chunks
 from .rtree import RTree, as_points, check_period
 
-__all__ = ["Family", "family_search", "METHODS", "BRUTE_LIMIT"]
+__all__ = ["Family", "family_search", "METHODS"]
 
 METHODS = ("auto", "rtree", "cells", "kdtree", "brute")
 
-#: Largest cloud the brute-force method accepts.
-BRUTE_LIMIT = 20_000
-
-#: Cells per horizon along each axis in the cell list (horizons per point).
-CELLS_PER_HORIZON = 2
-
-#: Columns per horizon along the two binned axes (one horizon for all points).
-COLUMNS_PER_HORIZON = 3
 
 
 @dataclass(frozen=True, repr=False)
@@ -87,9 +81,11 @@ def _index_dtype(n):
     return np.int32 if n < 2**31 - 1 else np.int64
 
 
-def _grid(pts3, hmax, period3, dim, per_horizon=CELLS_PER_HORIZON):
+def _grid(pts3, hmax, period3, dim, per_horizon=None):
     """Grid of cells over the first ``dim`` axes: origin, cell sizes and counts,
-    ``per_horizon`` cells per horizon and at most ~4 cells per point."""
+    ``per_horizon`` (default `cnem.config.CELLS_PER_HORIZON`) cells per horizon and at
+    most ~4 cells per point."""
+    per_horizon = config.CELLS_PER_HORIZON if per_horizon is None else per_horizon
     n = len(pts3)
     # column by column: reductions along axis 0 of an (n, 3) array are ~15x slower
     lo = np.array([pts3[:, k].min() if n else 0.0 for k in range(3)])
@@ -122,7 +118,7 @@ def _cells(pts3, horizon, period3, dim):
         if dim == 2:
             axes = [2, 0, 1]
             pts_c, per_c = np.ascontiguousarray(pts3[:, axes]), period3[axes]
-        origin, size, nc = _grid(pts_c, float(horizon[0]), per_c, 2, COLUMNS_PER_HORIZON)
+        origin, size, nc = _grid(pts_c, float(horizon[0]), per_c, 2, config.COLUMNS_PER_HORIZON)
         return P.uniform_family(pts_c, float(horizon[0]), origin, size, nc, per_c, sample,
                                 numba.get_num_threads())
     origin, size, nc = _grid(pts3, float(horizon.max()), period3, dim)
@@ -177,27 +173,35 @@ def family_search(points, horizon, *, period=None, method="auto"):
 
     Raises
     ------
-    ValueError
-        Bad shapes, non-positive horizon, points outside the periodic cell,
-        unknown method, or ``"brute"`` on more than `BRUTE_LIMIT` points.
+    SpatialError
+        Bad shapes, non-positive horizon, points outside the periodic cell.
+    OptionError
+        Unknown method.
+    LimitError
+        ``"brute"`` on more than `cnem.config.BRUTE_LIMIT` points.
     """
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, received {method!r}")
+    check_choice("method", method, METHODS)
     arr = np.asarray(points, dtype=np.float64)
     pts = as_points(arr if arr.size else arr.reshape(0, arr.shape[-1] if arr.ndim == 2 else 2))
     n, d = pts.shape
     per = check_period(period, d, pts)
-    h = np.ascontiguousarray(np.broadcast_to(np.asarray(horizon, dtype=np.float64), (n,)))
+    try:
+        h = np.ascontiguousarray(np.broadcast_to(np.asarray(horizon, dtype=np.float64), (n,)))
+    except ValueError:
+        raise SpatialError(f"horizon: expected a number or one per point ({n},), received "
+                           f"shape {np.shape(horizon)}") from None
     if n and (not np.isfinite(h).all() or (h <= 0).any()):
-        raise ValueError(f"horizon must be positive and finite, received min {h.min()!r}")
+        raise SpatialError(f"horizon must be positive and finite, received min {h.min()!r}; "
+                           f"pass a positive distance")
     if n == 0:
         return Family(np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int32), h, per)
     if method == "auto":
         method = choose_method(h)
     if method == "brute":
-        if n > BRUTE_LIMIT:
-            raise ValueError(f"method='brute' tests all n^2 pairs and is limited to "
-                             f"{BRUTE_LIMIT} points, received {n}; use method='auto'")
+        if n > config.BRUTE_LIMIT:
+            raise LimitError(f"method='brute' tests all n^2 pairs and is limited to "
+                             f"{config.BRUTE_LIMIT} points, received {n}; use method='auto' "
+                             f"(or raise cnem.config.BRUTE_LIMIT)")
         offsets, indices = K.brute_family(pts, h, per)
     elif method == "cells":
         pts3 = np.zeros((n, 3))

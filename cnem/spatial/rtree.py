@@ -12,22 +12,23 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import config
 from .._parallel import work_chunks
+from ..errors import SpatialError
 from . import _rtree_kernels as K
 
 __all__ = ["RTree", "check_period", "as_points"]
-
-#: Children per node (and boxes per leaf).
-FANOUT = 16
 
 
 def as_points(points, name="points"):
     """Validate a ``(n, d)`` float64 C-contiguous array with d = 2 or 3."""
     arr = np.ascontiguousarray(points, dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] not in (2, 3):
-        raise ValueError(f"{name}: expected a (n, 2) or (n, 3) array, received shape {arr.shape}")
+        raise SpatialError(f"{name}: expected a (n, 2) or (n, 3) array, received shape "
+                           f"{arr.shape}; pass one row of coordinates per point")
     if not np.isfinite(arr).all():
-        raise ValueError(f"{name}: coordinates must be finite, received NaN or inf")
+        raise SpatialError(f"{name}: expected finite coordinates, received NaN or inf; "
+                           f"drop or repair those rows")
     return arr
 
 
@@ -37,15 +38,16 @@ def check_period(period, dim, *points):
         return np.full(dim, np.inf)
     per = np.asarray(period, dtype=np.float64)
     if per.ndim > 1 or per.size not in (1, dim):
-        raise ValueError(f"period: expected a number or {dim} lengths, received {period!r}")
+        raise SpatialError(f"period: expected None, a number or {dim} lengths, received "
+                           f"{period!r}")
     per = np.broadcast_to(per, (dim,)).copy()
     if not (np.isfinite(per) & (per > 0)).all():
-        raise ValueError(f"period: expected {dim} positive lengths, received {period!r}")
+        raise SpatialError(f"period: expected {dim} positive finite lengths, received {period!r}")
     for arr in points:
         bad = ((arr < 0) | (arr >= per)).any(axis=1)
         if bad.any():
             first = np.flatnonzero(bad)[:3]
-            raise ValueError(
+            raise SpatialError(
                 f"{bad.sum()} points lie outside the periodic cell [0, L) with L = {per.tolist()}, "
                 f"first {arr[first].tolist()}; wrap them with np.mod(points, L) first")
     return per
@@ -87,9 +89,10 @@ class RTree:
         self._corners = None
         lo, hi = as_points(lo, "lo"), as_points(hi, "hi")
         if lo.shape != hi.shape:
-            raise ValueError(f"lo and hi must have the same shape, received {lo.shape} and {hi.shape}")
+            raise SpatialError(f"lo and hi must have the same shape, received {lo.shape} and "
+                               f"{hi.shape}; pass one lower and one upper corner per box")
         if (hi < lo).any():
-            raise ValueError(f"{int((hi < lo).any(axis=1).sum())} boxes have hi < lo; "
+            raise SpatialError(f"{int((hi < lo).any(axis=1).sum())} boxes have hi < lo; "
                              "pass lower corners as lo and upper corners as hi")
         self._corners = (lo, hi)
         self._build(0.5 * (lo + hi), 0.5 * (hi - lo), period)
@@ -111,30 +114,32 @@ class RTree:
 
     def _build(self, centre, half, period):
         b, d = centre.shape
-        self.dim = d
+        self.dim, self.fanout = d, config.FANOUT          # children per node, fixed per tree
         self.period = check_period(period, d, centre)
         if self.periodic:
             too_big = (half > 0.5 * self.period).any(axis=1)
             if too_big.any():
-                raise ValueError(f"{too_big.sum()} boxes are wider than the periodic cell")
+                raise SpatialError(f"expected boxes no wider than the periodic cell "
+                                   f"{self.period.tolist()}, received {too_big.sum()} boxes wider than the periodic "
+                                   f"cell; enlarge the period or split the boxes")
         self.size = b
         if b == 0:
             self.order = np.zeros(0, dtype=np.int64)
             return
-        order = _str_order(centre, FANOUT)
+        order = _str_order(centre, self.fanout)
         sizes = [b]
         while sizes[-1] > 1:
-            sizes.append(-(-sizes[-1] // FANOUT))
+            sizes.append(-(-sizes[-1] // self.fanout))
         level_start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         total = int(level_start[-1])
         cen, hw = np.empty((total, d)), np.empty((total, d))
         first, cnt = np.zeros(total, dtype=np.int64), np.zeros(total, dtype=np.int64)
         cen[:b], hw[:b] = centre[order], half[order]
         for lev in range(1, len(sizes)):
-            K.build_level(cen, hw, first, cnt, level_start[lev - 1], sizes[lev - 1], FANOUT,
+            K.build_level(cen, hw, first, cnt, level_start[lev - 1], sizes[lev - 1], self.fanout,
                           level_start[lev], self.period)
-            if sizes[lev] > FANOUT:     # STR again on this level's nodes before grouping them
-                perm = _str_order(cen[level_start[lev]:level_start[lev + 1]], FANOUT)
+            if sizes[lev] > self.fanout:     # STR again on this level's nodes before grouping them
+                perm = _str_order(cen[level_start[lev]:level_start[lev + 1]], self.fanout)
                 for arr in (cen, hw, first, cnt):
                     arr[level_start[lev]:level_start[lev + 1]] = \
                         arr[level_start[lev]:level_start[lev + 1]][perm]
@@ -150,7 +155,7 @@ class RTree:
         qlo = qcen if qlo is None else qlo
         qhi = qcen if qhi is None else qhi
         return K.query(self.centre, self.half, self.first, self.count, self.size, self.depth,
-                       FANOUT, self.order, qcen, qhalf, radius, kind, self.period, exclude_zero,
+                       self.fanout, self.order, qcen, qhalf, radius, kind, self.period, exclude_zero,
                        work_chunks(), self.lo, self.hi, qlo, qhi)
 
     def _points(self, points, name, *, in_cell=True):
@@ -159,7 +164,8 @@ class RTree:
             return np.zeros((0, self.dim))
         pts = as_points(arr, name)
         if pts.shape[1] != self.dim:
-            raise ValueError(f"{name}: expected dimension {self.dim}, received {pts.shape[1]}")
+            raise SpatialError(f"{name}: expected dimension {self.dim}, received {pts.shape[1]}; "
+                               f"query with points of the tree's dimension")
         if in_cell and self.periodic:
             check_period(self.period, self.dim, pts)
         return pts
@@ -185,7 +191,8 @@ class RTree:
         qlo = self._points(qlo, "qlo", in_cell=False)
         qhi = self._points(qhi, "qhi", in_cell=False)
         if qlo.shape != qhi.shape or (qhi < qlo).any():
-            raise ValueError("qlo and qhi must have the same shape with qlo <= qhi")
+            raise SpatialError(f"qlo and qhi must have the same shape with qlo <= qhi, received "
+                               f"shapes {qlo.shape} and {qhi.shape}; swap the corners")
         qcen = 0.5 * (qlo + qhi)
         if self.periodic:                # translate each query box into the cell
             shift = self.period * np.floor(qcen / self.period)
@@ -215,7 +222,8 @@ class RTree:
         pts = self._points(points, "points")
         radius = np.ascontiguousarray(np.broadcast_to(np.asarray(r, dtype=np.float64), (len(pts),)))
         if (radius < 0).any() or not np.isfinite(radius).all():
-            raise ValueError("r must be finite and non-negative")
+            raise SpatialError(f"r must be finite and non-negative, received min "
+                               f"{radius.min(initial=0.0)!r}; pass distances >= 0")
         kind = K.BALL_OPEN if strict else K.BALL_CLOSED
         return self._query(pts, np.zeros_like(pts), radius, kind, exclude_self)
 
@@ -232,7 +240,7 @@ class RTree:
         if self.size == 0:
             return np.full(len(pts), -1, dtype=np.int64), np.full(len(pts), np.inf)
         return K.nearest(self.centre, self.half, self.first, self.count, self.size, self.depth,
-                         FANOUT, self.order, pts, self.period, work_chunks())
+                         self.fanout, self.order, pts, self.period, work_chunks())
 
     def node_boxes(self, level):
         """Centre and half-width of the nodes at ``level`` (0: the boxes, sorted)."""

@@ -13,6 +13,8 @@ import pathlib
 
 import numpy as np
 
+from ...errors import InputError
+
 __all__ = ["checkpoint_path", "save", "load"]
 
 
@@ -42,12 +44,12 @@ def load(stem, comm, owned):
     """
     path = checkpoint_path(stem, comm.rank, comm.size)
     if not path.exists():
-        raise ValueError(f"restart: expected the checkpoint {path} (written by a run on "
+        raise InputError(f"restart: expected the checkpoint {path} (written by a run on "
                          f"{comm.size} ranks), found none; restart on the rank count of the "
                          f"run that wrote it")
     with np.load(path) as data:
         arrays = dict(data)
     if not np.array_equal(arrays["owned"], owned):
-        raise ValueError(f"restart: {path} holds another partition of the points; restart "
+        raise InputError(f"restart: {path} holds another partition of the points; restart "
                          f"the same body on the same number of ranks")
     return arrays

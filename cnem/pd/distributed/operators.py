@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _kernels as PK
+from ...errors import InputError
 from ..problem import Problem as SerialProblem
 from . import _kernels as K
 
@@ -18,9 +19,9 @@ __all__ = ["LocalOperators"]
 
 
 def _agree(comm, ok, message):
-    """Raise ``ValueError(message)`` on every rank if ``ok`` is False on any."""
+    """Raise ``InputError(message)`` on every rank if ``ok`` is False on any."""
     if not comm.allreduce(bool(ok), op=_land()):
-        raise ValueError(message)
+        raise InputError(message)
 
 
 def _land():

@@ -18,6 +18,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ...assembly.conditions import Conditions, per_point
+from ...errors import InputError, MaterialError, OptionError
 from .._kernels import pmb_forces
 from ...material import PLANES
 from ..solution import DynamicRun
@@ -79,10 +80,10 @@ class Problem(Conditions):
 
     def __init__(self, body, material, *, plane="stress", surface_correction=None):
         if plane not in PLANES:
-            raise ValueError(f"plane: expected 'stress' or 'strain', received {plane!r}")
+            raise OptionError(f"plane: expected 'stress' or 'strain', received {plane!r}")
         kind = getattr(material, "kind", None)
         if kind not in ("bond", "state"):
-            raise ValueError(f"material: expected cnem.pd.BondBased or StateBased (CPD runs "
+            raise MaterialError(f"material: expected cnem.pd.BondBased or StateBased (CPD runs "
                              f"serially only), received {type(material).__name__}")
         super().__init__()
         self.body, self.material, self.plane, self.dim = body, material, plane, body.dim
@@ -255,7 +256,7 @@ class Problem(Conditions):
         b, d, o = self.body, self.dim, self.body.n_owned
         dt, steps = float(dt), int(steps)
         if not dt > 0 or steps < 1:
-            raise ValueError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
+            raise InputError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
         every = max(1, steps // 10) if every is None else int(every)
         save_every = steps if checkpoint_every is None else int(checkpoint_every)
         rho = self.material.density

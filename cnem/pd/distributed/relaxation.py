@@ -15,6 +15,7 @@ import sys
 import numpy as np
 
 from ..relaxation import load_steps
+from ...errors import InputError
 from ..solution import Relaxation
 
 __all__ = ["relax"]
@@ -39,7 +40,7 @@ def relax(problem, *, tol=1e-8, max_steps=100_000, steps=1, every=None, progress
     tol, max_steps, steps = float(tol), int(max_steps), int(steps)
     every = 10 if every is None else int(every)
     if not tol > 0 or max_steps < 1 or steps < 1 or every < 1:
-        raise ValueError(f"expected tol > 0 and max_steps, steps, every >= 1, received tol={tol}, "
+        raise InputError(f"expected tol > 0 and max_steps, steps, every >= 1, received tol={tol}, "
                          f"max_steps={max_steps}, steps={steps}, every={every}")
     body, d, o = problem.body, problem.dim, problem.body.n_owned
     fixed, values = problem.owned_prescribed()
