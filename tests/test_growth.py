@@ -174,11 +174,12 @@ def test_tip_into_the_far_edge_splits_the_body_with_the_pieces_named():
 
 
 # ---------------------------------------------------------------------- events
-def uniaxial_setup(sigma):
-    """Unit square, traction sigma along y on top and bottom, rigid motions held."""
+def uniaxial_setup(sigma, **options):
+    """Unit square, traction sigma along y on top and bottom, rigid motions held
+    (``options``: more arguments of the problem)."""
     def setup(model):
         tol = 1e-9
-        prob = cnem.Elasticity(model, (E, NU), plane="strain")
+        prob = cnem.Elasticity(model, (E, NU), plane="strain", **options)
         prob.add_traction(lambda x, n: np.abs(np.abs(x[:, 1] - 0.5) - 0.5) < tol,
                           lambda x, n: sigma * n * [0.0, 1.0])
         prob.add_dirichlet(lambda p: np.hypot(*p.T) < tol, None)
@@ -249,3 +250,46 @@ def test_paris_cycles_follow_the_integral_of_the_handbook_sif():
     exact = float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(a)))
     assert hist.cycles[-1] == pytest.approx(exact, rel=0.01)
     assert np.all(np.diff(hist.cycles) > 0)
+
+
+# ------------------------------------------------------------ local update
+def grown_pair(dom, setup, steps, h=0.07):
+    """The same run by the local update and by full rebuilds."""
+    cloud = cnem.nodes.irregular(dom, h, seed=1)
+    return [grow(dom, cloud, setup, increment=0.06, steps=steps, progress=False, local=local)
+            for local in (True, False)]
+
+
+def assert_same_runs(local, full):
+    assert len(local.steps) == len(full.steps)
+    for a, b in zip(local.cracks, full.cracks):
+        assert a.shape == b.shape
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-10)      # unit square
+    for name in ("K", "angle", "K_eq"):
+        a, b = local.array(name), full.array(name)
+        assert np.array_equal(np.isnan(a), np.isnan(b))
+        ok = ~np.isnan(a)
+        np.testing.assert_allclose(a[ok], b[ok], rtol=1e-10, atol=1e-10 * np.abs(b[ok]).max())
+    u, v = local.solution.u, full.solution.u
+    assert u.shape == v.shape and np.abs(u - v).max() <= 1e-10 * np.abs(v).max()
+
+
+@pytest.mark.parametrize("crack", [[[0.35, 0.42], [0.65, 0.58]],      # internal, two tips
+                                   [[0.0, 0.45], [0.3, 0.55]]],       # edge crack
+                         ids=["internal", "edge"])
+def test_local_update_grows_the_same_path_as_full_rebuilds(crack, caplog):
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[crack])
+    with caplog.at_level("INFO", logger="cnem.fracture.growth"):
+        local, full = grown_pair(dom, uniaxial_setup(1.0), steps=2)
+    assert not [r for r in caplog.records if "refuses" in r.getMessage()]   # updated locally
+    assert np.abs(local.array("angle")[0]).min() > 1e-2              # mixed mode: the paths kink
+    assert_same_runs(local, full)
+
+
+def test_enriched_problem_falls_back_to_full_rebuilds_and_says_so(caplog):
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.45], [0.3, 0.55]]])
+    with caplog.at_level("INFO", logger="cnem.fracture.growth"):
+        local, full = grown_pair(dom, uniaxial_setup(1.0, enrich=dict(radius=0.12)), steps=2)
+    said = [r for r in caplog.records if "refuses the local update" in r.getMessage()]
+    assert len(said) == 1 and "enrich" in said[0].getMessage()
+    assert_same_runs(local, full)

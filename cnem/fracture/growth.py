@@ -31,9 +31,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from tqdm.auto import tqdm
 
-from ..errors import GeometryError, GrowthError, GrowthWarning
+from ..errors import CNEMError, GeometryError, GrowthError, GrowthWarning
 from ..geometry.cloud import NodeCloud
 from ..geometry.model import discretize
+from ..geometry.update import update
 from ..material import kappa as kolosov
 from ..nodes import irregular
 from . import advance
@@ -51,12 +52,6 @@ log = logging.getLogger(__name__)
 
 #: Events that also raise a `GrowthWarning` (the others are expected ends of growth).
 _WARN = {"crack", "closed", "sharp_kink", "left_domain"}
-
-
-def _rediscretize(old_model, domain, cloud):
-    """The model of the grown domain on its cloud (``old_model``: the model before
-    growing, None at the start; a local update may reuse it)."""
-    return discretize(cloud, progress=False)
 
 
 def _positive(value, name, allow_none=False):
@@ -89,13 +84,14 @@ def _crack_length(crack):
 class _Run:
     """The mutable state of one `grow` call."""
 
-    def __init__(self, domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep):
-        self.domain, self.cloud, self.setup = domain, cloud, setup
+    def __init__(self, domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep,
+                 local):
+        self.domain, self.cloud, self.setup, self.local = domain, cloud, setup, local
         self.criterion, self.K_Ic, self.max_kink = criterion, K_Ic, max_kink
         self.measure, self.radius, self.keep = measure, radius, keep
         self.cracks = [np.array(c, dtype=float) for c in domain.cracks]
         self.rows = _tip_rows(domain)
-        self.model = None
+        self.model = self.problem = None
         self.steps, self.events = [], []
 
     def event(self, kind, step, tip, point, message):
@@ -107,9 +103,32 @@ class _Run:
         return e
 
     def solve(self):
-        self.model = _rediscretize(self.model, self.domain, self.cloud)
-        sol = self.setup(self.model).solve(progress=False)
-        return sol
+        """Re-discretise the grown cloud, set the problem up and solve it."""
+        self.problem = self._problem()
+        self.model = self.problem.model
+        return self.problem.solve(progress=False)
+
+    def _problem(self):
+        """``setup`` on the model of the current cloud: by a local update of the previous
+        model and problem (`cnem.geometry.update.update`, the problem's ``update_from``)
+        while ``local``, else (and when the problem refuses the update) from scratch."""
+        if not self.local or self.problem is None:
+            return self.setup(discretize(self.cloud, progress=False))
+        change = update(self.model, self.cloud, progress=False)
+        prob = self.setup(change.model)
+        update_from = getattr(prob, "update_from", None)
+        if update_from is None:
+            reason = f"{type(prob).__name__} has no update_from"
+        else:
+            try:
+                return update_from(self.problem, change)
+            except CNEMError as err:
+                reason = str(err)
+        # the same model as discretize(cloud); only B~ and K are built from scratch
+        log.info("grow: the problem refuses the local update (%s); every further increment "
+                 "builds the model and the operators from scratch", reason)
+        self.local = False
+        return self.setup(change.model)
 
     def state(self, sol, step):
         """K, K_eq, angle, load factor at every active tip (NaN elsewhere)."""
@@ -231,7 +250,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
          criterion: Literal["max_hoop", "max_energy_release", "min_sed"] = "max_hoop",
          K_Ic: float | None = None, paris: np.ndarray | None = None, exponent: float | None = None,
          max_kink: float | None = None, measure: Callable[..., np.ndarray] | None = None,
-         radius: float | None = None, clearance: float = 0.5, keep: bool = True,
+         radius: float | None = None, clearance: float = 0.5, keep: bool = True, local: bool = True,
          progress: bool = True) -> CrackPath:
     """Grow the cracks of a domain step by step (quasi-static LEFM).
 
@@ -268,6 +287,13 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         and a tip that ends this close to the boundary is carried on to it.
     keep : bool
         Keep every step's solution (`CrackPath.write` needs them).
+    local : bool
+        Re-discretise each increment by a local update (`cnem.geometry.update.update`
+        and the problem's ``update_from``: only the cells the new segments reach are
+        recomputed, the result equals a fresh build); False rebuilds the model and the
+        operators from scratch. A problem that refuses the update (enrichment, other
+        settings than the previous one) falls back to the full build, said once through
+        `logging`.
     progress : bool
         A progress bar over the steps.
 
@@ -307,7 +333,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
     elif cloud.domain is not domain:
         raise GrowthError("cloud: expected a NodeCloud of `domain` (cloud.domain is domain), "
                           "received one of another domain; build it with cnem.nodes from `domain`")
-    run = _Run(domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep)
+    run = _Run(domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep, bool(local))
     bar = tqdm(total=steps, desc="crack growth", unit="step", disable=not progress, leave=False)
     sol = run.solve()
     mark = 0                                  # first event of the current step
