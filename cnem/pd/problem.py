@@ -1,40 +1,40 @@
-"""`Problem`: peridynamic statics (sparse tangent, Newton) and explicit dynamics."""
+"""`Problem`: a peridynamic body, its material and conditions; the bond operators and
+statics (sparse tangent, Newton). Explicit dynamics live in `cnem.pd.dynamics`, the
+surface correction in `cnem.pd.correction`."""
 
 from __future__ import annotations
 
 import logging
-import sys
 from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
-from tqdm.auto import tqdm
 
-from ..assembly.conditions import Conditions, per_point
+from ..assembly.conditions import Conditions
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from .. import config
 from ..errors import InputError, MaterialError, SolveError, UnsupportedError, check_choice
 from . import _kernels as K
-from .frames import FrameWriter
+from .correction import SurfaceCorrection
+from .dynamics import Dynamics
 from ..material import PLANES
-from .relaxation import relax
-from .solution import DynamicRun, StaticSolution
+from .solution import StaticSolution
 
 if TYPE_CHECKING:
-    import os
     from typing import Callable
+
     from numpy.typing import ArrayLike
+
     from .body import Body
     from .materials import BondBased, StateBased
-    from .solution import Relaxation
 
 __all__ = ["Problem"]
 
 log = logging.getLogger(__name__)
 
 
-class Problem(Conditions):
+class Problem(Conditions, SurfaceCorrection, Dynamics):
     """A peridynamic body with a material, loads and displacement conditions.
 
     Parameters
@@ -189,103 +189,6 @@ class Problem(Conditions):
         per = 0.5 * self.alpha[b.bond_i] * factor * self.weight * ed * ed * live
         return 0.5 * self.bulk * theta ** 2 + np.bincount(b.bond_i, weights=per, minlength=len(b))
 
-    def _classical_density(self, strain):
-        """``1/2 eps : C : eps`` of the material (d-dimensional law)."""
-        d = self.dim
-        if self.material.kind == "bond":
-            nu = self.material.poisson(d, self.plane)
-            E = self.material.E
-            mu = E / (2 * (1 + nu))
-            lam = E * nu / ((1 + nu) * (1 - 2 * nu))
-            if d == 2 and self.plane == "stress":
-                lam = 2 * lam * mu / (lam + 2 * mu)
-            k = lam + 2 * mu / d
-        else:
-            k, mu = self.bulk, self.shear
-        tr = np.trace(strain)
-        dev = strain - tr / d * np.eye(d)
-        return 0.5 * k * tr * tr + mu * (dev * dev).sum()
-
-    def _pmb_correction(self):
-        """The energy-method factors of the PMB from per-bond sums (numba), without
-        the operators."""
-        b, d = self.body, self.dim
-        pairs = np.array([(a, c) for a in range(d) for c in range(a, d)], dtype=np.int64)
-        Q = np.zeros((len(b), len(pairs), len(pairs)))
-        K.pmb_correction_moments(b.xi, b.length, self.weight, b.family.offsets, pairs, Q)
-        Q *= 0.25 * self.bond_stiffness
-        target = []
-        for a, c in pairs:
-            eps = np.zeros((d, d))
-            eps[a, c] = eps[c, a] = 1.0
-            target.append(self._classical_density(eps))
-        coef = np.ascontiguousarray(self._fit(Q, np.array(target)))
-        factor = np.empty(len(b.bond_i))
-        K.pmb_bond_factors(b.xi, b.length, b.family.offsets, b.bond_j, pairs, coef, factor)
-        return factor
-
-    @staticmethod
-    def _fit(Q, target):
-        """Per-point coefficients solving ``Q_i c_i = target`` (least squares where singular)."""
-        rhs = np.broadcast_to(target, Q.shape[:2])[..., None]
-        try:
-            return np.linalg.solve(Q, rhs)[..., 0]
-        except np.linalg.LinAlgError:                           # a point with too few bonds
-            return np.array([np.linalg.lstsq(q, target, rcond=None)[0] for q in Q])
-
-    def _test_fields(self):
-        """Uniform test strains and the direction functions of the correction: all unit
-        strains with ``n_a^2`` and ``n_a^2 n_c^2`` of the bond direction (bond-based), the
-        deviatoric shears with ``{1, sum n_a^2 n_b^2}`` (state-based deviatoric part)."""
-        d = self.dim
-        pairs = [(a, c) for a in range(d) for c in range(a, d)]
-        n = self.unit
-        if self.material.kind == "bond":
-            tests = []
-            for a, c in pairs:
-                eps = np.zeros((d, d))
-                eps[a, c] = eps[c, a] = 1e-3
-                tests.append(eps)
-            # even functions of the direction: n_a^2 for the normal tests, n_a^2 n_c^2
-            # for the shear tests
-            return tests, [n[:, a] ** 2 * (n[:, c] ** 2 if a != c else 1.0) for a, c in pairs]
-        tests = []
-        for a, c in pairs:
-            if a != c:
-                eps = np.zeros((d, d))
-                eps[a, c] = eps[c, a] = 1e-3
-                tests.append(eps)
-        eps = np.zeros((d, d))
-        eps[0, 0], eps[1, 1] = 1e-3, -1e-3
-        tests.append(eps)
-        quartic = sum(n[:, a] ** 2 * n[:, c] ** 2 for a, c in pairs if a != c)
-        return tests, [np.ones(len(n)), quartic]
-
-    def _correction(self):
-        """Bond factors of the energy method: at every point, a function of the bond
-        direction fitted so that the uniform test strains store the classical
-        energy density there; a bond takes the mean of its two points' functions."""
-        b = self.body
-        if self.material.kind == "bond":
-            return self._pmb_correction()
-        tests, basis = self._test_fields()
-        rows = []
-        for eps in tests:
-            u = b.points @ eps.T
-            dil = 0.0
-            if self.material.kind == "state":
-                dil = 0.5 * self.bulk * (self.T @ u.reshape(-1)) ** 2
-            rows.append([self.energy_density(u, P) - dil for P in basis])
-        Q = np.array(rows).transpose(2, 0, 1)                       # (n, tests, basis)
-        target = np.array([self._classical_density(eps) - (
-            0.5 * self.bulk * np.trace(eps) ** 2 if self.material.kind == "state" else 0.0)
-            for eps in tests])
-        coef = self._fit(Q, target)
-        G = np.array(basis)                                          # (basis, bonds)
-        gi = (coef[b.bond_i].T * G).sum(axis=0)
-        gj = (coef[b.bond_j].T * G).sum(axis=0)
-        return 0.5 * (gi + gj)
-
     def stiffness(self) -> sp.csr_matrix:
         """Sparse stiffness ``(d n, d n)``: the Hessian of the total strain energy
         ``sum_i V_i W_i`` (exact tangent of the linear models), live bonds only."""
@@ -370,7 +273,7 @@ class Problem(Conditions):
         return lambda u, tangent: (Kmat @ u, Kmat), Kmat
 
     def solve_static(self, *, tol: float = 1e-10, steps: int = 1, initial: ArrayLike | None = None,
-                     max_iterations: int = 20, line_search: bool = False) -> Relaxation:
+                     max_iterations: int = 20, line_search: bool = False) -> StaticSolution:
         """The former name of `solve` (the static Newton solve), kept as an alias:
         the same parameters and result."""
         return self.solve(tol=tol, steps=steps, initial=initial, max_iterations=max_iterations,
@@ -498,145 +401,3 @@ class Problem(Conditions):
                 break
         return trial
 
-    # -- dynamics -----------------------------------------------------------------------
-    def stable_time_step(self, safety: float = 0.8) -> float:
-        """Silling & Askari's bound ``sqrt(2 rho / sum_j C_ij V_j)`` (the smallest
-        over points) times ``safety``."""
-        self._linear_only("stable_time_step")
-        b = self.body
-        if self.material.kind == "bond":          # sum_j c_ij V_j / L_ij per point
-            per = self.bond_stiffness * self.factor * b.beta * b.volumes[b.bond_j] / b.length
-            diag = np.bincount(b.bond_i, weights=per, minlength=len(b))
-        else:
-            Kmat = self.stiffness()
-            diag = np.abs(Kmat).sum(axis=1).A.reshape(-1) / np.repeat(b.volumes, self.dim)
-        return safety * float(np.sqrt(2.0 * self.material.density / diag.max()))
-
-    def damage(self) -> np.ndarray:
-        """``1 - (live bond volume) / (all bond volume)`` per point, ``(n,)``."""
-        b = self.body
-        total = np.bincount(b.bond_i, weights=self.weight, minlength=len(b))
-        live = np.bincount(b.bond_i, weights=self.weight * self.alive, minlength=len(b))
-        return 1.0 - live / np.maximum(total, 1e-300)
-
-    def _force_state(self):
-        """What `_internal_force` keeps between calls: the PMB bond stiffnesses, or the
-        stiffness matrix of the live bonds (state-based)."""
-        if self.material.kind == "bond":
-            return {"stiffness": np.ascontiguousarray(self.bond_stiffness * self.factor *
-                                                      self.body.beta)}
-        return {"K": self.stiffness()}
-
-    def _internal_force(self, u, limit, state):
-        """Force per unit volume ``(n, d)``, breaking bonds (returns count broken)."""
-        b = self.body
-        if self.material.kind == "bond":
-            out = np.empty_like(u)
-            broken = K.pmb_forces(u, b.xi, b.length, b.family.offsets, b.bond_j, state["stiffness"],
-                                  b.volumes, self.alive, limit, out)
-            return out, broken
-        stretch = np.sqrt(((b.xi + u[b.bond_j] - u[b.bond_i]) ** 2).sum(axis=1)) / b.length - 1
-        broken = int(((stretch > limit) & (self.alive == 1)).sum())
-        if broken:
-            self.alive[stretch > limit] = 0
-            state["K"] = self.stiffness()
-        return -(state["K"] @ u.reshape(-1)).reshape(u.shape) / b.volumes[:, None], broken
-
-    def run_dynamic(self, dt: float, steps: int, *,
-                    velocity: np.ndarray | Callable[..., np.ndarray] | None = None,
-                    every: int | None = None, output: str | os.PathLike | None = None,
-                    progress: bool | None = None) -> DynamicRun:
-        """Explicit velocity Verlet with bond breaking.
-
-        Parameters
-        ----------
-        dt : float
-            Time step (see `stable_time_step`).
-        steps : int
-        velocity : (n, d) array_like or callable ``(n, d) -> (n, d)``, optional
-            Initial velocity.
-        every : int, optional
-            Store a frame (u, damage, energy) every so many steps (default: 10 frames),
-            and at the first and last steps.
-        output : str or os.PathLike, optional
-            A folder or a path stem: every frame is also written to a VTU file
-            (``<stem>_<step>.vtu``, see `cnem.pd.frames.FrameWriter`) with the point
-            data ``u (n, d)``, ``damage (n,)`` and ``velocity (n, d)``.
-        progress : bool, optional
-
-        Returns
-        -------
-        DynamicRun
-        """
-        self._linear_only("run_dynamic")
-        b, d, n = self.body, self.dim, len(self.body)
-        dt, steps = float(dt), int(steps)
-        if not dt > 0 or steps < 1:
-            raise InputError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
-        every = max(1, steps // 10) if every is None else int(every)
-        rho = self.material.density
-        limit = self.material.stretch_limit(d, self.plane, b.horizon)
-        state = self._force_state()
-        D, values = self.prescribed()
-        u = np.zeros((n, d))
-        u.reshape(-1)[D] = values
-        v = np.zeros((n, d))
-        if velocity is not None:
-            v[:] = per_point(velocity, b.points, d, "velocity")
-        v.reshape(-1)[D] = 0.0
-        fext = self.load().reshape(n, d) / b.volumes[:, None]
-        force, broken = self._internal_force(u, limit, state)
-        acc = (force + fext) / rho
-        writer = None if output is None else FrameWriter(output, b.points, steps)
-        times, frames, energy, files = [], [], [], []
-
-        def store(step):
-            times.append(step * dt)
-            frames.append((u.copy(), self.damage()))
-            energy.append(self._energy(u, v))
-            if writer is not None:
-                files.append(writer.write(step, u=u, damage=frames[-1][1], velocity=v))
-
-        store(0)
-        total_broken = broken
-        show = sys.stderr.isatty() if progress is None else progress
-        for step in tqdm(range(1, steps + 1), desc="PD steps", disable=not show, leave=False):
-            v += 0.5 * dt * acc
-            u += dt * v
-            u.reshape(-1)[D] = values
-            force, broken = self._internal_force(u, limit, state)
-            total_broken += broken
-            acc = (force + fext) / rho
-            v += 0.5 * dt * acc
-            v.reshape(-1)[D] = 0.0
-            if step % every == 0 or step == steps:
-                store(step)
-        return DynamicRun(self, u, velocity=v, damage=self.damage(), times=np.array(times),
-                          frames=frames, energy=np.array(energy), broken=total_broken,
-                          files=files)
-
-    def relax(self, *, tol: float = 1e-8, max_steps: int = 100_000, steps: int = 1,
-              every: int | None = None, progress: bool | None = None) -> Relaxation:
-        """Quasi-static equilibrium by adaptive dynamic relaxation (Kilic & Madenci 2010),
-        with bond breaking: see `cnem.pd.relaxation.relax` for the parameters.
-
-        Returns
-        -------
-        cnem.pd.relaxation.Relaxation
-            ``u (n, d)``, ``damage (n,)``, ``residual_history``, ``iterations``.
-        """
-        self._linear_only("relax")
-        return relax(self, tol=tol, max_steps=max_steps, steps=steps, every=every,
-                     progress=progress)
-
-    def _energy(self, u, v):
-        """Kinetic plus elastic energy (the linearised elastic energy)."""
-        b = self.body
-        kinetic = 0.5 * self.material.density * float(b.volumes @ (v * v).sum(axis=1))
-        if self.material.kind == "bond":          # the exact PMB energy of the deformed bonds
-            y = b.xi + u[b.bond_j] - u[b.bond_i]
-            s = np.sqrt((y * y).sum(axis=1)) / b.length - 1
-            per = 0.25 * self.bond_stiffness * self.factor * b.beta * s * s * b.length * \
-                b.volumes[b.bond_j] * self.alive
-            return kinetic + float(b.volumes @ np.bincount(b.bond_i, weights=per, minlength=len(b)))
-        return kinetic + float(b.volumes @ self.energy_density(u))

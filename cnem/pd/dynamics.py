@@ -1,0 +1,176 @@
+"""Explicit peridynamic dynamics: the stable time step, velocity Verlet with bond
+breaking and damage, and adaptive dynamic relaxation.
+
+`Dynamics` is a part of `cnem.pd.Problem`: it reads the problem's body, material,
+conditions and bond operators.
+"""
+
+from __future__ import annotations
+
+import sys
+from typing import TYPE_CHECKING
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from ..assembly.conditions import per_point
+from ..errors import InputError
+from . import _kernels as K
+from .frames import FrameWriter
+from .relaxation import relax
+from .solution import DynamicRun
+
+if TYPE_CHECKING:
+    import os
+    from typing import Callable
+
+    from .solution import Relaxation
+
+__all__ = ["Dynamics"]
+
+
+class Dynamics:
+    """Explicit dynamics and dynamic relaxation of a peridynamic problem (a mixin of
+    `Problem`)."""
+
+    def stable_time_step(self, safety: float = 0.8) -> float:
+        """Silling & Askari's bound ``sqrt(2 rho / sum_j C_ij V_j)`` (the smallest
+        over points) times ``safety``."""
+        self._linear_only("stable_time_step")
+        b = self.body
+        if self.material.kind == "bond":          # sum_j c_ij V_j / L_ij per point
+            per = self.bond_stiffness * self.factor * b.beta * b.volumes[b.bond_j] / b.length
+            diag = np.bincount(b.bond_i, weights=per, minlength=len(b))
+        else:
+            Kmat = self.stiffness()
+            diag = np.abs(Kmat).sum(axis=1).A.reshape(-1) / np.repeat(b.volumes, self.dim)
+        return safety * float(np.sqrt(2.0 * self.material.density / diag.max()))
+
+    def damage(self) -> np.ndarray:
+        """``1 - (live bond volume) / (all bond volume)`` per point, ``(n,)``."""
+        b = self.body
+        total = np.bincount(b.bond_i, weights=self.weight, minlength=len(b))
+        live = np.bincount(b.bond_i, weights=self.weight * self.alive, minlength=len(b))
+        return 1.0 - live / np.maximum(total, 1e-300)
+
+    def _force_state(self):
+        """What `_internal_force` keeps between calls: the PMB bond stiffnesses, or the
+        stiffness matrix of the live bonds (state-based)."""
+        if self.material.kind == "bond":
+            return {"stiffness": np.ascontiguousarray(self.bond_stiffness * self.factor *
+                                                      self.body.beta)}
+        return {"K": self.stiffness()}
+
+    def _internal_force(self, u, limit, state):
+        """Force per unit volume ``(n, d)``, breaking bonds (returns count broken)."""
+        b = self.body
+        if self.material.kind == "bond":
+            out = np.empty_like(u)
+            broken = K.pmb_forces(u, b.xi, b.length, b.family.offsets, b.bond_j, state["stiffness"],
+                                  b.volumes, self.alive, limit, out)
+            return out, broken
+        stretch = np.sqrt(((b.xi + u[b.bond_j] - u[b.bond_i]) ** 2).sum(axis=1)) / b.length - 1
+        broken = int(((stretch > limit) & (self.alive == 1)).sum())
+        if broken:
+            self.alive[stretch > limit] = 0
+            state["K"] = self.stiffness()
+        return -(state["K"] @ u.reshape(-1)).reshape(u.shape) / b.volumes[:, None], broken
+
+    def run_dynamic(self, dt: float, steps: int, *,
+                    velocity: np.ndarray | Callable[..., np.ndarray] | None = None,
+                    every: int | None = None, output: str | os.PathLike | None = None,
+                    progress: bool | None = None) -> DynamicRun:
+        """Explicit velocity Verlet with bond breaking.
+
+        Parameters
+        ----------
+        dt : float
+            Time step (see `stable_time_step`).
+        steps : int
+        velocity : (n, d) array_like or callable ``(n, d) -> (n, d)``, optional
+            Initial velocity.
+        every : int, optional
+            Store a frame (u, damage, energy) every so many steps (default: 10 frames),
+            and at the first and last steps.
+        output : str or os.PathLike, optional
+            A folder or a path stem: every frame is also written to a VTU file
+            (``<stem>_<step>.vtu``, see `cnem.pd.frames.FrameWriter`) with the point
+            data ``u (n, d)``, ``damage (n,)`` and ``velocity (n, d)``.
+        progress : bool, optional
+
+        Returns
+        -------
+        DynamicRun
+        """
+        self._linear_only("run_dynamic")
+        b, d, n = self.body, self.dim, len(self.body)
+        dt, steps = float(dt), int(steps)
+        if not dt > 0 or steps < 1:
+            raise InputError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
+        every = max(1, steps // 10) if every is None else int(every)
+        rho = self.material.density
+        limit = self.material.stretch_limit(d, self.plane, b.horizon)
+        state = self._force_state()
+        D, values = self.prescribed()
+        u = np.zeros((n, d))
+        u.reshape(-1)[D] = values
+        v = np.zeros((n, d))
+        if velocity is not None:
+            v[:] = per_point(velocity, b.points, d, "velocity")
+        v.reshape(-1)[D] = 0.0
+        fext = self.load().reshape(n, d) / b.volumes[:, None]
+        force, broken = self._internal_force(u, limit, state)
+        acc = (force + fext) / rho
+        writer = None if output is None else FrameWriter(output, b.points, steps)
+        times, frames, energy, files = [], [], [], []
+
+        def store(step):
+            times.append(step * dt)
+            frames.append((u.copy(), self.damage()))
+            energy.append(self._energy(u, v))
+            if writer is not None:
+                files.append(writer.write(step, u=u, damage=frames[-1][1], velocity=v))
+
+        store(0)
+        total_broken = broken
+        show = sys.stderr.isatty() if progress is None else progress
+        for step in tqdm(range(1, steps + 1), desc="PD steps", disable=not show, leave=False):
+            v += 0.5 * dt * acc
+            u += dt * v
+            u.reshape(-1)[D] = values
+            force, broken = self._internal_force(u, limit, state)
+            total_broken += broken
+            acc = (force + fext) / rho
+            v += 0.5 * dt * acc
+            v.reshape(-1)[D] = 0.0
+            if step % every == 0 or step == steps:
+                store(step)
+        return DynamicRun(self, u, velocity=v, damage=self.damage(), times=np.array(times),
+                          frames=frames, energy=np.array(energy), broken=total_broken,
+                          files=files)
+
+    def relax(self, *, tol: float = 1e-8, max_steps: int = 100_000, steps: int = 1,
+              every: int | None = None, progress: bool | None = None) -> Relaxation:
+        """Quasi-static equilibrium by adaptive dynamic relaxation (Kilic & Madenci 2010),
+        with bond breaking: see `cnem.pd.relaxation.relax` for the parameters.
+
+        Returns
+        -------
+        cnem.pd.relaxation.Relaxation
+            ``u (n, d)``, ``damage (n,)``, ``residual_history``, ``iterations``.
+        """
+        self._linear_only("relax")
+        return relax(self, tol=tol, max_steps=max_steps, steps=steps, every=every,
+                     progress=progress)
+
+    def _energy(self, u, v):
+        """Kinetic plus elastic energy (the linearised elastic energy)."""
+        b = self.body
+        kinetic = 0.5 * self.material.density * float(b.volumes @ (v * v).sum(axis=1))
+        if self.material.kind == "bond":          # the exact PMB energy of the deformed bonds
+            y = b.xi + u[b.bond_j] - u[b.bond_i]
+            s = np.sqrt((y * y).sum(axis=1)) / b.length - 1
+            per = 0.25 * self.bond_stiffness * self.factor * b.beta * s * s * b.length * \
+                b.volumes[b.bond_j] * self.alive
+            return kinetic + float(b.volumes @ np.bincount(b.bond_i, weights=per, minlength=len(b)))
+        return kinetic + float(b.volumes @ self.energy_density(u))
