@@ -3,6 +3,8 @@ and the slits a crack-tip cell wraps around."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import shapely
 
@@ -11,10 +13,13 @@ from ..geometry.pslg import CRACK
 from ..geometry.topology import constraint_edges
 from ..spatial.rtree import RTree
 
+if TYPE_CHECKING:
+    from ..geometry.model import Cells, Model
+
 __all__ = ["crack_faces", "slit_edges", "face_triangles"]
 
 
-def crack_faces(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def crack_faces(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Crack-face edges, each oriented with its own face's triangle on the left.
 
     Returns
@@ -32,7 +37,7 @@ def crack_faces(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return model.nodes[edges[:, 0]], model.nodes[edges[:, 1]], owner
 
 
-def slit_edges(model, faces: tuple, cells
+def slit_edges(model: Model, faces: tuple, cells: Cells
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Crack faces running inside cells (near crack tips a cell can wrap around the
     end of a crack; its polygon then does not show the slit, but the slit's two
@@ -87,7 +92,7 @@ def _line_parts(geom):
     return []
 
 
-def face_triangles(model, a: np.ndarray, b: np.ndarray, faces: tuple) -> np.ndarray:
+def face_triangles(model: Model, a: np.ndarray, b: np.ndarray, faces: tuple) -> np.ndarray:
     """For cell edges lying on a crack face, the triangle of that face on the
     cell's side (the shape functions there depend on the side); -1 elsewhere.
 

@@ -9,6 +9,7 @@ crack faces are seen from the cell's side, slits in crack-tip cells added
 from __future__ import annotations
 
 import logging
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -23,6 +24,11 @@ from . import _sparse_kernels as SK
 from .crack_faces import crack_faces, face_triangles, slit_edges
 from .csr import csr_pair, row_bounds
 from .edges import cell_edges, circle_pieces, distinct_edges
+
+if TYPE_CHECKING:
+    from typing import Sequence
+    from numpy.typing import ArrayLike
+    from ..geometry.model import Cells, Model
 
 __all__ = ["BoundaryQuadrature", "boundary_quadrature", "boundary_quadratures", "edge_points",
            "edges_to_cells", "graded_rule", "check_gauss"]
@@ -48,10 +54,12 @@ class BoundaryQuadrature:
         ``±1 / A_k`` for the edges of cell ``k``.
     """
 
-    def __init__(self, points, hint, wx, wy, to_cells):
+    def __init__(self, points: np.ndarray, hint: np.ndarray, wx: sp.csr_matrix, wy: sp.csr_matrix,
+                 to_cells: sp.csr_matrix):
         self.points, self.hint, self.wx, self.wy, self.to_cells = points, hint, wx, wy, to_cells
 
-    def cell_integrals(self, values, rows=None):
+    def cell_integrals(self, values: ArrayLike | sp.spmatrix, rows: np.ndarray | None = None
+                       ) -> tuple[np.ndarray | sp.csr_matrix, np.ndarray | sp.csr_matrix]:
         """``(1 / A_k) ∮_{Γ_k} f n dΓ`` for ``values = f(points)``, ``(q, ...)`` array or
         sparse ``(q, c)`` (then CSR results); returns the x and y parts, ``(m, ...)``.
         ``rows``: the point of each row of ``values`` when they come in another order."""
@@ -60,7 +68,8 @@ class BoundaryQuadrature:
             return self.to_cells @ (self.wx @ values), self.to_cells @ (self.wy @ values)
         return self.from_edges(self.edge_integrals(values, rows))
 
-    def from_edges(self, edges):
+    def from_edges(self, edges: tuple[sp.csr_matrix, sp.csr_matrix]
+                   ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """`cell_integrals` from the `edge_integrals` ``(ex, ey)`` of the same points
         (quadratures with the same points share them): two CSR ``(m, c)``."""
         ex, ey = edges
@@ -70,7 +79,8 @@ class BoundaryQuadrature:
             *row_bounds(ex.indptr), ex.indices, ex.data, ey.data, ex.shape[1],
             work_chunks()), (c.shape[0], ex.shape[1]))
 
-    def edge_integrals(self, values, rows=None):
+    def edge_integrals(self, values: sp.spmatrix | PointRows, rows: np.ndarray | None = None
+                       ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """``∫_e f n dΓ`` of every distinct edge for sparse ``values = f(points)``
         ``(q, c)`` (``rows`` as in `cell_integrals`), or for the shape functions
         as `point_rows` gives them: x and y parts, CSR ``(e, c)`` with one pattern."""
@@ -86,7 +96,7 @@ class BoundaryQuadrature:
             w.indptr, w.indices, w.data, self.wy.data, where, start, end, cols, vals, vals,
             ncol, work_chunks()), (w.shape[0], ncol))
 
-    def point_rows(self, model):
+    def point_rows(self, model: Model) -> PointRows:
         """The shape functions at the points, sides respected, as `point_rows` leaves
         them (for `edge_integrals`)."""
         return point_rows(model, self.points, triangles=self._hint())
@@ -102,7 +112,8 @@ class BoundaryQuadrature:
             where[rows] = np.arange(len(rows))
         return where
 
-    def shape_functions(self, model, select=None):
+    def shape_functions(self, model: Model, select: ArrayLike | None = None
+                        ) -> tuple[sp.csr_matrix, np.ndarray]:
         """The shape functions at the points (or at ``points[select]``), sides
         respected, rows in any order: returns ``(Phi, order)``, row ``r`` of ``Phi``
         at ``points[order[r]]`` (indices into the selection)."""
@@ -125,7 +136,8 @@ def graded_rule(s: np.ndarray, w: np.ndarray, start: np.ndarray, end: np.ndarray
     return S, W
 
 
-def boundary_quadrature(model, *, gauss: int = 2, cells=None, singular=None
+def boundary_quadrature(model: Model, *, gauss: int = 2, cells: Cells | None = None,
+                        singular: ArrayLike | None = None
                         ) -> BoundaryQuadrature:
     """Gauss points on every cell boundary: each edge cut at circumcircle crossings,
     ``gauss`` points per piece, crack faces seen from their side, slits in tip cells.
@@ -169,7 +181,8 @@ def _set_edges(model, cells, faces):
     return cell, a, b, hint, spoke
 
 
-def boundary_quadratures(model, cell_sets, *, gauss: int = 2, singular=None
+def boundary_quadratures(model: Model, cell_sets: Sequence[Cells], *, gauss: int = 2,
+                         singular: ArrayLike | None = None
                          ) -> list[BoundaryQuadrature]:
     """`boundary_quadrature` of several sets of cells with one set of points.
 
@@ -212,7 +225,7 @@ def boundary_quadratures(model, cell_sets, *, gauss: int = 2, singular=None
     return out
 
 
-def check_gauss(gauss) -> int:
+def check_gauss(gauss: int) -> int:
     """The number of Gauss points per piece of edge, checked (a positive int)."""
     gauss = int(gauss)
     if gauss < 1:
@@ -221,8 +234,8 @@ def check_gauss(gauss) -> int:
     return gauss
 
 
-def edge_points(model, rows: np.ndarray, hint: np.ndarray, whole: np.ndarray, group: np.ndarray,
-                gauss: int, singular
+def edge_points(model: Model, rows: np.ndarray, hint: np.ndarray, whole: np.ndarray,
+                group: np.ndarray, gauss: int, singular: ArrayLike | None
                 ) -> tuple[np.ndarray, np.ndarray, sp.csr_matrix, sp.csr_matrix]:
     """Gauss points on the distinct edges ``rows`` (see `distinct_edges`), cut at
     circumcircle crossings unless ``whole`` (then their midpoint alone); ``group``
@@ -250,7 +263,7 @@ def edge_points(model, rows: np.ndarray, hint: np.ndarray, whole: np.ndarray, gr
     return points, np.repeat(hint, np.diff(indptr)), wx, wy
 
 
-def edges_to_cells(cells, edge_cell: np.ndarray, sign: np.ndarray, occurrence: np.ndarray,
+def edges_to_cells(cells: Cells, edge_cell: np.ndarray, sign: np.ndarray, occurrence: np.ndarray,
                    count: int) -> sp.csr_matrix:
     """``±1 / A_k`` from the cells to the ``count`` distinct edges, ``(m, count)``
     CSR, for the directed edges of the cells (cell ``edge_cell``, distinct edge

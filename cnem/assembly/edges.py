@@ -7,14 +7,19 @@ Gauss points on the pieces integrate them with geometric convergence.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from . import _kernels as K
 
+if TYPE_CHECKING:
+    from ..geometry.model import Cells, Model
+
 __all__ = ["cell_edges", "circle_pieces", "distinct_edges"]
 
 
-def cell_edges(cells) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def cell_edges(cells: Cells) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Directed edges of every cell polygon (counter-clockwise).
 
     Returns
@@ -32,7 +37,7 @@ def cell_edges(cells) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return cell, cells.vertices, cells.vertices[nxt]
 
 
-def circle_pieces(model, a: np.ndarray, b: np.ndarray, whole: np.ndarray | None = None,
+def circle_pieces(model: Model, a: np.ndarray, b: np.ndarray, whole: np.ndarray | None = None,
                   group: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Pieces of the edges between circumcircle crossings (``whole``: (e,) bool,
     edges left in one piece).

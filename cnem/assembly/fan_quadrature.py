@@ -4,6 +4,7 @@ the sub-cells' edges taken from the cell edges they lie on (no search)."""
 from __future__ import annotations
 
 import logging
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -13,12 +14,16 @@ from .edge_quadrature import (BoundaryQuadrature, boundary_quadratures, check_ga
                               edges_to_cells)
 from .edges import cell_edges, distinct_edges
 
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+    from ..geometry.model import Cells, Model
+
 __all__ = ["fan_quadratures"]
 
 log = logging.getLogger(__name__)
 
 
-def fan_quadratures(model, cells, sub, parent, *, gauss: int = 2
+def fan_quadratures(model: Model, cells: Cells, sub: Cells, parent: ArrayLike, *, gauss: int = 2
                     ) -> tuple[BoundaryQuadrature, BoundaryQuadrature]:
     """`boundary_quadratures` of cells and of their fan sub-cells (`subdivide` with
     ``mark_spokes``), the sub-cells' edges taken from where they come from.

@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import GeometryError
 from .edge_quadrature import boundary_quadratures, check_gauss
@@ -14,7 +15,7 @@ from .passes import cell_runs, gradients_in_passes
 from .quadrature import subdivide, tip_cells
 
 if TYPE_CHECKING:
-    from ..geometry.model import Cells
+    from ..geometry.model import Cells, Model
 
 __all__ = ["SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient"]
 
@@ -32,7 +33,7 @@ class SmoothedGradient:
         shared count).
     """
 
-    def __init__(self, x, y, points):
+    def __init__(self, x: sp.csr_matrix, y: sp.csr_matrix, points: int):
         self.x, self.y, self.points = x, y, points
 
     def __iter__(self):
@@ -43,7 +44,8 @@ class SmoothedGradient:
         return f"<SmoothedGradient {m} cells x {n} nodes, {self.x.nnz} non-zeros, {self.points} points>"
 
 
-def smoothed_gradient(model, *, gauss: int = 2, cells=None) -> SmoothedGradient:
+def smoothed_gradient(model: Model, *, gauss: int = 2, cells: Cells | None = None
+                      ) -> SmoothedGradient:
     """The smoothed gradient operator ``B~`` of a model's cells, computed afresh
     (`SmoothedGradients` keeps it for the next users).
 
@@ -72,7 +74,7 @@ def smoothed_gradient(model, *, gauss: int = 2, cells=None) -> SmoothedGradient:
     return SmoothedGradient(*grad, points)
 
 
-def fan_gradient(model, *, gauss: int = 2) -> tuple[Cells, SmoothedGradient]:
+def fan_gradient(model: Model, *, gauss: int = 2) -> tuple[Cells, SmoothedGradient]:
     """Smoothed gradients on the fan sub-cells of the model's cells, computed afresh
     (`SmoothedGradients.fan` computes them with the cells' and keeps them).
 
@@ -151,7 +153,7 @@ class SmoothedGradients:
     gauss : int
     """
 
-    def __init__(self, model, *, gauss: int = 2, cells: SmoothedGradient | None = None):
+    def __init__(self, model: Model, *, gauss: int = 2, cells: SmoothedGradient | None = None):
         self.model = model
         self.gauss = check_gauss(gauss)
         if cells is not None and cells.x.shape != (len(model.cells.area), len(model.nodes)):
@@ -167,7 +169,7 @@ class SmoothedGradients:
             self._cells = smoothed_gradient(self.model, gauss=self.gauss)
         return self._cells
 
-    def of(self, cells) -> SmoothedGradient:
+    def of(self, cells: Cells) -> SmoothedGradient:
         """``B~`` of some integration cells: the kept `cells` one for ``model.cells``,
         computed afresh (and not kept) for others (the sub-cells of an enriched
         problem, say)."""

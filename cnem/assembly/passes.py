@@ -6,6 +6,8 @@ and shape functions live while it runs, and a small pass works in cache.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .. import config
@@ -14,10 +16,15 @@ from ..shape.natural import path_order
 from . import _sparse_kernels as SK
 from .csr import csr_pair
 
+if TYPE_CHECKING:
+    from typing import Callable, Sequence
+    from ..geometry.model import Cells, Model
+    from .edge_quadrature import BoundaryQuadrature
+
 __all__ = ["cell_runs", "gradients_in_passes"]
 
 
-def cell_runs(model, cells) -> list[np.ndarray] | None:
+def cell_runs(model: Model, cells: Cells) -> list[np.ndarray] | None:
     """Runs of at most ``config.CELLS_PER_PASS`` cells, one pass each, as index
     arrays into ``cells`` (None when one pass takes them all).
 
@@ -45,7 +52,9 @@ def cell_runs(model, cells) -> list[np.ndarray] | None:
     return [order[lo:lo + size] for lo in range(0, m, size)]
 
 
-def gradients_in_passes(model, sets: list, quadratures, runs: list | None = None,
+def gradients_in_passes(model: Model, sets: list,
+                        quadratures: Callable[..., Sequence[BoundaryQuadrature]],
+                        runs: list | None = None,
                         wanted: list[bool] | None = None) -> tuple[list, int]:
     """Smoothed gradients of several sets of cells, pass by pass.
 
