@@ -543,3 +543,25 @@ def test_errors():
         tree.query([[0.5, 0.5]], [[0.4, 0.6]])
     with pytest.raises(ValueError, match="same shape"):
         tree.query([[0.5, 0.5]], [[0.6, 0.6], [0.7, 0.7]])
+
+
+@pytest.mark.parametrize("offset, extent, n", [(1e12, 1.0, 300), (5e6, 100.0, 20_000)])
+def test_far_from_the_origin_in_bounded_time(offset, extent, n):
+    """Boxes are rounded outwards in one step, not one ulp per iteration: a cloud far
+    from the origin (UTM-like, or at 1e12) builds at once (it hung before) and its ball
+    queries are exact. Run in a subprocess with a time limit, so a regression fails
+    instead of hanging the suite."""
+    import subprocess
+    import sys
+    code = (
+        "import numpy as np, cnem.spatial as sp\n"
+        f"rng = np.random.default_rng(1); pts = {offset!r} + {extent!r} * rng.random(({n}, 2))\n"
+        "tree = sp.RTree.from_points(pts)\n"
+        f"r = 0.02 * {extent!r}; q = pts[:200]\n"
+        "o, i = tree.query_ball(q, r)\n"
+        "d = np.hypot(*(q[:, None, :] - pts[None, :, :]).transpose(2, 0, 1))\n"
+        "print(all(set(i[o[k]:o[k + 1]]) == set(np.flatnonzero(d[k] <= r)) for k in range(len(q))))\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=240)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "True"

@@ -80,9 +80,10 @@ def build_level(cen, half, first, cnt, start, count, fanout, out_start, period):
             c = 0.5 * (lo[k] + hi[k])
             h = 0.5 * (hi[k] - lo[k])
             # round outwards, in the arithmetic of the tests (|p - c| - h <= 0 for
-            # every p in [lo, hi]; rounding is monotone so the ends suffice)
-            while (hi[k] - c) - h > 0.0 or (c - lo[k]) - h > 0.0:
-                h = np.nextafter(h, np.inf)
+            # every p in [lo, hi]; rounding is monotone so the ends suffice): the
+            # smallest such h >= the half width is the larger rounded end distance
+            # (one step, whatever the distance from the origin)
+            h = max(h, hi[k] - c, c - lo[k])
             if np.isfinite(period[k]):
                 h += 4.0 * np.finfo(np.float64).eps * period[k]   # wrapping rounds too
                 if h >= 0.5 * period[k]:
