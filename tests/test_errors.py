@@ -451,3 +451,24 @@ def test_limits_name_their_config_bound(monkeypatch):
     assert "limited to 20 points, received 30" in msg and "cnem.config.BRUTE_LIMIT" in msg
     monkeypatch.setattr(config, "BRUTE_LIMIT", 30)
     assert len(cnem.spatial.family_search(pts, 0.2, method="brute").offsets) == 31
+
+
+def test_non_finite_inputs_are_named():
+    """A NaN crack tip, an exact stress with NaN and a PD body without bonds are errors
+    that say so, not numbers (issue 19)."""
+    dom = cnem.geometry.rectangle(2.0, 2.0, origin=(-1.0, -1.0), cracks=[[[-1.0, 0.0], [0.0, 0.0]]])
+    with pytest.raises(cnem.GeometryError, match="finite"):
+        dom.tip_frame((np.nan, 0.0))
+    model = cnem.discretize(cnem.nodes.regular(dom, 0.25), progress=False)
+    prob = cnem.Elasticity(model, (1.0, 0.3))
+    prob.add_dirichlet(lambda p: p[:, 1] < -1 + 1e-9, None)
+    prob.add_body_force([0.0, 1.0])
+    sol = prob.solve(progress=False)
+    with pytest.raises(cnem.InputError, match="finite"):
+        sol.energy_error(lambda x: np.where(x[:, :1] > 0.5, np.nan, 0.0) * np.ones((1, 3)))
+    assert np.isfinite(sol.energy_error(lambda x: np.zeros((len(x), 3))))
+    g = np.arange(0.0, 1.0 + 1e-9, 0.1)
+    pts = np.array([(x, y) for x in g for y in g])
+    with pytest.raises(cnem.InputError, match="no bonds"):
+        cnem.pd.Body(pts, 0.01, 0.05)
+    assert len(cnem.pd.Body(pts, 0.01, 0.3).bond_j) > 0

@@ -87,6 +87,11 @@ def energy_error_density(points: np.ndarray, region: np.ndarray, stress: np.ndar
     if exact.shape != (len(points), 3):
         raise InputError(f"exact_stress must return ({len(points)}, 3) values "
                          f"[sxx, syy, sxy], received shape {exact.shape}; return one row per point")
+    bad = ~np.isfinite(exact).all(axis=1)
+    if bad.any():
+        raise InputError(f"exact_stress must return finite values, received NaN or inf at "
+                         f"{int(bad.sum())} of {len(points)} points, the first at "
+                         f"{points[bad][0].tolist()}; check the exact solution there")
     diff = stress - exact
     return np.einsum("qi,qij,qj->q", diff, np.linalg.inv(C), diff)
 

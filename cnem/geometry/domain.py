@@ -288,6 +288,9 @@ class Domain:
         tip = np.asarray(tip, dtype=float).reshape(-1)
         if tip.shape != (2,):
             raise GeometryError(f"tip: expected a point (2,), received shape {tip.shape}")
+        if not np.isfinite(tip).all():
+            raise GeometryError(f"tip: expected finite coordinates, received {tip.tolist()}; "
+                                f"pass a point near the crack tip")
         at = tips[np.argmin(np.hypot(*(tips - tip).T))]
         for crack in self.cracks:
             for end, before in ((crack[-1], crack[-2]), (crack[0], crack[1])):

@@ -111,6 +111,11 @@ class Body:
         if segments is not None:
             test = pts if crossing_points is None else np.asarray(crossing_points, dtype=float)
             fam = remove_crossing(fam, test, segments)
+        if len(fam.indices) == 0:
+            spacing = float(np.median(vol) / self.thickness) ** (1.0 / d)
+            raise InputError(f"horizon: expected a horizon that reaches other points (about three "
+                             f"node spacings, here ~{3 * spacing:.3g}), received {horizon:.3g}: no "
+                             f"point has a neighbour within it, so the body has no bonds")
         self.family = fam
         self.period = fam.period
         index = fam.indices.dtype                  # int32 unless the cloud is huge
