@@ -15,7 +15,7 @@ The layers, lowest first (a module imports only from its own layer or lower ones
 ``tests/test_architecture.py`` checks it, ``docs/architecture.md`` draws it):
 
 ========== ==============================================================================
-core       ``errors``, ``config``, ``_parallel``, ``_memory``, ``_predicates``,
+core       ``errors``, ``config``, ``_compile``, ``_parallel``, ``_memory``, ``_predicates``,
            ``hyperdual``, ``material``, ``exact``
 spatial    ``spatial``: packed R-tree (periodic), family search, bond crossing
 shape      ``shape``: constrained natural-neighbour coordinates on a triangulation

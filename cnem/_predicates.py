@@ -2,6 +2,8 @@
 
 import numba
 
+from . import _compile  # noqa: F401  (says once when the kernels compile)
+
 
 @numba.njit(cache=True, inline="always")
 def orient2d(ax, ay, bx, by, cx, cy):

@@ -1,30 +1,35 @@
-"""The ``cnem`` command: run the demos and show what is installed.
+"""The ``cnem`` command: run the demos, compile the kernels ahead, show what is installed.
 
     cnem demo list                                   # the demos
-    cnem demo cylinder --nodes 687 --irregular --out results/
-    cnem demo cracked-plate --gamma 45 --out results/
+    cnem demo cylinder --nodes 687 --irregular       # pictures in results/bimaterial_cylinder/
+    cnem demo cracked-plate --gamma 45 --out my/folder/
     cnem pd list                                     # the peridynamics demos
-    cnem pd crack --n 16 32 --out results/           # PD and C-NEM on one cloud
+    cnem pd crack --n 16 32                          # PD and C-NEM on one cloud
     cnem pd branching --help                         # dynamic crack branching
-    cnem pd cpd --example tension2d --out results/   # CPD examples (Javili et al. §6)
+    cnem pd cpd --example tension2d                  # CPD examples (Javili et al. §6)
+    cnem warmup                                      # compile every kernel now (first run only)
     cnem info                                        # versions, threads
 
-Each demo keeps its own options (``cnem demo cylinder --help``); the demos
-are the modules of `cnem.demos` (``python -m cnem.demos.bimaterial_cylinder``),
-installed with the package.
+Each demo keeps its own options (``cnem demo cylinder --help``, defaults shown); the
+demos are the modules of `cnem.demos` (``python -m cnem.demos.bimaterial_cylinder``),
+installed with the package. Every demo writes its files to ``--out``, by default
+``results/<module>/`` (`output_folder`).
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import logging
+import pathlib
 import sys
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from typing import Sequence
 
-__all__ = ["main", "DEMOS", "PD_DEMOS"]
+__all__ = ["main", "DEMOS", "PD_DEMOS", "HelpFormatter", "demo_parser", "output_folder",
+           "show_compile_notice", "warmup", "build_parser"]
 
 #: Command-line name -> module of `cnem.demos`.
 DEMOS = {
@@ -48,9 +53,70 @@ PD_DEMOS = {
 #: Subcommand -> its table of demos.
 _TABLES = {"demo": DEMOS, "pd": PD_DEMOS}
 
-
 #: The package of the demo modules.
 PACKAGE = "cnem.demos"
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
+    """Help text as written, each option followed by its default (none for flags and for
+    options without one)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        if action.default in (None, False, argparse.SUPPRESS) or action.const is True:
+            return action.help or ""
+        return super()._get_help_string(action)
+
+
+def output_folder(module_file: str) -> str:
+    """The default output folder of a demo: ``results/<module>`` (pass the demo's ``__file__``).
+
+    >>> output_folder("/any/where/cnem/demos/bimaterial_cylinder.py")
+    'results/bimaterial_cylinder'
+    """
+    return f"results/{pathlib.PurePath(module_file).stem}"
+
+
+def demo_parser(module_file: str, doc: str, prog: str | None = None) -> argparse.ArgumentParser:
+    """The command line every demo starts from (the one place of the demos' output rule).
+
+    Parameters
+    ----------
+    module_file : str
+        The demo's ``__file__``: names its default output folder (`output_folder`).
+    doc : str
+        The demo's module docstring; its first line is the description.
+    prog : str, optional
+        The command shown in the usage line (``cnem demo cylinder``; `main` passes it),
+        by default the script's name.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        With defaults shown (`HelpFormatter`), ``--out`` (default ``results/<module>``) and
+        ``--no-plot``; the demo adds its own options. Compiling kernels is announced on the
+        terminal (`show_compile_notice`).
+    """
+    parser = argparse.ArgumentParser(prog=prog, description=doc.strip().split("\n")[0],
+                                     formatter_class=HelpFormatter)
+    parser.add_argument("--out", default=output_folder(module_file),
+                        help="folder for the files and pictures")
+    parser.add_argument("--no-plot", action="store_true", help="skip the pictures")
+    show_compile_notice()
+    return parser
+
+
+def show_compile_notice() -> None:
+    """Show the line `cnem._compile` logs when numba compiles the kernels on stderr (once
+    per process, ``cnem: compiling numba kernels, first run only ...``)."""
+    logger = logging.getLogger("cnem._compile")
+    if not any(getattr(h, "_cnem_notice", False) for h in logger.handlers):
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("cnem: %(message)s"))
+        handler.setLevel(logging.INFO)
+        handler._cnem_notice = True
+        logger.addHandler(handler)
+    if logger.getEffectiveLevel() > logging.INFO:
+        logger.setLevel(logging.INFO)
 
 
 def _module_name(name, command):
@@ -111,41 +177,106 @@ def _info():
     for mod in (numpy, scipy, numba, skfem):
         print(f"  {mod.__name__:8s} {mod.__version__}")
     print(f"  numba threads: {numba.get_num_threads()}")
+    print(f"  numba cache: {numba.config.CACHE_DIR or 'next to the sources (__pycache__)'}")
+
+
+#: What `warmup` runs: (demo module, positional arguments, keyword arguments), the
+#: smallest sizes that call every kernel the demos use.
+WARMUP = (
+    ("bimaterial_cylinder", (((7, 21),),), dict(irregular=(False, True))),
+    ("mode1_crack", ((1 / 8,),), {}),
+    ("inclined_crack", ((30.0,),), dict(sif_cloud=(0.2, 0.4, 0.05, 0.3),
+                                        paper_cloud=(0.2, 0.4, 0.05, 0.3))),
+    ("pd_vs_cnem_crack", ((1 / 16,),), {}),
+    ("growth_sent", (0.1,), dict(a1=0.3, increment=0.1, progress=False)),
+    ("pd_crack_branching", (), dict(h=2e-3, m=3.0, t_end=2e-6, progress=False)),
+    ("cpd_examples", (("tension2d",),), dict(quick=True)),
+)
+
+
+def warmup(progress: bool = True) -> list[str]:
+    """Compile (or load from numba's cache) every kernel the demos use, by running each
+    demo of `WARMUP` once at its smallest size, without pictures, into a temporary folder.
+
+    Returns
+    -------
+    list of str
+        ``module.function`` of each kernel compiled (empty when the cache was warm).
+    """
+    import contextlib
+    import io
+    import tempfile
+
+    from tqdm.auto import tqdm
+
+    from . import _compile
+    before = len(_compile.compiled)
+    with tempfile.TemporaryDirectory() as tmp:
+        for module, args, kwargs in tqdm(WARMUP, desc="warmup", disable=not progress, unit="demo"):
+            demo = importlib.import_module(f"{PACKAGE}.{module}")
+            with contextlib.redirect_stdout(io.StringIO()):
+                demo.main(*args, **kwargs, outdir=pathlib.Path(tmp) / module, plot=False)
+    return _compile.compiled[before:]
+
+
+def _warmup():
+    import time
+    t0 = time.perf_counter()
+    names = warmup(progress=sys.stderr.isatty())
+    print(f"cnem warmup: {len(names)} kernels compiled in {time.perf_counter() - t0:.0f} s"
+          if names else f"cnem warmup: every kernel was cached already "
+                        f"({time.perf_counter() - t0:.0f} s)")
+
+
+def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
+    """The ``cnem`` parser and its subcommands' parsers (``{"demo": ..., "pd": ..., ...}``)."""
+    parser = argparse.ArgumentParser(prog="cnem", description=__doc__.split("\n")[0],
+                                     formatter_class=HelpFormatter,
+                                     epilog=__doc__.split("\n\n", 1)[1])
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    commands = {}
+    for command, what in (("demo", "a demo"), ("pd", "a peridynamics demo")):
+        commands[command] = sub.add_parser(
+            command, help=f"run {what} (cnem {command} list)", add_help=False,
+            formatter_class=HelpFormatter,
+            usage=f"cnem {command} NAME [options] | cnem {command} NAME --help | "
+                  f"cnem {command} list",
+            description=f"Run {what}; its own options follow its name "
+                        f"(cnem {command} NAME --help).")
+        commands[command].add_argument("name", nargs="?", help=f"{what[2:]} name, or 'list'")
+    commands["warmup"] = sub.add_parser(
+        "warmup", help="compile every numba kernel now (first run only)",
+        formatter_class=HelpFormatter,
+        description="Compile every numba kernel the demos use, once, into numba's cache "
+                    "(about 2-4 min of CPU in a fresh environment; seconds when cached).")
+    commands["info"] = sub.add_parser("info", help="versions, threads and the numba cache",
+                                      formatter_class=HelpFormatter,
+                                      description="Versions, threads and the numba cache.")
+    return parser, commands
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``cnem`` command (and ``python -m cnem``)."""
     argv = sys.argv[1:] if argv is None else list(argv)
-    parser = argparse.ArgumentParser(prog="cnem", description=__doc__.split("\n")[0],
-                                     formatter_class=argparse.RawDescriptionHelpFormatter,
-                                     epilog=__doc__.split("\n\n", 1)[1])
-    sub = parser.add_subparsers(dest="command", required=True)
-    runners = {}
-    for command, what in (("demo", "a demo"), ("pd", "a peridynamics demo")):
-        runners[command] = sub.add_parser(
-            command, help=f"run {what} (cnem {command} list)", add_help=False,
-            usage=f"cnem {command} NAME [options] | cnem {command} NAME --help | "
-                  f"cnem {command} list",
-            description=f"Run {what}; its own options follow its name.")
-        runners[command].add_argument("name", nargs="?", help=f"{what[2:]} name, or 'list'")
-    sub.add_parser("info", help="versions and threads")
+    parser, commands = build_parser()
     args, rest = parser.parse_known_args(argv)
-    if args.command == "info":
+    show_compile_notice()
+    if args.command in ("info", "warmup"):
         if rest:
-            parser.error(f"unrecognised arguments: {' '.join(rest)}")
-        _info()
+            commands[args.command].error(f"unrecognised arguments: {' '.join(rest)}")
+        _info() if args.command == "info" else _warmup()
         return 0
     if args.name is None:
         if not {"-h", "--help"} & set(rest):
-            runners[args.command].error("expected a demo name, or 'list'")
-        runners[args.command].print_help()
+            commands[args.command].error("expected a demo name, or 'list'")
+        commands[args.command].print_help()
         print("\ndemos:" if args.command == "demo" else f"\n{args.command} demos:")
         _list(args.command)
         return 0
     if args.name == "list":
         _list(args.command)
         return 0
-    load_demo(args.name, args.command).cli(rest)
+    load_demo(args.name, args.command).cli(rest, prog=f"cnem {args.command} {args.name}")
     return 0
 
 

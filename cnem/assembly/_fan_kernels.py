@@ -3,6 +3,8 @@
 import numba
 import numpy as np
 
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
+
 
 @numba.njit(cache=True)
 def _min_fan(ax, ay, verts, lo, hi):

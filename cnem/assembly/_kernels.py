@@ -3,6 +3,8 @@
 import numba
 import numpy as np
 
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
+
 
 @numba.njit(cache=True, parallel=True)
 def circle_crossings(a, b, centre, radius2, cand_off, cand_idx, group, out_off, out_t, fill):

@@ -8,6 +8,8 @@ with a dense accumulator per thread (two passes: count, then fill).
 import numba
 import numpy as np
 
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
+
 
 @numba.njit(cache=True, inline="always")
 def _chunk(ch, nch, n):

@@ -39,7 +39,6 @@ Run ``python demos/bimaterial_cylinder.py --help`` for the options.
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 import sys
 import time
@@ -49,6 +48,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import cnem
+from cnem.cli import demo_parser
 from cnem.errors import InputError
 from cnem.exact import LayeredCylinder
 
@@ -331,18 +331,16 @@ def main(grids: tuple = GRIDS, *, irregular: tuple = (False, True), fem: bool = 
                 rates=rates, fem_rate=fem_rate, finest=finest, files=[str(f) for f in files])
 
 
-def cli(argv: Sequence[str] | None = None) -> None:
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/bimaterial_cylinder.py --help`` or ``cnem demo cylinder``."""
-    parser = argparse.ArgumentParser(prog="cnem demo cylinder", description=__doc__.split("\n")[0])
+    parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--nodes", type=int, nargs="+",
                         help="node counts (default the paper's 147 315 687 1863)")
     kind = parser.add_mutually_exclusive_group()
     kind.add_argument("--irregular", action="store_true", help="irregular clouds only")
     kind.add_argument("--regular", action="store_true", help="regular clouds only")
     parser.add_argument("--no-fem", action="store_true", help="skip the scikit-fem P1 anchor")
-    parser.add_argument("--no-plot", action="store_true", help="skip the pictures")
     parser.add_argument("--seed", type=int, default=0, help="seed of the irregular clouds")
-    parser.add_argument("--out", default="results/bimaterial_cylinder", help="output folder")
     args = parser.parse_args(argv)
     grids = GRIDS if not args.nodes else tuple(grid_for(n) for n in args.nodes)
     irregular = (True,) if args.irregular else (False,) if args.regular else (False, True)

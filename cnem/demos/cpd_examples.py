@@ -64,9 +64,9 @@ Run ``python demos/cpd_examples.py --help`` or ``cnem pd cpd --help``.
 
 from __future__ import annotations
 
-import argparse
 from typing import TYPE_CHECKING
 
+from cnem.cli import demo_parser
 from cnem.demos.cpd import stretch, structures
 from cnem.errors import OptionError
 
@@ -91,7 +91,7 @@ QUICK = {
 }
 
 
-def main(examples: tuple = EXAMPLES, *, quick: bool = False, outdir: str = "results/cpd",
+def main(examples: tuple = EXAMPLES, *, quick: bool = False, outdir: str = "results/cpd_examples",
          plot: bool = True) -> dict:
     """Run the examples (names from `EXAMPLES`), print their tables, write their pictures.
 
@@ -106,14 +106,12 @@ def main(examples: tuple = EXAMPLES, *, quick: bool = False, outdir: str = "resu
     return {e: RUN[e](**(QUICK[e] if quick else {}), outdir=outdir, plot=plot) for e in examples}
 
 
-def cli(argv: Sequence[str] | None = None) -> None:
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/cpd_examples.py --help`` or ``cnem pd cpd``."""
-    parser = argparse.ArgumentParser(prog="cnem pd cpd", description=__doc__.split("\n")[0])
+    parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--example", choices=EXAMPLES + ("all",), default="all",
-                        help="the example to run (default: all five)")
+                        help="the example to run (all: the five)")
     parser.add_argument("--quick", action="store_true", help="tiny versions (seconds)")
-    parser.add_argument("--no-plot", action="store_true", help="skip the pictures")
-    parser.add_argument("--out", default="results/cpd", help="output folder")
     args = parser.parse_args(argv)
     examples = EXAMPLES if args.example == "all" else (args.example,)
     return main(examples, quick=args.quick, outdir=args.out, plot=not args.no_plot)

@@ -20,18 +20,17 @@ Expected result
   (relative error ~1e-15).
 * Every crack node but the two tips is split into one node per crack face,
   so ``n_nodes - n_points == n_crack_points - 2``; there is one cell per node.
-* ``out/cracked_plate_cells.png`` shows the cells (paper Figure 16b), the crack
-  in red; ``out/cracked_plate_tip.png`` zooms on a tip (paper Figure 17): the
+* ``results/cracked_plate_geometry/cracked_plate_cells.png`` shows the cells (paper Figure 16b), the crack
+  in red; ``results/cracked_plate_geometry/cracked_plate_tip.png`` zooms on a tip (paper Figure 17): the
   cells shrink towards the tip, and no cell reaches across the crack — the
   cells of the two copies of a crack node lie on opposite faces.
-* ``out/cracked_plate.vtu`` holds the cells and nodes for ParaView.
+* ``results/cracked_plate_geometry/cracked_plate.vtu`` holds the cells and nodes for ParaView.
 
 Run ``python demos/cracked_plate_geometry.py --help`` for the sizes.
 """
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 import time
 from typing import TYPE_CHECKING
@@ -41,6 +40,7 @@ import numpy as np
 import cnem
 import cnem.io
 import cnem.plot
+from cnem.cli import demo_parser
 from cnem.geometry import SegmentKind, rectangle
 
 if TYPE_CHECKING:
@@ -72,7 +72,7 @@ def build(h: float = 0.1, h_min: float = 0.01, gamma_deg: float = 30.0,
 
 
 def main(h: float = 0.1, h_min: float = 0.01, gamma_deg: float = 30.0, growth: float = 0.1,
-         outdir: str = "out", plot: bool = True,
+         outdir: str = "results/cracked_plate_geometry", plot: bool = True,
          window_size: tuple[int, int] = (1200, 1200)) -> dict:
     """Build, discretise, write and draw the cracked plate.
 
@@ -138,21 +138,17 @@ def main(h: float = 0.1, h_min: float = 0.01, gamma_deg: float = 30.0, growth: f
     }
 
 
-def cli(argv: Sequence[str] | None = None) -> None:
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/cracked_plate_geometry.py --help`` or ``cnem demo cracked-plate``."""
-    parser = argparse.ArgumentParser(prog="cnem demo cracked-plate",
-                                     description=__doc__.splitlines()[0])
+    parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--h", type=float, default=0.1, help="spacing away from the crack")
     parser.add_argument("--h-min", type=float, default=0.01, help="spacing at the tips")
     parser.add_argument("--gamma", type=float, default=30.0, help="crack angle in degrees")
     parser.add_argument("--growth", type=float, default=0.1, help="spacing grading rate")
-    parser.add_argument("--out", "--outdir", dest="outdir", default="out",
-                        help="folder for files and pictures")
-    parser.add_argument("--no-plot", action="store_true", help="skip the pictures")
     parser.add_argument("--size", type=int, default=1200, help="picture size in pixels")
     args = parser.parse_args(argv)
     res = main(h=args.h, h_min=args.h_min, gamma_deg=args.gamma, growth=args.growth,
-               outdir=args.outdir, plot=not args.no_plot, window_size=(args.size, args.size))
+               outdir=args.out, plot=not args.no_plot, window_size=(args.size, args.size))
     print(f"cracked plate, gamma = {args.gamma:g} deg: {res['n_points']} cloud nodes -> "
           f"{res['n_nodes']} nodes ({res['n_split']} crack nodes split, "
           f"{res['n_crack_points']} on the crack incl. 2 tips), {res['n_cells']} cells "

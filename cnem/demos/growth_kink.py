@@ -24,13 +24,13 @@ Expected result
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 import cnem
+from cnem.cli import demo_parser
 from cnem.fracture.criteria import hoop_angle
 
 if TYPE_CHECKING:
@@ -138,12 +138,11 @@ def main(angles: tuple = ANGLES, *, cloud: tuple = CLOUD, outdir: str = "results
                 files=[str(f) for f in files])
 
 
-def cli(argv: Sequence[str] | None = None) -> None:
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_kink --help`` or ``cnem demo growth-kink``."""
-    parser = argparse.ArgumentParser(prog="cnem demo growth-kink", description=__doc__.split("\n")[0])
-    parser.add_argument("--angles", type=float, nargs="+", default=list(ANGLES))
-    parser.add_argument("--no-plot", action="store_true")
-    parser.add_argument("--out", default="results/growth_kink")
+    parser = demo_parser(__file__, __doc__, prog)
+    parser.add_argument("--angles", type=float, nargs="+", default=list(ANGLES),
+                        help="crack angles in degrees")
     args = parser.parse_args(argv)
     return main(tuple(args.angles), outdir=args.out, plot=not args.no_plot)
 

@@ -30,7 +30,6 @@ Expected result
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 import time
 from typing import TYPE_CHECKING
@@ -38,6 +37,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cnem
+from cnem.cli import demo_parser
 
 if TYPE_CHECKING:
     from typing import Sequence
@@ -118,15 +118,13 @@ def main(h: float = 0.02, *, a0: float = 0.2, a1: float = 0.6, increment: float 
                 seconds_per_increment=per_increment)
 
 
-def cli(argv: Sequence[str] | None = None) -> None:
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_sent --help`` or ``cnem demo growth-sent``."""
-    parser = argparse.ArgumentParser(prog="cnem demo growth-sent", description=__doc__.split("\n")[0])
+    parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--h", type=float, default=0.02, help="node spacing (fraction of W)")
     parser.add_argument("--increment", type=float, default=0.02, help="crack increment / W")
     parser.add_argument("--full", action="store_true",
                         help="rebuild the model and operators at every increment (no local update)")
-    parser.add_argument("--no-plot", action="store_true")
-    parser.add_argument("--out", default="results/growth_sent")
     args = parser.parse_args(argv)
     return main(args.h, increment=args.increment, outdir=args.out, plot=not args.no_plot,
                 local=not args.full)

@@ -26,13 +26,13 @@ Expected result
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 import cnem
+from cnem.cli import demo_parser
 from cnem.geometry import arc
 
 if TYPE_CHECKING:
@@ -112,14 +112,12 @@ def main(h: float = 0.25, *, increment: float = 1.0, steps: int = 12,
                 files=[str(f) for f in files], history=hist)
 
 
-def cli(argv: Sequence[str] | None = None) -> None:
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_two_holes --help`` or ``cnem demo growth-two-holes``."""
-    parser = argparse.ArgumentParser(prog="cnem demo growth-two-holes", description=__doc__.split("\n")[0])
+    parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--h", type=float, default=0.25, help="node spacing (mm)")
     parser.add_argument("--increment", type=float, default=1.0, help="crack increment (mm)")
-    parser.add_argument("--steps", type=int, default=12)
-    parser.add_argument("--no-plot", action="store_true")
-    parser.add_argument("--out", default="results/growth_two_holes")
+    parser.add_argument("--steps", type=int, default=12, help="growth increments")
     args = parser.parse_args(argv)
     return main(args.h, increment=args.increment, steps=args.steps, outdir=args.out, plot=not args.no_plot)
 

@@ -35,7 +35,6 @@ Run ``python demos/inclined_crack.py --help`` for the options.
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 import sys
 from typing import TYPE_CHECKING
@@ -44,6 +43,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import cnem
+from cnem.cli import demo_parser
 from cnem.exact import CentralCrack
 from cnem.fracture import sif
 
@@ -213,13 +213,12 @@ def main(angles: tuple = ANGLES, *, sif_cloud: tuple = SIF_CLOUD, paper_cloud: t
                 files=[str(f) for f in files])
 
 
-def cli(argv: Sequence[str] | None = None) -> None:
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/inclined_crack.py --help`` or ``cnem demo inclined-crack``."""
-    parser = argparse.ArgumentParser(prog="cnem demo inclined-crack", description=__doc__.split("\n")[0])
-    parser.add_argument("--angles", type=float, nargs="+", default=list(ANGLES))
+    parser = demo_parser(__file__, __doc__, prog)
+    parser.add_argument("--angles", type=float, nargs="+", default=list(ANGLES),
+                        help="crack angles in degrees")
     parser.add_argument("--h-min", type=float, default=SIF_CLOUD[2], help="spacing at the tips")
-    parser.add_argument("--no-plot", action="store_true")
-    parser.add_argument("--out", default="results/inclined_crack")
     args = parser.parse_args(argv)
     cloud = (SIF_CLOUD[0], SIF_CLOUD[1], args.h_min, SIF_CLOUD[3])
     return main(tuple(args.angles), sif_cloud=cloud, outdir=args.out, plot=not args.no_plot)

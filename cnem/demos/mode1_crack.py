@@ -40,7 +40,6 @@ Run ``python demos/mode1_crack.py --help`` for the options.
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 import sys
 from typing import TYPE_CHECKING
@@ -49,6 +48,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import cnem
+from cnem.cli import demo_parser
 from cnem.fracture import polar, sif, williams
 
 if TYPE_CHECKING:
@@ -205,14 +205,12 @@ def main(spacings: tuple = SPACINGS, *, methods: tuple = ("cnem", "enriched", "f
     return dict(rows=rows, rates=rates, files=[str(f) for f in files])
 
 
-def cli(argv: Sequence[str] | None = None) -> None:
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/mode1_crack.py --help`` or ``cnem demo mode1-crack``."""
-    parser = argparse.ArgumentParser(prog="cnem demo mode1-crack", description=__doc__.split("\n")[0])
+    parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--n", type=int, nargs="+", default=[8, 16, 32, 64],
                         help="nodes per side of the regular clouds (h = 1 / n)")
-    parser.add_argument("--no-fem", action="store_true")
-    parser.add_argument("--no-plot", action="store_true")
-    parser.add_argument("--out", default="results/mode1_crack")
+    parser.add_argument("--no-fem", action="store_true", help="skip the scikit-fem P1 anchor")
     args = parser.parse_args(argv)
     methods = ("cnem", "enriched") + (() if args.no_fem else ("fem",))
     return main(tuple(1.0 / n for n in args.n), methods=methods, outdir=args.out,

@@ -71,7 +71,6 @@ Run ``python demos/pd_crack_branching.py --help`` for the options.
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 import time
 from typing import TYPE_CHECKING
@@ -79,6 +78,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cnem.pd as pd
+from cnem.cli import demo_parser
 from cnem.errors import InputError
 from cnem.exact import rayleigh_speed
 from cnem.pd import cracks
@@ -402,22 +402,21 @@ def report(r, h, horizon, material, mat):
     return "\n".join(lines)
 
 
-def cli(argv: Sequence[str] | None = None) -> None:
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/pd_crack_branching.py --help`` or ``cnem pd branching``."""
-    parser = argparse.ArgumentParser(prog="cnem pd branching", description=__doc__.split("\n")[0])
-    parser.add_argument("--h", type=float, default=0.25, help="grid spacing in mm (default 0.25)")
-    parser.add_argument("--m", type=float, default=4.0, help="horizon / spacing (default 4)")
-    parser.add_argument("--time", type=float, default=46.0, help="simulated time in µs (default 46)")
-    parser.add_argument("--material", choices=sorted(MATERIALS), default="soda-lime")
+    parser = demo_parser(__file__, __doc__, prog)
+    parser.add_argument("--h", type=float, default=0.25, help="grid spacing in mm")
+    parser.add_argument("--m", type=float, default=4.0, help="horizon / spacing")
+    parser.add_argument("--time", type=float, default=46.0, help="simulated time in µs")
+    parser.add_argument("--material", choices=sorted(MATERIALS), default="soda-lime",
+                        help="the glass (see the module docstring)")
     parser.add_argument("--stress", type=float, help="edge traction in MPa (default: 2 for "
                         "soda-lime, 12 for duran50)")
     parser.add_argument("--frames", type=float, default=1.0, help="µs between damage frames")
     parser.add_argument("--quick", action="store_true",
                         help=f"a small run: h = {QUICK['h'] * 1e3:g} mm, m = {QUICK['m']:g}, "
                              f"{QUICK['t_end'] * 1e6:g} µs (overrides --h, --m, --time)")
-    parser.add_argument("--no-plot", action="store_true")
-    parser.add_argument("--no-progress", action="store_true")
-    parser.add_argument("--out", default="results/pd_crack_branching")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
     size = QUICK if args.quick else dict(h=args.h * 1e-3, m=args.m, t_end=args.time * 1e-6)
     try:

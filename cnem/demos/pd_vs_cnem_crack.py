@@ -33,14 +33,16 @@ Expected result
 
 from __future__ import annotations
 
-import argparse
 import pathlib
+import sys
 from typing import TYPE_CHECKING
 
 import numpy as np
+from tqdm.auto import tqdm
 
 import cnem
 import cnem.pd as pd
+from cnem.cli import demo_parser
 from cnem.exact import CentralCrack
 from cnem.fracture import sif
 from cnem.fracture.opening import crack_opening, k_from_opening
@@ -93,14 +95,15 @@ def griffith(x):
 
 
 def k_from_tips(x, delta, h):
-    """K_I fitted to the opening at 2h < r < a/2 from both tips (`k_from_opening`)."""
+    """K_I fitted to the opening at 2h < r < a/2 from both tips (`k_from_opening`); ``nan``
+    when the cloud is too coarse to put a node there (h >= a/6: `table` says so)."""
     r = A - np.abs(x)
     return k_from_opening(r, delta, E, NU, "stress", where=(r > 2 * h) & (r < 0.5 * A))
 
 
 def study(spacings: tuple = SPACINGS) -> list[dict]:
     rows = []
-    for h in spacings:
+    for h in tqdm(spacings, desc="clouds", disable=not sys.stderr.isatty(), leave=False):
         cloud = cnem.nodes.regular(domain(), h)
         cprob, csol = solve_cnem(cloud)
         body, psol = solve_pd(cloud, cprob)
@@ -123,12 +126,18 @@ def table(rows):
     k0 = SIGMA * np.sqrt(np.pi * A)
     lines = [f"{'h':>8} {'nodes':>6} {'PD bonds':>9} | {'opening err C-NEM':>17} {'PD':>7} | "
              f"{'K_I/K0 C-NEM':>12} {'PD':>7} | {'max|u_PD-u_C|/max|u|':>21}"]
+    coarse = [r["h"] for r in rows if not np.isfinite(r["K_pd"])]
     for r in rows:
+        k_pd = f"{r['K_pd'] / k0:>7.4f}" if np.isfinite(r["K_pd"]) else f"{'-':>6}*"
         lines.append(f"{r['h']:>8.4f} {r['nodes']:>6d} {r['bonds']:>9d} | {r['cnem_error']:>17.4f} "
-                     f"{r['pd_error']:>7.4f} | {r['K_cnem'] / k0:>12.4f} {r['K_pd'] / k0:>7.4f} | "
+                     f"{r['pd_error']:>7.4f} | {r['K_cnem'] / k0:>12.4f} {k_pd} | "
                      f"{r['u_difference']:>21.4f}")
     lines.append("opening errors: max |delta - Griffith| / max Griffith; K0 = sigma sqrt(pi a) "
                  "(infinite plate; this finite plate is a few % above)")
+    if coarse:
+        lines.append(f"* no PD K_I at h = {', '.join(f'{h:g}' for h in coarse)}: too coarse, the "
+                     f"opening fit needs nodes between 2h and a/2 = {0.5 * A:g} behind each tip, "
+                     f"i.e. h < a/6 = {A / 6:.4f} (--n {int(np.floor(6 / A)) + 1} or more)")
     return "\n".join(lines)
 
 
@@ -188,13 +197,11 @@ def main(spacings: tuple = SPACINGS, *, outdir: str = "results/pd_vs_cnem_crack"
     return dict(rows=[{k: r[k] for k in keep} for r in rows], files=[str(f) for f in files])
 
 
-def cli(argv: Sequence[str] | None = None) -> None:
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/pd_vs_cnem_crack.py --help`` or ``cnem demo pd-crack``."""
-    parser = argparse.ArgumentParser(prog="cnem demo pd-crack", description=__doc__.split("\n")[0])
+    parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--n", type=int, nargs="+", default=[16, 32, 64],
                         help="nodes per unit length (h = 1 / n)")
-    parser.add_argument("--no-plot", action="store_true")
-    parser.add_argument("--out", default="results/pd_vs_cnem_crack")
     args = parser.parse_args(argv)
     return main(tuple(1.0 / n for n in args.n), outdir=args.out, plot=not args.no_plot)
 

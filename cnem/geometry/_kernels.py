@@ -14,6 +14,7 @@ clipping path.
 import numba
 import numpy as np
 
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from .._predicates import orient2d as _orient
 
 #: Status codes of the fast path.

@@ -3,6 +3,8 @@
 import numba
 import numpy as np
 
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
+
 
 @numba.njit(cache=True)
 def add_rows(target, index, values, perm):

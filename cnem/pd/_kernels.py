@@ -3,6 +3,8 @@
 import numba
 import numpy as np
 
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
+
 
 @numba.njit(cache=True, parallel=True, fastmath=True)
 def pmb_forces(u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit, out):

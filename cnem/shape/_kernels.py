@@ -20,6 +20,7 @@ triangulation (cracks opened, neighbours across region boundaries cut):
 import numba
 import numpy as np
 
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from .._predicates import orient2d as _orient
 
 #: Row kinds returned by the counting pass.

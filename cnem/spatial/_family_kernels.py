@@ -8,6 +8,7 @@ so that all methods return identical sets even at ties.
 import numba
 import numpy as np
 
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from .._predicates import orient2d as _orient
 
 from ._rtree_kernels import _wrap

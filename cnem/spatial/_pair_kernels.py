@@ -30,6 +30,7 @@ identical to theirs.
 import numba
 import numpy as np
 
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from ._family_kernels import _dist2, _shifted_dist2, bin_points
 
 

@@ -10,6 +10,8 @@ Algorithms 1-5). ``period[k] = inf`` means "not periodic along k".
 import numba
 import numpy as np
 
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
+
 #: Query kinds.
 INTERSECT, BALL_CLOSED, BALL_OPEN = 0, 1, 2
 

@@ -15,7 +15,7 @@ __all__ = ["tension2d", "cube"]
 
 
 def tension2d(spacing: float = 0.02, *, m: float = 3.0, steps: int = 10, ratio: float = RATIO,
-              outdir: str = "results/cpd", plot: bool = True) -> dict:
+              outdir: str = "results/cpd_examples", plot: bool = True) -> dict:
     """§6.1, Figure 5: a unit square stretched to twice its length (n = 1), C2 = 0 and
     C2 >> C1 (`RATIO`). Left column u_x = 0, right column u_x = 1, u_y = 0 at the middle
     of both (lateral contraction free). Paper: D = 0.01 (default 0.02 here).
@@ -60,7 +60,7 @@ def tension2d(spacing: float = 0.02, *, m: float = 3.0, steps: int = 10, ratio: 
 
 
 def cube(n: int = 7, *, m: float = 2.0, steps: int = 8, ratio: float = RATIO,
-         outdir: str = "results/cpd", plot: bool = True) -> dict:
+         outdir: str = "results/cpd_examples", plot: bool = True) -> dict:
     """§6.1, Figure 6: a unit cube stretched to twice its height (n = 1) with one-,
     one- and two- (C2 >> C1) and one- and three-neighbour (C3 >> C1) interactions.
     Bottom u_z = 0, top u_z = 1, the axis' end points and one bottom point held

@@ -26,7 +26,7 @@ CANTILEVER_RATIO, TORSION_RATIO = 15.0, 0.5
 
 def cantilever(spacing: float = 0.04, *, C1s: tuple = (1.0, 2.0, 4.0), height: float = 0.2,
                aspect: int = 25, m: float = 3.0, steps: int = 20, load: float = 5.0,
-               outdir: str = "results/cpd", plot: bool = True) -> dict:
+               outdir: str = "results/cpd_examples", plot: bool = True) -> dict:
     """§6.2, Figure 7 (2-D row): a beam ``aspect * height`` long, clamped over the first
     horizon, bent by a downward force spread over the last horizon, for each C1 with
     C2 fixed (`CANTILEVER_RATIO` for C1 = 1), n = 2. The force is ``load * 3 E I / L^2``
@@ -77,7 +77,7 @@ def cantilever(spacing: float = 0.04, *, C1s: tuple = (1.0, 2.0, 4.0), height: f
 
 
 def torsion(n: int = 7, *, slenderness: int = 2, m: float = 1.5, angle: float = 180.0,
-            steps: int = 18, outdir: str = "results/cpd", plot: bool = True) -> dict:
+            steps: int = 18, outdir: str = "results/cpd_examples", plot: bool = True) -> dict:
     """§6.3, Figures 8-9: a block ``1 x 1 x slenderness``, bottom layer clamped, top
     layer turned by ``angle`` degrees about the axis in ``steps`` increments, C1 = 1, C3
     from `TORSION_RATIO`, n = 0. Each increment is one `solve` from the last
@@ -145,7 +145,7 @@ def _von_mises(body, u, lam, mu):
 
 
 def lshape(spacing: float = 1 / 40, *, ratios: tuple = (2.0, 3.0, 4.0, 5.0), pull: float = 1e-3,
-           outdir: str = "results/cpd", plot: bool = True) -> dict:
+           outdir: str = "results/cpd_examples", plot: bool = True) -> dict:
     """§6.4, Figure 10: the unit square without its top-right quarter, bottom clamped,
     top of the left arm pulled up by ``pull`` (u_x = 0 there), C2 = 0, n = 1, at one
     grid for horizons ``delta = m D`` (m >= 2: at m = 1.5 the 8-neighbour lattice is

@@ -10,6 +10,8 @@ the ghost values of ``j``.
 import numba
 import numpy as np
 
+from ... import _compile  # noqa: F401  (says once when the kernels compile)
+
 
 @numba.njit(cache=True, parallel=True)
 def sort_rows(offsets, keys):
