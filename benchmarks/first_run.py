@@ -1,0 +1,77 @@
+"""A newcomer's first run: the main demo and ``import cnem`` in fresh processes, with an
+empty numba cache (a fresh machine) and with the warm cache the first run left behind.
+
+    python benchmarks/first_run.py            # the README's main demo, cold then warm
+    python benchmarks/first_run.py --quick    # import cnem and cnem --help only (seconds)
+
+Each row is one fresh process (``NUMBA_CACHE_DIR`` pointed at a new empty folder for
+the cold rows, at the same folder afterwards for the warm ones); wall time and the CPU
+time of the process (user + system) are printed with the load average before and
+after, so that a run on a busy machine can be read: on a quiet machine the wall time
+of the compiling run is about its CPU time (numba compiles on one thread).
+Target (issue 21): the main demo under 90 s with an empty cache on a quiet machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import pathlib
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+#: label -> command (run from a temporary folder, this checkout first on the path).
+COMMANDS = {
+    "import cnem": [sys.executable, "-c", "import cnem"],
+    "cnem --help": [sys.executable, "-m", "cnem", "--help"],
+    "main demo": [sys.executable, str(ROOT / "demos" / "bimaterial_cylinder.py")],
+}
+
+
+def _run(command, cache, cwd):
+    """Wall and CPU seconds of one fresh process (``None`` if it failed)."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(cache),
+               PYVISTA_OFF_SCREEN="true")
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t0 = time.perf_counter()
+    done = subprocess.run(command, env=env, cwd=cwd, stdout=subprocess.DEVNULL,
+                          stderr=subprocess.PIPE, text=True)
+    wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if done.returncode:
+        print(done.stderr[-2000:], file=sys.stderr)
+        return None
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu, "compiling numba kernels" in done.stderr
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true",
+                        help="import cnem and cnem --help only (no demo)")
+    args = parser.parse_args(argv)
+    labels = ["import cnem", "cnem --help"] + ([] if args.quick else ["main demo"])
+    print(f"{'run':<24} {'wall s':>8} {'CPU s':>8} {'load before':>12} {'after':>6}  notice")
+    with tempfile.TemporaryDirectory() as tmp:
+        cache = pathlib.Path(tmp) / "numba-cache"
+        cache.mkdir()
+        for state in ("empty cache", "warm cache"):
+            for label in labels:
+                load = os.getloadavg()[0]
+                res = _run(COMMANDS[label], cache, tmp)
+                name = f"{label}, {state}"
+                if res is None:
+                    print(f"{name:<24} {'fails':>8}")
+                    continue
+                wall, cpu, notice = res
+                print(f"{name:<24} {wall:8.2f} {cpu:8.2f} {load:12.2f} {os.getloadavg()[0]:6.2f}"
+                      f"  {'compiling announced' if notice else '-'}", flush=True)
+
+
+if __name__ == "__main__":
+    main()

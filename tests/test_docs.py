@@ -1,0 +1,61 @@
+"""The documentation: the site builds with warnings as errors, the tutorial's script runs and
+its reactions balance its load, and the README's links resolve."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import pathlib
+import re
+import runpy
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(importlib.util.find_spec("mkdocs") is None
+                    or importlib.util.find_spec("mkdocstrings") is None,
+                    reason='the docs extra is not installed (pip install -e ".[docs]")')
+def test_site_builds_strict(tmp_path):
+    done = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir",
+                           str(tmp_path / "site")], cwd=ROOT, capture_output=True, text=True,
+                          env=dict(os.environ, PYTHONPATH=str(ROOT)))
+    assert done.returncode == 0, done.stderr[-3000:]
+    for page in ("index.html", "tutorial/index.html", "api/geometry/index.html",
+                 "demos/bimaterial_cylinder/index.html", "api-contract/index.html"):
+        assert (tmp_path / "site" / page).stat().st_size > 1000, page
+
+
+def test_every_docs_page_is_in_the_navigation():
+    nav = (ROOT / "mkdocs.yml").read_text()
+    pages = {p.relative_to(ROOT / "docs").as_posix() for p in (ROOT / "docs").rglob("*.md")}
+    assert pages == set(re.findall(r"([\w/.-]+\.md)", nav))
+
+
+def test_readme_links_resolve():
+    readme = (ROOT / "README.md").read_text()
+    links = re.findall(r"\]\((?!https?://)([^)#]+)", readme)
+    assert links
+    for link in links:
+        assert (ROOT / link).exists(), link
+
+
+@pytest.mark.slow
+def test_first_model_tutorial_balances_its_load(tmp_path, monkeypatch, capsys):
+    """The tutorial's script: the clamped edge's reactions balance the end load (10 N/mm down)
+    to the solver's tolerance, and it writes its file and picture."""
+    monkeypatch.chdir(tmp_path)
+    pyvista = importlib.util.find_spec("pyvista") is not None
+    script = ROOT / "docs" / "examples" / "first_model.py"
+    if not pyvista:
+        pytest.skip("the plot extra is not installed")
+    names = runpy.run_path(str(script), run_name="__main__")
+    np.testing.assert_allclose(names["reaction"], [0.0, 10.0], atol=1e-6 * 10.0)
+    assert names["dom"].area == pytest.approx(3.0 - names["hole"].area, rel=1e-12)
+    for f in ("l_plate.vtu", "l_plate_von_mises.png"):
+        assert (tmp_path / "results" / "first_model" / f).stat().st_size > 1000
