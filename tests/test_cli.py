@@ -25,6 +25,7 @@ def test_demo_list(capsys):
         assert name in out
 
 
+@pytest.mark.slow
 def test_demo_cylinder_writes_its_files(tmp_path, capsys):
     cli.main(["demo", "cylinder", "--nodes", "147", "--irregular", "--no-plot",
               "--out", str(tmp_path)])
@@ -90,6 +91,7 @@ def test_bad_cpd_options_are_named():
     assert done.value.code == 2
 
 
+@pytest.mark.slow
 def test_cnem_pd_cpd_runs_the_demo(tmp_path, capsys):
     cli.main(["pd", "cpd", "--example", "lshape", "--quick", "--no-plot", "--out",
               str(tmp_path)])

@@ -305,6 +305,7 @@ def test_every_demo_module_has_a_case():
     assert modules == set(cnem.demos.MODULES) == {case.module for case in CASES}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=[case.id for case in CASES])
 def test_demo(case, tmp_path):
     demo = importlib.import_module(f"cnem.demos.{case.module}")

@@ -201,6 +201,7 @@ def test_pointwise_energy_error_of_an_enriched_solution_vanishes_on_a_linear_fie
         sol.energy_error(exact, strain="nodal")
 
 
+@pytest.mark.slow
 def test_enrichment_improves_an_imposed_singular_field():
     """The mode-I Williams field imposed on the boundary: the enriched solutions are
     closer to it (energy norm) than plain C-NEM on the same nodes."""

@@ -43,6 +43,7 @@ def test_triangle_basis_gives_the_p1_stiffness(name):
     assert abs(scalar - ref).max() <= 1e-12 * abs(ref).max()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name, enrich, weight", [("three_rectangles_irregular", None, 1.0),
                                                   ("kinked_crack_irregular", None, 0.3),
                                                   ("kinked_crack_irregular", None, 0.0),

@@ -48,6 +48,7 @@ def test_uniform_strain_gives_the_classical_stress_in_the_bulk(material, nu, pla
         assert np.abs(force).max() < 1e-9 * np.abs(exact).max() * h
 
 
+@pytest.mark.slow
 def test_uniform_strain_in_3d():
     h = 0.1
     pts = _grid(h, dim=3)
@@ -110,6 +111,7 @@ def test_newton_history_and_load_steps():
     assert all(r[-1] <= 1e-10 * max(r[0], 1e-300) or r[-1] < 1e-14 for r in three.residual_history)
 
 
+@pytest.mark.slow
 def test_verlet_conserves_energy_without_breaking():
     h = 0.05
     pts = _grid(h, 1.0, 0.5)

@@ -106,6 +106,7 @@ def test_one_rank_in_process_equals_serial(serial, case):
     assert res.broken == serial[case][1].broken
 
 
+@pytest.mark.slow
 @needs_mpi
 @pytest.mark.parametrize("case", ["bond", "state", "periodic", "cube"])
 def test_ranks_give_the_serial_dynamics(serial, distributed, case):
@@ -115,6 +116,7 @@ def test_ranks_give_the_serial_dynamics(serial, distributed, case):
     np.testing.assert_allclose(res[f"{case}_energy"], serial[case][1].energy, rtol=1e-10)
 
 
+@pytest.mark.slow
 @needs_mpi
 def test_relaxation_reaches_the_serial_equilibrium(serial, distributed):
     ranks, res = distributed
@@ -126,6 +128,7 @@ def test_relaxation_reaches_the_serial_equilibrium(serial, distributed):
     assert np.abs(res["relax_u"] - static).max() <= 1e-6 * scale
 
 
+@pytest.mark.slow
 @needs_mpi
 def test_resumed_run_equals_the_uninterrupted_one(serial, distributed):
     ranks, res = distributed
@@ -135,6 +138,7 @@ def test_resumed_run_equals_the_uninterrupted_one(serial, distributed):
     np.testing.assert_array_equal(res["resumed_broken"], res["bond_broken"])
 
 
+@pytest.mark.slow
 @needs_mpi
 def test_pvtu_frames_hold_the_gathered_displacements(distributed):
     vtk = pytest.importorskip("vtk")

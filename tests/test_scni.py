@@ -185,6 +185,7 @@ def test_passes_over_runs_of_cells_give_the_same_operator(name, monkeypatch):
     assert runs.points > whole.points
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["kinked_crack_irregular", "three_rectangles_irregular",
                                   "plate_hole_irregular", "edge_crack_regular"])
 @pytest.mark.parametrize("per_pass", [None, 5])

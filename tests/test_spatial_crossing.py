@@ -57,6 +57,7 @@ def test_inclined_crack_through_a_random_cloud(method):
     assert dropped == {(j, i) for i, j in dropped}
 
 
+@pytest.mark.slow
 def test_kinked_crack_and_several_segments():
     pts = cloud(2500, seed=1)
     h = 0.02 + 0.03 * pts[:, 0]             # per-point horizons: families not symmetric
