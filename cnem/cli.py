@@ -189,7 +189,7 @@ WARMUP = (
                                         paper_cloud=(0.2, 0.4, 0.05, 0.3))),
     ("pd_vs_cnem_crack", ((1 / 16,),), {}),
     ("growth_sent", (0.1,), dict(a1=0.3, increment=0.1, progress=False)),
-    ("pd_crack_branching", (), dict(h=2e-3, m=3.0, t_end=2e-6, progress=False)),
+    ("pd_crack_branching", (), dict(h=0.5e-3, m=4.0, t_end=30e-6, progress=False)),
     ("cpd_examples", (("tension2d",),), dict(quick=True)),
 )
 

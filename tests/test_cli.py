@@ -206,3 +206,16 @@ def test_every_kernel_module_announces_compiling():
         source = path.read_text()
         if "numba.njit" in source and path.name != "_compile.py":
             assert "import _compile" in source, path
+
+
+@pytest.mark.slow
+def test_warmup_runs_every_listed_demo(monkeypatch):
+    """`cnem warmup` runs each demo of its list once, quietly, and reports what compiled."""
+    ran = []
+    for module, _, _ in cli.WARMUP:
+        demo = importlib.import_module(f"cnem.demos.{module}")
+        monkeypatch.setattr(demo, "main", lambda *a, _m=module, _f=demo.main, **k:
+                            (ran.append(_m), _f(*a, **k))[1])
+    compiled = cli.warmup(progress=False)
+    assert ran == [module for module, _, _ in cli.WARMUP]
+    assert all(name.startswith("cnem.") for name in compiled)

@@ -398,7 +398,9 @@ def report(r, h, horizon, material, mat):
              f"{'branch half-angle (first 5 mm)':<40} {r['half_angle']:>7.1f} deg",
              f"{'broken bonds':<40} {r['broken']:>12d}",
              f"{'energy balance before breaking':<40} {r['energy_error']:>12.1e}   |W - E| / W",
-             f"{'dissipated / (G0 t crack path)':<40} {r['dissipated'] / r['griffith']:>12.2f}"]
+             f"{'dissipated / (G0 t crack path)':<40} "
+             + (f"{r['dissipated'] / r['griffith']:>12.2f}" if r["griffith"] > 0 else
+                f"{'-':>12}   no crack path yet: run longer (--time)")]
     return "\n".join(lines)
 
 
