@@ -62,7 +62,7 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefau
     options without one)."""
 
     def _get_help_string(self, action: argparse.Action) -> str:
-        if action.default in (None, False, argparse.SUPPRESS) or action.const is True:
+        if any(action.default is nothing for nothing in (None, False, argparse.SUPPRESS)):
             return action.help or ""
         return super()._get_help_string(action)
 
