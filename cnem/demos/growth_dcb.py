@@ -103,6 +103,13 @@ def beam_load(a, root=0.0):
     return K_IC * H ** 1.5 / (2 * np.sqrt(3.0) * (np.asarray(a) + root * H))
 
 
+def beam_compliance(a, root=ROOT):
+    """Opening of the arm ends per unit end force of beam theory, 8 (a + root h)^3 / (E' h^3)
+    (both arms; bending only)."""
+    return 8.0 * (np.asarray(a) + root * H) ** 3 / (cnem.fracture.effective_modulus(E, NU, "strain")
+                                                     * H ** 3)
+
+
 def run(theta_deg, h, increment, steps, progress=False):
     """Grow one kinked crack until ``steps`` increments or until it cuts an arm off.
 
@@ -140,16 +147,17 @@ def _offsets_table(runs):
 
 def _load_table(r):
     print(f"theta0 = {r['theta']:.2f} deg: critical end force P_c = K_Ic / K_eq against beam theory "
-          f"(a = tip x)")
+          f"(a = tip x), and the compliance C (opening of the arm ends per unit end force) against "
+          f"beam theory with a + {ROOT} h")
     print(f"{'a':>6} {'y':>8} {'K_I':>8} {'K_II':>8} {'kink':>7} {'P_c':>8} {'beam':>8} "
-          f"{'err %':>7} {'+0.64h':>8} {'err %':>7} {'opening':>9}")
+          f"{'err %':>7} {'+0.64h':>8} {'err %':>7} {'C':>8} {'C beam':>8}")
     for k in range(len(r["length"])):
         a = r["tips"][k, 0]
         pb, pc = beam_load(a), beam_load(a, ROOT)
         print(f"{a:>6.3f} {r['tips'][k, 1]:>8.4f} {r['K'][k, 0]:>8.4f} {r['K'][k, 1]:>8.4f} "
               f"{r['kink_deg'][k]:>7.2f} {r['load'][k]:>8.5f} {pb:>8.5f} "
               f"{100 * (r['load'][k] / pb - 1):>7.2f} {pc:>8.5f} {100 * (r['load'][k] / pc - 1):>7.2f} "
-              f"{r['load'][k] * r['measure'][k]:>9.4f}")
+              f"{r['measure'][k]:>8.2f} {beam_compliance(a):>8.2f}")
 
 
 def _record(theta, hist, message):
