@@ -213,6 +213,24 @@ def _paths_figure(runs, path):
     plt.close(fig)
 
 
+def _load_figure(r, path):
+    """`CrackPath.plot` ``kind="load"`` with the straight crack of beam theory beside it."""
+    import matplotlib.pyplot as plt
+    fig = r["history"].plot(None, kind="load", length_unit="H", load_unit="K_Ic sqrt(H)",
+                            displacement_unit="K_Ic / (E sqrt(H))",
+                            title=f"DCB, theta0 = {r['theta']:.2f} deg: end force for growth")
+    a = np.linspace(r["length"][0], r["length"][-1], 100)
+    load, opening = fig.axes[0], fig.axes[1]
+    load.plot(a, beam_load(a), "k--", lw=1.0, label="beam theory, straight crack")
+    load.plot(a, beam_load(a, ROOT), "k-", lw=1.0, label=f"beam theory, a + {ROOT} h")
+    load.legend(fontsize=8)
+    opening.plot(beam_load(a, ROOT) * beam_compliance(a), beam_load(a, ROOT), "k-", lw=1.0,
+                 label=f"beam theory, a + {ROOT} h, straight crack")
+    opening.legend(fontsize=8)
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def _convergence(theta, h, increment, steps, base, progress):
     """The same angle with half the spacing and half the increment: the tip offsets
     of both runs at the crack lengths of the coarse one."""
@@ -267,9 +285,7 @@ def main(h: float = 0.05, *, increment: float = 0.1, steps: int = 30, angles: tu
     files = []
     if plot:
         _paths_figure(runs, out / "dcb_paths.png")
-        runs[-1]["history"].plot(out / "dcb_load.png", kind="load", length_unit="H",
-                                 load_unit="K_Ic sqrt(H)", displacement_unit="K_Ic / (E sqrt(H))",
-                                 title=f"DCB, theta0 = {runs[-1]['theta']:.2f} deg: end force for growth")
+        _load_figure(runs[-1], out / "dcb_load.png")
         files = [out / "dcb_paths.png", out / "dcb_load.png"]
     return dict(runs=runs, convergence=conv, files=[str(f) for f in files])
 
