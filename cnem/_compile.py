@@ -20,7 +20,7 @@ from numba.core import event
 __all__ = ["NOTICE", "compiled"]
 
 #: The line logged once, at the first compilation of a cnem kernel.
-NOTICE = ("compiling numba kernels, first run only (about 1-2 min of CPU for the main demo; "
+NOTICE = ("compiling numba kernels, first run only (about a minute of CPU for the main demo; "
           "cached on disk for the next runs; `cnem warmup` does it ahead)")
 
 logger = logging.getLogger(__name__)

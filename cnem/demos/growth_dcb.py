@@ -71,7 +71,6 @@ Expected result
 
 from __future__ import annotations
 
-import argparse
 import pathlib
 import warnings
 from typing import TYPE_CHECKING
@@ -79,6 +78,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cnem
+from cnem.cli import demo_parser
 
 if TYPE_CHECKING:
     from typing import Sequence
@@ -290,18 +290,16 @@ def main(h: float = 0.05, *, increment: float = 0.1, steps: int = 30, angles: tu
     return dict(runs=runs, convergence=conv, files=[str(f) for f in files])
 
 
-def cli(argv: Sequence[str] | None = None) -> None:
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_dcb --help`` or ``cnem demo growth-dcb``."""
-    parser = argparse.ArgumentParser(prog="cnem demo growth-dcb", description=__doc__.split("\n")[0])
+    parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--h", type=float, default=0.05, help="node spacing (units of H)")
     parser.add_argument("--increment", type=float, default=0.1, help="crack increment (units of H)")
-    parser.add_argument("--steps", type=int, default=30)
+    parser.add_argument("--steps", type=int, default=30, help="growth increments")
     parser.add_argument("--angles", type=float, nargs="+", default=list(ANGLES),
                         help="initial kink angles (degrees)")
     parser.add_argument("--converge", type=float, default=None,
                         help="an angle (the nearest one is taken): run it again with h / 2 and increment / 2")
-    parser.add_argument("--no-plot", action="store_true")
-    parser.add_argument("--out", default="results/growth_dcb")
     args = parser.parse_args(argv)
     return main(args.h, increment=args.increment, steps=args.steps, angles=tuple(args.angles),
                 converge=args.converge, outdir=args.out, plot=not args.no_plot)
