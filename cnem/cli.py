@@ -249,7 +249,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         "warmup", help="compile every numba kernel now (first run only)",
         formatter_class=HelpFormatter,
         description="Compile every numba kernel the demos use, once, into numba's cache "
-                    "(about 2-4 min of CPU in a fresh environment; seconds when cached).")
+                    "(about 2 min of CPU in a fresh environment; a warm cache only loads them).")
     commands["info"] = sub.add_parser("info", help="versions, threads and the numba cache",
                                       formatter_class=HelpFormatter,
                                       description="Versions, threads and the numba cache.")
