@@ -88,6 +88,7 @@ def test_frozen_data_objects():
     assert "nodes" in repr(model) and "cells" in repr(model)
 
 
+@pytest.mark.slow
 def test_no_kernel_compiles_at_import():
     """Every numba kernel compiles (or loads from its cache) on its first call, not when
     its module is imported: a fresh interpreter imports every module and finds no kernel

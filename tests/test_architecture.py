@@ -166,6 +166,7 @@ def test_the_checks_can_fail():
         "cnem.shape.natural" in GRAPH["cnem.geometry.model"]
 
 
+@pytest.mark.slow
 def test_import_is_lazy():
     """``import cnem`` loads no subpackage (and no numba, scipy or shapely); each one
     loads on first use."""

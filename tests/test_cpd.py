@@ -86,6 +86,7 @@ def test_force_and_tangent_are_the_derivatives_of_the_energy(dim, C):
     np.testing.assert_allclose(J, K.toarray(), rtol=0, atol=1e-6 * abs(K).max())
 
 
+@pytest.mark.slow
 def test_user_energy_written_with_hyperdual_functions():
     """A neo-Hookean-like stretch energy and an exponential area energy: the residual and
     tangent by hyper-dual numbers are the derivatives of the energy (finite

@@ -52,6 +52,7 @@ def test_sif_of_imposed_williams_fields(angle, KI, KII, plane, irregular):
                                atol=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("angle, KI, KII, plane", CASES[1:3])
 def test_sif_converges_with_refinement(angle, KI, KII, plane):
     errors = []

@@ -92,6 +92,7 @@ def williams_runs():
     return out
 
 
+@pytest.mark.slow
 def test_kink_under_imposed_williams_field_matches_the_closed_form(williams_runs):
     hist = williams_runs["base"][1]
     K = hist.steps[0].K[0]
@@ -230,6 +231,7 @@ def test_kink_sharper_than_max_kink_is_reported():
 
 
 # ------------------------------------------------------------------- Paris law
+@pytest.mark.slow
 def test_paris_cycles_follow_the_integral_of_the_handbook_sif():
     """K_I(a) of the SENT handbook formula imposed through the Williams field about
     the current tip: cycles against N = int da / (C K(a)^m)."""
@@ -274,6 +276,7 @@ def assert_same_runs(local, full):
     assert u.shape == v.shape and np.abs(u - v).max() <= 1e-10 * np.abs(v).max()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("crack", [[[0.35, 0.42], [0.65, 0.58]],      # internal, two tips
                                    [[0.0, 0.45], [0.3, 0.55]]],       # edge crack
                          ids=["internal", "edge"])
@@ -286,6 +289,7 @@ def test_local_update_grows_the_same_path_as_full_rebuilds(crack, caplog):
     assert_same_runs(local, full)
 
 
+@pytest.mark.slow
 def test_enriched_problem_falls_back_to_full_rebuilds_and_says_so(caplog):
     dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.45], [0.3, 0.55]]])
     with caplog.at_level("INFO", logger="cnem.fracture.growth"):

@@ -138,6 +138,7 @@ def test_offset_1e6_stiffness():
     _problem(cnem.discretize(cloud, progress=False)).stiffness()
 
 
+@pytest.mark.slow
 def test_internal_crack_both_tips_kinked_several_steps():
     crack = [[0.35, 0.9], [0.55, 1.0]]
     dom = cnem.Domain([SQUARE], cracks=[crack])
@@ -148,6 +149,7 @@ def test_internal_crack_both_tips_kinked_several_steps():
     _grow_and_compare(dom, cloud, [ahead[0], behind[0], ahead[1], behind[1], ahead[2]])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kink", [0.0, 0.25])
 def test_edge_crack_regular_cloud_several_steps(kink):
     crack = [[0.0, 1.0], [0.3, 1.0]]
@@ -158,6 +160,7 @@ def test_edge_crack_regular_cloud_several_steps(kink):
     _grow_and_compare(dom, cloud, _steps([0.3, 1.0], [1.0, 0.0], 1.37 * h, 3, kink=kink))
 
 
+@pytest.mark.slow
 def test_two_regions():
     crack = [[0.1, 0.8], [0.3, 0.9]]
     dom = cnem.Domain([LEFT, RIGHT], cracks=[crack])

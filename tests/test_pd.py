@@ -162,6 +162,7 @@ def test_no_bond_crosses_a_crack():
         assert len(np.unique(side[side != 0])) == 1
 
 
+@pytest.mark.slow
 def test_periodic_body_matches_the_interior_of_an_open_one():
     h, L = 0.05, 1.0
     pts = _grid(h, L - h, L - h)

@@ -96,6 +96,7 @@ def _assert_same_dynamics(serial, u, broken, case):
     assert len(_pairs(prob)) > 100                      # the runs do break bonds
 
 
+@pytest.mark.slow
 @needs_mpi
 @pytest.mark.parametrize("case", ["bond", "state", "periodic", "cube"])
 def test_one_rank_in_process_equals_serial(serial, case):

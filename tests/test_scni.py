@@ -172,6 +172,7 @@ def test_kept_by_their_owner_and_validated():
         SmoothedGradients(model, gauss=0)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["kinked_crack_irregular", "three_rectangles_irregular"])
 def test_passes_over_runs_of_cells_give_the_same_operator(name, monkeypatch):
     """B~ built a few cells at a time (edges between runs integrated twice) is the
@@ -233,6 +234,7 @@ def test_fan_gradient_shares_the_cells_points(name, per_pass, cells_cached, monk
     assert released() is None
 
 
+@pytest.mark.slow
 def test_runs_are_compact_blocks_whatever_the_order_of_the_nodes(monkeypatch):
     """Nodes in random order: the passes still take compact blocks of cells, so few
     edges lie between runs (runs of consecutive cells would share about 3/4 of

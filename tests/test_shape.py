@@ -118,6 +118,7 @@ def _compare_rows(model, points, got, ref_fn, tol):
 
 
 # ------------------------------------------------------------------ against the definition
+@pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
 def test_sibson_matches_reference(name):
     _, _, model = cases.model(name)

@@ -50,6 +50,7 @@ def assert_family(fam, n, ref, what=""):
     assert not diff, f"{what}: families differ from brute force, (row, missing, extra): {diff}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("case", CASES, ids=case_id)
 def test_family_matches_brute(case, method):
