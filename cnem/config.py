@@ -16,7 +16,8 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLE
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
-           "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER"]
+           "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER",
+           "DT_LIMIT"]
 
 # ---------------------------------------------------------------- geometry tolerances
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
@@ -93,6 +94,12 @@ NEWTON_INNER_FLOOR = 1e-12
 MIN_GAUSS = 4
 
 # ---------------------------------------------------------------- peridynamics
+#: Explicit PD dynamics refuses a time step above this many times Silling & Askari's
+#: bound (`stable_time_step(safety=1)`, guaranteed stable) and warns between the two:
+#: the critical step measured on uniform lattices (``2 / omega_max``, the largest
+#: eigenvalue of ``M^-1 K``) is 1.7 (PMB) to 2.0 (state-based) times the bound.
+DT_LIMIT = 2.0
+
 #: CPD interactions evaluated together (bounds the temporaries: ~0.3 KB per 2-D pair).
 CPD_CHUNK = 1 << 18
 

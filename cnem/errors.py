@@ -22,12 +22,15 @@ keeps working while ``except cnem.CNEMError`` catches everything cnem raises.
     │   └── LimitError                   a problem larger than a bound in `cnem.config`
     ├── UnsupportedError (NotImplementedError)   a valid request cnem does not implement
     ├── SolveError (RuntimeError)        a system that cannot be solved
+    │   ├── ConvergenceError             an iteration out of budget (``.history``: its residuals)
+    │   └── DivergenceError              a time integration whose state went non-finite
     ├── MissingExtraError (ImportError)  an optional dependency (an extra) is not installed
     └── PlotError                        `cnem.plot` cannot draw
         ├── PlotDependencyError (ImportError)    pyvista missing or unable to render
         └── PlotInputError (InputError)          a bad field name or view
 
     GrowthWarning (UserWarning)          a crack-growth event worth a look (not an error)
+    StabilityWarning (UserWarning)       a time step above the guaranteed-stable one
 
 >>> from cnem import errors
 >>> errors.check_choice("plane", "strain", ("stress", "strain"))
@@ -50,7 +53,7 @@ __all__ = ["CNEMError", "InputError", "OptionError", "GeometryError", "MaterialE
            "FormError", "ConditionError", "SpatialError", "FractureError", "GrowthError",
            "FormatError", "HyperDualError", "LimitError", "UnsupportedError", "SolveError",
            "PlotError", "PlotDependencyError", "PlotInputError", "MissingExtraError", "GrowthWarning",
-           "check_choice"]
+           "ConvergenceError", "DivergenceError", "StabilityWarning", "check_choice"]
 
 
 class CNEMError(Exception):
@@ -113,9 +116,45 @@ class SolveError(CNEMError, RuntimeError):
     """A linear or nonlinear system could not be solved."""
 
 
+class ConvergenceError(SolveError):
+    """An iterative solve (Newton, dynamic relaxation) that ran out of iterations.
+
+    Attributes
+    ----------
+    history : list of list of float
+        The residual norms recorded so far, one list per load step (the last one
+        is the step that did not converge).
+    """
+
+    def __init__(self, message: str, history: list | None = None):
+        super().__init__(message)
+        self.history = [] if history is None else history
+
+
+class DivergenceError(SolveError):
+    """A time integration whose state went non-finite.
+
+    Attributes
+    ----------
+    step : int
+        The first step with a non-finite displacement or velocity.
+    point : int
+        A point (global number) where it is not finite.
+    """
+
+    def __init__(self, message: str, step: int, point: int):
+        super().__init__(message)
+        self.step, self.point = step, point
+
+
 class GrowthWarning(UserWarning):
     """A crack-growth event the user should look at (see `cnem.fracture.history.EVENT_KINDS`);
-    a warning, not an error: the only class here outside `CNEMError`."""
+    a warning, not an error: with `StabilityWarning` the only classes here outside
+    `CNEMError`."""
+
+
+class StabilityWarning(UserWarning):
+    """An explicit time step above the guaranteed-stable one (it may still be stable)."""
 
 
 class MissingExtraError(CNEMError, ImportError):
