@@ -13,7 +13,7 @@ times the bound runs with a `cnem.errors.StabilityWarning`; a larger one is refu
 ...     check_time_step(100.0, 1.0)
 ... except InputError as exc:
 ...     print(str(exc)[:46])
-dt = 100 is 100 times the stable time step 1.0
+dt = 100 is 100 times the stable time step 1
 """
 
 from __future__ import annotations
