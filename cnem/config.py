@@ -17,9 +17,14 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLE
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
            "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER",
-           "DT_LIMIT"]
+           "DT_LIMIT", "COORDINATE_LIMIT"]
 
 # ---------------------------------------------------------------- geometry tolerances
+#: Coordinates (and their extent) must stay below this in magnitude: squared distances
+#: and in-circle determinants of larger ones overflow float64 (max 1.8e308).
+#: `cnem.errors.check_points` refuses them; rescale the model (other units).
+COORDINATE_LIMIT = 1e150
+
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
 #: are snapped onto it; vertices closer than this are the same vertex.
 SNAP_TOL = 1e-9

@@ -202,3 +202,115 @@ def check_choice(name: str, value: _Value, choices: Iterable[object], *,
         raise error(f"{name} must be one of {', '.join(map(repr, choices))}, received "
                     f"{value!r}; pass one of those")
     return value
+
+
+def check_array(name: str, value: object, *, shape: tuple | None = None, broadcast: bool = False,
+                finite: bool = True, positive: bool = False, nonnegative: bool = False,
+                error: type[InputError] = InputError, fix: str = "") -> "np.ndarray":
+    """``value`` as a float64 array, checked at a public boundary: its shape, its dtype
+    (numbers), finiteness (NaN and inf named with their first index) and sign.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, first in the message.
+    value : array_like
+    shape : tuple of int or None, optional
+        The expected shape; None entries take any length (``(None, 2)``: rows of two).
+    broadcast : bool
+        Accept a scalar (or anything NumPy broadcasts) to ``shape`` (all ints), e.g. one
+        horizon for every point.
+    finite, positive, nonnegative : bool
+        Reject NaN and inf (default); values ``<= 0``; values ``< 0``.
+    error : type, optional
+        The `InputError` subclass to raise.
+    fix : str, optional
+        How to fix it, appended to the message.
+
+    Returns
+    -------
+    ndarray
+        float64, C-contiguous (a copy when broadcast).
+
+    >>> check_array("radii", [1.0, 2.0], shape=(2,)).tolist()
+    [1.0, 2.0]
+    >>> try:
+    ...     check_array("radii", [1.0, float("nan")], shape=(2,))
+    ... except InputError as exc:
+    ...     print(exc)
+    radii: expected finite values, received NaN at index 1 (shape (2,))
+    """
+    import numpy as np
+
+    tail = f"; {fix}" if fix else ""
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        kind = type(value).__name__
+        raise error(f"{name}: expected numbers{_shape_text(shape)}, received a {kind} that does "
+                    f"not convert to one float array (ragged, or not numbers){tail}") from None
+    if shape is not None:
+        if broadcast:
+            try:
+                arr = np.broadcast_to(arr, shape)
+            except ValueError:
+                raise error(f"{name}: expected a number or an array of shape {shape}, received "
+                            f"shape {arr.shape}{tail}") from None
+        elif arr.ndim != len(shape) or any(want is not None and want != got
+                                           for want, got in zip(shape, arr.shape)):
+            raise error(f"{name}: expected{_shape_text(shape)}, received shape "
+                        f"{arr.shape}{tail}")
+    if not (arr.flags.c_contiguous and arr.flags.writeable):    # broadcast views too
+        arr = arr.copy()
+    if finite and not np.isfinite(arr).all():
+        first = np.flatnonzero(~np.isfinite(arr.reshape(-1)))[0]
+        where = np.unravel_index(first, arr.shape) if arr.ndim > 1 else first
+        what = "NaN" if np.isnan(arr.reshape(-1)[first]) else f"{float(arr.reshape(-1)[first])}"
+        at = f" at index {tuple(map(int, where)) if arr.ndim > 1 else int(where)}" \
+            if arr.ndim else ""
+        raise error(f"{name}: expected finite values, received {what}{at} (shape "
+                    f"{arr.shape}){tail}")
+    for flag, bad, text in ((positive, arr <= 0, "positive"), (nonnegative, arr < 0,
+                                                                 "non-negative")):
+        if flag and bad.any():
+            first = np.flatnonzero(bad.reshape(-1))[0]
+            raise error(f"{name}: expected {text} values, received {float(arr.reshape(-1)[first])!r} "
+                        f"at index {int(first)} (shape {arr.shape}){tail}")
+    return arr
+
+
+def check_points(name: str, value: object, *, dims: tuple = (2, 3),
+                 error: type[InputError] = InputError) -> "np.ndarray":
+    """``value`` as ``(n, d)`` float64 coordinates: `check_array` (finite, rows of
+    ``d`` in ``dims``) and magnitudes below `cnem.config.COORDINATE_LIMIT` (whose squares,
+    the squared distances and in-circle tests, stay representable).
+
+    >>> try:
+    ...     check_points("points", [[0.0, 0.0], [1e300, 0.0]])
+    ... except InputError as exc:
+    ...     print(str(exc)[:76])
+    points: expected coordinates below 1e+150 in magnitude (their squared distan
+    """
+    import numpy as np
+
+    from . import config
+
+    arr = check_array(name, value, error=error, fix="drop or repair those rows")
+    if arr.ndim != 2 or arr.shape[1] not in dims:
+        raise error(f"{name}: expected an (n, {' or '.join(map(str, dims))}) array of coordinates, "
+                    f"received shape {arr.shape}; pass one row per point")
+    top = float(np.abs(arr).max(initial=0.0))
+    if top >= config.COORDINATE_LIMIT:
+        raise error(f"{name}: expected coordinates below {config.COORDINATE_LIMIT:g} in "
+                    f"magnitude (their squared distances must not overflow float64), received "
+                    f"{top:g} (shape {arr.shape}); express the model in other units")
+    return arr
+
+
+def _shape_text(shape):
+    """`` an array of shape (n, 2)`` for a message (None entries as letters)."""
+    if shape is None:
+        return ""
+    names = iter("nmkpq")
+    return " an array of shape (" + ", ".join(str(s) if s is not None else next(names)
+                                              for s in shape) + (",)" if len(shape) == 1 else ")")

@@ -23,7 +23,7 @@ from ..assembly.triangles import triangle_basis
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import GeometryError, InputError, SolveError
 from ..geometry.topology import constraint_edges
-from ..material import lame, parse_materials, stiffness_matrix
+from ..material import check_stiffness, lame, parse_materials, stiffness_matrix
 from .solution import ElasticSolution
 
 if TYPE_CHECKING:
@@ -95,8 +95,8 @@ class Elasticity(Conditions):
         #: smoothed strain per cell cannot control the extra dofs)
         self.cells = (model.cells if self.enrichment is None
                       else subdivide(model.cells, model.nodes, node_apex=tip_cells(model))[0])
-        self.materials = parse_materials(materials, len(model.domain.regions))
         lame(1.0, 0.0, plane)                       # validates `plane`
+        self.materials = parse_materials(materials, len(model.domain.regions), plane)
         self.stabilization = float(stabilization)
         if not (np.isfinite(self.stabilization) and self.stabilization >= 0):
             raise InputError(f"stabilization: expected a number >= 0, received {stabilization!r}")
@@ -194,6 +194,7 @@ class Elasticity(Conditions):
                 extra = (self._sub_cell_stiffness(a) if sub_cells
                          else self._pointwise_stabilization_stiffness(a))
                 K = extra if K is None else K + extra
+            check_stiffness(K.data, self.materials, "the assembled stiffness")
             self._K = K
         return self._K
 
