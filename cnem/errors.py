@@ -297,8 +297,8 @@ def check_points(name: str, value: object, *, dims: tuple = (2, 3),
 
     arr = check_array(name, value, error=error, fix="drop or repair those rows")
     if arr.ndim != 2 or arr.shape[1] not in dims:
-        raise error(f"{name}: expected an (n, {' or '.join(map(str, dims))}) array of coordinates, "
-                    f"received shape {arr.shape}; pass one row per point")
+        raise error(f"{name}: expected an {' or '.join(f'(n, {d})' for d in dims)} array of "
+                    f"coordinates, received shape {arr.shape}; pass one row per point")
     top = float(np.abs(arr).max(initial=0.0))
     if top >= config.COORDINATE_LIMIT:
         raise error(f"{name}: expected coordinates below {config.COORDINATE_LIMIT:g} in "

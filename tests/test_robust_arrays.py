@@ -50,9 +50,9 @@ def test_query_radii(bad, match):
 @pytest.mark.parametrize("bad, match", [
     (np.full(3, 0.3), r"horizon: expected a number or an array of shape \(121,\), received "
                       r"shape \(3,\)"),
-    (np.r_[np.full(N - 1, 0.3), np.nan], r"horizon: expected finite values, received NaN at "
-                                         r"index 120"),
-    (np.inf, r"horizon: expected finite values, received inf")])
+    (np.r_[np.full(N - 1, 0.3), np.nan], r"horizon must be positive and finite, received "
+                                         r"nan at point 120"),
+    (np.inf, r"horizon must be positive and finite, received inf at point 0")])
 def test_per_point_horizons(bad, match):
     with pytest.raises(cnem.SpatialError, match=match):
         family_search(POINTS, bad)
@@ -89,7 +89,7 @@ def test_node_coordinates_nan_named_by_row():
     with pytest.raises(cnem.InputError, match=r"points: expected finite values, received NaN at "
                                               r"index \(121, 0\).*drop or repair"):
         pd.Body(pts, 0.01, 0.3)
-    with pytest.raises(cnem.InputError, match=r"expected an \(n, 2 or 3\) array"):
+    with pytest.raises(cnem.InputError, match=r"expected an \(n, 2\) or \(n, 3\) array"):
         check_points("points", np.zeros((4, 4)))
 
 

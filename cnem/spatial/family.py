@@ -189,11 +189,13 @@ def family_search(points: ArrayLike, horizon: float | ArrayLike, *,
     pts = as_points(arr if arr.size else arr.reshape(0, arr.shape[-1] if arr.ndim == 2 else 2))
     n, d = pts.shape
     per = check_period(period, d, pts)
-    h = check_array("horizon", horizon, shape=(n,), broadcast=True, error=SpatialError,
-                    fix="pass a number or one positive distance per point")
-    if n and (h <= 0).any():
-        raise SpatialError(f"horizon must be positive and finite, received min {h.min()!r}; "
-                           f"pass a positive distance")
+    h = check_array("horizon", horizon, shape=(n,), broadcast=True, finite=False,
+                    error=SpatialError, fix="pass a number or one positive distance per point")
+    bad = ~(np.isfinite(h) & (h > 0))
+    if bad.any():
+        first = int(np.argmax(bad))
+        raise SpatialError(f"horizon must be positive and finite, received {float(h[first])!r} at point "
+                           f"{first}; pass a positive distance")
     if n == 0:
         return Family(np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int32), h, per)
     if method == "auto":
