@@ -17,7 +17,8 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLE
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
            "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER",
-           "DT_LIMIT", "COORDINATE_LIMIT"]
+           "DT_LIMIT", "COORDINATE_LIMIT", "DIRECT_MEMORY", "DIRECT_FILL",
+           "CG_MAXITER"]
 
 # ---------------------------------------------------------------- geometry tolerances
 #: Coordinates (and their extent) must stay below this in magnitude: squared distances
@@ -83,6 +84,19 @@ MESH_NODES_RTOL = 0.05
 #: factors fill in much faster (at 200k unknowns: 74 s direct against 7 s for
 #: smoothed aggregation + CG, 36 iterations).
 DIRECT_NNZ = 2_500_000
+
+#: CG iterations `cnem.assembly.linsolve.solve_spd` allows before it calls a solve stalled.
+CG_MAXITER = 2000
+
+#: Bytes a sparse direct factor may take when `solve_spd` falls back to it after a
+#: stalled iterative solve (None: half of the memory available when it is asked).
+DIRECT_MEMORY = None
+
+#: ``(fill, unknowns, exponent)``: SuperLU's factor (COLAMD) holds about
+#: ``fill (N / unknowns)^exponent`` times the matrix's non-zeros (measured on
+#: branch-enriched SCNI stiffnesses: 7.3 at 6.3k unknowns, 14.9 at 40k; the rule is
+#: 10 % above both).
+DIRECT_FILL = (16.5, 40_000, 0.4)
 
 #: Largest relative tolerance of the inner linear solve of a Newton step in
 #: `cnem.pd.Problem.solve_static` (inexact Newton: ``min(NEWTON_FORCING, |R| / ref)``).

@@ -304,14 +304,19 @@ class Elasticity(Conditions):
         """The keywords of `cnem.assembly.linsolve.solve_spd` for the system on ``dofs``
         (the free ones): the P1 matrix its smoothed aggregation is built on (made only
         if the iterative path is taken), and for plain SCNI smoothing with K itself
-        (its oscillating low-energy modes, which P1 lacks).
+        (its oscillating low-energy modes, which P1 lacks); with enrichment, which
+        of the dofs are nodal (the enriched block is then solved exactly inside the
+        preconditioner).
 
         Returns
         -------
         dict
         """
-        return dict(preconditioner=lambda: self.preconditioner_matrix(dofs),
-                    smooth_with_matrix=self.stabilization == 0)
+        options = dict(preconditioner=lambda: self.preconditioner_matrix(dofs),
+                       smooth_with_matrix=self.stabilization == 0)
+        if self.enrichment is not None:
+            options["nodal"] = np.asarray(dofs) < 2 * len(self.model.nodes)
+        return options
 
     def preconditioner_matrix(self, dofs: np.ndarray | None = None) -> sp.spmatrix | None:
         """The P1 stiffness of the nodes on the model's triangles (same materials):
@@ -352,7 +357,10 @@ class Elasticity(Conditions):
             aggregation (rigid-body modes) + CG above, the hierarchy built on the P1
             stiffness of the same nodes on the model's triangles (without enrichment:
             see `preconditioner_matrix`; for plain SCNI, ``stabilization=0``, the
-            finest level smoothed with K itself).
+            finest level smoothed with K itself). With enrichment the hierarchy is
+            built on the nodal block and the enriched block is factorised (see
+            `cnem.assembly.linsolve.solve_spd`). A stalled CG falls back to the direct
+            solve when its factor fits in memory (`cnem.config.DIRECT_MEMORY`).
         tol : float
             Relative residual of the iterative solver.
         progress : bool, optional
@@ -365,7 +373,9 @@ class Elasticity(Conditions):
         Raises
         ------
         SolveError
-            Rigid motions not fixed by the Dirichlet conditions (named).
+            Rigid motions not fixed by the Dirichlet conditions (named), or a stalled
+            iterative solve whose direct fallback would not fit in memory (the message
+            says what to change).
         """
         if progress is None:
             progress = sys.stderr.isatty()
