@@ -45,7 +45,10 @@ OptionError True
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import TypeVar
+from typing import TYPE_CHECKING, TypeVar
+
+if TYPE_CHECKING:
+    import numpy as np
 
 _Value = TypeVar("_Value")
 
@@ -206,7 +209,7 @@ def check_choice(name: str, value: _Value, choices: Iterable[object], *,
 
 def check_array(name: str, value: object, *, shape: tuple | None = None, broadcast: bool = False,
                 finite: bool = True, positive: bool = False, nonnegative: bool = False,
-                error: type[InputError] = InputError, fix: str = "") -> "np.ndarray":
+                error: type[InputError] = InputError, fix: str = "") -> np.ndarray:
     """``value`` as a float64 array, checked at a public boundary: its shape, its dtype
     (numbers), finiteness (NaN and inf named with their first index) and sign.
 
@@ -280,7 +283,7 @@ def check_array(name: str, value: object, *, shape: tuple | None = None, broadca
 
 
 def check_points(name: str, value: object, *, dims: tuple = (2, 3),
-                 error: type[InputError] = InputError) -> "np.ndarray":
+                 error: type[InputError] = InputError) -> np.ndarray:
     """``value`` as ``(n, d)`` float64 coordinates: `check_array` (finite, rows of
     ``d`` in ``dims``) and magnitudes below `cnem.config.COORDINATE_LIMIT` (whose squares,
     the squared distances and in-circle tests, stay representable).
