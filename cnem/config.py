@@ -88,9 +88,10 @@ DIRECT_NNZ = 2_500_000
 #: CG iterations `cnem.assembly.linsolve.solve_spd` allows before it calls a solve stalled.
 CG_MAXITER = 2000
 
-#: Bytes a sparse direct factor may take when `solve_spd` falls back to it after a
-#: stalled iterative solve (None: half of the memory available when it is asked).
-DIRECT_MEMORY = None
+#: Memory a sparse direct factor may take when `solve_spd` falls back to it after a
+#: stalled iterative solve: a fraction (at most 1) of the memory available when it is
+#: asked, or bytes (above 1).
+DIRECT_MEMORY = 0.5
 
 #: ``(fill, unknowns, exponent)``: SuperLU's factor (COLAMD) holds about
 #: ``fill (N / unknowns)^exponent`` times the matrix's non-zeros (measured on

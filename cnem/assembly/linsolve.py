@@ -263,13 +263,15 @@ def direct_factor_bytes(A: sp.spmatrix) -> float:
 
 
 def _memory_budget():
-    """`cnem.config.DIRECT_MEMORY`, or half of the memory available now."""
-    if config.DIRECT_MEMORY is not None:
-        return float(config.DIRECT_MEMORY)
+    """Bytes of `cnem.config.DIRECT_MEMORY`: itself above 1, else that fraction of the
+    memory available now."""
+    share = float(config.DIRECT_MEMORY)
+    if share > 1.0:
+        return share
     try:
-        return 0.5 * os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):        # no sysconf: a modest default
-        return 2e9
+        return share * os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):        # no sysconf: of a modest 4 GB
+        return share * 4e9
 
 
 def _fall_back(A, b, rel, its, tol, what):
