@@ -20,36 +20,24 @@ Run: ``python benchmarks/enriched_solve.py --nodes 16000 100000 [--direct]``.
 
 import argparse
 import logging
+import pathlib
+import sys
 import time
 
 import numpy as np
 import scipy.sparse.linalg as spla
-from skfem import condense
 
-import cnem
 from cnem.assembly import linsolve
 
 from _harness import peak_rss_bytes
 
 
 def build(nodes, radius):
-    """The condensed system and its nodal mask and rigid modes."""
-    h = 1.0 / np.sqrt(nodes)
-    dom = cnem.Domain([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]],
-                      cracks=[[[-0.1, 0.0], [0.1, 0.0]]])
-    model = cnem.discretize(cnem.nodes.regular(dom, h))
-    prob = cnem.Elasticity(model, (1.0, 0.3), enrich=dict(radius=radius, functions="branch"))
-    prob.add_dirichlet(lambda p: p[:, 1] < -0.5 + 1e-9, None)
-    prob.add_dirichlet(lambda p: p[:, 1] > 0.5 - 1e-9, 1, 1e-3)
-    K, f = prob.stiffness(), prob.load()
-    D, values = prob.prescribed()
-    x = np.zeros(K.shape[0])
-    x[D] = values
-    A, b, _, interior = condense(K, f, x=x, D=D)
-    modes = np.zeros((K.shape[0], 3))
-    modes[:2 * len(model.nodes)] = linsolve.rigid_modes(model.nodes)
-    return len(model.nodes), A.tocsr(), b, prob.solver_options(interior)["nodal"], \
-        modes[interior]
+    """The condensed system, its nodal mask and rigid modes (the tests' plate,
+    `tests/test_robust_solve.py`)."""
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
+    from test_robust_solve import _centre_cracked
+    return _centre_cracked(1.0 / np.sqrt(nodes), radius)
 
 
 def main():
@@ -61,8 +49,8 @@ def main():
     logging.basicConfig(level=logging.INFO, format="  %(message)s")
     for nodes in args.nodes:
         start = time.perf_counter()
-        n, A, b, nodal, modes = build(nodes, args.radius)
-        print(f"{n} nodes, {A.shape[0]} unknowns ({(~nodal).sum()} enriched), {A.nnz} "
+        A, b, nodal, modes = build(nodes, args.radius)
+        print(f"{A.shape[0]} unknowns ({(~nodal).sum()} enriched), {A.nnz} "
               f"non-zeros, estimated direct factor {linsolve.direct_factor_bytes(A) / 1e9:.2f} "
               f"GB; model + K {time.perf_counter() - start:.1f} s", flush=True)
         start = time.perf_counter()
