@@ -38,6 +38,7 @@ from ..geometry.update import update
 from ..material import kappa as kolosov
 from ..nodes import irregular
 from . import advance
+from .refine import Refinement, as_refinement, refined_cloud
 from .criteria import CRITERIA, kink
 from .history import CrackPath, GrowthEvent, Step
 from .interaction import sif
@@ -85,8 +86,9 @@ class _Run:
     """The mutable state of one `grow` call."""
 
     def __init__(self, domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep,
-                 local):
+                 local, refine=None):
         self.domain, self.cloud, self.setup, self.local = domain, cloud, setup, local
+        self.refine = refine          # the cloud that is discretized: `nodes()`
         self.criterion, self.K_Ic, self.max_kink = criterion, K_Ic, max_kink
         self.measure, self.radius, self.keep = measure, radius, keep
         self.cracks = [np.array(c, dtype=float) for c in domain.cracks]
@@ -108,13 +110,22 @@ class _Run:
         self.model = self.problem.model
         return self.problem.solve(progress=False)
 
+    def nodes(self):
+        """The cloud of this increment: the background ``cloud``, refined about the
+        active tips when ``refine`` is set (`cnem.fracture.refine`)."""
+        if self.refine is None:
+            return self.cloud
+        tips = [self.cracks[c][e] for c, e, active in self.rows if active]
+        return refined_cloud(self.cloud, np.reshape(tips, (-1, 2)), self.refine)
+
     def _problem(self):
         """``setup`` on the model of the current cloud: by a local update of the previous
         model and problem (`cnem.geometry.update.update`, the problem's ``update_from``)
         while ``local``, else (and when the problem refuses the update) from scratch."""
+        cloud = self.nodes()
         if not self.local or self.problem is None:
-            return self.setup(discretize(self.cloud, progress=False))
-        change = update(self.model, self.cloud, progress=False)
+            return self.setup(discretize(cloud, progress=False))
+        change = update(self.model, cloud, progress=False)
         prob = self.setup(change.model)
         update_from = getattr(prob, "update_from", None)
         if update_from is None:
@@ -251,7 +262,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
          K_Ic: float | None = None, paris: np.ndarray | None = None, exponent: float | None = None,
          max_kink: float | None = None, measure: Callable[..., np.ndarray] | None = None,
          radius: float | None = None, clearance: float = 0.5, keep: bool = True, local: bool = True,
-         progress: bool = True) -> CrackPath:
+         refine: Refinement | float | None = None, progress: bool = True) -> CrackPath:
     """Grow the cracks of a domain step by step (quasi-static LEFM).
 
     Parameters
@@ -294,6 +305,12 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         operators from scratch. A problem that refuses the update (enrichment, other
         settings than the previous one) falls back to the full build, said once through
         `logging`.
+    refine : Refinement or float, optional
+        Nodes graded towards every growing tip (`cnem.fracture.refine`): a disc
+        about each tip whose spacing falls to ``refine.spacing`` (a float: that
+        spacing) at the tip; the disc moves with the tip and the background nodes
+        come back behind it, so the cloud keeps its size. ``cloud`` is then the
+        background cloud. Default none.
     progress : bool
         A progress bar over the steps.
 
@@ -333,7 +350,8 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
     elif cloud.domain is not domain:
         raise GrowthError("cloud: expected a NodeCloud of `domain` (cloud.domain is domain), "
                           "received one of another domain; build it with cnem.nodes from `domain`")
-    run = _Run(domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep, bool(local))
+    run = _Run(domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep, bool(local),
+               as_refinement(refine))
     bar = tqdm(total=steps, desc="crack growth", unit="step", disable=not progress, leave=False)
     sol = run.solve()
     mark = 0                                  # first event of the current step
