@@ -85,3 +85,15 @@ def test_bad_refinements_raise_growth_errors():
         refined_cloud(cloud, dom.tips, Refinement(spacing=2 * H))
     with pytest.raises(GrowthError, match="at least the spacing difference"):
         refined_cloud(cloud, dom.tips, Refinement(spacing=H / 4, radius=H / 2))
+
+
+def test_a_crack_tip_far_ahead_on_the_prolonged_line_is_not_joined():
+    """Only a tip within reach of the new segment joins it (not one farther on its line)."""
+    from cnem.fracture.advance import first_hit
+    cracks = [np.array([[0.0, 0.5], [0.2, 0.5]]), np.array([[1.0, 0.5], [0.8, 0.5]])]
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=cracks)
+    far = first_hit(dom, cracks, 0, -1, cracks[0][-1], np.array([0.3, 0.5]), 0.05)
+    assert far.kind is None
+    near = first_hit(dom, cracks, 0, -1, cracks[0][-1], np.array([0.78, 0.5]), 0.05)
+    assert near.kind == "joined" and near.crack == 1
+    np.testing.assert_array_equal(near.point, [0.8, 0.5])

@@ -127,8 +127,8 @@ def first_hit(domain: Domain, cracks: list, crack: int, end: int, start: np.ndar
             continue
         for other_end in (0, -1):                # a tip ahead, within reach of the segment
             t, dist = segment_projection(c[other_end], start, start + (length + reach) * e)
-            s = float(t[0]) * (length + reach)
-            if dist[0] < reach and tol < s < best.distance + reach \
+            s = float(t[0]) * (length + reach)        # along the probe, not the line beyond it
+            if dist[0] < reach and tol < s < min(best.distance + reach, length + reach) \
                     and domain.polygon.boundary.distance(Point(c[other_end])) > tol:
                 best = Hit("joined", s, c[other_end].copy(), j, other_end)
     if best.kind == "crack" and best.crack != crack:
@@ -178,6 +178,8 @@ def grown_cloud(cloud: NodeCloud, domain: Domain, segments: list, spacings: list
         new_h.append(np.full(pieces, h))
     new_pts, new_h = np.concatenate(new_pts), np.concatenate(new_h)
     fresh = cKDTree(pts[keep]).query(new_pts)[0] > domain.tolerance   # a joined tip is a node
+    twice = cKDTree(new_pts).query_pairs(domain.tolerance, output_type="ndarray")
+    fresh[twice.max(axis=1)] = False          # two tips that met in this step: one node
     points = np.concatenate([pts[keep], new_pts[fresh]])
     given = np.concatenate([spacing[keep], new_h[fresh]])
     out = from_points(domain, points)

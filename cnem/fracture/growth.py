@@ -173,7 +173,9 @@ class _Run:
         """Append the new segments; update the domain and the cloud."""
         segments, spacings = [], []
         for i in np.flatnonzero(increments > 0):
-            c, end, _ = self.rows[i]
+            c, end, active = self.rows[i]
+            if not active:                  # joined by another tip earlier in this step
+                continue
             crack = self.cracks[c]
             start = crack[end].copy()
             d = advance.tip_direction(crack, end)
