@@ -8,6 +8,7 @@ and behind the tip the nodes are the background ones again.
 
 import numpy as np
 import pytest
+import shapely
 from scipy.spatial import cKDTree
 
 import cnem
@@ -97,3 +98,20 @@ def test_a_crack_tip_far_ahead_on_the_prolonged_line_is_not_joined():
     near = first_hit(dom, cracks, 0, -1, cracks[0][-1], np.array([0.78, 0.5]), 0.05)
     assert near.kind == "joined" and near.crack == 1
     np.testing.assert_array_equal(near.point, [0.8, 0.5])
+
+
+def test_a_segment_grazing_a_hole_is_carried_onto_it():
+    """A segment that passes closer than ``reach`` to a hole without crossing it ends on the
+    hole (a thinner ligament than the nodes resolve) instead of touching it."""
+    from cnem.fracture.advance import first_hit
+    hole = cnem.geometry.arc((0.5, 0.7), 0.2, 0.0, 2 * np.pi, 0.02)[:-1][::-1]
+    crack = np.array([[0.0, 0.5], [0.2, 0.5]])
+    dom = cnem.Domain([([[0, 0], [1, 0], [1, 1], [0, 1]], [hole])], cracks=[crack])
+    lowest = dom.polygon.interiors[0].coords
+    bottom = min(y for _, y in lowest)
+    start = np.array([0.2, bottom - 0.01])
+    hit = first_hit(dom, [np.array([[0.0, start[1]], start])], 0, -1, start,
+                    start + [0.6, 0.0], 0.03)
+    assert hit.kind == "hole"
+    assert abs(hit.point[0] - 0.5) < 0.03
+    assert shapely.Point(hit.point).distance(dom.polygon.interiors[0]) < 1e-9

@@ -209,7 +209,8 @@ STUDY = ((0.25, 1.0, None, False), (0.25, 1.0, None, True), (0.25, 1.0, RING, Fa
          (0.125, 0.5, RING, False), (0.125, 0.25, RING, False))
 
 
-def study(runs=STUDY, outdir: str = "results/growth_two_holes", progress: bool = False) -> list:
+def study(runs: Sequence[tuple] = STUDY, outdir: str = "results/growth_two_holes",
+          progress: bool = False) -> list:
     """Convergence of the paths with the spacing and the increment (long: minutes).
 
     Every run is compared at equal crack lengths (3, 5, ..., 11 and 12.5 mm from the mouth,

@@ -3,8 +3,9 @@ and the node cloud of the grown domain.
 
 A new segment runs from the tip at the kink angle for the tip's increment. It
 is cut where it meets the outer boundary, a hole or another crack; when it ends
-within ``clearance`` local spacings of the boundary it is carried on to it (no
-ligament thinner than the nodes can resolve). Meeting another crack's tip
+or passes within ``clearance`` local spacings of the boundary it is carried on
+to it, to the boundary point nearest to the segment (no ligament thinner than
+the nodes can resolve). Meeting another crack's tip
 joins the two cracks into one polyline. The cloud keeps its nodes, but those
 closer than ``clearance`` local spacings to a new segment, and gets nodes
 along each new segment about one local spacing apart (the new tip among them).
@@ -19,6 +20,7 @@ import numpy as np
 import shapely
 from scipy.spatial import cKDTree
 from shapely.geometry import LineString, Point
+from shapely.ops import nearest_points
 
 from ..errors import GeometryError
 from ..geometry.domain import Domain
@@ -110,11 +112,18 @@ def first_hit(domain: Domain, cracks: list, crack: int, end: int, start: np.ndar
     probe = LineString([start, start + (length + reach) * e])
     tol = domain.tolerance
     best = Hit(None, np.inf, stop)
+    segment = LineString([start, stop])
     for ring, kind in _rings(domain):
-        for p in _points_of(probe.intersection(ring)):
+        crossings = _points_of(probe.intersection(ring))
+        for p in crossings:
             s = float((p - start) @ e)
             if tol < s < best.distance:
                 best = Hit(kind, s, p)
+        if len(crossings) == 0 and segment.distance(ring) < reach:   # grazes it: a thin ligament
+            on_segment, on_ring = (np.asarray(q.coords[0]) for q in nearest_points(segment, ring))
+            s = float((on_segment - start) @ e)
+            if tol < s < best.distance:
+                best = Hit(kind, float(np.hypot(*(on_ring - start))), on_ring)
     for j, c in enumerate(cracks):
         line = c[:-1] if (j == crack and end == -1) else c[1:] if j == crack else c
         if len(line) < 2:
