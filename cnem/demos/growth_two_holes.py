@@ -35,14 +35,30 @@ towards the hole at (17, 3), which it does not reach.
 
 What we find (``--study``)
 --------------------------
-Our cracks are drawn much closer to the hole they pass first: the left crack
-keeps turning up after its first kink (about +14, +10, +3 degrees) to y = 5
-at x = 4.3, 0.4 mm below the hole at (3, 7), then turns back and runs at
-y = 5.0 - 5.3 until the two cracks pass each other near the centre and stop
-(event "crack") after 11 steps. The study table gives the path against the
-node spacing, the increment and the supports: the supports of the published
-run change our path by a few hundredths of a mm only. See the docstring of
-`study` and the closing note of issue 18 for the numbers.
+The spacing does not change our path, the increment does. Measured (left
+crack; the right one is its half-turn image to 0.01 mm):
+
+* first kink 16.0 degrees (h = 0.25, no rings), 16.81 (h = 0.25, rings h/4),
+  16.85 (h = 0.125, rings h/4), 16.88 (h = 0.125, rings h/8): converged at
+  16.9, the published one is 19.2. The second kink (after 1 mm) is +13.7
+  with every cloud (published +1.6): our crack keeps turning up towards the
+  hole at (3, 7), with K_II / K_I about -0.12 after each kink.
+* increment 1 mm: the crack passes 0.4 mm below that hole at (4.3, 5.0),
+  kinks down by 24 and 30 degrees, runs at y = 5.0 - 5.3 and meets the other
+  crack near the centre after 11 steps (event "crack"); h = 0.25 and
+  h = 0.125 give the same path to 0.15 mm. Increment 0.5 mm: it passes the
+  hole 0.09 mm from it at (4.50, 5.54). Increment 0.25 mm (h = 0.25 and
+  0.125, rings h/4 and h/8): it runs *into* the hole at (3.96, 5.25) (within
+  0.04 mm in all three runs) at a crack length of 4.9 mm (event "hole").
+* the published supports (u_x = 0 at two corners; h = 0.25, no rings) move
+  our tips by less than 0.01 mm over the first 4 steps and by 0.2 - 0.45 mm
+  after the crack has passed the hole; they are not the cause of the gap.
+
+So the converged C-NEM path of this problem by maximum hoop stress ends in
+the first hole; the published path, one mesh and 1 mm increments, does not
+curve towards it at all (its K_II vanishes after the first kink). Ours at
+1 mm increments ends 1.3 mm from the published end points, about 2 mm from
+the published path (Hausdorff). We tuned nothing to close that gap.
 
 Expected result
 ---------------
