@@ -35,8 +35,8 @@ import importlib
 from .errors import (CNEMError, ConditionError, FormatError, FormError, FractureError,
                      GeometryError, GrowthError, GrowthWarning, HyperDualError, InputError,
                      LimitError, MaterialError, MissingExtraError, OptionError,
-                     PlotDependencyError, PlotError, PlotInputError, SolveError, SpatialError,
-                     UnsupportedError)
+                     PlotDependencyError, PlotError, PlotInputError, SIFWarning, SolveError,
+                     SpatialError, UnsupportedError)
 
 __version__ = "0.1.0"
 
@@ -54,7 +54,7 @@ __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticS
            "spatial", "hyperdual", "pd", "fem", "material",
            "CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError", "FormError",
            "ConditionError", "SpatialError", "FractureError", "GrowthError", "FormatError",
-           "HyperDualError", "GrowthWarning", "MissingExtraError",
+           "HyperDualError", "GrowthWarning", "SIFWarning", "MissingExtraError",
            "LimitError", "UnsupportedError", "SolveError", "PlotError", "PlotDependencyError",
            "PlotInputError", "__version__"]
 

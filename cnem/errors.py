@@ -28,6 +28,7 @@ keeps working while ``except cnem.CNEMError`` catches everything cnem raises.
         └── PlotInputError (InputError)          a bad field name or view
 
     GrowthWarning (UserWarning)          a crack-growth event worth a look (not an error)
+    SIFWarning (UserWarning)             stress intensity factors that do not check out
 
 >>> from cnem import errors
 >>> errors.check_choice("plane", "strain", ("stress", "strain"))
@@ -50,6 +51,7 @@ __all__ = ["CNEMError", "InputError", "OptionError", "GeometryError", "MaterialE
            "FormError", "ConditionError", "SpatialError", "FractureError", "GrowthError",
            "FormatError", "HyperDualError", "LimitError", "UnsupportedError", "SolveError",
            "PlotError", "PlotDependencyError", "PlotInputError", "MissingExtraError", "GrowthWarning",
+           "SIFWarning",
            "check_choice"]
 
 
@@ -115,7 +117,12 @@ class SolveError(CNEMError, RuntimeError):
 
 class GrowthWarning(UserWarning):
     """A crack-growth event the user should look at (see `cnem.fracture.history.EVENT_KINDS`);
-    a warning, not an error: the only class here outside `CNEMError`."""
+    a warning, not an error (like `SIFWarning`, outside `CNEMError`)."""
+
+
+class SIFWarning(UserWarning):
+    """Stress intensity factors that do not check themselves: K differs between the nested
+    integration discs, or a user's disc reaches past an obstacle (`cnem.fracture.sif`)."""
 
 
 class MissingExtraError(CNEMError, ImportError):
