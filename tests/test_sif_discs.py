@@ -129,7 +129,8 @@ def _centre_crack(h, gamma_deg=0.0, a=0.2, W=1.0, H=2.0):
 
 def test_coarse_centre_crack_disc_stops_short_of_the_other_tip():
     """a/W = 0.2 on a uniform cloud of 4 spacings per crack: six spacings (the old default)
-    would span the other tip (+11 % on this plate); the default discs stop before it."""
+    would span the other tip (+8.2 % on this plate); the default discs stop before it
+    (measured -3.6 %, and -1.0 % at h = 0.05)."""
     sol, d, exact = _centre_crack(0.1)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
