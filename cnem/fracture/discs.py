@@ -29,6 +29,7 @@ from ..errors import FractureError
 
 if TYPE_CHECKING:
     from ..geometry.domain import Domain
+    from ..geometry.model import Model
 
 __all__ = ["Clearance", "clearance", "default_radii", "local_spacing"]
 
@@ -54,7 +55,7 @@ class Clearance(NamedTuple):
     point: np.ndarray
 
 
-def local_spacing(model, tip: np.ndarray) -> float:
+def local_spacing(model: Model, tip: np.ndarray) -> float:
     """Median length of the triangle edges at the node nearest to ``tip``."""
     node = np.argmin(np.hypot(*(model.nodes - tip).T))
     tri = model.triangles[(model.triangles == node).any(axis=1)]
@@ -133,7 +134,7 @@ def clearance(domain: Domain, tip: np.ndarray, direction: np.ndarray) -> Clearan
     return Clearance(distance, obstacle, np.asarray(where, dtype=float))
 
 
-def default_radii(model, tip: np.ndarray, limit: Clearance) -> tuple[np.ndarray, float]:
+def default_radii(model: Model, tip: np.ndarray, limit: Clearance) -> tuple[np.ndarray, float]:
     """Nested disc radii about a tip: ``SIF_DISCS`` radii in geometric progression from
     ``SIF_INNER`` times the largest to the largest, ``SIF_REACH`` times the clearance.
 
