@@ -17,7 +17,7 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLE
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
            "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER", "SIF_DISCS",
-           "SIF_REACH", "SIF_INNER", "SIF_STRAIGHTNESS", "SIF_SPREAD", "SIF_SPACINGS"]
+           "SIF_REACH", "SIF_INNER", "SIF_STRAIGHTNESS", "SIF_BEND_SPACINGS", "SIF_SPREAD", "SIF_SPACINGS"]
 
 # ---------------------------------------------------------------- geometry tolerances
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
@@ -149,6 +149,11 @@ SIF_INNER = 0.5
 #: The crack inside a disc of radius R may leave the straight line through the tip
 #: by at most this times R (a kink or a curved path behind the tip limits the disc).
 SIF_STRAIGHTNESS = 0.01
+
+#: ... but a kink or bend limits the default discs to no fewer than this many local
+#: node spacings (a kink one increment behind a growing tip would leave a disc of a
+#: spacing or less, whose K is off by tens of %; six spacings was the old default).
+SIF_BEND_SPACINGS = 6.0
 
 #: Relative spread of K over the discs above which `cnem.fracture.sif` warns.
 SIF_SPREAD = 0.01

@@ -25,7 +25,7 @@ from scipy.spatial import cKDTree
 import cnem
 from cnem.errors import SIFWarning
 from cnem.fracture import nodal_williams, sif
-from cnem.fracture.discs import clearance
+from cnem.fracture.discs import clearance, default_radii
 from cnem.geometry import SegmentKind
 
 E, NU, KI, KII = 1.0, 0.3, 1.0, 0.5
@@ -174,11 +174,29 @@ def test_clearance_sees_holes_interfaces_other_cracks_and_kinks():
     kinked = cnem.geometry.rectangle(2.0, 2.0, origin=(-1, -1),
                                      cracks=[[[-0.2 - 0.5 * np.cos(k), 0.5 * np.sin(k)], [-0.2, 0.0], [0, 0]]])
     lim = clearance(kinked, *kinked.tip_frame((0.0, 0.0)))
-    assert "kink" in lim.obstacle
-    assert 0.2 < lim.distance < 0.2 / (1 - cnem.config.SIF_STRAIGHTNESS / np.sin(k)) * 1.01
+    assert lim.obstacle == "the other tip of crack 0"
+    np.testing.assert_allclose(lim.distance, np.hypot(0.2 + 0.5 * np.cos(k), 0.5 * np.sin(k)))
+    assert 0.2 < lim.straight < 0.2 / (1 - cnem.config.SIF_STRAIGHTNESS / np.sin(k)) * 1.01
     # a straight crack split into collinear pieces (crack growth) is one straight crack
     pieces = cnem.geometry.rectangle(1.0, 2.0, cracks=[[[0.0, 1.0], [0.1, 1.0], [0.15, 1.0], [0.2, 1.0]]])
-    np.testing.assert_allclose(clearance(pieces, *pieces.tip_frame((0.2, 1.0))).distance, 0.2, rtol=1e-12)
+    lim = clearance(pieces, *pieces.tip_frame((0.2, 1.0)))
+    np.testing.assert_allclose(lim.distance, 0.2, rtol=1e-12)
+    assert lim.straight == np.inf
+
+
+def test_a_kink_limits_the_discs_but_not_below_a_few_spacings():
+    """Discs stop at a kink far behind the tip; a fresh kink one spacing behind a growing tip
+    leaves them six spacings wide (a smaller disc cannot resolve the field)."""
+    for s0, h in ((0.3, 0.1), (0.05, 0.05)):
+        k = np.deg2rad(20.0)
+        dom = cnem.geometry.rectangle(2.0, 2.0, origin=(-1, -1),
+                                      cracks=[[[-s0 - 0.5 * np.cos(k), 0.5 * np.sin(k)], [-s0, 0.0], [0, 0]]])
+        model = cnem.discretize(cnem.nodes.regular(dom, h), progress=False)
+        lim = clearance(dom, *dom.tip_frame((0.0, 0.0)))
+        radii, spacing, limited_by = default_radii(model, np.zeros(2), lim)
+        assert "bend" in limited_by
+        np.testing.assert_allclose(radii[-1], max(0.9 * lim.straight, 6 * spacing), rtol=1e-12)
+        assert radii[-1] < lim.distance
 
 
 def test_clearance_is_relative_to_the_model():

@@ -10,11 +10,12 @@ auxiliary fields are traction-free too). A disc must therefore stay
 * clear of every other crack, and of the other tip of its own crack;
 * on the straight part of its own crack: the crack inside the disc of radius ``R``
   may leave the line through the tip by at most ``SIF_STRAIGHTNESS * R``
-  (`cnem.config`), so a kink or a curved crack path behind the tip limits ``R``.
+  (`cnem.config`), so a kink or a curved crack path behind the tip limits ``R``
+  (a soft limit: not below ``SIF_BEND_SPACINGS`` node spacings).
 
 `clearance` measures that limit on the domain's geometry; `default_radii` spreads
 a few nested discs below it (`cnem.config.SIF_DISCS`, ``SIF_INNER``,
-``SIF_REACH``).
+``SIF_REACH``, ``SIF_BEND_SPACINGS``).
 """
 
 from __future__ import annotations
@@ -38,21 +39,30 @@ _SAMPLES = 256
 
 
 class Clearance(NamedTuple):
-    """The largest disc about a tip the interaction integral may use.
+    """How far a disc about a tip may reach.
 
     Attributes
     ----------
     distance : float
-        Radius at which the disc first meets an obstacle.
+        Radius at which the disc first meets an obstacle it must not cross: the outer
+        boundary, a hole, an interface, another crack, the other tip of its crack.
     obstacle : str
         What it meets (for messages).
     point : (2,) ndarray
         Where.
+    straight : float
+        Radius up to which the own crack stays on the straight line through the tip
+        (``inf`` when it does up to ``distance``): beyond it the auxiliary fields are
+        no longer traction-free on the crack faces, a soft limit (`default_radii`).
+    bend : (2,) ndarray
+        Where the crack leaves that line (NaN when it does not).
     """
 
     distance: float
     obstacle: str
     point: np.ndarray
+    straight: float = np.inf
+    bend: np.ndarray = np.full(2, np.nan)
 
 
 def local_spacing(model: Model, tip: np.ndarray) -> float:
@@ -127,16 +137,21 @@ def clearance(domain: Domain, tip: np.ndarray, direction: np.ndarray) -> Clearan
     start = crack[0]
     if (np.hypot(*(domain.tips - start).T) == 0).any():
         found.append((float(np.hypot(*(start - tip))), f"the other tip of crack {own}", start))
-    bend = _off_line(crack, tip, direction)
-    if bend is not None:
-        found.append((bend[0], f"a kink or bend of crack {own} behind the tip", bend[1]))
     distance, obstacle, where = min(found, key=lambda f: f[0])
-    return Clearance(distance, obstacle, np.asarray(where, dtype=float))
+    bend = _off_line(crack, tip, direction)
+    if bend is None or bend[0] >= distance:
+        return Clearance(distance, obstacle, np.asarray(where, dtype=float))
+    return Clearance(distance, obstacle, np.asarray(where, dtype=float), bend[0], bend[1])
 
 
-def default_radii(model: Model, tip: np.ndarray, limit: Clearance) -> tuple[np.ndarray, float]:
+def default_radii(model: Model, tip: np.ndarray, limit: Clearance) -> tuple[np.ndarray, float, str]:
     """Nested disc radii about a tip: ``SIF_DISCS`` radii in geometric progression from
     ``SIF_INNER`` times the largest to the largest, ``SIF_REACH`` times the clearance.
+
+    A kink or bend of the own crack closer than that (``limit.straight``) limits the
+    discs too, but not below ``SIF_BEND_SPACINGS`` local node spacings: a disc of a
+    spacing or less cannot resolve the field, while a kink inside the disc only
+    perturbs K by a few % (docs/fracture.md); the hard limit still holds.
 
     Parameters
     ----------
@@ -151,10 +166,19 @@ def default_radii(model: Model, tip: np.ndarray, limit: Clearance) -> tuple[np.n
         Increasing.
     spacing : float
         The local node spacing at the tip (`local_spacing`), to check the discs against.
+    limited_by : str
+        What limits the largest disc (for messages).
     """
+    spacing = local_spacing(model, tip)
     outer = config.SIF_REACH * limit.distance
+    limited_by = f"{limit.obstacle} ({limit.distance:.4g} from the tip)"
+    bent = max(config.SIF_REACH * limit.straight, config.SIF_BEND_SPACINGS * spacing)
+    if bent < outer:
+        outer = bent
+        limited_by = (f"the bend of the crack at {limit.bend.tolist()} "
+                      f"({limit.straight:.4g} from the tip)")
     if not outer > 0:
         raise FractureError(f"the crack tip {tip.tolist()} lies on {limit.obstacle} (at "
                             f"{limit.point.tolist()}): no integration disc fits about it; "
                             "expected a tip inside one material, away from other cracks")
-    return np.geomspace(config.SIF_INNER * outer, outer, config.SIF_DISCS), local_spacing(model, tip)
+    return np.geomspace(config.SIF_INNER * outer, outer, config.SIF_DISCS), spacing, limited_by

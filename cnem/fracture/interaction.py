@@ -133,7 +133,7 @@ def _spread(values):
     return float(np.ptp(values, axis=0).max() / size) if size > 0 else float("nan")
 
 
-def _check(res, spacing, user):
+def _check(res, spacing, limited_by, user):
     """Warn (`SIFWarning`) when the discs disagree, hold too few spacings, or a user's disc
     reaches past an obstacle."""
     lim, at = res.clearance, res.tip.tolist()
@@ -145,16 +145,16 @@ def _check(res, spacing, user):
                       f"below {lim.distance:.4g}, e.g. {best:.4g} (leave radius=None to check "
                       "nested discs up to it)", SIFWarning, stacklevel=3)
         return
-    if not user and best < config.SIF_SPACINGS * spacing:
-        warnings.warn(f"only {best / spacing:.2g} local node spacings ({spacing:.4g}) fit between "
-                      f"the tip {at} and {lim.obstacle} ({lim.distance:.4g} away): K is not "
-                      f"resolved on such discs; refine the nodes near the tip (to a spacing "
-                      f"below {best / (2 * config.SIF_SPACINGS):.3g})", SIFWarning, stacklevel=3)
+    if not user and res.radius < config.SIF_SPACINGS * spacing:
+        warnings.warn(f"only {res.radius / spacing:.2g} local node spacings ({spacing:.4g}) fit "
+                      f"between the tip {at} and {limited_by}: K is not resolved on such "
+                      f"discs; refine the nodes near the tip (to a spacing below "
+                      f"{res.radius / (2 * config.SIF_SPACINGS):.3g})", SIFWarning, stacklevel=3)
     elif res.spread > config.SIF_SPREAD:
         K = ", ".join(f"R = {R:.4g}: ({a:.5g}, {b:.5g})" for R, (a, b) in zip(res.radii, res.values))
         warnings.warn(f"K_I, K_II at the tip {at} vary by {100 * res.spread:.3g} % of |K| over "
                       f"the discs [{K}] (more than {100 * config.SIF_SPREAD:g} %): the largest "
-                      f"disc, radius {res.radii[-1]:.4g} (the largest clear of {lim.obstacle}), is "
+                      f"disc, radius {res.radii[-1]:.4g} (limited by {limited_by}), is "
                       f"the most reliable; use it, or refine the nodes near the tip for a "
                       "converged K", SIFWarning, stacklevel=3)
 
@@ -172,8 +172,8 @@ def sif(sol: Any, tip: np.ndarray, *, radius: float | None = None, order: int = 
         One integration disc of this radius. Default: ``config.SIF_DISCS`` nested discs
         from half the largest to the largest, ``config.SIF_REACH`` (0.9) times the
         distance from the tip to the first obstacle (the outer boundary, a hole, an
-        interface, another crack, the other tip, a kink behind the tip:
-        `cnem.fracture.discs.clearance`); K is that of the largest disc.
+        interface, another crack, the other tip; a kink behind the tip too, but not
+        below six node spacings: `cnem.fracture.discs`); K is that of the largest disc.
     order : int
         Degree of the triangle rule on the cells.
 
@@ -209,11 +209,11 @@ def sif(sol: Any, tip: np.ndarray, *, radius: float | None = None, order: int = 
         if not np.isfinite(radius) or radius <= 0:
             raise FractureError(f"radius: expected a positive number, received {radius}; leave "
                                 f"it None for nested discs up to {limit.obstacle}")
-        radii, spacing = np.array([radius]), float("nan")
+        radii, spacing, limited_by = np.array([radius]), float("nan"), limit.obstacle
     else:
-        radii, spacing = default_radii(model, at, limit)
+        radii, spacing, limited_by = default_radii(model, at, limit)
     values, region = _disc_integrals(sol, at, d, radii, order)
     res = SIFResult(*values[-1], tip=at, direction=d, radius=float(radii[-1]), region=region,
                     radii=radii, values=values, spread=_spread(values), clearance=limit)
-    _check(res, spacing, user)
+    _check(res, spacing, limited_by, user)
     return res
