@@ -171,8 +171,8 @@ def test_clearance_sees_holes_interfaces_other_cracks_and_kinks():
     np.testing.assert_allclose(lim.distance, np.hypot(0.2, 0.15), rtol=1e-9)
     # a 10 degree kink 0.2 behind the tip: the disc may reach little past it
     k = np.deg2rad(10.0)
-    kinked = cnem.geometry.rectangle(2.0, 2.0, origin=(-1, -1),
-                                     cracks=[[[-0.2 - 0.5 * np.cos(k), 0.5 * np.sin(k)], [-0.2, 0.0], [0, 0]]])
+    start = [-0.2 - 0.5 * np.cos(k), 0.5 * np.sin(k)]
+    kinked = cnem.geometry.rectangle(2.0, 2.0, origin=(-1, -1), cracks=[[start, [-0.2, 0.0], [0, 0]]])
     lim = clearance(kinked, *kinked.tip_frame((0.0, 0.0)))
     assert lim.obstacle == "the other tip of crack 0"
     np.testing.assert_allclose(lim.distance, np.hypot(0.2 + 0.5 * np.cos(k), 0.5 * np.sin(k)))
@@ -201,11 +201,12 @@ def test_a_kink_limits_the_discs_but_not_below_a_few_spacings():
 
 def test_clearance_is_relative_to_the_model():
     """The same edge crack moved by 1e6 and scaled by 1e-3: the same clearance, scaled."""
-    base = clearance(*(lambda d: (d, *d.tip_frame(d.tips[0])))(
-        cnem.geometry.rectangle(1.0, 2.0, cracks=[[[0.0, 1.0], [0.3, 1.05]]])))
+    def limit(shift, scale):
+        crack = shift + scale * np.array([[0.0, 1.0], [0.3, 1.05]])
+        dom = cnem.geometry.rectangle(scale, 2 * scale, origin=(shift, shift), cracks=[crack])
+        return clearance(dom, *dom.tip_frame(dom.tips[0]))
+    base = limit(0.0, 1.0)
     for shift, scale in ((1e6, 1.0), (0.0, 1e-3)):
-        dom = cnem.geometry.rectangle(scale, 2 * scale, origin=(shift, shift),
-                                      cracks=[[[shift, shift + scale], [shift + 0.3 * scale, shift + 1.05 * scale]]])
-        lim = clearance(dom, *dom.tip_frame(dom.tips[0]))
+        lim = limit(shift, scale)
         np.testing.assert_allclose(lim.distance, scale * base.distance, rtol=1e-8)
         assert lim.obstacle == base.obstacle
