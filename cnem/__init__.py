@@ -36,8 +36,8 @@ from .errors import (CNEMError, ConditionError, ConvergenceError, DivergenceErro
                      FormatError, FormError, FractureError, GeometryError, GrowthError,
                      GrowthWarning, HyperDualError, InputError,
                      LimitError, MaterialError, MissingExtraError, OptionError,
-                     PlotDependencyError, PlotError, PlotInputError, SolveError, SpatialError,
-                     StabilityWarning, UnsupportedError)
+                     PlotDependencyError, PlotError, PlotInputError, SIFWarning, SolveError,
+                     SpatialError, StabilityWarning, UnsupportedError)
 
 __version__ = "0.1.0"
 
@@ -55,7 +55,7 @@ __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticS
            "spatial", "hyperdual", "pd", "fem", "material",
            "CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError", "FormError",
            "ConditionError", "SpatialError", "FractureError", "GrowthError", "FormatError",
-           "HyperDualError", "GrowthWarning", "MissingExtraError",
+           "HyperDualError", "GrowthWarning", "SIFWarning", "MissingExtraError",
            "LimitError", "UnsupportedError", "SolveError", "PlotError", "PlotDependencyError",
            "PlotInputError", "ConvergenceError", "DivergenceError", "StabilityWarning",
            "__version__"]

@@ -18,7 +18,8 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLE
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
            "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER",
            "DT_LIMIT", "COORDINATE_LIMIT", "DIRECT_MEMORY", "DIRECT_FILL",
-           "CG_MAXITER"]
+           "CG_MAXITER", "SIF_DISCS", "SIF_REACH", "SIF_INNER", "SIF_STRAIGHTNESS",
+           "SIF_BEND_SPACINGS", "SIF_SPREAD", "SIF_SPACINGS"]
 
 # ---------------------------------------------------------------- geometry tolerances
 #: Coordinates (and their extent) must stay below this in magnitude: squared distances
@@ -158,3 +159,32 @@ ROW_SLOTS = 8
 #: triangles, above which they are located with an R-tree of the triangles
 #: (`Model.triangle_tree`, built once) rather than of the circumcircles.
 TRIANGLE_TREE_AFTER = 0.01
+
+# ---------------------------------------------------------------- stress intensity factors
+#: Nested integration discs of `cnem.fracture.sif` by default (3 to 6 make sense).
+SIF_DISCS = 4
+
+#: The largest default disc, as a fraction of the distance from the tip to the first
+#: obstacle (a boundary, a hole, an interface, another crack or tip, a kink behind the
+#: tip; `cnem.fracture.discs.clearance`): the disc stays clear of it.
+SIF_REACH = 0.9
+
+#: The smallest default disc as a fraction of the largest (smaller discs are less
+#: accurate on every cloud measured: docs/fracture.md).
+SIF_INNER = 0.5
+
+#: The crack inside a disc of radius R may leave the straight line through the tip
+#: by at most this times R (a kink or a curved path behind the tip limits the disc).
+SIF_STRAIGHTNESS = 0.01
+
+#: ... but a kink or bend limits the default discs to no fewer than this many local
+#: node spacings (a kink one increment behind a growing tip would leave a disc of a
+#: spacing or less, whose K is off by tens of %; six spacings was the old default).
+SIF_BEND_SPACINGS = 6.0
+
+#: Relative spread of K over the discs above which `cnem.fracture.sif` warns.
+SIF_SPREAD = 0.01
+
+#: Fewer local node spacings than this in the largest disc that fits: `sif` warns
+#: (the discs cannot resolve the near-tip field; refine the nodes at the tip).
+SIF_SPACINGS = 3.0

@@ -31,6 +31,7 @@ keeps working while ``except cnem.CNEMError`` catches everything cnem raises.
 
     GrowthWarning (UserWarning)          a crack-growth event worth a look (not an error)
     StabilityWarning (UserWarning)       a time step above the guaranteed-stable one
+    SIFWarning (UserWarning)             stress intensity factors that do not check out
 
 >>> from cnem import errors
 >>> errors.check_choice("plane", "strain", ("stress", "strain"))
@@ -56,7 +57,8 @@ __all__ = ["CNEMError", "InputError", "OptionError", "GeometryError", "MaterialE
            "FormError", "ConditionError", "SpatialError", "FractureError", "GrowthError",
            "FormatError", "HyperDualError", "LimitError", "UnsupportedError", "SolveError",
            "PlotError", "PlotDependencyError", "PlotInputError", "MissingExtraError", "GrowthWarning",
-           "ConvergenceError", "DivergenceError", "StabilityWarning", "check_choice"]
+           "ConvergenceError", "DivergenceError", "StabilityWarning", "SIFWarning",
+           "check_choice"]
 
 
 class CNEMError(Exception):
@@ -152,12 +154,17 @@ class DivergenceError(SolveError):
 
 class GrowthWarning(UserWarning):
     """A crack-growth event the user should look at (see `cnem.fracture.history.EVENT_KINDS`);
-    a warning, not an error: with `StabilityWarning` the only classes here outside
-    `CNEMError`."""
+    a warning, not an error: with `StabilityWarning` and `SIFWarning` the only classes here
+    outside `CNEMError`."""
 
 
 class StabilityWarning(UserWarning):
     """An explicit time step above the guaranteed-stable one (it may still be stable)."""
+
+
+class SIFWarning(UserWarning):
+    """Stress intensity factors that do not check themselves: K differs between the nested
+    integration discs, or a user's disc reaches past an obstacle (`cnem.fracture.sif`)."""
 
 
 class MissingExtraError(CNEMError, ImportError):

@@ -351,7 +351,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         ``measure(solution) -> float`` recorded per step (a load-point displacement,
         say: times ``load_factor`` it gives the load-displacement curve).
     radius : float, optional
-        Interaction-integral radius (`sif`; default a few local node spacings).
+        Interaction-integral radius (`sif`; default nested discs up to the largest that fits).
     clearance : float
         Nodes closer than ``clearance`` local spacings to a new segment are dropped,
         and a tip that ends this close to the boundary is carried on to it.
