@@ -130,8 +130,9 @@ def test_a_notched_strip_breaks_straight_across_on_its_symmetry_line():
     assert run.steps[0].broken > 0
     # the crack runs between two rows: their points lose ~40 % of their bonds
     path = ridge_path(prob.body.points, run.damage, (0.2, mid), threshold=0.3)
-    assert np.abs(path[1:-1, 1] - mid).max() < 1e-9      # the band's middle: the line itself
-    assert np.abs(path[:, 1] - mid).max() <= 0.5 * 0.05 + 1e-9   # its ends: a row next to it
+    inner = path[(path[:, 0] > 0.2 + 0.15) & (path[:, 0] < 1.0 - 0.15)]
+    assert len(inner) >= 2 and np.abs(inner[:, 1] - mid).max() < 1e-9   # the band's middle
+    assert np.abs(path[:, 1] - mid).max() <= 0.5 * 0.05 + 1e-9   # near its ends: within h / 2
     assert path[-1, 0] > 1.0 - 0.1
     reaction = run.array("reaction")[:, 1]
     assert reaction[-1] < 0.05 * reaction.max()
