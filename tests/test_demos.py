@@ -267,6 +267,24 @@ def check_growth_two_holes(demo, res, outdir):
     assert np.abs(tips[:, 0] + tips[:, 1] - [20.0, 10.0]).max() < 0.15
 
 
+def check_growth_pd_vs_cnem(demo, res, outdir):
+    r = res["results"][0]
+    # C-NEM: both paths start at the initial tips and grow by the 1 mm increments
+    for path, tip in zip(r["cnem_paths"], demo.TIPS):
+        np.testing.assert_allclose(path[0], tip, atol=1e-12)
+        assert np.hypot(*np.diff(path, axis=0).T) == pytest.approx(1.0, rel=1e-9)
+    # both first kinks turn the cracks by less than the maximum-hoop-stress limit (70.5 deg)
+    assert all(abs(row["kink_cnem"]) < 70.6 for row in r["rows"])
+    # PD: the ramp starts where the elastic solution's largest stretch is critical, so the
+    # first bonds break in the first step; damage is a fraction
+    assert r["pd_started"] == pytest.approx(r["pd_first_bond"], rel=1e-12)
+    assert 0.0 <= r["damage"].min() and r["damage"].max() <= 1.0
+    assert r["pd_steps"] <= 4
+    assert "Hausdorff" in res["table"]
+    for f in res["files"]:
+        assert pathlib.Path(f).stat().st_size > 1000
+
+
 CASES = [
     Case("cracked-plate-30", "cracked_plate_geometry",
          check_cracked_plate(30.0, 0.2, 0.04, 0.3, HAS_PYVISTA),
@@ -294,6 +312,8 @@ CASES = [
          sizes=dict(cloud=(0.8, 0.005, 0.3), progress=False), plot=False),
     Case("growth-two-holes", "growth_two_holes", check_growth_two_holes, args=(0.5,),
          sizes=dict(steps=2, progress=False), plot=False),
+    Case("growth-pd-vs-cnem", "growth_pd_vs_cnem", check_growth_pd_vs_cnem, args=((1.0,),),
+         sizes=dict(steps=2, load_steps=4), plot=True),
 ]
 
 

@@ -109,10 +109,10 @@ def _first_breaking_factor(prob):
     return prob.material.stretch_limit(2, prob.plane, b.horizon) / float(stretch.max())
 
 
-def _pd(cloud, model, horizon_factor, factor_step, factor_max, max_rounds):
+def _pd(cloud, model, horizon_factor, factor_step, factor_max, max_rounds, load_steps):
     body, prob = _pd_problem(cloud, model, horizon_factor)
     start = _first_breaking_factor(prob)
-    factors = start * np.arange(1.0, factor_max / start + 1e-9, factor_step)
+    factors = start * np.arange(1.0, factor_max / start + 1e-9, factor_step)[:load_steps]
     # the PMB kernel on one thread: on a shared, busy machine two threads stall each
     # other (measured 20x slower per force evaluation at a load average of 18)
     with one_thread():
@@ -185,7 +185,7 @@ def compare(cnem_path, pd_path, other_cnem, other_pd, direction, increment, reac
 
 
 def study(h, *, model="bond", horizon_factor=3.0, increment=1.0, steps=12, factor_step=0.02,
-          factor_max=1.5, max_rounds=100):
+          factor_max=1.5, max_rounds=100, load_steps=None):
     """Both methods on the regular cloud of spacing ``h``; one dict."""
     dom = plate.domain(h)
     cloud = cnem.nodes.irregular(dom, h, seed=0)
@@ -193,7 +193,7 @@ def study(h, *, model="bond", horizon_factor=3.0, increment=1.0, steps=12, facto
     cpaths, c_factor, hist = _cnem(dom, cloud, increment, steps)
     t1 = time.perf_counter()
     body, run, ppaths, start, started = _pd(cloud, model, horizon_factor, factor_step, factor_max,
-                                            max_rounds)
+                                            max_rounds, load_steps)
     t2 = time.perf_counter()
     rows = [compare(cpaths[i], ppaths[i], cpaths[1 - i], ppaths[1 - i], DIRECTIONS[i], increment,
                     h) for i in range(2)]
@@ -258,8 +258,13 @@ def _plot(results, path):
 
 def main(spacings: Sequence[float] = (0.25,), *, model: str = "bond", steps: int = 12,
          factor_step: float = 0.02, factor_max: float = 1.5, max_rounds: int = 100,
-         outdir: str = "results/growth_pd_vs_cnem", plot: bool = True) -> dict:
+         load_steps: int | None = None, outdir: str = "results/growth_pd_vs_cnem",
+         plot: bool = True) -> dict:
     """Run `study` at every spacing; print the table, draw the paths.
+
+    ``load_steps`` caps the PD load steps (from the first-breaking factor up by
+    ``factor_step`` of it to ``factor_max``); ``max_rounds`` bounds each step's
+    break-and-settle rounds.
 
     Returns
     -------
@@ -271,7 +276,7 @@ def main(spacings: Sequence[float] = (0.25,), *, model: str = "bond", steps: int
     results = []
     for h in spacings:
         r = study(h, model=model, steps=steps, factor_step=factor_step, factor_max=factor_max,
-                  max_rounds=max_rounds)
+                  max_rounds=max_rounds, load_steps=load_steps)
         print(f"h = {h:g}: C-NEM {r['seconds'][0]:.0f} s, PD {r['seconds'][1]:.0f} s "
               f"({r['pd_steps']} load steps, {r['pd_broken']} bonds broken, "
               f"{r['pd_incomplete']} steps cut at max_rounds, stopped: {r['pd_stopped']}; "
