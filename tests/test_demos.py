@@ -276,8 +276,9 @@ def check_growth_pd_vs_cnem(demo, res, outdir):
     # both first kinks turn the cracks by less than the maximum-hoop-stress limit (70.5 deg)
     assert all(abs(row["kink_cnem"]) < 70.6 for row in r["rows"])
     # PD: the ramp starts where the elastic solution's largest stretch is critical, so the
-    # first bonds break in the first step; damage is a fraction
-    assert r["pd_started"] == pytest.approx(r["pd_first_bond"], rel=1e-12)
+    # first bonds break at its first or second step (at the first, the largest stretch is
+    # critical, to round-off); damage is a fraction
+    assert r["pd_first_bond"] <= r["pd_started"] <= 1.02 * r["pd_first_bond"] * (1 + 1e-9)
     assert 0.0 <= r["damage"].min() and r["damage"].max() <= 1.0
     assert r["pd_steps"] <= 4
     assert "Hausdorff" in res["table"]
