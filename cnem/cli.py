@@ -37,6 +37,7 @@ DEMOS = {
     "growth-kink": "growth_kink",
     "growth-two-holes": "growth_two_holes",
     "growth-pd-vs-cnem": "growth_pd_vs_cnem",
+    "growth-dcb": "growth_dcb",
 }
 
 #: ``cnem pd <name>`` -> module of `cnem.demos` (add a PD demo here).
