@@ -174,7 +174,8 @@ def _arrival(path, other, reach):
     return np.nan, "none"
 
 
-def compare(cnem_path, pd_path, other_cnem, other_pd, direction, increment, reach):
+def compare(cnem_path: np.ndarray, pd_path: np.ndarray, other_cnem: np.ndarray,
+            other_pd: np.ndarray, direction: np.ndarray, increment: float, reach: float) -> dict:
     """The comparison of one crack's two paths (see the module)."""
     common = min(_length(cnem_path), _length(pd_path))
     hausdorff = (shapely.hausdorff_distance(shapely.LineString(_cut(cnem_path, common)),
@@ -189,8 +190,9 @@ def compare(cnem_path, pd_path, other_cnem, other_pd, direction, increment, reac
                 length_cnem=_length(cnem_path), length_pd=_length(pd_path))
 
 
-def study(h, *, model="bond", horizon_factor=3.0, increment=1.0, steps=12, factor_step=0.02,
-          factor_max=1.5, max_rounds=100, load_steps=None):
+def study(h: float, *, model: str = "bond", horizon_factor: float = 3.0, increment: float = 1.0,
+          steps: int = 12, factor_step: float = 0.02, factor_max: float = 1.5,
+          max_rounds: int = 100, load_steps: int | None = None) -> dict:
     """Both methods on the regular cloud of spacing ``h``; one dict."""
     dom = plate.domain(h)
     cloud = cnem.nodes.irregular(dom, h, seed=0)
@@ -211,7 +213,7 @@ def study(h, *, model="bond", horizon_factor=3.0, increment=1.0, steps=12, facto
                 points=body.points, damage=run.damage, seconds=(t1 - t0, t2 - t1))
 
 
-def table(results):
+def table(results: list) -> str:
     lines = [f"{'h':>5} {'delta':>6} {'nodes':>6} {'crack':>5} | {'Hausdorff':>9} {'over':>5} | "
              f"{'kink C-NEM':>10} {'PD':>7} | {'reaches C-NEM':>18} {'PD':>18} | "
              f"{'start factor C-NEM':>18} {'PD':>6}"]

@@ -147,7 +147,8 @@ def load_steps(x: np.ndarray, forces: Callable[..., np.ndarray], density: np.nda
         still breaks bonds in its last round ends settled but not complete.
     after_step : callable, optional
         Called after each step as ``after_step(step, fraction, rounds=, broken=,
-        iterations=, residual=, complete=)`` (``rounds``: the settles that broke bonds).
+        iterations=, residual=, complete=)`` (``rounds``: the settles that broke bonds);
+        a true return value ends the run there.
 
     Returns
     -------
@@ -203,9 +204,10 @@ def load_steps(x: np.ndarray, forces: Callable[..., np.ndarray], density: np.nda
         history.append(res)
         total += used
         broken += step_broken
-        if after_step is not None:
-            after_step(step, frac, rounds=rounds, broken=step_broken, iterations=used,
-                       residual=norm, complete=not exhausted)
+        if after_step is not None and after_step(step, frac, rounds=rounds, broken=step_broken,
+                                                 iterations=used, residual=norm,
+                                                 complete=not exhausted):
+            break
     return history, total, broken
 
 
@@ -336,8 +338,7 @@ class System:
         during ``after_step``)."""
         def after(*args, **kwargs):
             self.flat[self.free] = self.x
-            if after_step is not None:
-                after_step(*args, **kwargs)
+            return after_step is not None and after_step(*args, **kwargs)
 
         out = load_steps(self.x, self.forces, self.density, self.external, self.load,
                          self.prescribe, tol=tol, noise=self.noise, limit=self.limit,
