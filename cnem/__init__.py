@@ -32,11 +32,12 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import (CNEMError, ConditionError, FormatError, FormError, FractureError,
-                     GeometryError, GrowthError, GrowthWarning, HyperDualError, InputError,
+from .errors import (CNEMError, ConditionError, ConvergenceError, DivergenceError,
+                     FormatError, FormError, FractureError, GeometryError, GrowthError,
+                     GrowthWarning, HyperDualError, InputError,
                      LimitError, MaterialError, MissingExtraError, OptionError,
                      PlotDependencyError, PlotError, PlotInputError, SolveError, SpatialError,
-                     UnsupportedError)
+                     StabilityWarning, UnsupportedError)
 
 __version__ = "0.1.0"
 
@@ -56,7 +57,8 @@ __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticS
            "ConditionError", "SpatialError", "FractureError", "GrowthError", "FormatError",
            "HyperDualError", "GrowthWarning", "MissingExtraError",
            "LimitError", "UnsupportedError", "SolveError", "PlotError", "PlotDependencyError",
-           "PlotInputError", "__version__"]
+           "PlotInputError", "ConvergenceError", "DivergenceError", "StabilityWarning",
+           "__version__"]
 
 
 def __getattr__(name: str):

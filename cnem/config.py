@@ -16,9 +16,16 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLE
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
-           "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER"]
+           "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER",
+           "DT_LIMIT", "COORDINATE_LIMIT", "DIRECT_MEMORY", "DIRECT_FILL",
+           "CG_MAXITER"]
 
 # ---------------------------------------------------------------- geometry tolerances
+#: Coordinates (and their extent) must stay below this in magnitude: squared distances
+#: and in-circle determinants of larger ones overflow float64 (max 1.8e308).
+#: `cnem.errors.check_points` refuses them; rescale the model (other units).
+COORDINATE_LIMIT = 1e150
+
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
 #: are snapped onto it; vertices closer than this are the same vertex.
 SNAP_TOL = 1e-9
@@ -78,6 +85,20 @@ MESH_NODES_RTOL = 0.05
 #: smoothed aggregation + CG, 36 iterations).
 DIRECT_NNZ = 2_500_000
 
+#: CG iterations `cnem.assembly.linsolve.solve_spd` allows before it calls a solve stalled.
+CG_MAXITER = 2000
+
+#: Memory a sparse direct factor may take when `solve_spd` falls back to it after a
+#: stalled iterative solve: a fraction (at most 1) of the memory available when it is
+#: asked, or bytes (above 1).
+DIRECT_MEMORY = 0.5
+
+#: ``(fill, unknowns, exponent)``: SuperLU's factor (COLAMD) holds about
+#: ``fill (N / unknowns)^exponent`` times the matrix's non-zeros (measured on
+#: branch-enriched SCNI stiffnesses: 7.3 at 6.3k unknowns, 14.9 at 40k; the rule is
+#: 10 % above both).
+DIRECT_FILL = (16.5, 40_000, 0.4)
+
 #: Largest relative tolerance of the inner linear solve of a Newton step in
 #: `cnem.pd.Problem.solve_static` (inexact Newton: ``min(NEWTON_FORCING, |R| / ref)``).
 NEWTON_FORCING = 1e-3
@@ -93,6 +114,12 @@ NEWTON_INNER_FLOOR = 1e-12
 MIN_GAUSS = 4
 
 # ---------------------------------------------------------------- peridynamics
+#: Explicit PD dynamics refuses a time step above this many times Silling & Askari's
+#: bound (`stable_time_step(safety=1)`, guaranteed stable) and warns between the two:
+#: the critical step measured on uniform lattices (``2 / omega_max``, the largest
+#: eigenvalue of ``M^-1 K``) is 1.7 (PMB) to 2.0 (state-based) times the bound.
+DT_LIMIT = 2.0
+
 #: CPD interactions evaluated together (bounds the temporaries: ~0.3 KB per 2-D pair).
 CPD_CHUNK = 1 << 18
 

@@ -42,7 +42,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ..assembly.linsolve import free_rigid_motions
-from ..errors import InputError, SolveError
+from ..errors import ConvergenceError, InputError, SolveError
 from .solution import Relaxation
 
 if TYPE_CHECKING:
@@ -93,7 +93,7 @@ def _settle(x, forces, density, target, budget, record, dot=np.dot):
     norm = float(np.sqrt(dot(force, force)))
     velocity = 0.5 * force / density
     iterations = 0
-    while norm > target and norm > 0.0 and iterations < budget:
+    while norm > target and norm > 0.0 and iterations < budget:      # False on NaN
         iterations += 1
         x += velocity
         previous, force = force, forces()
@@ -104,12 +104,21 @@ def _settle(x, forces, density, target, budget, record, dot=np.dot):
     return norm
 
 
-def unsettled(step: int, norm: float, scale: float, target: float, max_steps: int) -> SolveError:
-    """The `SolveError` of a load step that has not settled within ``max_steps``."""
-    return SolveError(
+def unsettled(step: int, norm: float, scale: float, target: float, max_steps: int,
+              history: list | None = None) -> ConvergenceError:
+    """The `ConvergenceError` of a load step that has not settled within ``max_steps``
+    (or whose residual went non-finite); ``history``: the residuals so far, one list per
+    load step."""
+    if not np.isfinite(norm):
+        return ConvergenceError(
+            f"dynamic relaxation diverged in load step {step}: the out-of-balance force is "
+            f"not finite (residual {norm}); check the loads and material constants (the "
+            f"forces must stay finite), or use more load steps", history)
+    return ConvergenceError(
         f"dynamic relaxation did not converge in load step {step}: residual "
         f"{norm:.3e} ({norm / scale:.1e} of the reference {scale:.3e}, wanted "
-        f"{target / scale:.1e}) after {max_steps} iterations; raise max_steps or tol")
+        f"{target / scale:.1e}) after {max_steps} iterations; raise max_steps or tol "
+        f"(the residual history is the error's .history)", history)
 
 
 def load_steps(x: np.ndarray, forces: Callable[..., np.ndarray], density: np.ndarray,
@@ -185,9 +194,9 @@ def load_steps(x: np.ndarray, forces: Callable[..., np.ndarray], density: np.nda
         while True:
             norm = _settle(x, lambda: forces()[0], density, target, max_steps - used, record,
                            dot)
-            if norm > target:
+            if not (norm <= target and np.isfinite(norm)):          # not settled, or not finite
                 bar.close()
-                raise unsettled(step, norm, scale, target, max_steps)
+                raise unsettled(step, norm, scale, target, max_steps, history + [res + [norm]])
             exhausted = max_rounds is not None and rounds >= max_rounds
             if exhausted:
                 break
@@ -247,9 +256,11 @@ def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: i
     Raises
     ------
     SolveError
-        Rigid motions left free by the Dirichlet conditions (named), or a load
-        step that has not settled within ``max_steps`` iterations (the
-        residual reached is given).
+        Rigid motions left free by the Dirichlet conditions (named).
+    ConvergenceError
+        A load step that has not settled within ``max_steps`` iterations, or whose
+        residual went non-finite (the residual reached is given, the residual
+        history is the error's ``history``).
     """
     tol, max_steps, steps = float(tol), int(max_steps), int(steps)
     every = 10 if every is None else int(every)
