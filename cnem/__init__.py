@@ -32,11 +32,12 @@ from __future__ import annotations
 
 import importlib
 
-from .errors import (CNEMError, ConditionError, FormatError, FormError, FractureError,
-                     GeometryError, GrowthError, GrowthWarning, HyperDualError, InputError,
+from .errors import (CNEMError, ConditionError, ConvergenceError, DivergenceError,
+                     FormatError, FormError, FractureError, GeometryError, GrowthError,
+                     GrowthWarning, HyperDualError, InputError,
                      LimitError, MaterialError, MissingExtraError, OptionError,
-                     PlotDependencyError, PlotError, PlotInputError, SolveError, SpatialError,
-                     UnsupportedError)
+                     PlotDependencyError, PlotError, PlotInputError, SIFWarning, SolveError,
+                     SpatialError, StabilityWarning, UnsupportedError)
 
 __version__ = "0.1.0"
 
@@ -54,9 +55,10 @@ __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticS
            "spatial", "hyperdual", "pd", "fem", "material",
            "CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError", "FormError",
            "ConditionError", "SpatialError", "FractureError", "GrowthError", "FormatError",
-           "HyperDualError", "GrowthWarning", "MissingExtraError",
+           "HyperDualError", "GrowthWarning", "SIFWarning", "MissingExtraError",
            "LimitError", "UnsupportedError", "SolveError", "PlotError", "PlotDependencyError",
-           "PlotInputError", "__version__"]
+           "PlotInputError", "ConvergenceError", "DivergenceError", "StabilityWarning",
+           "__version__"]
 
 
 def __getattr__(name: str):

@@ -41,6 +41,7 @@ DEMOS = {
     "growth-sent": "growth_sent",
     "growth-kink": "growth_kink",
     "growth-two-holes": "growth_two_holes",
+    "growth-pd-vs-cnem": "growth_pd_vs_cnem",
     "growth-dcb": "growth_dcb",
 }
 

@@ -16,9 +16,17 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLE
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
-           "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER"]
+           "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER",
+           "DT_LIMIT", "COORDINATE_LIMIT", "DIRECT_MEMORY", "DIRECT_FILL",
+           "CG_MAXITER", "SIF_DISCS", "SIF_REACH", "SIF_INNER", "SIF_STRAIGHTNESS",
+           "SIF_BEND_SPACINGS", "SIF_SPREAD", "SIF_SPACINGS"]
 
 # ---------------------------------------------------------------- geometry tolerances
+#: Coordinates (and their extent) must stay below this in magnitude: squared distances
+#: and in-circle determinants of larger ones overflow float64 (max 1.8e308).
+#: `cnem.errors.check_points` refuses them; rescale the model (other units).
+COORDINATE_LIMIT = 1e150
+
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
 #: are snapped onto it; vertices closer than this are the same vertex.
 SNAP_TOL = 1e-9
@@ -78,6 +86,20 @@ MESH_NODES_RTOL = 0.05
 #: smoothed aggregation + CG, 36 iterations).
 DIRECT_NNZ = 2_500_000
 
+#: CG iterations `cnem.assembly.linsolve.solve_spd` allows before it calls a solve stalled.
+CG_MAXITER = 2000
+
+#: Memory a sparse direct factor may take when `solve_spd` falls back to it after a
+#: stalled iterative solve: a fraction (at most 1) of the memory available when it is
+#: asked, or bytes (above 1).
+DIRECT_MEMORY = 0.5
+
+#: ``(fill, unknowns, exponent)``: SuperLU's factor (COLAMD) holds about
+#: ``fill (N / unknowns)^exponent`` times the matrix's non-zeros (measured on
+#: branch-enriched SCNI stiffnesses: 7.3 at 6.3k unknowns, 14.9 at 40k; the rule is
+#: 10 % above both).
+DIRECT_FILL = (16.5, 40_000, 0.4)
+
 #: Largest relative tolerance of the inner linear solve of a Newton step in
 #: `cnem.pd.Problem.solve_static` (inexact Newton: ``min(NEWTON_FORCING, |R| / ref)``).
 NEWTON_FORCING = 1e-3
@@ -93,6 +115,12 @@ NEWTON_INNER_FLOOR = 1e-12
 MIN_GAUSS = 4
 
 # ---------------------------------------------------------------- peridynamics
+#: Explicit PD dynamics refuses a time step above this many times Silling & Askari's
+#: bound (`stable_time_step(safety=1)`, guaranteed stable) and warns between the two:
+#: the critical step measured on uniform lattices (``2 / omega_max``, the largest
+#: eigenvalue of ``M^-1 K``) is 1.7 (PMB) to 2.0 (state-based) times the bound.
+DT_LIMIT = 2.0
+
 #: CPD interactions evaluated together (bounds the temporaries: ~0.3 KB per 2-D pair).
 CPD_CHUNK = 1 << 18
 
@@ -131,3 +159,32 @@ ROW_SLOTS = 8
 #: triangles, above which they are located with an R-tree of the triangles
 #: (`Model.triangle_tree`, built once) rather than of the circumcircles.
 TRIANGLE_TREE_AFTER = 0.01
+
+# ---------------------------------------------------------------- stress intensity factors
+#: Nested integration discs of `cnem.fracture.sif` by default (3 to 6 make sense).
+SIF_DISCS = 4
+
+#: The largest default disc, as a fraction of the distance from the tip to the first
+#: obstacle (a boundary, a hole, an interface, another crack or tip, a kink behind the
+#: tip; `cnem.fracture.discs.clearance`): the disc stays clear of it.
+SIF_REACH = 0.9
+
+#: The smallest default disc as a fraction of the largest (smaller discs are less
+#: accurate on every cloud measured: docs/fracture.md).
+SIF_INNER = 0.5
+
+#: The crack inside a disc of radius R may leave the straight line through the tip
+#: by at most this times R (a kink or a curved path behind the tip limits the disc).
+SIF_STRAIGHTNESS = 0.01
+
+#: ... but a kink or bend limits the default discs to no fewer than this many local
+#: node spacings (a kink one increment behind a growing tip would leave a disc of a
+#: spacing or less, whose K is off by tens of %; six spacings was the old default).
+SIF_BEND_SPACINGS = 6.0
+
+#: Relative spread of K over the discs above which `cnem.fracture.sif` warns.
+SIF_SPREAD = 0.01
+
+#: Fewer local node spacings than this in the largest disc that fits: `sif` warns
+#: (the discs cannot resolve the near-tip field; refine the nodes at the tip).
+SIF_SPACINGS = 3.0

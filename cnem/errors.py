@@ -22,12 +22,16 @@ keeps working while ``except cnem.CNEMError`` catches everything cnem raises.
     │   └── LimitError                   a problem larger than a bound in `cnem.config`
     ├── UnsupportedError (NotImplementedError)   a valid request cnem does not implement
     ├── SolveError (RuntimeError)        a system that cannot be solved
+    │   ├── ConvergenceError             an iteration out of budget (``.history``: its residuals)
+    │   └── DivergenceError              a time integration whose state went non-finite
     ├── MissingExtraError (ImportError)  an optional dependency (an extra) is not installed
     └── PlotError                        `cnem.plot` cannot draw
         ├── PlotDependencyError (ImportError)    pyvista missing or unable to render
         └── PlotInputError (InputError)          a bad field name or view
 
     GrowthWarning (UserWarning)          a crack-growth event worth a look (not an error)
+    StabilityWarning (UserWarning)       a time step above the guaranteed-stable one
+    SIFWarning (UserWarning)             stress intensity factors that do not check out
 
 >>> from cnem import errors
 >>> errors.check_choice("plane", "strain", ("stress", "strain"))
@@ -42,7 +46,10 @@ OptionError True
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import TypeVar
+from typing import TYPE_CHECKING, TypeVar
+
+if TYPE_CHECKING:
+    import numpy as np
 
 _Value = TypeVar("_Value")
 
@@ -50,6 +57,7 @@ __all__ = ["CNEMError", "InputError", "OptionError", "GeometryError", "MaterialE
            "FormError", "ConditionError", "SpatialError", "FractureError", "GrowthError",
            "FormatError", "HyperDualError", "LimitError", "UnsupportedError", "SolveError",
            "PlotError", "PlotDependencyError", "PlotInputError", "MissingExtraError", "GrowthWarning",
+           "ConvergenceError", "DivergenceError", "StabilityWarning", "SIFWarning",
            "check_choice"]
 
 
@@ -113,9 +121,50 @@ class SolveError(CNEMError, RuntimeError):
     """A linear or nonlinear system could not be solved."""
 
 
+class ConvergenceError(SolveError):
+    """An iterative solve (Newton, dynamic relaxation) that ran out of iterations.
+
+    Attributes
+    ----------
+    history : list of list of float
+        The residual norms recorded so far, one list per load step (the last one
+        is the step that did not converge).
+    """
+
+    def __init__(self, message: str, history: list | None = None):
+        super().__init__(message)
+        self.history = [] if history is None else history
+
+
+class DivergenceError(SolveError):
+    """A time integration whose state went non-finite.
+
+    Attributes
+    ----------
+    step : int
+        The first step with a non-finite displacement or velocity.
+    point : int
+        A point (global number) where it is not finite.
+    """
+
+    def __init__(self, message: str, step: int, point: int):
+        super().__init__(message)
+        self.step, self.point = step, point
+
+
 class GrowthWarning(UserWarning):
     """A crack-growth event the user should look at (see `cnem.fracture.history.EVENT_KINDS`);
-    a warning, not an error: the only class here outside `CNEMError`."""
+    a warning, not an error: with `StabilityWarning` and `SIFWarning` the only classes here
+    outside `CNEMError`."""
+
+
+class StabilityWarning(UserWarning):
+    """An explicit time step above the guaranteed-stable one (it may still be stable)."""
+
+
+class SIFWarning(UserWarning):
+    """Stress intensity factors that do not check themselves: K differs between the nested
+    integration discs, or a user's disc reaches past an obstacle (`cnem.fracture.sif`)."""
 
 
 class MissingExtraError(CNEMError, ImportError):
@@ -163,3 +212,115 @@ def check_choice(name: str, value: _Value, choices: Iterable[object], *,
         raise error(f"{name} must be one of {', '.join(map(repr, choices))}, received "
                     f"{value!r}; pass one of those")
     return value
+
+
+def check_array(name: str, value: object, *, shape: tuple | None = None, broadcast: bool = False,
+                finite: bool = True, positive: bool = False, nonnegative: bool = False,
+                error: type[InputError] = InputError, fix: str = "") -> np.ndarray:
+    """``value`` as a float64 array, checked at a public boundary: its shape, its dtype
+    (numbers), finiteness (NaN and inf named with their first index) and sign.
+
+    Parameters
+    ----------
+    name : str
+        The argument's name, first in the message.
+    value : array_like
+    shape : tuple of int or None, optional
+        The expected shape; None entries take any length (``(None, 2)``: rows of two).
+    broadcast : bool
+        Accept a scalar (or anything NumPy broadcasts) to ``shape`` (all ints), e.g. one
+        horizon for every point.
+    finite, positive, nonnegative : bool
+        Reject NaN and inf (default); values ``<= 0``; values ``< 0``.
+    error : type, optional
+        The `InputError` subclass to raise.
+    fix : str, optional
+        How to fix it, appended to the message.
+
+    Returns
+    -------
+    ndarray
+        float64, C-contiguous (a copy when broadcast).
+
+    >>> check_array("radii", [1.0, 2.0], shape=(2,)).tolist()
+    [1.0, 2.0]
+    >>> try:
+    ...     check_array("radii", [1.0, float("nan")], shape=(2,))
+    ... except InputError as exc:
+    ...     print(exc)
+    radii: expected finite values, received NaN at index 1 (shape (2,))
+    """
+    import numpy as np
+
+    tail = f"; {fix}" if fix else ""
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        kind = type(value).__name__
+        raise error(f"{name}: expected numbers{_shape_text(shape)}, received a {kind} that does "
+                    f"not convert to one float array (ragged, or not numbers){tail}") from None
+    if shape is not None:
+        if broadcast:
+            try:
+                arr = np.broadcast_to(arr, shape)
+            except ValueError:
+                raise error(f"{name}: expected a number or an array of shape {shape}, received "
+                            f"shape {arr.shape}{tail}") from None
+        elif arr.ndim != len(shape) or any(want is not None and want != got
+                                           for want, got in zip(shape, arr.shape)):
+            raise error(f"{name}: expected{_shape_text(shape)}, received shape "
+                        f"{arr.shape}{tail}")
+    if not (arr.flags.c_contiguous and arr.flags.writeable):    # broadcast views too
+        arr = arr.copy()
+    if finite and not np.isfinite(arr).all():
+        first = np.flatnonzero(~np.isfinite(arr.reshape(-1)))[0]
+        where = np.unravel_index(first, arr.shape) if arr.ndim > 1 else first
+        what = "NaN" if np.isnan(arr.reshape(-1)[first]) else f"{float(arr.reshape(-1)[first])}"
+        at = f" at index {tuple(map(int, where)) if arr.ndim > 1 else int(where)}" \
+            if arr.ndim else ""
+        raise error(f"{name}: expected finite values, received {what}{at} (shape "
+                    f"{arr.shape}){tail}")
+    for flag, bad, text in ((positive, arr <= 0, "positive"), (nonnegative, arr < 0,
+                                                                 "non-negative")):
+        if flag and bad.any():
+            first = np.flatnonzero(bad.reshape(-1))[0]
+            raise error(f"{name}: expected {text} values, received {float(arr.reshape(-1)[first])!r} "
+                        f"at index {int(first)} (shape {arr.shape}){tail}")
+    return arr
+
+
+def check_points(name: str, value: object, *, dims: tuple = (2, 3),
+                 error: type[InputError] = InputError) -> np.ndarray:
+    """``value`` as ``(n, d)`` float64 coordinates: `check_array` (finite, rows of
+    ``d`` in ``dims``) and magnitudes below `cnem.config.COORDINATE_LIMIT` (whose squares,
+    the squared distances and in-circle tests, stay representable).
+
+    >>> try:
+    ...     check_points("points", [[0.0, 0.0], [1e300, 0.0]])
+    ... except InputError as exc:
+    ...     print(str(exc)[:76])
+    points: expected coordinates below 1e+150 in magnitude (their squared distan
+    """
+    import numpy as np
+
+    from . import config
+
+    arr = check_array(name, value, error=error, fix="drop or repair those rows")
+    if arr.ndim != 2 or arr.shape[1] not in dims:
+        raise error(f"{name}: expected an {' or '.join(f'(n, {d})' for d in dims)} array of "
+                    f"coordinates, received shape {arr.shape}; pass one row per point")
+    top = float(np.abs(arr).max(initial=0.0))
+    if top >= config.COORDINATE_LIMIT:
+        raise error(f"{name}: expected coordinates below {config.COORDINATE_LIMIT:g} in "
+                    f"magnitude (their squared distances must not overflow float64), received "
+                    f"{top:g} (shape {arr.shape}); express the model in other units")
+    return arr
+
+
+def _shape_text(shape):
+    """`` an array of shape (n, 2)`` for a message (None entries as letters)."""
+    if shape is None:
+        return ""
+    names = iter("nmkpq")
+    return " an array of shape (" + ", ".join(str(s) if s is not None else next(names)
+                                              for s in shape) + (",)" if len(shape) == 1 else ")")

@@ -246,8 +246,8 @@ class P1Elasticity(Conditions):
                  plane: str = "stress", nodes: np.ndarray | None = None,
                  max_area: float | None = None, quality: float = 30.0):
         self.domain = domain
-        self.materials = parse_materials(materials, len(domain.regions))
         lame(1.0, 0.0, plane)                       # validates `plane`
+        self.materials = parse_materials(materials, len(domain.regions), plane)
         self.plane = plane
         t0 = time.perf_counter()
         points, tri, self.region = mesh_domain(domain, nodes=nodes, max_area=max_area,

@@ -13,14 +13,17 @@ from numpy.typing import ArrayLike
 
 from .errors import MaterialError, check_choice
 
-__all__ = ["PLANES", "parse_materials", "lame", "stiffness_matrix", "kappa", "effective_modulus"]
+__all__ = ["PLANES", "parse_materials", "check_stiffness", "lame", "stiffness_matrix", "kappa", "effective_modulus"]
 
 #: The 2-D idealisations: plane stress or plane strain.
 PLANES = ("stress", "strain")
 
 
-def parse_materials(materials: ArrayLike, nregions: int) -> np.ndarray:
-    """``(r, 2)`` array of ``(E, nu)`` per region from one pair or a list of pairs."""
+def parse_materials(materials: ArrayLike, nregions: int,
+                    plane: Literal["stress", "strain"] | None = None) -> np.ndarray:
+    """``(r, 2)`` array of ``(E, nu)`` per region from one pair or a list of pairs; with
+    ``plane``, also their elasticity matrices must be finite (E near the float64 limit
+    overflows them)."""
     try:
         arr = np.asarray(materials, dtype=float)
     except (TypeError, ValueError):
@@ -38,7 +41,21 @@ def parse_materials(materials: ArrayLike, nregions: int) -> np.ndarray:
     if not ((nu > -1.0) & (nu < 0.5)).all():
         raise MaterialError(f"materials: Poisson ratios must lie in (-1, 0.5), received "
                             f"{nu.tolist()}")
+    if plane is not None:
+        check_stiffness(stiffness_matrix(E, nu, plane), arr, "the elasticity matrix")
     return arr
+
+
+def check_stiffness(values: np.ndarray, materials: np.ndarray, what: str) -> None:
+    """Raise `MaterialError` naming the materials when ``values`` (a stiffness built from
+    ``materials``, ``(r, 2)`` pairs (E, nu)) are not all finite."""
+    if not np.isfinite(values).all():
+        top = int(np.argmax(materials[:, 0]))
+        raise MaterialError(
+            f"materials: {what} is not finite (float64 overflow) for E up to "
+            f"{materials[top, 0]:g} (material {top}, nu = {materials[top, 1]:g}): expected "
+            f"moduli whose stiffness and stresses are representable; express E in other "
+            f"units (e.g. MPa or GPa instead of Pa)")
 
 
 def lame(E: ArrayLike, nu: ArrayLike,
@@ -54,9 +71,10 @@ def lame(E: ArrayLike, nu: ArrayLike,
     check_choice("plane", plane, PLANES)
     E, nu = np.asarray(E, dtype=float), np.asarray(nu, dtype=float)
     mu = E / (2.0 * (1.0 + nu))
-    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-    if plane == "stress":
-        lam = 2.0 * lam * mu / (lam + 2.0 * mu)
+    if plane == "stress":        # 2 lambda mu / (lambda + 2 mu), without the product
+        lam = E * nu / ((1.0 + nu) * (1.0 - nu))
+    else:
+        lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
     return lam, mu
 
 

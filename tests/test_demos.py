@@ -267,6 +267,25 @@ def check_growth_two_holes(demo, res, outdir):
     assert np.abs(tips[:, 0] + tips[:, 1] - [20.0, 10.0]).max() < 0.15
 
 
+def check_growth_pd_vs_cnem(demo, res, outdir):
+    r = res["results"][0]
+    # C-NEM: both paths start at the initial tips and grow by the 1 mm increments
+    for path, tip in zip(r["cnem_paths"], demo.TIPS):
+        np.testing.assert_allclose(path[0], tip, atol=1e-12)
+        assert np.hypot(*np.diff(path, axis=0).T) == pytest.approx(1.0, rel=1e-9)
+    # both first kinks turn the cracks by less than the maximum-hoop-stress limit (70.5 deg)
+    assert all(abs(row["kink_cnem"]) < 70.6 for row in r["rows"])
+    # PD: the ramp starts where the elastic solution's largest stretch is critical, so the
+    # first bonds break at its first or second step (at the first, the largest stretch is
+    # critical, to round-off); damage is a fraction
+    assert r["pd_first_bond"] <= r["pd_started"] <= 1.02 * r["pd_first_bond"] * (1 + 1e-9)
+    assert 0.0 <= r["damage"].min() and r["damage"].max() <= 1.0
+    assert r["pd_steps"] <= 4
+    assert "Hausdorff" in res["table"]
+    for f in res["files"]:
+        assert pathlib.Path(f).stat().st_size > 1000
+
+
 def check_growth_dcb(demo, res, outdir):
     """Kinked DCB cracks (quick size): every path curves away from the centre line, the
     more the larger the initial angle, at the critical load of root-rotation-corrected
@@ -315,6 +334,8 @@ CASES = [
          sizes=dict(cloud=(0.8, 0.005, 0.3), progress=False), plot=False),
     Case("growth-two-holes", "growth_two_holes", check_growth_two_holes, args=(0.5,),
          sizes=dict(steps=2, progress=False), plot=False),
+    Case("growth-pd-vs-cnem", "growth_pd_vs_cnem", check_growth_pd_vs_cnem, args=((1.0,),),
+         sizes=dict(steps=2, load_steps=4), plot=True),
     Case("growth-dcb", "growth_dcb", check_growth_dcb, args=(0.1,),
          sizes=lambda demo: dict(increment=0.2, steps=3, angles=demo.ANGLES[1:], progress=False),
          plot=True),

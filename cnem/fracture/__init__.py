@@ -18,13 +18,14 @@ from .criteria import CRITERIA, kink
 from .enrichment import Enrichment
 from ..geometry.domain import Domain
 from .growth import grow
+from .refine import Refinement
 from .history import CrackPath, GrowthEvent, Step
 from .interaction import SIFResult, sif
 from ..material import effective_modulus, kappa
 from .williams import nodal_williams, polar, williams
 
 __all__ = ["sif", "SIFResult", "Enrichment", "tip_frame", "williams", "nodal_williams", "polar", "kappa",
-           "effective_modulus", "grow", "CrackPath", "Step", "GrowthEvent", "kink", "CRITERIA"]
+           "effective_modulus", "grow", "Refinement", "CrackPath", "Step", "GrowthEvent", "kink", "CRITERIA"]
 
 #: `Domain.tip_frame` as a function of ``(domain, tip)``.
 tip_frame = Domain.tip_frame

@@ -3,8 +3,9 @@ and the node cloud of the grown domain.
 
 A new segment runs from the tip at the kink angle for the tip's increment. It
 is cut where it meets the outer boundary, a hole or another crack; when it ends
-within ``clearance`` local spacings of the boundary it is carried on to it (no
-ligament thinner than the nodes can resolve). Meeting another crack's tip
+or passes within ``clearance`` local spacings of the boundary it is carried on
+to it, to the boundary point nearest to the segment (no ligament thinner than
+the nodes can resolve). Meeting another crack's tip
 joins the two cracks into one polyline. The cloud keeps its nodes, but those
 closer than ``clearance`` local spacings to a new segment, and gets nodes
 along each new segment about one local spacing apart (the new tip among them).
@@ -21,7 +22,7 @@ import numpy as np
 import shapely
 from scipy.spatial import cKDTree
 from shapely.geometry import LineString, MultiLineString, Point
-from shapely.ops import split
+from shapely.ops import nearest_points, split
 
 from ..errors import GeometryError
 from ..geometry.domain import Domain
@@ -113,11 +114,18 @@ def first_hit(domain: Domain, cracks: list, crack: int, end: int, start: np.ndar
     probe = LineString([start, start + (length + reach) * e])
     tol = domain.tolerance
     best = Hit(None, np.inf, stop)
+    segment = LineString([start, stop])
     for ring, kind in _rings(domain):
-        for p in _points_of(probe.intersection(ring)):
+        crossings = _points_of(probe.intersection(ring))
+        for p in crossings:
             s = float((p - start) @ e)
             if tol < s < best.distance:
                 best = Hit(kind, s, p)
+        if len(crossings) == 0 and segment.distance(ring) < reach:   # grazes it: a thin ligament
+            on_segment, on_ring = (np.asarray(q.coords[0]) for q in nearest_points(segment, ring))
+            s = float((on_segment - start) @ e)
+            if tol < s < best.distance:
+                best = Hit(kind, float(np.hypot(*(on_ring - start))), on_ring)
     for j, c in enumerate(cracks):
         line = c[:-1] if (j == crack and end == -1) else c[1:] if j == crack else c
         if len(line) < 2:
@@ -130,8 +138,8 @@ def first_hit(domain: Domain, cracks: list, crack: int, end: int, start: np.ndar
             continue
         for other_end in (0, -1):                # a tip ahead, within reach of the segment
             t, dist = segment_projection(c[other_end], start, start + (length + reach) * e)
-            s = float(t[0]) * (length + reach)
-            if dist[0] < reach and tol < s < best.distance + reach \
+            s = float(t[0]) * (length + reach)        # along the probe, not the line beyond it
+            if dist[0] < reach and tol < s < min(best.distance + reach, length + reach) \
                     and domain.polygon.boundary.distance(Point(c[other_end])) > tol:
                 best = Hit("joined", s, c[other_end].copy(), j, other_end)
     if best.kind == "crack" and best.crack != crack:
@@ -181,6 +189,8 @@ def grown_cloud(cloud: NodeCloud, domain: Domain, segments: list, spacings: list
         new_h.append(np.full(pieces, h))
     new_pts, new_h = np.concatenate(new_pts), np.concatenate(new_h)
     fresh = cKDTree(pts[keep]).query(new_pts)[0] > domain.tolerance   # a joined tip is a node
+    twice = cKDTree(new_pts).query_pairs(domain.tolerance, output_type="ndarray")
+    fresh[twice.max(axis=1)] = False          # two tips that met in this step: one node
     return _cloud(domain, np.concatenate([pts[keep], new_pts[fresh]]),
                   np.concatenate([spacing[keep], new_h[fresh]]))
 

@@ -40,6 +40,7 @@ from ..geometry.update import update
 from ..material import kappa as kolosov
 from ..nodes import irregular
 from . import advance
+from .refine import Refinement, as_refinement, refined_cloud
 from .criteria import CRITERIA, kink
 from .history import CrackPath, GrowthEvent, Step
 from .interaction import sif
@@ -87,8 +88,9 @@ class _Run:
     """The mutable state of one `grow` call."""
 
     def __init__(self, domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep,
-                 local, continue_with=None):
+                 local, continue_with=None, refine=None):
         self.domain, self.cloud, self.setup, self.local = domain, cloud, setup, local
+        self.refine = refine          # the cloud that is discretized: `nodes()`
         self.continue_with = continue_with
         self.retired = {}                     # row -> (tip, crack length) of a crack gone
         self.split = None                     # the split event until the next solve
@@ -124,13 +126,22 @@ class _Run:
                 "or loads may lie on the pieces dropped: continue with another piece, or give "
                 "supports the remaining body keeps)") from err
 
+    def nodes(self):
+        """The cloud of this increment: the background ``cloud``, refined about the
+        active tips when ``refine`` is set (`cnem.fracture.refine`)."""
+        if self.refine is None:
+            return self.cloud
+        tips = [self.cracks[c][e] for c, e, active in self.rows if active]
+        return refined_cloud(self.cloud, np.reshape(tips, (-1, 2)), self.refine)
+
     def _problem(self):
         """``setup`` on the model of the current cloud: by a local update of the previous
         model and problem (`cnem.geometry.update.update`, the problem's ``update_from``)
         while ``local``, else (and when the problem refuses the update) from scratch."""
+        cloud = self.nodes()
         if not self.local or self.problem is None:
-            return self.setup(discretize(self.cloud, progress=False))
-        change = update(self.model, self.cloud, progress=False)
+            return self.setup(discretize(cloud, progress=False))
+        change = update(self.model, cloud, progress=False)
         prob = self.setup(change.model)
         update_from = getattr(prob, "update_from", None)
         if update_from is None:
@@ -181,7 +192,9 @@ class _Run:
         """Append the new segments; update the domain and the cloud."""
         segments, spacings = [], []
         for i in np.flatnonzero(increments > 0):
-            c, end, _ = self.rows[i]
+            c, end, active = self.rows[i]
+            if not active:                  # joined by another tip earlier in this step
+                continue
             crack = self.cracks[c]
             start = crack[end].copy()
             d = advance.tip_direction(crack, end)
@@ -308,7 +321,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
          max_kink: float | None = None, measure: Callable[..., np.ndarray] | None = None,
          radius: float | None = None, clearance: float = 0.5, keep: bool = True, local: bool = True,
          continue_with: Literal["largest"] | int | Callable[[list], int] | None = None,
-         progress: bool = True) -> CrackPath:
+         refine: Refinement | float | None = None, progress: bool = True) -> CrackPath:
     """Grow the cracks of a domain step by step (quasi-static LEFM).
 
     Parameters
@@ -338,7 +351,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         ``measure(solution) -> float`` recorded per step (a load-point displacement,
         say: times ``load_factor`` it gives the load-displacement curve).
     radius : float, optional
-        Interaction-integral radius (`sif`; default a few local node spacings).
+        Interaction-integral radius (`sif`; default nested discs up to the largest that fits).
     clearance : float
         Nodes closer than ``clearance`` local spacings to a new segment are dropped,
         and a tip that ends this close to the boundary is carried on to it.
@@ -351,6 +364,12 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         operators from scratch. A problem that refuses the update (enrichment, other
         settings than the previous one) falls back to the full build, said once through
         `logging`.
+    refine : Refinement or float, optional
+        Nodes graded towards every growing tip (`cnem.fracture.refine`): a disc
+        about each tip whose spacing falls to ``refine.spacing`` (a float: that
+        spacing) at the tip; the disc moves with the tip and the background nodes
+        come back behind it, so the cloud keeps its size. ``cloud`` is then the
+        background cloud. Default none.
     continue_with : "largest", int or callable, optional
         What to do when the cracks cut the body apart. None (default): stop with a
         `GeometryError` naming the pieces. Else go on with one piece: ``"largest"``,
@@ -406,7 +425,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         raise GrowthError("cloud: expected a NodeCloud of `domain` (cloud.domain is domain), "
                           "received one of another domain; build it with cnem.nodes from `domain`")
     run = _Run(domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep, bool(local),
-               continue_with)
+               continue_with, as_refinement(refine))
     bar = tqdm(total=steps, desc="crack growth", unit="step", disable=not progress, leave=False)
     sol = run.solve()
     mark = 0                                  # first event of the current step

@@ -23,7 +23,7 @@ from ..assembly.triangles import triangle_basis
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from ..errors import GeometryError, InputError, SolveError
 from ..geometry.topology import constraint_edges
-from ..material import lame, parse_materials, stiffness_matrix
+from ..material import check_stiffness, lame, parse_materials, stiffness_matrix
 from .solution import ElasticSolution
 
 if TYPE_CHECKING:
@@ -95,8 +95,8 @@ class Elasticity(Conditions):
         #: smoothed strain per cell cannot control the extra dofs)
         self.cells = (model.cells if self.enrichment is None
                       else subdivide(model.cells, model.nodes, node_apex=tip_cells(model))[0])
-        self.materials = parse_materials(materials, len(model.domain.regions))
         lame(1.0, 0.0, plane)                       # validates `plane`
+        self.materials = parse_materials(materials, len(model.domain.regions), plane)
         self.stabilization = float(stabilization)
         if not (np.isfinite(self.stabilization) and self.stabilization >= 0):
             raise InputError(f"stabilization: expected a number >= 0, received {stabilization!r}")
@@ -194,6 +194,7 @@ class Elasticity(Conditions):
                 extra = (self._sub_cell_stiffness(a) if sub_cells
                          else self._pointwise_stabilization_stiffness(a))
                 K = extra if K is None else K + extra
+            check_stiffness(K.data, self.materials, "the assembled stiffness")
             self._K = K
         return self._K
 
@@ -303,14 +304,19 @@ class Elasticity(Conditions):
         """The keywords of `cnem.assembly.linsolve.solve_spd` for the system on ``dofs``
         (the free ones): the P1 matrix its smoothed aggregation is built on (made only
         if the iterative path is taken), and for plain SCNI smoothing with K itself
-        (its oscillating low-energy modes, which P1 lacks).
+        (its oscillating low-energy modes, which P1 lacks); with enrichment, which
+        of the dofs are nodal (the enriched block is then solved exactly inside the
+        preconditioner).
 
         Returns
         -------
         dict
         """
-        return dict(preconditioner=lambda: self.preconditioner_matrix(dofs),
-                    smooth_with_matrix=self.stabilization == 0)
+        options = dict(preconditioner=lambda: self.preconditioner_matrix(dofs),
+                       smooth_with_matrix=self.stabilization == 0)
+        if self.enrichment is not None:
+            options["nodal"] = np.asarray(dofs) < 2 * len(self.model.nodes)
+        return options
 
     def preconditioner_matrix(self, dofs: np.ndarray | None = None) -> sp.spmatrix | None:
         """The P1 stiffness of the nodes on the model's triangles (same materials):
@@ -351,7 +357,10 @@ class Elasticity(Conditions):
             aggregation (rigid-body modes) + CG above, the hierarchy built on the P1
             stiffness of the same nodes on the model's triangles (without enrichment:
             see `preconditioner_matrix`; for plain SCNI, ``stabilization=0``, the
-            finest level smoothed with K itself).
+            finest level smoothed with K itself). With enrichment the hierarchy is
+            built on the nodal block and the enriched block is factorised (see
+            `cnem.assembly.linsolve.solve_spd`). A stalled CG falls back to the direct
+            solve when its factor fits in memory (`cnem.config.DIRECT_MEMORY`).
         tol : float
             Relative residual of the iterative solver.
         progress : bool, optional
@@ -364,7 +373,9 @@ class Elasticity(Conditions):
         Raises
         ------
         SolveError
-            Rigid motions not fixed by the Dirichlet conditions (named).
+            Rigid motions not fixed by the Dirichlet conditions (named), or a stalled
+            iterative solve whose direct fallback would not fit in memory (the message
+            says what to change).
         """
         if progress is None:
             progress = sys.stderr.isatty()

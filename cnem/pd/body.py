@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, check_array, check_points
 from ..spatial import family_search, remove_crossing
 from ._kernels import bond_geometry
 
@@ -39,20 +39,24 @@ def checked_input(points: np.ndarray, volumes: float | ArrayLike, horizon: float
     Raises
     ------
     InputError
-        Not a non-empty ``(n, 2)`` or ``(n, 3)`` array, or non-positive volumes, horizon
-        or thickness.
+        Not a non-empty ``(n, 2)`` or ``(n, 3)`` array of finite coordinates below
+        `cnem.config.COORDINATE_LIMIT`, volumes of the wrong length or not positive
+        and finite, a horizon not one positive number, a non-positive thickness.
     """
-    pts = np.ascontiguousarray(points, dtype=float)
-    if pts.ndim != 2 or pts.shape[1] not in (2, 3) or len(pts) == 0:
+    pts = check_points("points", points)
+    if len(pts) == 0:
         raise InputError(f"points: expected a non-empty (n, 2) or (n, 3) array, received "
                          f"shape {pts.shape}")
     n, d = pts.shape
-    vol = np.broadcast_to(np.asarray(volumes, dtype=float), (n,)).copy()
-    if not (np.isfinite(vol).all() and (vol > 0).all()):
-        raise InputError(f"volumes: expected positive finite volumes, a number or one per "
-                         f"point, received min {vol.min()!r}")
-    horizon = float(horizon)
-    if not np.isfinite(horizon) or horizon <= 0:
+    vol = check_array("volumes", volumes, shape=(n,), broadcast=True, positive=True,
+                      fix="pass positive finite volumes, a number or one per point")
+    if np.ndim(horizon) != 0:
+        raise InputError(f"horizon: expected one positive number (a Body has one horizon), "
+                         f"received shape {np.shape(horizon)}; pass a number, typically three "
+                         f"node spacings")
+    horizon = float(check_array("horizon", horizon, fix="pass a positive number, typically "
+                                                         "three node spacings"))
+    if horizon <= 0:
         raise InputError(f"horizon: expected a positive number, received {horizon}; "
                          f"typically three node spacings")
     thick = float(thickness) if d == 2 else 1.0

@@ -17,6 +17,7 @@ from ..assembly.conditions import per_point
 from ..errors import InputError
 from . import _kernels as K
 from .frames import FrameWriter
+from .guards import check_time_step, diverged, first_non_finite
 from .relaxation import relax
 from .solution import DynamicRun
 
@@ -85,7 +86,9 @@ class Dynamics:
         Parameters
         ----------
         dt : float
-            Time step (see `stable_time_step`).
+            Time step (see `stable_time_step`). Above Silling & Askari's bound
+            (``stable_time_step(safety=1)``) a `cnem.errors.StabilityWarning`; above
+            `cnem.config.DT_LIMIT` times it, refused (`cnem.pd.guards`).
         steps : int
         velocity : (n, d) array_like or callable ``(n, d) -> (n, d)``, optional
             Initial velocity.
@@ -101,12 +104,21 @@ class Dynamics:
         Returns
         -------
         DynamicRun
+
+        Raises
+        ------
+        InputError
+            ``dt`` above `cnem.config.DT_LIMIT` times the stable step.
+        DivergenceError
+            The displacement or velocity went non-finite (the step and a point are named).
         """
         self._linear_only("run_dynamic")
         b, d, n = self.body, self.dim, len(self.body)
         dt, steps = float(dt), int(steps)
         if not dt > 0 or steps < 1:
             raise InputError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
+        stable = self.stable_time_step(1.0)
+        check_time_step(dt, stable)
         every = max(1, steps // 10) if every is None else int(every)
         rho = self.material.density
         limit = self.material.stretch_limit(d, self.plane, b.horizon)
@@ -143,6 +155,8 @@ class Dynamics:
             acc = (force + fext) / rho
             v += 0.5 * dt * acc
             v.reshape(-1)[D] = 0.0
+            if (bad := first_non_finite(u, v)) >= 0:
+                raise diverged(step, dt, bad, b.points[bad], stable)
             if step % every == 0 or step == steps:
                 store(step)
         return DynamicRun(self, u, velocity=v, damage=self.damage(), times=np.array(times),

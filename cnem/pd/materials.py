@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import MaterialError
+from . import critical_stretch as from_energy
 
 if TYPE_CHECKING:
     from typing import Literal
@@ -35,9 +36,10 @@ class BondBased:
     critical_stretch : float, optional
         Bonds break beyond it (dynamics); ``None``: unbreakable.
     fracture_energy : float, optional
-        ``G0``, giving the critical stretch ``sqrt(5 G0 / (9 K delta))`` (3-D:
-        ``sqrt(5 G0 / (9 K delta))`` with K the bulk modulus; 2-D plane stress:
-        ``sqrt(4 pi G0 / (9 E delta))``) when ``critical_stretch`` is not given.
+        ``G0``, giving the critical stretch when ``critical_stretch`` is not given
+        (`cnem.pd.critical_stretch.bond_based`): ``sqrt(4 pi G0 / (9 E delta))`` in
+        plane stress, ``sqrt(5 pi G0 / (12 E delta))`` in plane strain and
+        ``sqrt(5 G0 / (9 K delta))`` in 3-D (K the bulk modulus).
     density : float
         Mass density (dynamics).
     """
@@ -70,10 +72,7 @@ class BondBased:
             return self.critical_stretch
         if self.fracture_energy is None:
             return np.inf
-        if dim == 2 and plane == "stress":
-            return float(np.sqrt(4.0 * np.pi * self.fracture_energy / (9.0 * self.E * horizon)))
-        K = self.E / (3.0 * (1.0 - 2.0 * self.poisson(dim, plane)))
-        return float(np.sqrt(5.0 * self.fracture_energy / (9.0 * K * horizon)))
+        return from_energy.bond_based(self.fracture_energy, self.E, horizon, plane, dim)
 
     def __repr__(self):
         return f"<BondBased E={self.E:g}, critical stretch {self.critical_stretch}>"
@@ -92,14 +91,17 @@ class StateBased:
     ----------
     E, nu : float
     critical_stretch : float, optional
-        Bonds break beyond it (dynamics).
+        Bonds break beyond it (dynamics, relaxation).
+    fracture_energy : float, optional
+        ``G_c``, giving the critical stretch when ``critical_stretch`` is not given
+        (2-D, `cnem.pd.critical_stretch.state_based`).
     density : float
     """
 
     kind = "state"
 
     def __init__(self, E: float, nu: float, *, critical_stretch: float | None = None,
-                 density: float = 1.0):
+                 fracture_energy: float | None = None, density: float = 1.0):
         self.E = _positive("E", E)
         nu = float(nu)
         if not -1.0 < nu < 0.5:
@@ -107,6 +109,8 @@ class StateBased:
         self.nu = nu
         self.critical_stretch = None if critical_stretch is None else _positive(
             "critical_stretch", critical_stretch)
+        self.fracture_energy = None if fracture_energy is None else _positive(
+            "fracture_energy", fracture_energy)
         self.density = _positive("density", density)
 
     def moduli(self, dim: int, plane: Literal['stress', 'strain']) -> tuple:
@@ -121,7 +125,13 @@ class StateBased:
         return lam + mu, mu
 
     def stretch_limit(self, dim: int, plane: Literal['stress', 'strain'], horizon: float) -> float:
-        return np.inf if self.critical_stretch is None else self.critical_stretch
+        """The critical stretch (given, or from the fracture energy; inf if neither)."""
+        if self.critical_stretch is not None:
+            return self.critical_stretch
+        if self.fracture_energy is None:
+            return np.inf
+        return from_energy.state_based(self.fracture_energy, self.E, self.nu, horizon, plane,
+                                            dim)
 
     def __repr__(self):
         return f"<StateBased E={self.E:g}, nu={self.nu:g}>"

@@ -14,7 +14,8 @@ import scipy.sparse as sp
 from ..assembly.conditions import Conditions
 from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from .. import config
-from ..errors import InputError, MaterialError, SolveError, UnsupportedError, check_choice
+from ..errors import (ConvergenceError, InputError, MaterialError, SolveError, UnsupportedError,
+                      check_choice)
 from . import _kernels as K
 from .correction import SurfaceCorrection
 from .dynamics import Dynamics
@@ -316,8 +317,11 @@ class Problem(Conditions, SurfaceCorrection, Dynamics):
         Raises
         ------
         SolveError
-            Rigid motions not fixed (named), or a load step that does not converge
-            (named, with its last residual).
+            Rigid motions not fixed (named), or a linear solve that fails.
+        ConvergenceError
+            A load step that does not converge, or whose residual goes non-finite
+            (named, with its residuals; the error's ``history`` holds those of every
+            load step so far).
         """
         d, n = self.dim, len(self.body)
         steps, max_iterations = int(steps), int(max_iterations)
@@ -354,17 +358,18 @@ class Problem(Conditions, SurfaceCorrection, Dynamics):
             while not (res[-1] <= tol * (ref := self._reference(load[interior], f[D], res))
                        or res[-1] == 0.0):
                 if not np.isfinite(res[-1]):
-                    raise SolveError(
+                    raise ConvergenceError(
                         f"load step {step} of {steps}, Newton iteration {len(res) - 1}: the "
                         f"internal forces are not finite (an interaction inverted or collapsed "
                         f"where its energy is undefined); try more load steps or "
-                        f"line_search=True")
+                        f"line_search=True", history + [res])
                 if len(res) > max_iterations:
-                    raise SolveError(
+                    raise ConvergenceError(
                         f"Newton did not converge in load step {step} of {steps}: residual "
                         f"{res[-1]:.3e} (wanted {tol * ref:.3e}) after {len(res) - 1} "
-                        f"iteration(s); try more load steps, line_search=True or a larger "
-                        f"max_iterations")
+                        f"iteration(s), residuals {', '.join(f'{r:.2e}' for r in res)}; try "
+                        f"more load steps, line_search=True or a larger max_iterations",
+                        history + [res])
                 floor = config.NEWTON_INNER_FLOOR
                 rtol = min(tol, floor) if linear else min(config.NEWTON_FORCING,
                                                           max(res[-1] / ref, floor))

@@ -42,13 +42,13 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ..assembly.linsolve import free_rigid_motions
-from ..errors import InputError, SolveError
+from ..errors import ConvergenceError, InputError, SolveError
 from .solution import Relaxation
 
 if TYPE_CHECKING:
-    from typing import Any, Callable
+    from typing import Any, Callable, Sequence
 
-__all__ = ["relax", "Relaxation", "load_steps", "unsettled"]
+__all__ = ["relax", "Relaxation", "System", "load_steps", "unsettled"]
 
 log = logging.getLogger(__name__)
 
@@ -93,7 +93,7 @@ def _settle(x, forces, density, target, budget, record, dot=np.dot):
     norm = float(np.sqrt(dot(force, force)))
     velocity = 0.5 * force / density
     iterations = 0
-    while norm > target and norm > 0.0 and iterations < budget:
+    while norm > target and norm > 0.0 and iterations < budget:      # False on NaN
         iterations += 1
         x += velocity
         previous, force = force, forces()
@@ -104,18 +104,29 @@ def _settle(x, forces, density, target, budget, record, dot=np.dot):
     return norm
 
 
-def unsettled(step: int, norm: float, scale: float, target: float, max_steps: int) -> SolveError:
-    """The `SolveError` of a load step that has not settled within ``max_steps``."""
-    return SolveError(
+def unsettled(step: int, norm: float, scale: float, target: float, max_steps: int,
+              history: list | None = None) -> ConvergenceError:
+    """The `ConvergenceError` of a load step that has not settled within ``max_steps``
+    (or whose residual went non-finite); ``history``: the residuals so far, one list per
+    load step."""
+    if not np.isfinite(norm):
+        return ConvergenceError(
+            f"dynamic relaxation diverged in load step {step}: the out-of-balance force is "
+            f"not finite (residual {norm}); check the loads and material constants (the "
+            f"forces must stay finite), or use more load steps", history)
+    return ConvergenceError(
         f"dynamic relaxation did not converge in load step {step}: residual "
         f"{norm:.3e} ({norm / scale:.1e} of the reference {scale:.3e}, wanted "
-        f"{target / scale:.1e}) after {max_steps} iterations; raise max_steps or tol")
+        f"{target / scale:.1e}) after {max_steps} iterations; raise max_steps or tol "
+        f"(the residual history is the error's .history)", history)
 
 
 def load_steps(x: np.ndarray, forces: Callable[..., np.ndarray], density: np.ndarray,
                external: np.ndarray, load: np.ndarray, prescribe: Callable[..., np.ndarray], *,
                tol: float, noise: float, limit: float, steps: int, max_steps: int, every: int,
-               show: bool, dot: Callable[..., np.ndarray] = np.dot) -> tuple[list, int, int]:
+               show: bool, dot: Callable[..., np.ndarray] = np.dot,
+               fractions: Sequence[float] | None = None, max_rounds: int | None = None,
+               after_step: Callable[..., None] | None = None) -> tuple[list, int, int]:
     """The load steps of `relax`: each settles from the last equilibrium, then breaks the
     over-stretched bonds and settles again until no bond breaks.
 
@@ -133,10 +144,20 @@ def load_steps(x: np.ndarray, forces: Callable[..., np.ndarray], density: np.nda
     tol, noise, limit : float
         Relative tolerance, smallest reachable residual, critical stretch.
     steps, max_steps, every : int
+        ``steps`` equal load steps to the full load (unless ``fractions`` is given).
     show : bool
         Progress bars.
     dot : callable (a, b) -> float
         Inner product of dof vectors (a sum over the ranks when they are split).
+    fractions : sequence of float, optional
+        The load factor of each step instead (``steps`` is then its length).
+    max_rounds : int, optional
+        Most break-and-settle rounds per step (default unbounded): a step that
+        still breaks bonds in its last round ends settled but not complete.
+    after_step : callable, optional
+        Called after each step as ``after_step(step, fraction, rounds=, broken=,
+        iterations=, residual=, complete=)`` (``rounds``: the settles that broke bonds);
+        a true return value ends the run there.
 
     Returns
     -------
@@ -147,18 +168,19 @@ def load_steps(x: np.ndarray, forces: Callable[..., np.ndarray], density: np.nda
     def norm_of(v):
         return float(np.sqrt(dot(v, v)))
 
+    if fractions is None:
+        fractions = [step / steps for step in range(1, steps + 1)]
     broken = 0
     history, total = [], 0
-    for step in range(1, steps + 1):
-        frac = step / steps
+    for step, frac in enumerate(fractions, start=1):
         prescribe(frac)
         external[:] = frac * load
         start = norm_of(forces()[0])
         scale = norm_of(external) or start
         target = max(tol * scale, noise)
         res, used = [start], 0
-        bar = tqdm(total=max_steps, desc=f"ADR load step {step}/{steps}", disable=not show,
-                   leave=False)
+        bar = tqdm(total=max_steps, desc=f"ADR load step {step}/{len(fractions)}",
+                   disable=not show, leave=False)
 
         def record(norm):
             nonlocal used
@@ -168,22 +190,33 @@ def load_steps(x: np.ndarray, forces: Callable[..., np.ndarray], density: np.nda
                 bar.update(every)
                 bar.set_postfix(residual=f"{norm / max(scale, 1e-300):.1e}", refresh=False)
 
+        rounds, step_broken = 0, 0
         while True:
             norm = _settle(x, lambda: forces()[0], density, target, max_steps - used, record,
                            dot)
-            if norm > target:
+            if not (norm <= target and np.isfinite(norm)):          # not settled, or not finite
                 bar.close()
-                raise unsettled(step, norm, scale, target, max_steps)
+                raise unsettled(step, norm, scale, target, max_steps, history + [res + [norm]])
+            exhausted = max_rounds is not None and rounds >= max_rounds
+            if exhausted:
+                break
             count = forces(limit)[1]                # break the over-stretched bonds
             if not count:
                 break
-            broken += count
+            rounds += 1
+            step_broken += count
         bar.close()
         if used % every:
             res.append(norm)
-        log.info("ADR load step %d: %d iterations, residual %.3e", step, used, norm)
+        log.info("ADR load step %d: %d iterations, %d rounds, %d bonds broken, residual %.3e",
+                 step, used, rounds, step_broken, norm)
         history.append(res)
         total += used
+        broken += step_broken
+        if after_step is not None and after_step(step, frac, rounds=rounds, broken=step_broken,
+                                                 iterations=used, residual=norm,
+                                                 complete=not exhausted):
+            break
     return history, total, broken
 
 
@@ -223,50 +256,104 @@ def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: i
     Raises
     ------
     SolveError
-        Rigid motions left free by the Dirichlet conditions (named), or a load
-        step that has not settled within ``max_steps`` iterations (the
-        residual reached is given).
+        Rigid motions left free by the Dirichlet conditions (named).
+    ConvergenceError
+        A load step that has not settled within ``max_steps`` iterations, or whose
+        residual went non-finite (the residual reached is given, the residual
+        history is the error's ``history``).
     """
     tol, max_steps, steps = float(tol), int(max_steps), int(steps)
     every = 10 if every is None else int(every)
     if not tol > 0 or max_steps < 1 or steps < 1 or every < 1:
         raise InputError(f"expected tol > 0 and max_steps, steps, every >= 1, received tol={tol}, "
                          f"max_steps={max_steps}, steps={steps}, every={every}")
-    body, d, n = problem.body, problem.dim, len(problem.body)
-    stiffness = problem.stiffness()
-    fixed, values = problem.prescribed()
-    free_motions = free_rigid_motions(stiffness, body.points, fixed)
-    if free_motions:
-        raise SolveError("dynamic relaxation cannot settle: the Dirichlet conditions leave free "
-                         "the " + "; ".join(free_motions) + ". Fix them with add_dirichlet")
-    free = np.setdiff1d(np.arange(d * n), fixed)
-    density = 0.25 * np.asarray(abs(stiffness).sum(axis=1)).reshape(-1)[free]   # dt = 1
-    limit = problem.material.stretch_limit(d, problem.plane, body.horizon)
-    state = problem._force_state()
-    volumes = np.repeat(body.volumes, d)[free]
-    load = problem.load()
-    u = np.zeros((n, d))
-    flat, x = u.reshape(-1), np.zeros(len(free))              # x: the free dofs
-    external = np.zeros(len(free))
-    # the force at zero displacement is the round-off of the bond stretches (it should
-    # vanish): a residual below a few times it cannot be reached
-    noise = 10.0 * float(np.linalg.norm(volumes * problem._internal_force(
-        u, np.inf, state)[0].reshape(-1)[free]))
+    system = System(problem)
+    show = sys.stderr.isatty() if progress is None else progress
+    history, total, broken = system.run(tol=tol, steps=steps, max_steps=max_steps, every=every,
+                                        show=show)
+    return Relaxation(problem, system.u, damage=problem.damage(), residual_history=history,
+                      iterations=total, broken=broken)
 
-    def forces(breaking=np.inf):
+
+class System:
+    """The free dofs, fictitious density and forces of a serial ADR run on a problem.
+
+    Parameters
+    ----------
+    problem : cnem.pd.Problem
+        BondBased or StateBased.
+
+    Attributes
+    ----------
+    u : (n, d) ndarray
+        Displacements (updated by `run`).
+    free, fixed : int ndarray
+        Free and prescribed dofs; ``values`` the prescribed values (full load).
+
+    Raises
+    ------
+    SolveError
+        Rigid motions left free by the Dirichlet conditions (named).
+    """
+
+    def __init__(self, problem: Any):
+        self.problem = problem
+        body, d, n = problem.body, problem.dim, len(problem.body)
+        stiffness = problem.stiffness()
+        self.fixed, self.values = problem.prescribed()
+        free_motions = free_rigid_motions(stiffness, body.points, self.fixed)
+        if free_motions:
+            raise SolveError("dynamic relaxation cannot settle: the Dirichlet conditions leave "
+                             "free the " + "; ".join(free_motions) + ". Fix them with "
+                             "add_dirichlet")
+        self.free = free = np.setdiff1d(np.arange(d * n), self.fixed)
+        self.density = 0.25 * np.asarray(abs(stiffness).sum(axis=1)).reshape(-1)[free]  # dt = 1
+        self.limit = problem.material.stretch_limit(d, problem.plane, body.horizon)
+        self.state = problem._force_state()
+        self.volumes = np.repeat(body.volumes, d)
+        self.load = problem.load()[free]
+        self.u = np.zeros((n, d))
+        self.flat, self.x = self.u.reshape(-1), np.zeros(len(free))     # x: the free dofs
+        self.external = np.zeros(len(free))
+        # the force at zero displacement is the round-off of the bond stretches (it should
+        # vanish): a residual below a few times it cannot be reached
+        self.noise = 10.0 * float(np.linalg.norm(self._nodal_force()[0][free]))
+
+    def _nodal_force(self, breaking=np.inf):
+        """Internal forces times volumes at ``u``, ``(d n,)``, and the bonds broken."""
+        force, count = self.problem._internal_force(self.u, breaking, self.state)
+        return self.volumes * force.reshape(-1), count
+
+    def forces(self, breaking: float = np.inf) -> tuple[np.ndarray, int]:
         """Out-of-balance force on the free dofs at ``x`` (``(f,)``), and the number of
         bonds stretched beyond ``breaking`` (broken by this call)."""
-        flat[free] = x
-        force, count = problem._internal_force(u, breaking, state)
-        return external + volumes * force.reshape(-1)[free], count
+        self.flat[self.free] = self.x
+        force, count = self._nodal_force(breaking)
+        return self.external + force[self.free], count
 
-    def prescribe(fraction):
-        flat[fixed] = fraction * values
+    def prescribe(self, fraction: float) -> None:
+        """The Dirichlet values at ``fraction`` of theirs."""
+        self.flat[self.fixed] = fraction * self.values
 
-    show = sys.stderr.isatty() if progress is None else progress
-    history, total, broken = load_steps(x, forces, density, external, load[free], prescribe,
-                                        tol=tol, noise=noise, limit=limit, steps=steps,
-                                        max_steps=max_steps, every=every, show=show)
-    flat[free] = x
-    return Relaxation(problem, u, damage=problem.damage(), residual_history=history,
-                      iterations=total, broken=broken)
+    def reactions(self) -> np.ndarray:
+        """``(d n,)`` the forces that hold the prescribed dofs at ``u`` (zero on the free
+        dofs): minus the internal forces there."""
+        out = np.zeros_like(self.flat)
+        out[self.fixed] = -self._nodal_force()[0][self.fixed]
+        return out
+
+    def run(self, *, tol: float, max_steps: int, every: int, show: bool, steps: int = 1,
+            fractions: Sequence[float] | None = None, max_rounds: int | None = None,
+            after_step: Callable[..., None] | None = None) -> tuple[list, int, int]:
+        """`load_steps` on this system; ``u`` holds the last equilibrium after it (and
+        during ``after_step``)."""
+        def after(*args, **kwargs):
+            self.flat[self.free] = self.x
+            return after_step is not None and after_step(*args, **kwargs)
+
+        out = load_steps(self.x, self.forces, self.density, self.external, self.load,
+                         self.prescribe, tol=tol, noise=self.noise, limit=self.limit,
+                         steps=steps, max_steps=max_steps, every=every, show=show,
+                         fractions=fractions, max_rounds=max_rounds, after_step=after)
+        self.flat[self.free] = self.x
+        return out

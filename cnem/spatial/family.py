@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from .. import config
-from ..errors import LimitError, SpatialError, check_choice
+from ..errors import LimitError, SpatialError, check_array, check_choice
 from . import _family_kernels as K
 from . import _pair_kernels as P
 from .._parallel import work_chunks
@@ -189,14 +189,13 @@ def family_search(points: ArrayLike, horizon: float | ArrayLike, *,
     pts = as_points(arr if arr.size else arr.reshape(0, arr.shape[-1] if arr.ndim == 2 else 2))
     n, d = pts.shape
     per = check_period(period, d, pts)
-    try:
-        h = np.ascontiguousarray(np.broadcast_to(np.asarray(horizon, dtype=np.float64), (n,)))
-    except ValueError:
-        raise SpatialError(f"horizon: expected a number or one per point ({n},), received "
-                           f"shape {np.shape(horizon)}") from None
-    if n and (not np.isfinite(h).all() or (h <= 0).any()):
-        raise SpatialError(f"horizon must be positive and finite, received min {h.min()!r}; "
-                           f"pass a positive distance")
+    h = check_array("horizon", horizon, shape=(n,), broadcast=True, finite=False,
+                    error=SpatialError, fix="pass a number or one positive distance per point")
+    bad = ~(np.isfinite(h) & (h > 0))
+    if bad.any():
+        first = int(np.argmax(bad))
+        raise SpatialError(f"horizon must be positive and finite, received {float(h[first])!r} at point "
+                           f"{first}; pass a positive distance")
     if n == 0:
         return Family(np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int32), h, per)
     if method == "auto":

@@ -15,22 +15,16 @@ from numpy.typing import ArrayLike
 
 from .. import config
 from .._parallel import work_chunks
-from ..errors import SpatialError
+from ..errors import SpatialError, check_array, check_points
 from . import _rtree_kernels as K
 
 __all__ = ["RTree", "check_period", "as_points"]
 
 
 def as_points(points: ArrayLike, name: str = "points") -> np.ndarray:
-    """Validate a ``(n, d)`` float64 C-contiguous array with d = 2 or 3."""
-    arr = np.ascontiguousarray(points, dtype=np.float64)
-    if arr.ndim != 2 or arr.shape[1] not in (2, 3):
-        raise SpatialError(f"{name}: expected a (n, 2) or (n, 3) array, received shape "
-                           f"{arr.shape}; pass one row of coordinates per point")
-    if not np.isfinite(arr).all():
-        raise SpatialError(f"{name}: expected finite coordinates, received NaN or inf; "
-                           f"drop or repair those rows")
-    return arr
+    """Validate a ``(n, d)`` float64 C-contiguous array with d = 2 or 3, finite and
+    below `cnem.config.COORDINATE_LIMIT` (`cnem.errors.check_points`)."""
+    return check_points(name, points, error=SpatialError)
 
 
 def check_period(period: ArrayLike | None, dim: int, *points: np.ndarray) -> np.ndarray:
@@ -222,10 +216,8 @@ class RTree:
         indices : (k,) int64 ndarray
         """
         pts = self._points(points, "points")
-        radius = np.ascontiguousarray(np.broadcast_to(np.asarray(r, dtype=np.float64), (len(pts),)))
-        if (radius < 0).any() or not np.isfinite(radius).all():
-            raise SpatialError(f"r must be finite and non-negative, received min "
-                               f"{radius.min(initial=0.0)!r}; pass distances >= 0")
+        radius = check_array("r", r, shape=(len(pts),), broadcast=True, nonnegative=True,
+                             error=SpatialError, fix="pass one distance >= 0, or one per point")
         kind = K.BALL_OPEN if strict else K.BALL_CLOSED
         return self._query(pts, np.zeros_like(pts), radius, kind, exclude_self)
 

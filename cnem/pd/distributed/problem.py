@@ -22,6 +22,7 @@ from ...assembly.conditions import Conditions, per_point
 from ...errors import InputError, MaterialError, OptionError
 from .._kernels import pmb_forces
 from ...material import PLANES
+from ..guards import check_time_step, diverged, first_non_finite
 from ..solution import DynamicRun
 from . import _kernels as K
 from . import checkpoint as ckpt
@@ -270,6 +271,8 @@ class Problem(Conditions):
         dt, steps = float(dt), int(steps)
         if not dt > 0 or steps < 1:
             raise InputError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
+        stable = self.stable_time_step(1.0)
+        check_time_step(dt, stable)
         every = max(1, steps // 10) if every is None else int(every)
         save_every = steps if checkpoint_every is None else int(checkpoint_every)
         rho = self.material.density
@@ -324,6 +327,7 @@ class Problem(Conditions):
             acc = (force + fext) / rho
             v += 0.5 * dt * acc
             v.reshape(-1)[D] = 0.0
+            self._check_finite(step, dt, owned_u, v, stable)
             if step % every == 0 or step == steps:
                 store(step)
             if checkpoint is not None and step % save_every == 0:
@@ -338,6 +342,15 @@ class Problem(Conditions):
             times=np.array(times), frames=frames, energy=np.array(energy), files=files,
             broken=earlier + self.comm.allreduce(broken_here), local=local, step=steps)
 
+    def _check_finite(self, step, dt, u, v, stable):
+        """`cnem.pd.guards.diverged` on every rank once any rank's owned ``u`` or ``v``
+        is not finite (the lowest global point number that is)."""
+        bad = first_non_finite(u, v)
+        point = self.comm.allreduce(int(self.body.owned[bad]) if bad >= 0 else len(self.body),
+                                    op=_min())
+        if point < len(self.body):
+            raise diverged(step, dt, point, self.body.global_points[point], stable)
+
     def relax(self, *, tol: float = 1e-8, max_steps: int = 100_000, steps: int = 1,
               every: int | None = None, progress: bool | None = None) -> Relaxation:
         """Adaptive dynamic relaxation over the ranks (`cnem.pd.distributed.relaxation.relax`);
@@ -349,4 +362,9 @@ class Problem(Conditions):
 def _max():
     from .comm import mpi
     return mpi().MAX
+
+
+def _min():
+    from .comm import mpi
+    return mpi().MIN
 

@@ -37,9 +37,10 @@ def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: i
 
     Raises
     ------
-    SolveError
-        A load step that has not settled within ``max_steps`` iterations (the
-        residual reached is given). Unlike the serial solver, free rigid motions are
+    ConvergenceError
+        A load step that has not settled within ``max_steps`` iterations, or whose
+        residual went non-finite (the residual reached is given, the residual
+        history is the error's ``history``). Unlike the serial solver, free rigid motions are
         not detected beforehand: they show as a load step that does not settle.
     """
     tol, max_steps, steps = float(tol), int(max_steps), int(steps)

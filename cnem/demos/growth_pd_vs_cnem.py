@@ -1,0 +1,320 @@
+"""The two-hole plate grown by C-NEM (LEFM, maximum hoop stress) and broken by quasi-static PD on the same nodes.
+
+The problem
+-----------
+The plate, holes, edge cracks, material and supports of
+`cnem.demos.growth_two_holes` (imported, not copied), on the cloud of that demo
+(`cnem.nodes.irregular`, spacing ``h``, seed 0):
+
+* C-NEM: `cnem.fracture.grow` with the demo's ``setup``, increments of 1 mm,
+  ``K_Ic`` given, so each step also has its critical load factor.
+* PD: `cnem.pd.Body.from_cloud` on the very nodes of the initial C-NEM model
+  (horizon ``m h``, m = 3), the same E and G_c = K_Ic^2 / E' (plane strain),
+  bond-based PMB by default (``model="state"``: the linear peridynamic solid
+  with the same nu); the critical stretch from G_c by
+  `cnem.pd.critical_stretch`. The top-edge displacement of ``setup`` is ramped
+  by `cnem.pd.quasistatic` (ADR to equilibrium, bonds breaking at equilibrium
+  until none breaks, each step bounded); it starts at the factor at which the
+  first bond of the elastic solution reaches the critical stretch. PD's
+  displacement conditions hold the layers of points within one horizon of the
+  bottom and top edges (a single prescribed row over-stretches the bonds next
+  to it: 1.8x the mean strain, measured on a strip), u_x = 0 at the origin.
+* The PD crack paths are the ridges of damage >= 0.5 from each initial tip
+  (`cnem.geometry.ridge.ridge_path`).
+
+Compared: the Hausdorff distance between the paths (shapely; the longer path
+cut to the length of the shorter one), the first kink angle (the chord over the
+first increment from the initial tip, against the crack direction), the crack
+length at which each path first comes within ``h`` of a hole, the outer
+boundary or the other crack, and the load factor at which growth starts.
+
+Expected result
+---------------
+C-NEM sends the two cracks between the holes (its growth is LEFM, independent of
+K_Ic except for the load factor). PD has a material length, the horizon: at
+delta = 1.4 mm (h = 0.5 mm), longer than the 1 mm notches and of the order of the
+hole radius, its first bonds break at about 0.4 of C-NEM's critical load, between
+the holes rather than at the notches, and the plate fails through a diffuse
+damage band from hole to hole: no PD crack runs from a notch, and the table says
+so (NaN rows). The PD paths follow the notches only where delta is well below the
+notch length (finer clouds; more PD load steps). The picture
+(``pd_cnem_paths.png``) draws both paths over the geometry on the PD damage
+field, one panel per spacing.
+"""
+
+from __future__ import annotations
+
+import pathlib
+import time
+from typing import TYPE_CHECKING
+
+import numpy as np
+import shapely
+
+import cnem
+import cnem.pd as pd
+from cnem._parallel import one_thread
+from cnem.cli import demo_parser
+from cnem.errors import GeometryError
+from cnem.demos import growth_two_holes as plate
+from cnem.geometry.ridge import ridge_path
+from cnem.pd.critical_stretch import fracture_energy
+from cnem.pd.quasistatic import load_drop, quasistatic
+
+if TYPE_CHECKING:
+    from typing import Sequence
+
+__all__ = ["main", "cli", "compare"]
+
+#: Fracture toughness, MPa sqrt(mm) (50 MPa sqrt(m): a steel-like value).
+K_IC = 50.0 * np.sqrt(1000.0)
+#: Initial tips (left crack, right crack) and crack directions.
+TIPS = np.array([[1.0, 2.85], [plate.L - 1.0, 7.15]])
+DIRECTIONS = np.array([[1.0, 0.0], [-1.0, 0.0]])
+
+
+def _cnem(dom, cloud, increment, steps):
+    try:
+        hist = cnem.fracture.grow(dom, cloud, plate.setup, increment=increment, steps=steps,
+                                  K_Ic=K_IC, progress=False)
+    except GeometryError as exc:            # the cracks joined and cut the plate: the run so far
+        print(f"C-NEM: {exc}")
+        hist = exc.history
+    tips = hist.paths()                                     # (steps + 1, tips, 2)
+    order = [int(np.argmin(np.hypot(*(tips[0] - t).T))) for t in TIPS]
+    paths = [_dedupe(tips[:, i]) for i in order]
+    return paths, float(hist.steps[0].critical_load_factor), hist
+
+
+def _dedupe(path):
+    """A polyline without repeated vertices (a tip that stopped repeats its position)."""
+    keep = np.r_[True, np.hypot(*np.diff(path, axis=0).T) > 1e-12]
+    return path[keep]
+
+
+def _pd_problem(cloud, model, horizon_factor):
+    body = pd.Body.from_cloud(cloud, horizon_factor)
+    G_c = fracture_energy(K_IC, plate.E, plate.NU, "strain")
+    material = (pd.BondBased(plate.E, fracture_energy=G_c) if model == "bond" else
+                pd.StateBased(plate.E, plate.NU, fracture_energy=G_c))
+    prob = pd.Problem(body, material, plane="strain")
+    layer = body.horizon
+    prob.add_dirichlet(lambda p: p[:, 1] < layer, 1)
+    prob.add_dirichlet(lambda p: np.hypot(*p.T) < 1e-9 * plate.L, 0)
+    prob.add_dirichlet(lambda p: p[:, 1] > plate.B - layer, 1, plate.PULL)
+    return body, prob
+
+
+def _first_breaking_factor(prob):
+    """The load factor at which the most stretched bond of the (linear) elastic solution
+    at factor 1 reaches the critical stretch."""
+    b = prob.body
+    u = prob.solve().u
+    stretch = np.hypot(*(b.xi + u[b.bond_j] - u[b.bond_i]).T) / b.length - 1.0
+    return prob.material.stretch_limit(2, prob.plane, b.horizon) / float(stretch.max())
+
+
+def _pd(cloud, model, horizon_factor, factor_step, factor_max, max_rounds, load_steps):
+    body, prob = _pd_problem(cloud, model, horizon_factor)
+    start = _first_breaking_factor(prob)
+    factors = start * np.arange(1.0, factor_max / start + 1e-9, factor_step)[:load_steps]
+    # the PMB kernel on one thread: on a shared, busy machine two threads stall each
+    # other (measured 20x slower per force evaluation at a load average of 18)
+    with one_thread():
+        run = quasistatic(prob, factors, stop=load_drop(0.2), max_rounds=max_rounds,
+                          progress=False)
+    started = next((s.factor for s in run.steps if s.broken), np.nan)
+    paths = []
+    for tip in TIPS:
+        near = np.hypot(*(body.points - tip).T) < body.horizon
+        paths.append(ridge_path(body.points, run.damage, tip) if (run.damage[near] >= 0.5).any()
+                     else tip[None].copy())
+    return body, run, paths, start, started
+
+
+def _length(path):
+    return float(np.hypot(*np.diff(path, axis=0).T).sum()) if len(path) > 1 else 0.0
+
+
+def _cut(path, length):
+    """The polyline from its start to arc length ``length``."""
+    if len(path) < 2:
+        return path
+    line = shapely.LineString(path)
+    length = min(length, line.length)
+    s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(path, axis=0).T))]
+    inner = path[s < length]
+    end = np.array(line.interpolate(length).coords[0])
+    return np.vstack([inner, end])
+
+
+def _kink_deg(path, direction, chord):
+    """Angle (degrees, counter-clockwise) of the chord from the path's start over arc
+    length ``chord``, against ``direction``."""
+    if _length(path) == 0.0:
+        return np.nan
+    end = _cut(path, chord)[-1] - path[0]
+    return float(np.degrees(np.arctan2(direction[0] * end[1] - direction[1] * end[0],
+                                       direction @ end)))
+
+
+def _arrival(path, other, reach):
+    """Crack growth (arc length from the initial tip) at which ``path`` first comes
+    within ``reach`` of a hole, the outer boundary or ``other``, and what it meets."""
+    holes = [shapely.Point(c).buffer(plate.R, 256).exterior for c in plate.HOLES]
+    outer = shapely.box(0.0, 0.0, plate.L, plate.B).exterior
+    targets = {"hole": shapely.MultiLineString(holes), "boundary": outer}
+    if _length(other) > 0:
+        targets["other crack"] = shapely.LineString(other)
+    s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(path, axis=0).T))]
+    for k, p in enumerate(path[1:], start=1):
+        for name, target in targets.items():
+            if shapely.distance(shapely.Point(p), target) < reach:
+                return float(s[k]), name
+    return np.nan, "none"
+
+
+def compare(cnem_path: np.ndarray, pd_path: np.ndarray, other_cnem: np.ndarray,
+            other_pd: np.ndarray, direction: np.ndarray, increment: float, reach: float) -> dict:
+    """The comparison of one crack's two paths (see the module)."""
+    common = min(_length(cnem_path), _length(pd_path))
+    hausdorff = (shapely.hausdorff_distance(shapely.LineString(_cut(cnem_path, common)),
+                                            shapely.LineString(_cut(pd_path, common)))
+                 if common > 0 else np.nan)
+    c_len, c_what = _arrival(cnem_path, other_cnem, reach)
+    p_len, p_what = _arrival(pd_path, other_pd, reach)
+    return dict(hausdorff=float(hausdorff), compared_length=common,
+                kink_cnem=_kink_deg(cnem_path, direction, increment),
+                kink_pd=_kink_deg(pd_path, direction, increment),
+                reach_cnem=c_len, meets_cnem=c_what, reach_pd=p_len, meets_pd=p_what,
+                length_cnem=_length(cnem_path), length_pd=_length(pd_path))
+
+
+def study(h: float, *, model: str = "bond", horizon_factor: float = 3.0, increment: float = 1.0,
+          steps: int = 12, factor_step: float = 0.02, factor_max: float = 1.5,
+          max_rounds: int = 100, load_steps: int | None = None) -> dict:
+    """Both methods on the regular cloud of spacing ``h``; one dict."""
+    dom = plate.domain(h)
+    cloud = cnem.nodes.irregular(dom, h, seed=0)
+    t0 = time.perf_counter()
+    cpaths, c_factor, hist = _cnem(dom, cloud, increment, steps)
+    t1 = time.perf_counter()
+    body, run, ppaths, start, started = _pd(cloud, model, horizon_factor, factor_step, factor_max,
+                                            max_rounds, load_steps)
+    t2 = time.perf_counter()
+    rows = [compare(cpaths[i], ppaths[i], cpaths[1 - i], ppaths[1 - i], DIRECTIONS[i], increment,
+                    h) for i in range(2)]
+    return dict(h=h, horizon=body.horizon, nodes=len(body), rows=rows, cnem_paths=cpaths,
+                pd_paths=ppaths, cnem_factor=c_factor, pd_first_bond=start, pd_started=started,
+                pd_steps=len(run.steps), pd_stopped=run.stopped,
+                pd_incomplete=int(sum(not s.complete for s in run.steps)),
+                pd_broken=int(run.array("broken").sum()),
+                critical_stretch=run.problem.material.stretch_limit(2, "strain", body.horizon),
+                points=body.points, damage=run.damage, seconds=(t1 - t0, t2 - t1))
+
+
+def table(results: list) -> str:
+    lines = [f"{'h':>5} {'delta':>6} {'nodes':>6} {'crack':>5} | {'Hausdorff':>9} {'over':>5} | "
+             f"{'kink C-NEM':>10} {'PD':>7} | {'reaches C-NEM':>18} {'PD':>18} | "
+             f"{'start factor C-NEM':>18} {'PD':>6}"]
+    for r in results:
+        for name, row in zip(("left", "right"), r["rows"]):
+            c = f"{row['reach_cnem']:.2f} {row['meets_cnem']}"
+            p = f"{row['reach_pd']:.2f} {row['meets_pd']}"
+            lines.append(f"{r['h']:>5.3f} {r['horizon']:>6.3f} {r['nodes']:>6d} {name:>5} | "
+                         f"{row['hausdorff']:>9.3f} {row['compared_length']:>5.1f} | "
+                         f"{row['kink_cnem']:>10.2f} {row['kink_pd']:>7.2f} | {c:>18} {p:>18} | "
+                         f"{r['cnem_factor']:>18.4f} {r['pd_started']:>6.4f}")
+    lines.append("lengths in mm; Hausdorff over the first 'over' mm of both paths; kink: chord over "
+                 "the first increment, degrees; reaches: crack growth when the path comes within h "
+                 "of a hole / the boundary / the other crack; start factor: the multiple of the "
+                 "0.1 mm pull at which growth starts (C-NEM: K_eq = K_Ic; PD: first broken bond)")
+    return "\n".join(lines)
+
+
+def _plot(results, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(len(results), 1, figsize=(9.0, 4.6 * len(results)), squeeze=False)
+    for ax, r in zip(axes[:, 0], results):
+        sc = ax.scatter(*r["points"].T, c=r["damage"], s=4.0 * (0.25 / r["h"]) ** 2, cmap="Greys",
+                        vmin=0.0, vmax=1.0, zorder=1)
+        ax.plot([0, plate.L, plate.L, 0, 0], [0, 0, plate.B, plate.B, 0], "k-", lw=1)
+        for c in plate.HOLES:
+            t = np.linspace(0, 2 * np.pi, 200)
+            ax.plot(c[0] + plate.R * np.cos(t), c[1] + plate.R * np.sin(t), "k-", lw=1)
+        for tip, direction in zip(TIPS, DIRECTIONS):
+            ax.plot(*np.array([tip - direction, tip]).T, "k-", lw=2.5)
+        for k, (cp, pp) in enumerate(zip(r["cnem_paths"], r["pd_paths"])):
+            ax.plot(*cp.T, "o-", color="tab:blue", ms=3, lw=2,
+                    label="C-NEM (max hoop, 1 mm steps)" if k == 0 else None, zorder=3)
+            ax.plot(*pp.T, "s-", color="tab:red", ms=2.5, lw=1.5,
+                    label="PD ridge of damage >= 0.5" if k == 0 else None, zorder=4)
+        ax.set_aspect("equal")
+        ax.set_xlim(-0.3, plate.L + 0.3)
+        ax.set_ylim(-0.3, plate.B + 0.3)
+        ax.set_title(f"h = {r['h']:g} mm, PD horizon {r['horizon']:.3g} mm, {r['nodes']} nodes",
+                     fontsize=10)
+        ax.legend(loc="upper center", fontsize=8, framealpha=0.9)
+        fig.colorbar(sc, ax=ax, label="PD damage", shrink=0.8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(spacings: Sequence[float] = (0.25,), *, model: str = "bond", steps: int = 12,
+         factor_step: float = 0.02, factor_max: float = 1.5, max_rounds: int = 100,
+         load_steps: int | None = None, outdir: str = "results/growth_pd_vs_cnem",
+         plot: bool = True) -> dict:
+    """Run `study` at every spacing; print the table, draw the paths.
+
+    ``load_steps`` caps the PD load steps (from the first-breaking factor up by
+    ``factor_step`` of it to ``factor_max``); ``max_rounds`` bounds each step's
+    break-and-settle rounds.
+
+    Returns
+    -------
+    dict
+        ``results`` (one dict per spacing, see `study`), ``table`` (str), ``files``.
+    """
+    out = pathlib.Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    results = []
+    for h in spacings:
+        r = study(h, model=model, steps=steps, factor_step=factor_step, factor_max=factor_max,
+                  max_rounds=max_rounds, load_steps=load_steps)
+        print(f"h = {h:g}: C-NEM {r['seconds'][0]:.0f} s, PD {r['seconds'][1]:.0f} s "
+              f"({r['pd_steps']} load steps, {r['pd_broken']} bonds broken, "
+              f"{r['pd_incomplete']} steps cut at max_rounds, stopped: {r['pd_stopped']}; "
+              f"critical stretch {r['critical_stretch']:.4g}, first bond at factor "
+              f"{r['pd_first_bond']:.4f})", flush=True)
+        results.append(r)
+    text = table(results)
+    print(text)
+    files = []
+    if plot:
+        files.append(out / "pd_cnem_paths.png")
+        _plot(results, files[-1])
+    (out / "table.txt").write_text(text + "\n")
+    return dict(results=results, table=text, files=[str(f) for f in files])
+
+
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> dict:
+    """Command line: ``python -m cnem.demos.growth_pd_vs_cnem --help`` or
+    ``cnem demo growth-pd-vs-cnem``."""
+    parser = demo_parser(__file__, __doc__, prog)
+    parser.add_argument("--h", type=float, nargs="+", default=[0.25], help="node spacings (mm)")
+    parser.add_argument("--model", choices=("bond", "state"), default="bond",
+                        help="the PD material model")
+    parser.add_argument("--steps", type=int, default=12, help="C-NEM increments")
+    parser.add_argument("--factor-step", type=float, default=0.02,
+                        help="PD load step, a fraction of the first-breaking factor")
+    parser.add_argument("--factor-max", type=float, default=1.5, help="largest PD load factor")
+    args = parser.parse_args(argv)
+    return main(args.h, model=args.model, steps=args.steps, factor_step=args.factor_step,
+                factor_max=args.factor_max, outdir=args.out, plot=not args.no_plot)
+
+
+if __name__ == "__main__":
+    cli()

@@ -1,0 +1,104 @@
+"""Solves that do not give up (issue 19, item 8): branch-enriched systems converge with
+the nodal-block AMG + enriched-block LU preconditioner, a stalled CG falls back to the
+direct solve when its factor fits in memory and otherwise says what to change."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+import scipy.sparse.linalg as spla
+from skfem import condense
+
+import cnem
+from cnem import config
+from cnem.assembly import linsolve
+
+
+def _centre_cracked(h, radius=0.1):
+    """The condensed system of a centre-cracked square plate, branch-enriched, pulled on
+    its top edge: ``A, b``, the nodal mask and the rigid modes of the free dofs."""
+    dom = cnem.Domain([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]],
+                      cracks=[[[-0.1, 0.0], [0.1, 0.0]]])
+    model = cnem.discretize(cnem.nodes.regular(dom, h))
+    prob = cnem.Elasticity(model, (1.0, 0.3), enrich=dict(radius=radius, functions="branch"))
+    prob.add_dirichlet(lambda p: p[:, 1] < -0.5 + 1e-9, None)
+    prob.add_dirichlet(lambda p: p[:, 1] > 0.5 - 1e-9, 1, 1e-3)
+    K, f = prob.stiffness(), prob.load()
+    D, values = prob.prescribed()
+    x = np.zeros(K.shape[0])
+    x[D] = values
+    A, b, _, interior = condense(K, f, x=x, D=D)
+    n2 = 2 * len(model.nodes)
+    modes = np.zeros((K.shape[0], 3))
+    modes[:n2] = linsolve.rigid_modes(model.nodes)
+    return A.tocsr(), b, prob.solver_options(interior)["nodal"], modes[interior]
+
+
+@pytest.fixture(scope="module")
+def small():
+    return _centre_cracked(0.02)          # 2.6k nodes, 6.3k unknowns, 1.3k of them enriched
+
+
+def _relative_residual(A, x, b):
+    return np.linalg.norm(A @ x - b) / np.linalg.norm(b)
+
+
+def test_enriched_system_converges_with_the_block_preconditioner(small, caplog):
+    # a hierarchy built on the whole matrix stalls here (2000 iterations, residual 2.8e-9)
+    A, b, nodal, modes = small
+    assert 0 < (~nodal).sum() < len(nodal)
+    with caplog.at_level(logging.INFO, logger="cnem.assembly.linsolve"):
+        x = linsolve.solve_spd(A, b, modes=modes, method="amg", nodal=nodal, tol=1e-10)
+    assert _relative_residual(A, x, b) <= 1e-9
+    its = [int(r.getMessage().split(": ")[1].split()[0]) for r in caplog.records
+           if "enriched dofs by LU" in r.getMessage()]
+    assert its and its[0] < 200
+    assert not any("solving directly" in r.getMessage() for r in caplog.records)
+    direct = spla.spsolve(A.tocsc(), b)
+    error = x - direct                       # in the energy norm (the enriched dofs are
+    assert error @ (A @ error) <= 1e-10 * (direct @ (A @ direct))      # ill-conditioned)
+
+
+def test_a_stalled_solve_falls_back_to_direct_when_it_fits(small, monkeypatch, caplog):
+    A, b, nodal, modes = small
+    monkeypatch.setattr(config, "CG_MAXITER", 2)
+    monkeypatch.setattr(config, "DIRECT_MEMORY", 1e12)
+    with caplog.at_level(logging.WARNING, logger="cnem.assembly.linsolve"):
+        x = linsolve.solve_spd(A, b, modes=modes, method="amg", nodal=nodal)
+    assert any("solving directly instead" in r.getMessage() for r in caplog.records)
+    assert _relative_residual(A, x, b) <= 1e-12
+
+
+def test_a_stalled_solve_that_cannot_go_direct_says_what_to_change(small, monkeypatch):
+    A, b, nodal, modes = small
+    monkeypatch.setattr(config, "CG_MAXITER", 2)
+    monkeypatch.setattr(config, "DIRECT_MEMORY", 1e3)
+    with pytest.raises(cnem.SolveError, match=r"stopped at relative residual .* after 2 "
+                                              r"iterations .*would need about .* GB .*"
+                                              r"method='direct'.*enrichment radius"):
+        linsolve.solve_spd(A, b, modes=modes, method="amg", nodal=nodal)
+
+
+def test_factor_estimate_is_an_upper_bound_of_the_measured_one(small):
+    A, b, _, _ = small
+    lu = spla.splu(A.tocsc())
+    assert 12.0 * (lu.L.nnz + lu.U.nnz) <= linsolve.direct_factor_bytes(A) <= \
+        3 * 12.0 * (lu.L.nnz + lu.U.nnz)
+
+
+def test_nodal_mask_of_the_wrong_length_is_named(small):
+    A, b, nodal, modes = small
+    with pytest.raises(cnem.InputError, match=r"nodal: expected a \(\d+,\) boolean mask"):
+        linsolve.solve_spd(A, b, method="amg", nodal=nodal[:-1] | False)
+
+
+@pytest.mark.slow
+def test_enriched_plate_of_16k_nodes_solves_on_the_automatic_path():
+    # 15.9k nodes, 39.7k unknowns (8.2k enriched), 3.3M non-zeros: above DIRECT_NNZ, so
+    # "auto" takes CG; it stalled before (residual 5.5e-6 after 2000 iterations)
+    A, b, nodal, modes = _centre_cracked(0.008)
+    assert A.nnz > config.DIRECT_NNZ and 15_000 < len(nodal) // 2
+    x = linsolve.solve_spd(A, b, modes=modes, nodal=nodal, tol=1e-10)
+    assert _relative_residual(A, x, b) <= 1e-9
