@@ -4,13 +4,16 @@ errors that name the real cause."""
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 
 import numpy as np
 import pytest
 
+import cnem
 import reference as R
+from cnem.errors import GeometryError
 from cnem.spatial import family_search
 
 FAMILY_METHODS = ["auto", "rtree", "cells", "kdtree", "brute"]
@@ -65,3 +68,41 @@ def test_family_far_from_the_origin_in_bounded_time():
         "print(all(ok), sum(map(len, want)))\n")
     ok, bonds = run_boxed(code).split()
     assert ok == "True" and int(bonds) > 3000
+
+
+# ------------------------------------------------------------------ messages naming the cause
+SQUARE = [[0, 0], [1, 0], [1, 1], [0, 1]]
+
+
+@pytest.mark.parametrize("holes, message", [
+    ([[[0, 0.5], [0.3, 0.3], [0.3, 0.7]]],
+     r"region 0 hole 0 touches the outer boundary at \(0, 0\.5\): rings must not touch"),
+    ([[[1e-12, 0.5], [0.3, 0.3], [0.3, 0.7]]],
+     r"region 0 hole 0 touches the outer boundary at \(.*, 0\.5\): rings must not touch"),
+    ([[[0.2, 0.2], [0.5, 0.5], [0.2, 0.5]], [[0.5, 0.5], [0.8, 0.8], [0.8, 0.5]]],
+     r"region 0 holes 0 and 1 touch at \(0\.5, 0\.5\): rings must not touch"),
+], ids=["hole-vertex-on-outline", "hole-1e-12-from-outline", "two-holes-at-a-point"])
+def test_touching_rings_rejected_at_construction(holes, message):
+    """shapely accepts rings touching at one point, but the body is pinched to nothing
+    there; the Domain says so instead of the cells failing later."""
+    with pytest.raises(GeometryError, match=message):
+        cnem.Domain((SQUARE, holes))
+
+
+def test_rings_apart_accepted():
+    dom = cnem.Domain((SQUARE, [[[1e-3, 0.5], [0.3, 0.3], [0.3, 0.7]]]))
+    assert dom.area == pytest.approx(1 - 0.5 * 0.4 * (0.3 - 1e-3))
+
+
+def test_boundary_finer_than_the_cloud_is_named():
+    """A 5000-vertex circle at h = 0.2 (vertices 1.3e-3 apart): the message says the
+    boundary is finer than the nodes and what to do, at the node's true position
+    (on the circle; it was printed shifted by the cloud's minimum corner)."""
+    t = np.linspace(0, 2 * np.pi, 5000, endpoint=False)
+    centre = np.array([3.0, -2.0])
+    dom = cnem.Domain(centre + np.column_stack([np.cos(t), np.sin(t)]))
+    with pytest.raises(GeometryError, match="boundary there is much finer than the node "
+                                            "cloud.*coarsen the outline") as err:
+        cnem.discretize(cnem.nodes.regular(dom, 0.2), progress=False)
+    x, y = map(float, re.search(r"at \(([^,]+), ([^)]+)\)", str(err.value)).groups())
+    assert np.hypot(x - centre[0], y - centre[1]) == pytest.approx(1.0, abs=1e-5)
