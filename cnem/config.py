@@ -12,7 +12,8 @@ into the kernels as a constant).
 True
 """
 
-__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "BOUNDARY_FINER", "CLEARANCE", "FANOUT",
+__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "BOUNDARY_FINER", "CLEARANCE", "MIN_SPACING", "MAX_NODES", "SPACING_COUNT_TOL",
+           "SPACING_BISECTIONS", "FANOUT",
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
@@ -46,6 +47,22 @@ BOUNDARY_FINER = 0.25
 #: Interior nodes closer than this fraction of the local spacing to a boundary,
 #: interface or crack are dropped (the boundary nodes stand there); `cnem.nodes`.
 CLEARANCE = 0.5
+
+#: Smallest node spacing `cnem.nodes` accepts, relative to the domain diameter
+#: (ten snapping tolerances `SNAP_TOL`).
+MIN_SPACING = 1e-8
+
+#: Most nodes `cnem.nodes` generates (estimated before generating; above it
+#: `cnem.errors.LimitError`).
+MAX_NODES = 20_000_000
+
+#: Node spacing laws are sampled along each boundary, interface and crack edge
+#: until bisecting a sample interval changes its expected node count by less
+#: than this ...
+SPACING_COUNT_TOL = 0.01
+
+#: ... or after this many bisections (then `cnem.errors.LimitError`).
+SPACING_BISECTIONS = 200
 
 # ---------------------------------------------------------------- spatial search
 #: Children per R-tree node (and boxes per leaf); a tree keeps the value it was
