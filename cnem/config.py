@@ -12,7 +12,8 @@ into the kernels as a constant).
 True
 """
 
-__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "BOUNDARY_FINER", "CLEARANCE", "MIN_SPACING", "MAX_NODES", "SPACING_COUNT_TOL",
+__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "BOUNDARY_FINER", "CLEARANCE", "MIN_SPACING", "MAX_NODES", "FILL_SPACINGS", "SPACING_NEIGHBOURS",
+           "SPACING_COUNT_TOL",
            "SPACING_BISECTIONS", "FANOUT",
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
@@ -55,6 +56,14 @@ MIN_SPACING = 1e-8
 #: Most nodes `cnem.nodes` generates (estimated before generating; above it
 #: `cnem.errors.LimitError`).
 MAX_NODES = 20_000_000
+
+#: `cnem.nodes.from_points` fills a gap along a boundary, interface or crack edge
+#: that spans more than this many local node spacings.
+FILL_SPACINGS = 2.0
+
+#: ... the local spacing at a user's point being its mean distance to this many
+#: nearest others.
+SPACING_NEIGHBOURS = 4
 
 #: Node spacing laws are sampled along each boundary, interface and crack edge
 #: until bisecting a sample interval changes its expected node count by less

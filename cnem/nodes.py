@@ -319,25 +319,101 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
 
 
-def from_points(domain: Domain, points: ArrayLike) -> NodeCloud:
+def _point_spacing(pts):
+    """(p,) local spacing at each point: the mean distance to its
+    `cnem.config.SPACING_NEIGHBOURS` nearest others (``inf`` for a lone point); a
+    single nearest neighbour is too noisy a measure on irregular clouds."""
+    k = min(config.SPACING_NEIGHBOURS, len(pts) - 1)
+    if k < 1:
+        return np.full(len(pts), np.inf)
+    return cKDTree(pts).query(pts, k=k + 1)[0][:, 1:].mean(axis=1)
+
+
+def _fill_edges(domain, pts, seg_of, user_spacing, fill):
+    """Nodes along the gaps of each PSLG edge longer than `cnem.config.FILL_SPACINGS`
+    local spacings (at each place, the `_point_spacing` of the user's point nearest
+    to it, or the distance to that point if larger).
+
+    Returns the new points and the edge each lies on; with ``fill=False`` a gap
+    raises a `GeometryError` naming it.
+    """
+    v, edges, kinds = domain.pslg.vertices, domain.pslg.edges, domain.pslg.kind
+    finite = np.isfinite(user_spacing)
+    if not finite.any():
+        return np.empty((0, 2)), np.empty(0, dtype=np.int64)
+    tree = cKDTree(pts[finite])
+    spacing = user_spacing[finite]
+
+    def spacing_of(x):
+        # a place farther from every point than their spacing lies in a gap of the cloud
+        dist, j = tree.query(x)
+        return np.maximum(spacing[j], dist)
+
+    new, new_edge, gaps = [], [], []
+    for k, (ea, eb) in enumerate(edges):
+        on = pts[seg_of == k]
+        t = (on - v[ea]) @ (v[eb] - v[ea])
+        chain = np.concatenate([v[ea][None], on[np.argsort(t)], v[eb][None]])
+        for pa, pb in zip(chain[:-1], chain[1:]):
+            samples, cum = _count_along(pa, pb, spacing_of)
+            if cum[-1] <= config.FILL_SPACINGS:
+                continue
+            if not fill:
+                gaps.append((kinds[k] != SegmentKind.CRACK, k, pa, pb, cum[-1]))
+                continue
+            pieces = int(round(cum[-1]))
+            t = np.interp(np.linspace(0, cum[-1], pieces + 1)[1:-1], cum, samples)
+            new.append(pa + t[:, None] * (pb - pa))
+            new_edge.append(np.full(len(t), k, dtype=np.int64))
+    if gaps:
+        _, k, pa, pb, count = min(gaps, key=lambda g: g[:2])     # cracks first
+        kind = SegmentKind(kinds[k])
+        harm = ("the crack face there stays straight and cannot open (K_I about half)"
+                if kind == SegmentKind.CRACK else "it is integrated coarsely")
+        raise GeometryError(
+            f"{len(gaps)} gaps along the domain's edges hold no point over more than "
+            f"{config.FILL_SPACINGS:g} local spacings, first the {kind.name.lower()} gap from "
+            f"{pa.tolist()} to {pb.tolist()} (edge {k}, ~{count:.1f} spacings): {harm}; add "
+            "points along it or pass fill=True")
+    if not new:
+        return np.empty((0, 2)), np.empty(0, dtype=np.int64)
+    return np.concatenate(new), np.concatenate(new_edge)
+
+
+def from_points(domain: Domain, points: ArrayLike, *, fill: bool = True) -> NodeCloud:
     """The user's own nodes, with missing corners and crack vertices added.
 
     Points within ``domain.tolerance`` of a boundary, interface or crack are
     snapped onto it (onto the vertex if they are that close to one).
 
+    A boundary, interface or crack edge needs nodes along it at about the local
+    spacing: a crack face with no node between its tips stays a straight line
+    and cannot open (K_I comes out at about half its value), a boundary is
+    integrated coarsely. With ``fill=True`` (the default) every gap along an edge
+    longer than `cnem.config.FILL_SPACINGS` local spacings (at each place, the
+    mean distance of the user's point nearest to it to its
+    `cnem.config.SPACING_NEIGHBOURS` nearest others, or the distance to that point
+    if larger) gets nodes at that spacing; with ``fill=False`` such a gap is an error naming it.
+
     Parameters
     ----------
     domain : Domain
     points : (p, 2) array_like
+    fill : bool
+        Fill long gaps along the edges with nodes (else raise).
 
     Returns
     -------
     NodeCloud
+        ``points[:p]`` are the user's points (snapped) in their order; nodes
+        filled in along the edges and missing vertices follow.
 
     Raises
     ------
     GeometryError
-        Points outside the domain or duplicated (closer than the tolerance).
+        Points outside the domain or duplicated (closer than the tolerance);
+        with ``fill=False``, an edge gap longer than `cnem.config.FILL_SPACINGS`
+        local spacings.
     """
     pts = np.array(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
@@ -371,6 +447,10 @@ def from_points(domain: Domain, points: ArrayLike) -> NodeCloud:
         raise GeometryError(
             f"{len(pairs)} pairs of duplicated points (closer than {tol:.3g}), first "
             + ", ".join(f"{i} and {j}" for i, j in pairs[:5]) + "; remove the duplicates")
+    user_spacing = _point_spacing(pts)
+    filled, filled_edge = _fill_edges(domain, pts, seg_of, user_spacing, fill)
+    seg_of = np.concatenate([seg_of, filled_edge])
+    pts = np.concatenate([pts, filled])
     # a crack edge between two tips with no point on it gets its midpoint
     lonely = np.flatnonzero(_tip_to_tip(domain) & ~np.isin(np.arange(len(edges)), seg_of))
     mids = 0.5 * (v[edges[lonely, 0]] + v[edges[lonely, 1]])
