@@ -106,6 +106,30 @@ def _drop_repeats(ring, tol):
     return ring[keep] if keep.sum() >= 3 else ring
 
 
+def _drop_spikes(ring, tol):
+    """Remove the tips of zero-width spikes: vertices where the ring turns straight
+    back (the edges in and out anti-parallel, closer than ``tol`` to one line).
+
+    An overlay can leave a sliver a few grid steps wide along a constraint edge
+    (two wedges along the same edge, drawn from its two ends); once `_drop_repeats`
+    merges the two vertices of its tip, the ring folds back along the edge, which
+    is not a valid polygon.
+    """
+    for _ in range(len(ring)):
+        if len(ring) <= 3:
+            break
+        into = ring - np.roll(ring, 1, axis=0)
+        out = np.roll(ring, -1, axis=0) - ring
+        cross = into[:, 0] * out[:, 1] - into[:, 1] * out[:, 0]
+        dot = np.einsum("ij,ij->i", into, out)
+        longest = np.maximum(np.linalg.norm(into, axis=1), np.linalg.norm(out, axis=1))
+        spike = np.flatnonzero((dot < 0) & (np.abs(cross) <= tol * longest))
+        if spike.size == 0:
+            break
+        ring = np.delete(ring, spike[0], axis=0)
+    return ring
+
+
 def _splice_hole(ring, hole):
     """Join a hole that touches the outer ring at a vertex into the ring (None if
     it does not touch).
@@ -235,7 +259,7 @@ class _ExactCells:
             ring = _splice_hole(ring, np.asarray(hole.coords)[:-1])
             if ring is None:
                 raise self._unresolved(i, r, "has a hole")
-        return ring
+        return _drop_spikes(ring, 10 * self.grid)
 
     def _where(self, i):
         """Node ``i`` in the caller's coordinates, formatted."""
