@@ -5,17 +5,13 @@ visible from ``x`` (the segment between them crosses no boundary, interface or
 crack; touching at the node is allowed) and no node visible from ``x`` is
 nearer. A node on an interface owns one cell per region.
 
-Three paths compute the cells:
+Two paths compute the cells:
 
 * the *fast path* (numba, `._kernels.fast_cells`): a node whose circumcentres
   are all visible from it and whose dual polygon is star-shaped around it owns
   exactly the polygon of its circumcentres (closed by the node and the
   midpoints of its two constraint edges when it sits on a straight boundary or
   a convex corner);
-* the *convex path* (`_ExactCells.convex_cell`), for the other nodes of a
-  region that is a convex polygon without cracks (every node sees all of it):
-  the region's hull cut by the bisectors with the nearby nodes, exactly, with
-  no snap grid (thin strips, whose circumcentres all lie outside, need it);
 * the *exact path* (shapely, snap-rounded overlays), for every other node and
   region (reflex corners, crack tips, interfaces, circumcentres behind a
   constraint): the cell is the part of a bounding box that node ``i`` sees
