@@ -237,22 +237,3 @@ def test_cells_of_random_hexagons_are_valid_polygons(seed):
     assert not invalid, [shapely.validation.explain_validity(polys[k]) for k in invalid]
     assert c.area.sum() == pytest.approx(dom.area, rel=1e-12)
     assert dom.polygon.symmetric_difference(shapely.union_all(polys)).area < 1e-12 * dom.area
-
-
-def test_sliver_cells_exact_and_in_bounded_time():
-    """A 1 x 1e-6 strip with irregular boundary nodes: every circumcentre lies outside
-    the strip, so every cell is clipped; in a convex region they are cut by half-planes
-    (no snap grid: the overlays' grid, relative to the whole cloud, made the areas wrong
-    by 5e-8, and the overlays took seconds per hundred cells). Areas sum to the
-    domain's to round-off and every cell is a valid polygon."""
-    code = (
-        "import numpy as np, shapely, cnem\n"
-        "dom = cnem.Domain([[0, 0], [1, 0], [1, 1e-6], [0, 1e-6]])\n"
-        "model = cnem.discretize(cnem.nodes.irregular(dom, 1e-3, seed=0), progress=False)\n"
-        "c = model.cells\n"
-        "valid = all(shapely.Polygon(c.vertices[c.offsets[k]:c.offsets[k + 1]]).is_valid\n"
-        "            for k in range(len(c.node)))\n"
-        "print(abs(c.area.sum() - dom.area) / dom.area, valid, c.area.min() > 0)\n")
-    error, valid, positive = run_boxed(code).split()
-    assert float(error) < 1e-13
-    assert valid == "True" and positive == "True"

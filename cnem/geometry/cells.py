@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike
-from scipy.spatial import ConvexHull, cKDTree
+from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
 from .. import config
@@ -145,40 +145,6 @@ def _splice_hole(ring, hole):
     return np.concatenate([ring[:a + 1], np.roll(hole, -b, axis=0)[1:], hole[b:b + 1], ring[a + 1:]])
 
 
-def _clip(ring, origin, normal, level):
-    """The part of convex polygon ``ring`` (CCW) where ``(y - origin) . normal <= level``
-    (Sutherland-Hodgman)."""
-    val = (ring - origin) @ normal - level
-    out = []
-    for k in range(len(ring)):
-        a, b, va, vb = ring[k - 1], ring[k], val[k - 1], val[k]
-        if (va > 0) != (vb > 0):
-            out.append(a + va / (va - vb) * (b - a))
-        if vb <= 0:
-            out.append(b)
-    return np.asarray(out).reshape(-1, 2)
-
-
-def _convex_regions(nodes, triangles, region, edges, edge_region):
-    """Regions that are convex polygons: a disc (V - E + F = 1) whose boundary
-    nodes all have an interior angle of at most pi (a crack tip has 2 pi)."""
-    a = nodes[triangles]
-    u, v = np.roll(a, -1, axis=1) - a, np.roll(a, 1, axis=1) - a
-    angle = np.abs(np.arctan2(u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0],
-                              np.einsum("tkd,tkd->tk", u, v)))
-    convex = set()
-    for r in np.unique(region).tolist():
-        t = triangles[region == r]
-        sides = np.sort(np.stack([t, np.roll(t, -1, axis=1)], axis=2).reshape(-1, 2), axis=1)
-        if len(np.unique(t)) - len(np.unique(sides, axis=0)) + len(t) != 1:
-            continue
-        total = np.bincount(t.ravel(), weights=angle[region == r].ravel(), minlength=len(nodes))
-        rim = np.unique(edges[edge_region == r])
-        if (total[rim] <= np.pi * (1 + 1e-9)).all():
-            convex.add(r)
-    return convex
-
-
 class _ExactCells:
     """State shared by the exact (clipping) path."""
 
@@ -196,36 +162,6 @@ class _ExactCells:
         on_edge = np.column_stack([edges.ravel(), np.repeat(self.edge_region, 2)])
         self.constrained = set(map(tuple, on_edge.tolist()))
         self.circ_r = np.linalg.norm(cc - nodes[triangles[:, 0]], axis=1)
-
-    def convex_cell(self, i, r, hull):
-        """The cell of node ``i`` in a convex region (`_convex_regions`) whose
-        counter-clockwise outline is ``hull``: every node of the region sees every
-        point of it, so the cell is the outline cut by the bisectors with the nodes
-        nearby -- exact half-plane clipping, no snapping (the overlays' grid is
-        relative to the whole cloud: in a strip 1e-6 thick it made areas wrong by 5e-8)."""
-        x = self.nodes[i]
-        lo, hi = self.box(i, r)
-        cell = hull
-        for axis in range(2):
-            step = np.eye(2)[axis]
-            cell = _clip(_clip(cell, hi, step, 0.0), lo, -step, 0.0)
-        radius = np.linalg.norm(cell - x, axis=1).max(initial=0.0)
-        tiny = config.MERGE_TOL * radius
-        near = np.asarray(self.node_tree.query_ball_point(x, 2 * radius), dtype=np.int64)
-        dist = np.linalg.norm(self.nodes[near] - x, axis=1)
-        order = np.argsort(dist)
-        for j, dj in zip(near[order], dist[order]):
-            if dj > 2 * radius:
-                break            # j is farther from every point of the cell than i
-            if dj <= tiny or not self.member(j, r):
-                continue
-            d = self.nodes[j] - x
-            cell = _clip(cell, x, d, 0.5 * (d @ d))
-            radius = np.linalg.norm(cell - x, axis=1).max(initial=0.0)
-        if len(cell) < 3:
-            raise GeometryError(f"node {i} at {self._where(i)} has an empty cell in "
-                                f"region {r}; is it a duplicate of another node?")
-        return _drop_spikes(_drop_repeats(cell, tiny), tiny)
 
     def fan(self, i, r):
         ts = self.star[self.offsets[i]:self.offsets[i + 1]]
@@ -269,20 +205,13 @@ class _ExactCells:
         shadow = _shadows(self.nodes[i], xy[hit], 4 * reach)
         return geom if shadow is None else _overlay(shapely.difference, geom, shadow, self.grid)
 
-    def box(self, i, r):
-        """Corners ``lo, hi`` of a box holding the cell: around the circumcircles of
-        the node's triangles, within the extent of the nodes."""
+    def cell(self, i, r):
         x = self.nodes[i]
         fan = self.fan(i, r)
         lo = (self.cc[fan] - self.circ_r[fan, None]).min(axis=0)
         hi = (self.cc[fan] + self.circ_r[fan, None]).max(axis=0)
         lo = np.clip(np.minimum(lo, x), self.extent[0], self.extent[1])
         hi = np.clip(np.maximum(hi, x), self.extent[0], self.extent[1])
-        return lo, hi
-
-    def cell(self, i, r):
-        x = self.nodes[i]
-        lo, hi = self.box(i, r)
         box = (lo[0], lo[1], hi[0], hi[1])
         reach = float(np.max(np.linalg.norm(np.array([[lo[0], lo[1]], [hi[0], lo[1]],
                                                        [hi[0], hi[1]], [lo[0], hi[1]]]) - x, axis=1)))
@@ -358,12 +287,6 @@ class _ExactCells:
                              "node: refine it there")
 
 
-def _hull(nodes, triangles):
-    """(k, 2) counter-clockwise convex hull of the vertices of ``triangles``."""
-    pts = nodes[np.unique(triangles)]
-    return pts[ConvexHull(pts).vertices]
-
-
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
                   progress: bool | None = None, neighbors: np.ndarray | None = None,
                   only: ArrayLike | None = None, origin: ArrayLike | None = None
@@ -411,12 +334,9 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     slow = which[status != FAST]
     pairs = sorted({(int(i), int(r)) for i in slow
                     for r in region[star[offsets[i]:offsets[i + 1]]]})
-    convex = _convex_regions(nodes, triangles, region, exact.edges, exact.edge_region)
-    hulls = {r: _hull(nodes, triangles[region == r]) for r in convex
-             if any(p[1] == r for p in pairs)}
-    slow_polys = [exact.convex_cell(i, r, hulls[r]) if r in convex else exact.cell(i, r)
-                  for i, r in tqdm(pairs, desc="clipping cells", leave=False,
-                                   disable=None if progress is None else not progress)]
+    slow_polys = [exact.cell(i, r) for i, r in tqdm(
+        pairs, desc="clipping cells", disable=None if progress is None else not progress,
+        leave=False)]
     cell_node = np.concatenate([fast, np.array([p[0] for p in pairs], dtype=np.int64)])
     cell_region = np.concatenate([region[rtri[is_fast]], np.array([p[1] for p in pairs], dtype=np.int64)])
     counts = np.concatenate([poff[is_fast + 1] - poff[is_fast],
