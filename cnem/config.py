@@ -12,7 +12,9 @@ into the kernels as a constant).
 True
 """
 
-__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLEARANCE", "FANOUT",
+__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "BOUNDARY_FINER", "CLEARANCE", "MIN_SPACING", "MAX_NODES", "FILL_SPACINGS", "SPACING_NEIGHBOURS",
+           "SPACING_COUNT_TOL",
+           "SPACING_BISECTIONS", "FANOUT",
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
@@ -45,10 +47,39 @@ GRID_TOL = 1e-13
 #: taken to be at a node or on a constraint edge in the shape functions.
 SHAPE_TOL = 1e-12
 
+#: A cell that the cloud cannot resolve is blamed on the boundary when the
+#: boundary segments at its node are shorter than this fraction of the distance
+#: to the nearest interior node (a fine outline around a coarse cloud); `cnem.geometry.cells`.
+BOUNDARY_FINER = 0.25
+
 # ---------------------------------------------------------------- node generation
 #: Interior nodes closer than this fraction of the local spacing to a boundary,
 #: interface or crack are dropped (the boundary nodes stand there); `cnem.nodes`.
 CLEARANCE = 0.5
+
+#: Smallest node spacing `cnem.nodes` accepts, relative to the domain diameter
+#: (ten snapping tolerances `SNAP_TOL`).
+MIN_SPACING = 1e-8
+
+#: Most nodes `cnem.nodes` generates (estimated before generating; above it
+#: `cnem.errors.LimitError`).
+MAX_NODES = 20_000_000
+
+#: `cnem.nodes.from_points` fills a gap along a boundary, interface or crack edge
+#: that spans more than this many local node spacings.
+FILL_SPACINGS = 2.0
+
+#: ... the local spacing at a user's point being its mean distance to this many
+#: nearest others.
+SPACING_NEIGHBOURS = 4
+
+#: Node spacing laws are sampled along each boundary, interface and crack edge
+#: until bisecting a sample interval changes its expected node count by less
+#: than this ...
+SPACING_COUNT_TOL = 0.01
+
+#: ... or after this many bisections (then `cnem.errors.LimitError`).
+SPACING_BISECTIONS = 200
 
 # ---------------------------------------------------------------- spatial search
 #: Children per R-tree node (and boxes per leaf); a tree keeps the value it was

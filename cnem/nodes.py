@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from . import config
-from .errors import GeometryError
+from .errors import GeometryError, LimitError
 from .geometry.cloud import NodeCloud
 from .geometry.pslg import SegmentKind, segment_projection
 
@@ -38,7 +38,33 @@ def _check_spacing(dom, h, name="h"):
     if h >= dom.diameter:
         raise GeometryError(f"{name} = {h:g} is not smaller than the domain diameter "
                             f"{dom.diameter:g}; choose a spacing that fits several nodes")
+    smallest = config.MIN_SPACING * dom.diameter
+    if h < smallest:
+        raise GeometryError(
+            f"{name} = {h:g} is below the smallest spacing this domain resolves, {smallest:.3g} "
+            f"(cnem.config.MIN_SPACING = {config.MIN_SPACING:g} times the diameter "
+            f"{dom.diameter:.3g}; nodes closer are within a few snapping tolerances "
+            f"{dom.tolerance:.3g} of each other); expected {name} >= {smallest:.3g}")
     return h
+
+
+def _check_count(estimate, what, fix):
+    """Refuse a cloud of more than `cnem.config.MAX_NODES` nodes before building it."""
+    if estimate > config.MAX_NODES:
+        raise LimitError(f"{what} would need ~{estimate:.3g} nodes, more than "
+                         f"cnem.config.MAX_NODES = {config.MAX_NODES:g}; expected {fix} "
+                         "(or raise cnem.config.MAX_NODES)")
+
+
+def _uniform_count(dom, h):
+    """Nodes of a cloud of spacing ``h``: the area over h^2 and the PSLG's length over h."""
+    v, e = dom.pslg.vertices, dom.pslg.edges
+    return dom.area / h**2 + np.linalg.norm(v[e[:, 1]] - v[e[:, 0]], axis=1).sum() / h
+
+
+def _check_uniform_count(dom, h, caller):
+    _check_count(_uniform_count(dom, h), f"{caller} with h = {h:g}",
+                 f"h >= {np.sqrt(dom.area / config.MAX_NODES):.3g}")
 
 
 def _edge_lines(dom):
@@ -59,6 +85,47 @@ def _tip_to_tip(dom):
     return (kinds == SegmentKind.CRACK) & is_tip[edges[:, 0]] & is_tip[edges[:, 1]]
 
 
+def _count_along(pa, pb, spacing_of):
+    """Cumulative node count along segment ``pa-pb`` under the spacing law.
+
+    The density ``length / spacing_of(x)`` is integrated by the trapezoid rule
+    on 65 samples, each interval bisected again while its midpoint changes its
+    count by more than `cnem.config.SPACING_COUNT_TOL` nodes: a law that shrinks
+    to a tiny spacing at a tip is followed down to it (a fixed rule gave the
+    first 1/64 of the segment one uniform tiny spacing).
+
+    Returns
+    -------
+    t : (m,) ndarray
+        Increasing parameters in [0, 1].
+    cum : (m,) ndarray
+        Nodes expected between ``pa`` and ``pa + t (pb - pa)``.
+    """
+    length = np.linalg.norm(pb - pa)
+
+    def density(t):
+        return length / spacing_of(pa + t[:, None] * (pb - pa))
+
+    t = np.linspace(0.0, 1.0, 65)
+    dens = density(t)
+    for _ in range(config.SPACING_BISECTIONS):
+        mid = 0.5 * (t[1:] + t[:-1])
+        dmid = density(mid)
+        error = np.abs(dmid - 0.5 * (dens[1:] + dens[:-1])) * np.diff(t)
+        split = error > config.SPACING_COUNT_TOL
+        if not split.any():
+            break
+        t, dens = np.concatenate([t, mid[split]]), np.concatenate([dens, dmid[split]])
+        order = np.argsort(t, kind="stable")
+        t, dens = t[order], dens[order]
+    else:
+        raise LimitError(
+            f"the node spacing along the segment {pa.tolist()} - {pb.tolist()} is not resolved "
+            f"after {config.SPACING_BISECTIONS} bisections of its samples; expected a spacing "
+            "law that is bounded below by a positive h_min")
+    return t, np.concatenate([[0.0], np.cumsum(0.5 * (dens[1:] + dens[:-1]) * np.diff(t))])
+
+
 def _boundary_nodes(dom, spacing_of, jitter=None):
     """Nodes along every PSLG edge, about ``spacing_of(x)`` apart.
 
@@ -68,12 +135,9 @@ def _boundary_nodes(dom, spacing_of, jitter=None):
     needs_split = _tip_to_tip(dom)
     points, segments, seg_kind = [v], [], []
     count = len(v)
-    samples = np.linspace(0.0, 1.0, 65)
     for (a, b), k, split in zip(edges, kinds, needs_split):
         pa, pb = v[a], v[b]
-        length = np.linalg.norm(pb - pa)
-        dens = length / spacing_of(pa + samples[:, None] * (pb - pa))
-        cum = np.concatenate([[0.0], np.cumsum(0.5 * (dens[1:] + dens[:-1]) * np.diff(samples))])
+        samples, cum = _count_along(pa, pb, spacing_of)
         pieces = max(2 if split else 1, int(round(cum[-1])))
         t = np.interp(np.linspace(0, cum[-1], pieces + 1)[1:-1], cum, samples)
         if jitter is not None and len(t):
@@ -103,20 +167,33 @@ def _keep_interior(dom, pts, clearance):
     return pts[keep]
 
 
-def _lattice(dom, h, offset=0.0, near=None, reach=np.inf):
-    """Square lattice of spacing ``h`` over the domain's bounding box, or only over
-    the part of it within ``reach`` of the points ``near`` (box around them)."""
+def _lattice(dom, h, offset=0.0):
+    """Square lattice of spacing ``h`` over the domain's bounding box."""
     xmin, ymin, xmax, ymax = dom.bounds
-    if near is not None and np.isfinite(reach):
-        lo, hi = near.min(axis=0) - reach, near.max(axis=0) + reach
-        # stay on the same lattice: snap the box to lattice lines of the full box
-        x0 = xmin + np.floor(max(lo[0] - xmin, 0) / h) * h
-        y0 = ymin + np.floor(max(lo[1] - ymin, 0) / h) * h
-        xmin, ymin, xmax, ymax = x0, y0, min(xmax, hi[0]), min(ymax, hi[1])
     xs = xmin + offset + h * np.arange(int(np.ceil((xmax - xmin) / h)) + 1)
     ys = ymin + offset + h * np.arange(int(np.ceil((ymax - ymin) / h)) + 1)
     gx, gy = np.meshgrid(xs, ys)
     return np.column_stack([gx.ravel(), gy.ravel()])
+
+
+def _lattice_near(dom, h, offset, centres, reach):
+    """The points of `_lattice` ``(dom, h, offset)`` within a box of half-width
+    ``reach`` around each centre (each lattice point once).
+
+    A box per centre, not one around them all: two crack tips far apart at a
+    tiny spacing would otherwise fill the whole strip between them.
+    """
+    xmin, ymin, xmax, ymax = dom.bounds
+    corner = np.array([xmin, ymin]) + offset
+    top = np.ceil(np.array([xmax - xmin, ymax - ymin]) / h).astype(np.int64)
+    lo = np.clip(np.floor((centres - reach - corner) / h), 0, top).astype(np.int64)
+    hi = np.clip(np.ceil((centres + reach - corner) / h), 0, top).astype(np.int64)
+    boxes = []
+    for (i0, j0), (i1, j1) in zip(lo, hi):
+        gi, gj = np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1))
+        boxes.append(np.column_stack([gi.ravel(), gj.ravel()]))
+    ij = np.unique(np.concatenate(boxes), axis=0)
+    return np.column_stack([xmin + offset + h * ij[:, 0], ymin + offset + h * ij[:, 1]])
 
 
 def _assemble(dom, boundary, interior, spacing_of):
@@ -139,6 +216,7 @@ def regular(domain: Domain, h: float) -> NodeCloud:
     NodeCloud
     """
     h = _check_spacing(domain, h)
+    _check_uniform_count(domain, h, "regular")
     spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
     lattice = _lattice(domain, h)
     interior = _keep_interior(domain, lattice, config.CLEARANCE * h)
@@ -156,6 +234,7 @@ def irregular(domain: Domain, h: float, *, seed: int = 0) -> NodeCloud:
     NodeCloud
     """
     h = _check_spacing(domain, h)
+    _check_uniform_count(domain, h, "irregular")
     rng = np.random.default_rng(seed)
     spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
     lattice = _lattice(domain, h, offset=0.5 * h)
@@ -163,6 +242,24 @@ def irregular(domain: Domain, h: float, *, seed: int = 0) -> NodeCloud:
     interior = _keep_interior(domain, lattice, config.CLEARANCE * h)
     boundary = _boundary_nodes(domain, spacing_of, jitter=rng)
     return _assemble(domain, boundary, interior, spacing_of)
+
+
+def _check_graded_count(dom, h, h_min, growth, centres):
+    """Refuse a graded cloud of too many nodes: the uniform part, plus about
+    ``2 pi / growth^2 ln(h / h_min)`` nodes around each centre (the integral of
+    ``1 / s^2`` over the disc where the spacing ``s = h_min + growth d`` is below h)."""
+    distinct = len(np.unique(centres, axis=0))
+    per_centre = 2 * np.pi / growth**2 * np.log(h / h_min)
+    uniform = _uniform_count(dom, h)
+    if uniform > 0.5 * config.MAX_NODES:
+        fix = f"h >= {np.sqrt(2 * dom.area / config.MAX_NODES):.3g}"
+    else:
+        room = (config.MAX_NODES - uniform) / distinct
+        fix = (f"h_min >= {h * np.exp(-room * growth**2 / (2 * np.pi)):.3g}, a larger growth "
+               "or fewer refinement centres")
+    _check_count(uniform + distinct * per_centre,
+                 f"graded with h = {h:g}, h_min = {h_min:g}, growth = {growth:g} around "
+                 f"{distinct} centres", fix)
 
 
 def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: float = 0.3,
@@ -196,6 +293,7 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
     centres = np.asarray(near, dtype=float).reshape(-1, 2)
     if len(centres) == 0:
         raise GeometryError("graded: `near` is empty; give at least one refinement point")
+    _check_graded_count(domain, h, h_min, growth, centres)
     tree = cKDTree(centres)
 
     def spacing_of(x):
@@ -206,8 +304,10 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
     for k in range(levels + 1):
         hk = h / 2 ** k
         # level k is used only where s(x) < 2 hk, i.e. near the centres
-        reach = np.inf if k == 0 else (2 * hk - h_min) / growth
-        pts = _lattice(domain, hk, offset=0.5 * hk, near=centres, reach=reach)
+        if k == 0:
+            pts = _lattice(domain, hk, offset=0.5 * hk)
+        else:
+            pts = _lattice_near(domain, hk, 0.5 * hk, centres, (2 * hk - h_min) / growth)
         s = spacing_of(pts)
         level = np.clip(np.floor(np.log2(h / s)), 0, levels)
         interior.append(pts[level == k])
@@ -219,25 +319,101 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
 
 
-def from_points(domain: Domain, points: ArrayLike) -> NodeCloud:
+def _point_spacing(pts):
+    """(p,) local spacing at each point: the mean distance to its
+    `cnem.config.SPACING_NEIGHBOURS` nearest others (``inf`` for a lone point); a
+    single nearest neighbour is too noisy a measure on irregular clouds."""
+    k = min(config.SPACING_NEIGHBOURS, len(pts) - 1)
+    if k < 1:
+        return np.full(len(pts), np.inf)
+    return cKDTree(pts).query(pts, k=k + 1)[0][:, 1:].mean(axis=1)
+
+
+def _fill_edges(domain, pts, seg_of, user_spacing, fill):
+    """Nodes along the gaps of each PSLG edge longer than `cnem.config.FILL_SPACINGS`
+    local spacings (at each place, the `_point_spacing` of the user's point nearest
+    to it, or the distance to that point if larger).
+
+    Returns the new points and the edge each lies on; with ``fill=False`` a gap
+    raises a `GeometryError` naming it.
+    """
+    v, edges, kinds = domain.pslg.vertices, domain.pslg.edges, domain.pslg.kind
+    finite = np.isfinite(user_spacing)
+    if not finite.any():
+        return np.empty((0, 2)), np.empty(0, dtype=np.int64)
+    tree = cKDTree(pts[finite])
+    spacing = user_spacing[finite]
+
+    def spacing_of(x):
+        # a place farther from every point than their spacing lies in a gap of the cloud
+        dist, j = tree.query(x)
+        return np.maximum(spacing[j], dist)
+
+    new, new_edge, gaps = [], [], []
+    for k, (ea, eb) in enumerate(edges):
+        on = pts[seg_of == k]
+        t = (on - v[ea]) @ (v[eb] - v[ea])
+        chain = np.concatenate([v[ea][None], on[np.argsort(t)], v[eb][None]])
+        for pa, pb in zip(chain[:-1], chain[1:]):
+            samples, cum = _count_along(pa, pb, spacing_of)
+            if cum[-1] <= config.FILL_SPACINGS:
+                continue
+            if not fill:
+                gaps.append((kinds[k] != SegmentKind.CRACK, k, pa, pb, cum[-1]))
+                continue
+            pieces = int(round(cum[-1]))
+            t = np.interp(np.linspace(0, cum[-1], pieces + 1)[1:-1], cum, samples)
+            new.append(pa + t[:, None] * (pb - pa))
+            new_edge.append(np.full(len(t), k, dtype=np.int64))
+    if gaps:
+        _, k, pa, pb, count = min(gaps, key=lambda g: g[:2])     # cracks first
+        kind = SegmentKind(kinds[k])
+        harm = ("the crack face there stays straight and cannot open (K_I about half)"
+                if kind == SegmentKind.CRACK else "it is integrated coarsely")
+        raise GeometryError(
+            f"{len(gaps)} gaps along the domain's edges hold no point over more than "
+            f"{config.FILL_SPACINGS:g} local spacings, first the {kind.name.lower()} gap from "
+            f"{pa.tolist()} to {pb.tolist()} (edge {k}, ~{count:.1f} spacings): {harm}; add "
+            "points along it or pass fill=True")
+    if not new:
+        return np.empty((0, 2)), np.empty(0, dtype=np.int64)
+    return np.concatenate(new), np.concatenate(new_edge)
+
+
+def from_points(domain: Domain, points: ArrayLike, *, fill: bool = True) -> NodeCloud:
     """The user's own nodes, with missing corners and crack vertices added.
 
     Points within ``domain.tolerance`` of a boundary, interface or crack are
     snapped onto it (onto the vertex if they are that close to one).
 
+    A boundary, interface or crack edge needs nodes along it at about the local
+    spacing: a crack face with no node between its tips stays a straight line
+    and cannot open (K_I comes out at about half its value), a boundary is
+    integrated coarsely. With ``fill=True`` (the default) every gap along an edge
+    longer than `cnem.config.FILL_SPACINGS` local spacings (at each place, the
+    mean distance of the user's point nearest to it to its
+    `cnem.config.SPACING_NEIGHBOURS` nearest others, or the distance to that point
+    if larger) gets nodes at that spacing; with ``fill=False`` such a gap is an error naming it.
+
     Parameters
     ----------
     domain : Domain
     points : (p, 2) array_like
+    fill : bool
+        Fill long gaps along the edges with nodes (else raise).
 
     Returns
     -------
     NodeCloud
+        ``points[:p]`` are the user's points (snapped) in their order; nodes
+        filled in along the edges and missing vertices follow.
 
     Raises
     ------
     GeometryError
-        Points outside the domain or duplicated (closer than the tolerance).
+        Points outside the domain or duplicated (closer than the tolerance);
+        with ``fill=False``, an edge gap longer than `cnem.config.FILL_SPACINGS`
+        local spacings.
     """
     pts = np.array(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
@@ -271,6 +447,10 @@ def from_points(domain: Domain, points: ArrayLike) -> NodeCloud:
         raise GeometryError(
             f"{len(pairs)} pairs of duplicated points (closer than {tol:.3g}), first "
             + ", ".join(f"{i} and {j}" for i, j in pairs[:5]) + "; remove the duplicates")
+    user_spacing = _point_spacing(pts)
+    filled, filled_edge = _fill_edges(domain, pts, seg_of, user_spacing, fill)
+    seg_of = np.concatenate([seg_of, filled_edge])
+    pts = np.concatenate([pts, filled])
     # a crack edge between two tips with no point on it gets its midpoint
     lonely = np.flatnonzero(_tip_to_tip(domain) & ~np.isin(np.arange(len(edges)), seg_of))
     mids = 0.5 * (v[edges[lonely, 0]] + v[edges[lonely, 1]])

@@ -292,7 +292,11 @@ def test_short_internal_crack_is_opened():
     for cloud in (cnem.nodes.regular(dom, 0.25),
                   cnem.nodes.from_points(dom, np.random.default_rng(1).random((200, 2)) * 0.98 + 0.01)):
         model = cnem.discretize(cloud, progress=False)
-        assert len(model.nodes) == len(cloud.points) + 1
+        # every crack node but the two tips is split (from_points also fills the crack
+        # at the local spacing of its random points: 0.2 long, ~3 spacings)
+        inside = len(np.unique(cloud.segments[cloud.segment_kind == 2])) - 2
+        assert inside >= 1
+        assert len(model.nodes) == len(cloud.points) + inside
         assert np.count_nonzero(model.segment_kind == 2) == 2 * np.count_nonzero(cloud.segment_kind == 2)
         assert abs(model.cells.area.sum() - dom.area) <= 1e-12 * dom.area
 

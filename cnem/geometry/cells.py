@@ -106,8 +106,33 @@ def _drop_repeats(ring, tol):
     return ring[keep] if keep.sum() >= 3 else ring
 
 
-def _splice_hole(ring, hole, i, x):
-    """Join a hole that touches the outer ring at a vertex into the ring.
+def _drop_spikes(ring, tol):
+    """Remove the tips of zero-width spikes: vertices where the ring turns straight
+    back (the edges in and out anti-parallel, closer than ``tol`` to one line).
+
+    An overlay can leave a sliver a few grid steps wide along a constraint edge
+    (two wedges along the same edge, drawn from its two ends); once `_drop_repeats`
+    merges the two vertices of its tip, the ring folds back along the edge, which
+    is not a valid polygon.
+    """
+    for _ in range(len(ring)):
+        if len(ring) <= 3:
+            break
+        into = ring - np.roll(ring, 1, axis=0)
+        out = np.roll(ring, -1, axis=0) - ring
+        cross = into[:, 0] * out[:, 1] - into[:, 1] * out[:, 0]
+        dot = np.einsum("ij,ij->i", into, out)
+        longest = np.maximum(np.linalg.norm(into, axis=1), np.linalg.norm(out, axis=1))
+        spike = np.flatnonzero((dot < 0) & (np.abs(cross) <= tol * longest))
+        if spike.size == 0:
+            break
+        ring = np.delete(ring, spike[0], axis=0)
+    return ring
+
+
+def _splice_hole(ring, hole):
+    """Join a hole that touches the outer ring at a vertex into the ring (None if
+    it does not touch).
 
     Snap-rounded overlays return a notch that touches the boundary at one
     point as a hole touching the shell; the cell is the simple ring that walks
@@ -116,16 +141,15 @@ def _splice_hole(ring, hole, i, x):
     d = np.linalg.norm(ring[:, None, :] - hole[None, :, :], axis=2)
     a, b = np.unravel_index(np.argmin(d), d.shape)
     if d[a, b] > 0:
-        raise GeometryError(f"the cell of node {i} at {x.tolist()} has a hole; the node cloud "
-                            "is too coarse or degenerate near this node")
+        return None
     return np.concatenate([ring[:a + 1], np.roll(hole, -b, axis=0)[1:], hole[b:b + 1], ring[a + 1:]])
 
 
 class _ExactCells:
     """State shared by the exact (clipping) path."""
 
-    def __init__(self, nodes, triangles, region, nb, offsets, star, cc):
-        self.nodes, self.tri, self.region = nodes, triangles, region
+    def __init__(self, nodes, triangles, region, nb, offsets, star, cc, origin):
+        self.nodes, self.tri, self.region, self.origin = nodes, triangles, region, origin
         self.extent = (nodes.min(axis=0), nodes.max(axis=0))   # every cell lies inside
         self.grid = config.GRID_TOL * float(np.hypot(*(self.extent[1] - self.extent[0])))
         self.offsets, self.star, self.cc = offsets, star, cc
@@ -224,22 +248,48 @@ class _ExactCells:
         parts = [g for g in getattr(cell, "geoms", [cell]) if g.geom_type == "Polygon"]
         parts.sort(key=lambda g: g.area, reverse=True)
         if not parts or parts[0].area <= 0:
-            raise GeometryError(f"node {i} at {self.nodes[i].tolist()} has an empty cell in "
+            raise GeometryError(f"node {i} at {self._where(i)} has an empty cell in "
                                 f"region {r}; is it a duplicate of another node?")
         total = sum(g.area for g in parts)
         if total - parts[0].area > 1e-9 * total:
-            raise GeometryError(f"the cell of node {i} at {self.nodes[i].tolist()} in region {r} "
-                                "is not connected; the node cloud is too coarse near this node")
+            raise self._unresolved(i, r, "is not connected")
         poly = shapely.geometry.polygon.orient(parts[0], 1.0)
         ring = _drop_repeats(np.asarray(poly.exterior.coords)[:-1], 10 * self.grid)
         for hole in poly.interiors:
-            ring = _splice_hole(ring, np.asarray(hole.coords)[:-1], i, self.nodes[i])
-        return ring
+            ring = _splice_hole(ring, np.asarray(hole.coords)[:-1])
+            if ring is None:
+                raise self._unresolved(i, r, "has a hole")
+        return _drop_spikes(ring, 10 * self.grid)
+
+    def _where(self, i):
+        """Node ``i`` in the caller's coordinates, formatted."""
+        x = self.nodes[i] + self.origin
+        return f"({x[0]:.6g}, {x[1]:.6g})"
+
+    def _unresolved(self, i, r, what):
+        """The error for a cell the cloud cannot resolve, naming the likely cause: a
+        boundary much finer than the nodes inside it, or a cloud too coarse there."""
+        head = f"the cell of node {i} at {self._where(i)} in region {r} {what}"
+        at_i = (self.edges == i).any(axis=1) & (self.edge_region == r)
+        free = np.ones(len(self.nodes), dtype=bool)
+        free[self.edges.ravel()] = False
+        if at_i.any() and free.any():
+            seg = np.linalg.norm(np.diff(self.nodes[self.edges[at_i]], axis=1), axis=2).max()
+            inner = cKDTree(self.nodes[free]).query(self.nodes[i])[0]
+            if seg < config.BOUNDARY_FINER * inner:
+                return GeometryError(
+                    f"{head}: the boundary there is much finer than the node cloud (segments "
+                    f"{seg:.3g} long, the nearest interior node {inner:.3g} away); coarsen the "
+                    f"outline to vertices about one node spacing apart (e.g. shapely's "
+                    f"simplify(tolerance ~ spacing / 10)) or refine the nodes near it to a "
+                    f"spacing of about {seg:.3g} (cnem.nodes.graded)")
+        return GeometryError(f"{head}; the node cloud is too coarse or degenerate near this "
+                             "node: refine it there")
 
 
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
                   progress: bool | None = None, neighbors: np.ndarray | None = None,
-                  only: ArrayLike | None = None
+                  only: ArrayLike | None = None, origin: ArrayLike | None = None
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Constrained Voronoi cells of a (crack-split) constrained Delaunay triangulation.
 
@@ -257,6 +307,9 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
         Compute the cells of these nodes alone (default: of every node); a
         cell depends only on the triangulation, so these are the same cells
         as those of the whole diagram (`cnem.geometry.update` relies on it).
+    origin : (2,) array_like, optional
+        Where the origin of ``nodes`` lies in the caller's coordinates (when they
+        are given in a local frame): added to the points named in errors.
 
     Returns
     -------
@@ -276,7 +329,8 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
                                           config.MERGE_TOL, max_deg, which)
     is_fast = np.flatnonzero(status == FAST)     # positions in `which`
     fast = which[is_fast]
-    exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc)
+    origin = np.zeros(2) if origin is None else np.asarray(origin, dtype=float)
+    exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, origin)
     slow = which[status != FAST]
     pairs = sorted({(int(i), int(r)) for i in slow
                     for r in region[star[offsets[i]:offsets[i + 1]]]})

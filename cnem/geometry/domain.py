@@ -51,6 +51,25 @@ def _check_zero_length(arr, closed, what, tol):
             f"at {_fmt(cur[k])}; remove the repeated vertex")
 
 
+def _check_rings_apart(shell, holes, what, tol):
+    """Rings of one polygon that touch (closer than ``tol``): a hole on the shell or on
+    another hole. shapely accepts a single touching point, but the body there is
+    pinched to nothing and no cloud can resolve it."""
+    rings = [shapely.LinearRing(r) for r in [shell] + holes]
+    left, right = shapely.STRtree(rings).query(rings, predicate="dwithin", distance=tol)
+    for a, b in sorted(zip(left.tolist(), right.tolist())):
+        if a >= b:
+            continue
+        where = _fmt(shapely.shortest_line(rings[a], rings[b]).coords[0])
+        if a == 0:
+            raise GeometryError(
+                f"{what} hole {b - 1} touches the outer boundary at {where}: rings must not "
+                "touch; move it inside or merge it into the outline")
+        raise GeometryError(
+            f"{what} holes {a - 1} and {b - 1} touch at {where}: rings must not touch; move "
+            "them apart or merge them into one hole")
+
+
 def _as_polygon(obj, index, tol):
     """Coerce one region description into a valid, CCW-oriented shapely Polygon."""
     what = f"region {index}"
@@ -68,6 +87,8 @@ def _as_polygon(obj, index, tol):
         for k, h in enumerate(holes):
             _check_zero_length(h, True, f"{what} hole {k}", tol)
     poly = Polygon(shell, holes)
+    if tol is not None and holes and poly.is_valid:
+        _check_rings_apart(shell, holes, what, tol)
     if not poly.is_valid:
         raise GeometryError(f"{what} is not a valid polygon: {explain_validity(poly)}; "
                             "a ring must not cross or touch itself (bow-tie) and holes must lie "

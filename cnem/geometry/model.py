@@ -248,7 +248,7 @@ def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:
     shift = nodes.min(axis=0)        # a local frame keeps the snap grid above round-off
     node, cell_region, offsets, vertices = voronoi_cells(nodes - shift, tri, region,
                                                          progress=progress,
-                                                         neighbors=neighbors[0])
+                                                         neighbors=neighbors[0], origin=shift)
     vertices += shift
     timings["cells"] = time.perf_counter() - t2
     log.info("discretize: %d nodes, %s", len(nodes),

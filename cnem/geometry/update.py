@@ -295,7 +295,7 @@ def update(model: Model, cloud: NodeCloud, *, progress: bool | None = None) -> M
     with one_thread():                  # a few cells
         node, cell_region, offsets, vertices = voronoi_cells(
             nodes - shift, tri, region, progress=progress, neighbors=neighbors[0],
-            only=np.flatnonzero(redo))
+            only=np.flatnonzero(redo), origin=shift)
         vertices += shift
         fresh = Cells(node, cell_region, offsets, vertices)
     new_of_old_node = np.full(len(model.nodes), -1, dtype=np.int64)

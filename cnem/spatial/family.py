@@ -146,6 +146,18 @@ def _rtree(pts, horizon, period):
     return tree.query_ball(pts, horizon, strict=True, exclude_self=True)
 
 
+def _unit_scale(horizon):
+    """Power of two that brings the largest horizon to about 1.
+
+    Scaling coordinates, horizons and periods by a power of two is exact, so the
+    families are unchanged wherever the squared distances were representable; it
+    keeps them representable (neither subnormal nor overflowing) for bodies of
+    any size, e.g. coordinates of order 1e-300, whose squared distances would
+    underflow to zero.
+    """
+    return float(np.ldexp(1.0, -int(np.frexp(horizon.max())[1])))
+
+
 def choose_method(horizon):
     """The fastest method for the data: the R-tree when the horizon varies a lot
     (graded clouds; a cell list would size its cells for the largest horizon),
@@ -200,20 +212,22 @@ def family_search(points: ArrayLike, horizon: float | ArrayLike, *,
         return Family(np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int32), h, per)
     if method == "auto":
         method = choose_method(h)
+    scale = _unit_scale(h)
+    xs, hs, ps = pts * scale, h * scale, per * scale       # exact: a power of two
     if method == "brute":
         if n > config.BRUTE_LIMIT:
             raise LimitError(f"method='brute' tests all n^2 pairs and is limited to "
                              f"{config.BRUTE_LIMIT} points, received {n}; use method='auto' "
                              f"(or raise cnem.config.BRUTE_LIMIT)")
-        offsets, indices = K.brute_family(pts, h, per)
+        offsets, indices = K.brute_family(xs, hs, ps)
     elif method == "cells":
         pts3 = np.zeros((n, 3))
-        pts3[:, :d] = pts
+        pts3[:, :d] = xs
         per3 = np.full(3, np.inf)
-        per3[:d] = per
-        offsets, indices = _cells(pts3, h, per3, d)
+        per3[:d] = ps
+        offsets, indices = _cells(pts3, hs, per3, d)
     elif method == "kdtree":
-        offsets, indices = _kdtree(pts, h, per)
+        offsets, indices = _kdtree(xs, hs, ps)
     else:
-        offsets, indices = _rtree(pts, h, per)
+        offsets, indices = _rtree(xs, hs, ps)
     return Family(offsets, indices.astype(_index_dtype(n), copy=False), h, per)
