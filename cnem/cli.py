@@ -78,6 +78,21 @@ def output_folder(module_file: str) -> str:
     return f"results/{pathlib.PurePath(module_file).stem}"
 
 
+def demo_command(module_file: str) -> str | None:
+    """The ``cnem`` command that runs a demo module (``cnem demo <name>`` first, then
+    ``cnem pd <name>``), None for a module in no table.
+
+    >>> demo_command("/any/where/cnem/demos/cracked_plate_geometry.py")
+    'cnem demo cracked-plate'
+    """
+    stem = pathlib.PurePath(module_file).stem
+    for sub, table in _TABLES.items():
+        for name, module in table.items():
+            if module == stem:
+                return f"cnem {sub} {name}"
+    return None
+
+
 def demo_parser(module_file: str, doc: str, prog: str | None = None) -> argparse.ArgumentParser:
     """The command line every demo starts from (the one place of the demos' output rule).
 
@@ -88,8 +103,8 @@ def demo_parser(module_file: str, doc: str, prog: str | None = None) -> argparse
     doc : str
         The demo's module docstring; its first line is the description.
     prog : str, optional
-        The command shown in the usage line (``cnem demo cylinder``; `main` passes it),
-        by default the script's name.
+        The command shown in the usage line (`main` passes the one it was called as), by
+        default the demo's ``cnem`` command (`demo_command`).
 
     Returns
     -------
@@ -98,7 +113,8 @@ def demo_parser(module_file: str, doc: str, prog: str | None = None) -> argparse
         ``--no-plot``; the demo adds its own options. Compiling kernels is announced on the
         terminal (`show_compile_notice`).
     """
-    parser = argparse.ArgumentParser(prog=prog, description=doc.strip().split("\n")[0],
+    parser = argparse.ArgumentParser(prog=prog or demo_command(module_file),
+                                     description=doc.strip().split("\n")[0],
                                      formatter_class=HelpFormatter)
     parser.add_argument("--out", default=output_folder(module_file),
                         help="folder for the files and pictures")

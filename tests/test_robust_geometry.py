@@ -15,7 +15,7 @@ import shapely.validation
 
 import cnem
 import reference as R
-from cnem.errors import GeometryError, LimitError
+from cnem.errors import GeometryError, LimitError, SpatialError
 from cnem.spatial import family_search
 
 FAMILY_METHODS = ["auto", "rtree", "cells", "kdtree", "brute"]
@@ -38,18 +38,26 @@ def same_rows(fam, ref):
 
 # ------------------------------------------------------------------ family search
 @pytest.mark.parametrize("method", FAMILY_METHODS)
-@pytest.mark.parametrize("unit", [1e-300, 1e300])
-def test_family_in_extreme_units(method, unit):
-    """Coordinates of order 1e-300 (squared distances below the smallest double) and
-    1e300 (squared distances overflow) give the brute-force families of the same cloud
-    in units where squares are representable (scaling by a power of two is exact)."""
+def test_family_in_tiny_units(method):
+    """Coordinates of order 1e-300 (squared distances below the smallest double) give
+    the brute-force families of the same cloud in units where squares are representable
+    (scaling by a power of two is exact)."""
     rng = np.random.default_rng(4)
     pts = rng.uniform(0, 1, (300, 2))
-    power = 2.0 ** (-996 if unit < 1 else 996)       # about `unit`, and exact
+    power = 2.0 ** -996                        # about 1e-300, and exact
     ref = R.brute_family(pts, 0.15)
     fam = family_search(pts * power, 0.15 * power, method=method)
     assert ref[1].size > 3000                  # the families are not empty
     assert same_rows(fam, ref)
+
+
+@pytest.mark.parametrize("method", FAMILY_METHODS)
+def test_family_in_huge_units_is_refused_by_name(method):
+    """Coordinates of order 1e300 are refused at the public boundary, as everywhere in
+    the library (`cnem.config.COORDINATE_LIMIT`), with the fix in the message."""
+    pts = np.random.default_rng(4).uniform(0, 1, (300, 2)) * 2.0 ** 996
+    with pytest.raises(SpatialError, match="expected coordinates below .* other units"):
+        family_search(pts, 0.15 * 2.0 ** 996, method=method)
 
 
 def test_family_far_from_the_origin_in_bounded_time():
