@@ -12,7 +12,8 @@ into the kernels as a constant).
 True
 """
 
-__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "CLEARANCE", "FANOUT",
+__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "ROUNDOFF_ULPS",
+           "CLEARANCE", "FANOUT",
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
@@ -36,6 +37,11 @@ GRID_TOL = 1e-13
 #: Relative distance (times the domain diameter) under which a query point is
 #: taken to be at a node or on a constraint edge in the shape functions.
 SHAPE_TOL = 1e-12
+
+#: Far from the origin the coordinates themselves are known only to their
+#: round-off (``Frame.resolution``: ``eps`` times their magnitude): the shape
+#: functions' node and edge tolerances are at least this many times it.
+ROUNDOFF_ULPS = 16
 
 # ---------------------------------------------------------------- node generation
 #: Interior nodes closer than this fraction of the local spacing to a boundary,
