@@ -33,10 +33,12 @@ class Frame(NamedTuple):
     Attributes
     ----------
     origin : (2,) ndarray
-        The multiple of ``scale`` nearest the centre of the model's bounding
-        box: a difference of two nearby floats is exact (Sterbenz), and so is
-        a difference with a coarse origin, so the shift loses nothing and the
-        way back gives the same floats (a cell vertex at a node is that node).
+        The lower left corner of the model's bounding box rounded down to a
+        multiple of ``scale``: a difference of two nearby floats is exact
+        (Sterbenz), and so is a difference with a coarse origin, so the shift
+        loses nothing and the way back gives the same floats (a cell vertex at
+        a node is that node); a model in other units (``scale`` times a power
+        of two) has the same local coordinates.
     scale : float
         A power of two near the model's extent: the scaling is exact.
     resolution : float
@@ -64,6 +66,6 @@ def local_frame(bounds: ArrayLike) -> Frame:
     lo, hi = np.asarray(bounds[:2], dtype=np.float64), np.asarray(bounds[2:], dtype=np.float64)
     extent = float(np.max(hi - lo))
     scale = float(2.0 ** np.round(np.log2(extent))) if extent > 0 else 1.0
-    origin = scale * np.round(0.5 * (lo + hi) / scale)
+    origin = scale * np.floor(lo / scale)
     largest = float(np.max(np.abs(np.concatenate([lo, hi]))))
     return Frame(origin, scale, np.finfo(np.float64).eps * largest / scale)
