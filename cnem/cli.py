@@ -36,6 +36,7 @@ DEMOS = {
     "growth-sent": "growth_sent",
     "growth-kink": "growth_kink",
     "growth-two-holes": "growth_two_holes",
+    "growth-dcb": "growth_dcb",
 }
 
 #: ``cnem pd <name>`` -> module of `cnem.demos` (add a PD demo here).

@@ -267,6 +267,27 @@ def check_growth_two_holes(demo, res, outdir):
     assert np.abs(tips[:, 0] + tips[:, 1] - [20.0, 10.0]).max() < 0.15
 
 
+def check_growth_dcb(demo, res, outdir):
+    """Kinked DCB cracks (quick size): every path curves away from the centre line, the
+    more the larger the initial angle, at the critical load of root-rotation-corrected
+    beam theory while the crack is still straight."""
+    runs = res["runs"]
+    assert [r["theta"] for r in runs] == pytest.approx([2.862405, 5.710593], abs=1e-5)
+    for r in runs:
+        y = r["tips"][:, 1]
+        assert y[0] == pytest.approx(demo.KINK * demo.H * np.sin(np.radians(r["theta"])), rel=1e-9)
+        assert np.all(np.diff(y) > 0)                    # away from the centre line, faster
+        assert np.all(np.diff(np.diff(y)) > 0)           # and faster: the path curves away
+        assert np.all(r["kink_deg"][:-1] > 0)            # every kink turns further away
+        # P_c = K_Ic / K_eq: 2 sqrt(3) P (a + 0.64 h) / h^(3/2) = K_Ic at the first tip
+        assert r["load"][0] == pytest.approx(r["beam_root"][0], rel=0.03)
+        assert r["load"][0] < 0.85 * r["beam"][0]        # slender beam theory: far too stiff
+        assert r["measure"][1] > r["measure"][0]         # a longer crack: a more compliant beam
+    small, large = runs
+    n = min(len(small["tips"]), len(large["tips"]))
+    assert np.all(large["tips"][1:n, 1] > small["tips"][1:n, 1] * 1.5)
+
+
 CASES = [
     Case("cracked-plate-30", "cracked_plate_geometry",
          check_cracked_plate(30.0, 0.2, 0.04, 0.3, HAS_PYVISTA),
@@ -294,6 +315,9 @@ CASES = [
          sizes=dict(cloud=(0.8, 0.005, 0.3), progress=False), plot=False),
     Case("growth-two-holes", "growth_two_holes", check_growth_two_holes, args=(0.5,),
          sizes=dict(steps=2, progress=False), plot=False),
+    Case("growth-dcb", "growth_dcb", check_growth_dcb, args=(0.1,),
+         sizes=lambda demo: dict(increment=0.2, steps=3, angles=demo.ANGLES[1:], progress=False),
+         plot=True),
 ]
 
 

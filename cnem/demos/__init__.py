@@ -8,8 +8,8 @@ Each module states its problem and the expected result in its docstring, has
 """
 
 #: The demo modules (``cnem.demos.<name>``; `cnem.cli` gives them command-line names).
-MODULES = ("bimaterial_cylinder", "cpd_examples", "cracked_plate_geometry", "growth_kink",
-           "growth_sent", "growth_two_holes", "inclined_crack", "mode1_crack",
+MODULES = ("bimaterial_cylinder", "cpd_examples", "cracked_plate_geometry", "growth_dcb",
+           "growth_kink", "growth_sent", "growth_two_holes", "inclined_crack", "mode1_crack",
            "pd_crack_branching", "pd_vs_cnem_crack")
 
 __all__ = ["MODULES"]

@@ -8,6 +8,8 @@ ligament thinner than the nodes can resolve). Meeting another crack's tip
 joins the two cracks into one polyline. The cloud keeps its nodes, but those
 closer than ``clearance`` local spacings to a new segment, and gets nodes
 along each new segment about one local spacing apart (the new tip among them).
+When the cracks cut the body apart, `remaining_body` keeps one piece (the
+cracks that cut it become its boundary) and `cloud_in` its nodes.
 """
 
 from __future__ import annotations
@@ -18,7 +20,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import shapely
 from scipy.spatial import cKDTree
-from shapely.geometry import LineString, Point
+from shapely.geometry import LineString, MultiLineString, Point
+from shapely.ops import split
 
 from ..errors import GeometryError
 from ..geometry.domain import Domain
@@ -30,7 +33,7 @@ if TYPE_CHECKING:
     from ..geometry.cloud import NodeCloud
 
 __all__ = ["Hit", "tip_direction", "local_spacing", "first_hit", "grown_cloud", "pieces",
-           "check_connected", "rebuilt_domain"]
+           "check_connected", "rebuilt_domain", "describe", "remaining_body", "cloud_in"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -178,11 +181,15 @@ def grown_cloud(cloud: NodeCloud, domain: Domain, segments: list, spacings: list
         new_h.append(np.full(pieces, h))
     new_pts, new_h = np.concatenate(new_pts), np.concatenate(new_h)
     fresh = cKDTree(pts[keep]).query(new_pts)[0] > domain.tolerance   # a joined tip is a node
-    points = np.concatenate([pts[keep], new_pts[fresh]])
-    given = np.concatenate([spacing[keep], new_h[fresh]])
+    return _cloud(domain, np.concatenate([pts[keep], new_pts[fresh]]),
+                  np.concatenate([spacing[keep], new_h[fresh]]))
+
+
+def _cloud(domain, points, spacing):
+    """`from_points` with the nominal spacing of each given point (the median for the
+    vertices it appends: it keeps the given points first)."""
     out = from_points(domain, points)
-    # from_points keeps the given points first and appends missing vertices
-    full = np.concatenate([given, np.full(len(out.points) - len(given), np.median(given))])
+    full = np.concatenate([spacing, np.full(len(out.points) - len(spacing), np.median(spacing))])
     return dataclasses.replace(out, spacing=full)
 
 
@@ -202,17 +209,88 @@ def pieces(domain: Domain) -> list:
     return sorted(parts, key=lambda g: -g.area)
 
 
+def describe(parts: Sequence, which: Sequence[int] | None = None) -> str:
+    """``"piece k: area ..., bounds (...), around (x, y)"`` for the pieces ``which``
+    (default all) of a list of `pieces`."""
+    which = range(len(parts)) if which is None else which
+    return "; ".join(
+        f"piece {k}: area {parts[k].area:.4g}, bounds "
+        f"({', '.join(f'{b:.4g}' for b in parts[k].bounds)}), around "
+        f"({parts[k].representative_point().x:.4g}, {parts[k].representative_point().y:.4g})"
+        for k in which)
+
+
 def check_connected(domain: Domain, step: int) -> None:
     """Raise `GeometryError` naming the pieces when the cracks cut the body apart."""
     parts = pieces(domain)
     if len(parts) > 1:
-        names = "; ".join(
-            f"piece {k}: area {g.area:.4g}, bounds ({', '.join(f'{b:.4g}' for b in g.bounds)}), "
-            f"around ({g.representative_point().x:.4g}, {g.representative_point().y:.4g})"
-            for k, g in enumerate(parts))
         raise GeometryError(
-            f"after step {step} the cracks cut the body into {len(parts)} pieces: {names}; the "
-            "run stops here (the crack path so far is in the error's `history`)")
+            f"after step {step} the cracks cut the body into {len(parts)} pieces: "
+            f"{describe(parts)}; the run stops here (the crack path so far is in the error's "
+            "`history`; grow(..., continue_with=\"largest\") goes on with the largest piece)")
+
+
+def remaining_body(domain: Domain, piece: shapely.Polygon) -> tuple[Domain, list]:
+    """The domain of one piece of a body that the cracks cut apart.
+
+    Each region is split along the cracks and keeps its parts in ``piece``; a crack
+    that runs along the piece's boundary becomes boundary, a crack of another piece
+    is dropped, the others stay.
+
+    Parameters
+    ----------
+    domain : Domain
+        The body cut apart.
+    piece : shapely.Polygon
+        One of its `pieces`.
+
+    Returns
+    -------
+    (Domain, list of int)
+        The piece as a domain (regions in the same order) and, for every crack of
+        ``domain``, its index among the cracks of the piece (-1 if it is gone).
+
+    Raises
+    ------
+    GeometryError
+        The piece holds none or several parts of a material region (the region
+        numbers of ``setup``'s materials would change), or a crack lies partly in
+        it and partly on its boundary or outside.
+    """
+    tol = domain.tolerance
+    lines = MultiLineString([np.asarray(c) for c in domain.cracks])
+    regions = []
+    for r, region in enumerate(domain.regions):
+        parts = [g for g in split(region, lines).geoms
+                 if g.intersection(piece).area > 0.5 * g.area]
+        if len(parts) != 1:
+            raise GeometryError(
+                f"continue_with: the piece kept holds {len(parts)} parts of material region {r}; "
+                "expected exactly one (a region dropped or in several parts would renumber the "
+                "regions of setup's materials); continue with another piece or stop at the split")
+        regions.append(parts[0])
+    kept = shapely.union_all(regions)
+    edge, inside, interior = kept.boundary.buffer(tol), kept.buffer(tol), kept.buffer(-tol)
+    index, cracks = [], []
+    for j, c in enumerate(domain.cracks):
+        line = LineString(c)
+        if edge.contains(line) or not line.intersects(interior):
+            index.append(-1)                     # boundary of the piece now, or elsewhere
+        elif inside.contains(line):
+            index.append(len(cracks))
+            cracks.append(np.asarray(c))
+        else:
+            raise GeometryError(
+                f"continue_with: crack {j} lies partly inside the piece kept and partly on its "
+                "boundary or outside it; such a piece is not a Domain cnem can represent, stop at "
+                "the split instead")
+    return Domain(regions, cracks=cracks), index
+
+
+def cloud_in(cloud: NodeCloud, domain: Domain) -> NodeCloud:
+    """The nodes of ``cloud`` in (or on the boundary of) ``domain``, as its cloud."""
+    near = shapely.dwithin(shapely.points(cloud.points), domain.polygon, domain.tolerance)
+    return _cloud(domain, cloud.points[near], cloud.spacing[near])
 
 
 def rebuilt_domain(domain: Domain, cracks: Sequence[np.ndarray]) -> Domain:

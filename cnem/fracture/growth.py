@@ -5,7 +5,9 @@ K_II at every growing tip by the interaction integral (`sif`), turns them into
 a kink angle and an equivalent SIF by a criterion (`cnem.fracture.criteria`),
 and appends a straight segment at every tip. The node cloud stays: the new
 crack vertices become nodes, the nodes too close to a new segment are dropped
-(`cnem.fracture.advance`), and the grown domain is discretized again.
+(`cnem.fracture.advance`), and the grown domain is discretized again. A body
+that the cracks cut apart stops the run, or, with ``continue_with``, loses its
+loose pieces and goes on growing.
 
 >>> import numpy as np, cnem
 >>> dom = cnem.geometry.rectangle(1.0, 2.0, cracks=[[[0.0, 1.0], [0.3, 1.0]]])
@@ -85,8 +87,11 @@ class _Run:
     """The mutable state of one `grow` call."""
 
     def __init__(self, domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep,
-                 local):
+                 local, continue_with=None):
         self.domain, self.cloud, self.setup, self.local = domain, cloud, setup, local
+        self.continue_with = continue_with
+        self.retired = {}                     # row -> (tip, crack length) of a crack gone
+        self.split = None                     # the split event until the next solve
         self.criterion, self.K_Ic, self.max_kink = criterion, K_Ic, max_kink
         self.measure, self.radius, self.keep = measure, radius, keep
         self.cracks = [np.array(c, dtype=float) for c in domain.cracks]
@@ -104,9 +109,20 @@ class _Run:
 
     def solve(self):
         """Re-discretise the grown cloud, set the problem up and solve it."""
-        self.problem = self._problem()
-        self.model = self.problem.model
-        return self.problem.solve(progress=False)
+        if self.split is None:
+            self.problem = self._problem()
+            self.model = self.problem.model
+            return self.problem.solve(progress=False)
+        split, self.split, self.problem = self.split, None, None   # a new body: built afresh
+        try:
+            self.problem = self._problem()
+            self.model = self.problem.model
+            return self.problem.solve(progress=False)
+        except CNEMError as err:
+            raise GeometryError(
+                f"{split.message}; setup(model) on the remaining body fails: {err} (its supports "
+                "or loads may lie on the pieces dropped: continue with another piece, or give "
+                "supports the remaining body keeps)") from err
 
     def _problem(self):
         """``setup`` on the model of the current cloud: by a local update of the previous
@@ -133,7 +149,8 @@ class _Run:
     def state(self, sol, step):
         """K, K_eq, angle, load factor at every active tip (NaN elsewhere)."""
         t = len(self.rows)
-        tips = np.array([self.cracks[c][e] for c, e, _ in self.rows]).reshape(t, 2)
+        tips = np.array([self.retired[i][0] if i in self.retired else self.cracks[c][e]
+                         for i, (c, e, _) in enumerate(self.rows)]).reshape(t, 2)
         active = np.array([a for *_, a in self.rows], dtype=bool)
         K, K_eq, angle = np.full((t, 2), np.nan), np.full(t, np.nan), np.full(t, np.nan)
         for i in np.flatnonzero(active):
@@ -153,7 +170,9 @@ class _Run:
                            f"{np.degrees(self.max_kink):.2f} degrees")
         with np.errstate(divide="ignore", invalid="ignore"):
             load = np.where(K_eq > 0, self.K_Ic / K_eq, np.nan) if self.K_Ic else np.full(t, np.nan)
-        lengths = np.array([_crack_length(self.cracks[c]) for c, *_ in self.rows]).reshape(t)
+        lengths = np.array([self.retired[i][1] if i in self.retired else
+                            _crack_length(self.cracks[c])
+                            for i, (c, *_) in enumerate(self.rows)]).reshape(t)
         return dict(tips=tips, active=active, K=K, K_eq=K_eq, angle=angle, load_factor=load,
                     crack_length=lengths,
                     measure=float(self.measure(sol)) if self.measure else np.nan)
@@ -205,9 +224,46 @@ class _Run:
         if not segments:
             return False
         self.domain = advance.rebuilt_domain(self.domain, self.cracks)
-        advance.check_connected(self.domain, step)
         self.cloud = advance.grown_cloud(self.cloud, self.domain, segments, spacings, clearance)
+        if self.continue_with is None:
+            advance.check_connected(self.domain, step)
+        else:
+            self._keep_one_piece(step)
         return True
+
+    def _keep_one_piece(self, step):
+        """With ``continue_with``: drop the loose pieces (their nodes and cracks) and go on
+        with the piece chosen, recorded as event ``"split"``."""
+        parts = advance.pieces(self.domain)
+        if len(parts) < 2:
+            return
+        choice = self.continue_with
+        k = 0 if choice == "largest" else choice(parts) if callable(choice) else choice
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < len(parts):
+            raise GeometryError(
+                f"after step {step} the cracks cut the body into {len(parts)} pieces: "
+                f"{advance.describe(parts)}; continue_with: expected the index of one of them "
+                f"(0 the largest), received {k!r}")
+        dropped = [j for j in range(len(parts)) if j != k]
+        domain, index = advance.remaining_body(self.domain, parts[k])
+        gone = [j for j, i in enumerate(index) if i < 0]
+        for r, row in enumerate(self.rows):
+            if r in self.retired:
+                continue
+            if index[row[0]] < 0:                # its crack is boundary now, or dropped
+                self.retired[r] = (self.cracks[row[0]][row[1]].copy(),
+                                   _crack_length(self.cracks[row[0]]))
+                row[0], row[2] = -1, False
+            else:
+                row[0] = index[row[0]]
+        self.cracks = [c for c, i in zip(self.cracks, index) if i >= 0]
+        self.domain, self.cloud = domain, advance.cloud_in(self.cloud, domain)
+        point = parts[dropped[0]].representative_point()
+        self.split = self.event(
+            "split", step, -1, [point.x, point.y],
+            f"after step {step} the cracks cut the body into {len(parts)} pieces; continuing with "
+            f"{advance.describe(parts, [k])}, dropped {advance.describe(parts, dropped)} and "
+            f"crack{'s' if len(gone) != 1 else ''} {gone} (now boundary or in a dropped piece)")
 
     def _join(self, i, hit):
         """Crack of tip ``i`` joined to ``hit.crack`` at its end ``hit.end``: one polyline."""
@@ -251,6 +307,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
          K_Ic: float | None = None, paris: np.ndarray | None = None, exponent: float | None = None,
          max_kink: float | None = None, measure: Callable[..., np.ndarray] | None = None,
          radius: float | None = None, clearance: float = 0.5, keep: bool = True, local: bool = True,
+         continue_with: Literal["largest"] | int | Callable[[list], int] | None = None,
          progress: bool = True) -> CrackPath:
     """Grow the cracks of a domain step by step (quasi-static LEFM).
 
@@ -294,6 +351,15 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         operators from scratch. A problem that refuses the update (enrichment, other
         settings than the previous one) falls back to the full build, said once through
         `logging`.
+    continue_with : "largest", int or callable, optional
+        What to do when the cracks cut the body apart. None (default): stop with a
+        `GeometryError` naming the pieces. Else go on with one piece: ``"largest"``,
+        the index of a piece in the list of pieces sorted largest first, or a callable
+        ``continue_with(pieces) -> index`` given that list (shapely Polygons). The
+        other pieces are dropped with their nodes; the cracks along the cut become
+        boundary, the cracks in a dropped piece go with it (their tips stop), and the
+        event ``"split"`` names what was dropped. The remaining body is discretized
+        afresh and ``setup`` must still find its supports and loads on it.
     progress : bool
         A progress bar over the steps.
 
@@ -306,8 +372,9 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
     GrowthError
         Bad arguments.
     GeometryError
-        The domain has no tip, or the cracks cut the body apart (with the run so
-        far as the error's ``history``).
+        The domain has no tip, or the cracks cut the body apart without
+        ``continue_with``, or ``setup`` fails on the piece kept (with the run so far
+        as the error's ``history``).
     """
     if criterion not in CRITERIA:
         raise GrowthError(f"criterion: expected one of {sorted(CRITERIA)}, received {criterion!r}")
@@ -328,12 +395,18 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         raise GrowthError(f"exponent: expected a number >= 0, received {exponent!r}")
     max_kink = _positive(max_kink, "max_kink", allow_none=True)
     clearance = _positive(clearance, "clearance")
+    if not (continue_with is None or continue_with == "largest" or callable(continue_with)
+            or (isinstance(continue_with, (int, np.integer)) and not isinstance(continue_with, bool)
+                and continue_with >= 0)):
+        raise GrowthError(f"continue_with: expected None, \"largest\", a piece index >= 0 or "
+                          f"a callable(pieces) -> index, received {continue_with!r}")
     if not isinstance(cloud, NodeCloud):
         cloud = irregular(domain, _positive(cloud, "cloud (a spacing)"), seed=0)
     elif cloud.domain is not domain:
         raise GrowthError("cloud: expected a NodeCloud of `domain` (cloud.domain is domain), "
                           "received one of another domain; build it with cnem.nodes from `domain`")
-    run = _Run(domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep, bool(local))
+    run = _Run(domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep, bool(local),
+               continue_with)
     bar = tqdm(total=steps, desc="crack growth", unit="step", disable=not progress, leave=False)
     sol = run.solve()
     mark = 0                                  # first event of the current step

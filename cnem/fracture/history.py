@@ -31,7 +31,8 @@ EVENT_KINDS = {
     "sharp_kink": "the kink is sharper than max_kink, or the criterion found no opening "
                   "direction inside its range",
     "left_domain": "the increment would leave the domain: it was cut where it meets the boundary",
-    "split": "the body came apart",
+    "split": "the cracks cut the body apart and, with continue_with, the loose pieces were "
+             "dropped (tip -1: the whole body)",
 }
 
 
