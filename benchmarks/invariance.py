@@ -12,7 +12,7 @@ horizontally, a unit traction pulling the top edge up (the traction does not sca
 displacements scale with ``s`` and K_I with ``sqrt(s)``).
 
 What is compared (each against the case ``o = 0, s = 1``, mapped back by ``(x - o) / s``)
----------------------------------------------------------------------------------------
+-------------------------------------------------------------
 ``cells``   max over cells of the distance between their vertex sets and of the area
             difference, relative to the domain's diameter (its square for areas); ``shape``  max entry difference of the
             Sibson matrices at 2000 random points inside the domain (the same relative points);
@@ -89,8 +89,8 @@ def _compare(got, ref, n):
     out = {}
     go, ro = got["offsets"], ref["offsets"]
     if len(go) == len(ro):
-        far = max(_vertex_distance(got["vertices"][go[c]:go[c + 1]], ref["vertices"][ro[c]:ro[c + 1]])
-                  for c in range(len(ro) - 1))
+        far = max(_vertex_distance(got["vertices"][go[c]:go[c + 1]],
+                                   ref["vertices"][ro[c]:ro[c + 1]]) for c in range(len(ro) - 1))
         out["cells"] = max(far / DIAMETER, np.abs(got["area"] - ref["area"]).max() / DIAMETER ** 2)
     else:
         out["cells"] = np.inf

@@ -145,9 +145,9 @@ class Model:
 
     @property
     def frame(self) -> Frame:
-        """Frame: the local frame (origin at the centre of the domain's box, a power-of-two
-        scale) in which the geometric computations run, so that the model answers the
-        same at any origin and in any units."""
+        """Frame: the local frame (origin at the domain box's lower-left corner rounded
+        to a coarse grid, a power-of-two scale) in which the geometric computations
+        run, so that the model answers the same at any origin and in any units."""
         return self._derive("frame", lambda: local_frame(self.domain.bounds))
 
     def local_nodes(self) -> np.ndarray:
