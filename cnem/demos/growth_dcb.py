@@ -200,9 +200,9 @@ def _paths_figure(runs, path):
                 label=f"theta0 = {r['theta']:.2f} deg"
                 + (" (ends on the top face)" if xy[-1, 1] > 0.9 * H else ""))
     ax.annotate("", xy=(0.0, 0.9 * H), xytext=(0.0, 0.45 * H),
-                arrowprops=dict(arrowstyle="<-", color="tab:red"))
+                arrowprops=dict(arrowstyle="->", color="tab:red"))
     ax.annotate("", xy=(0.0, -0.9 * H), xytext=(0.0, -0.45 * H),
-                arrowprops=dict(arrowstyle="<-", color="tab:red"))
+                arrowprops=dict(arrowstyle="->", color="tab:red"))
     ax.set_aspect("equal")
     ax.set_xlabel("x (H)")
     ax.set_ylabel("y (H)")
