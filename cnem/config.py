@@ -12,9 +12,9 @@ into the kernels as a constant).
 True
 """
 
-__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "BOUNDARY_FINER", "CLEARANCE", "MIN_SPACING", "MAX_NODES", "FILL_SPACINGS", "SPACING_NEIGHBOURS",
-           "SPACING_COUNT_TOL",
-           "SPACING_BISECTIONS", "FANOUT",
+__all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "ROUNDOFF_ULPS",
+           "BOUNDARY_FINER", "CLEARANCE", "MIN_SPACING", "MAX_NODES", "FILL_SPACINGS",
+           "SPACING_NEIGHBOURS", "SPACING_COUNT_TOL", "SPACING_BISECTIONS", "FANOUT",
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
            "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
@@ -51,6 +51,11 @@ SHAPE_TOL = 1e-12
 #: boundary segments at its node are shorter than this fraction of the distance
 #: to the nearest interior node (a fine outline around a coarse cloud); `cnem.geometry.cells`.
 BOUNDARY_FINER = 0.25
+
+#: Far from the origin the coordinates themselves are known only to their
+#: round-off (``Frame.resolution``: ``eps`` times their magnitude): the shape
+#: functions' node and edge tolerances are at least this many times it.
+ROUNDOFF_ULPS = 16
 
 # ---------------------------------------------------------------- node generation
 #: Interior nodes closer than this fraction of the local spacing to a boundary,

@@ -66,7 +66,8 @@ def _assert_equal_models(got, ref):
     size = ref.domain.diameter
     np.testing.assert_allclose(gc.area, rc.area, rtol=0, atol=TOL * size ** 2)
     worst = max(_rotated_max(gc.polygon(c), rc.polygon(c)) for c in range(len(rc)))
-    assert worst <= TOL * size
+    # far from the origin a vertex is known to a few units in the last place
+    assert worst <= TOL * size + 4 * np.spacing(np.abs(ref.nodes).max())
 
 
 def _grow_and_compare(domain, cloud, steps, *, edit=None, operators=True):
@@ -127,15 +128,20 @@ def test_internal_crack_two_steps_equals_discretize(scale, offset):
 
 
 def test_offset_1e6_model_equals_discretize():
-    """Far from the origin: the model (B~ and K cannot be built there yet, see below)."""
+    """Far from the origin: the model (B~ and K of the update and of a fresh model differ
+    there by the round-off of the assembly's global coordinates, ~5e-10)."""
     _grow_and_compare(*_offset_case(1.0, 1e6), operators=False)
 
 
-@pytest.mark.xfail(strict=True, raises=GeometryError,
-                   reason="known: the shape functions lose points at 1e6 offsets (shape layer)")
 def test_offset_1e6_stiffness():
-    dom, cloud, _ = _offset_case(1.0, 1e6)
-    _problem(cnem.discretize(cloud, progress=False)).stiffness()
+    """The stiffness of the origin's cloud moved by 1e6 is the origin's, to the
+    round-off of the moved coordinates (eps * 1e6 / diameter ~ 1e-10)."""
+    _, cloud, _ = _offset_case(1.0, 0.0)
+    dom, _, _ = _offset_case(1.0, 1e6)
+    moved = cnem.nodes.from_points(dom, cloud.points + 1e6)
+    far = _problem(cnem.discretize(moved, progress=False)).stiffness()
+    near = _problem(cnem.discretize(cloud, progress=False)).stiffness()
+    assert _relative(far, near) < 1e-8
 
 
 @pytest.mark.slow

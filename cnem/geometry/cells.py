@@ -29,6 +29,7 @@ from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
 from .. import config
+from .._predicates import Frame
 from ..errors import GeometryError
 from ._kernels import FAST, fast_cells
 from .topology import circumcenters, constraint_edges, triangle_neighbors, vertex_triangles
@@ -148,8 +149,8 @@ def _splice_hole(ring, hole):
 class _ExactCells:
     """State shared by the exact (clipping) path."""
 
-    def __init__(self, nodes, triangles, region, nb, offsets, star, cc, origin):
-        self.nodes, self.tri, self.region, self.origin = nodes, triangles, region, origin
+    def __init__(self, nodes, triangles, region, nb, offsets, star, cc, frame):
+        self.nodes, self.tri, self.region, self.frame = nodes, triangles, region, frame
         self.extent = (nodes.min(axis=0), nodes.max(axis=0))   # every cell lies inside
         self.grid = config.GRID_TOL * float(np.hypot(*(self.extent[1] - self.extent[0])))
         self.offsets, self.star, self.cc = offsets, star, cc
@@ -263,7 +264,7 @@ class _ExactCells:
 
     def _where(self, i):
         """Node ``i`` in the caller's coordinates, formatted."""
-        x = self.nodes[i] + self.origin
+        x = self.nodes[i] if self.frame is None else self.frame.to_global(self.nodes[i])
         return f"({x[0]:.6g}, {x[1]:.6g})"
 
     def _unresolved(self, i, r, what):
@@ -276,6 +277,8 @@ class _ExactCells:
         if at_i.any() and free.any():
             seg = np.linalg.norm(np.diff(self.nodes[self.edges[at_i]], axis=1), axis=2).max()
             inner = cKDTree(self.nodes[free]).query(self.nodes[i])[0]
+            if self.frame is not None:                     # lengths in the caller's units
+                seg, inner = seg * self.frame.scale, inner * self.frame.scale
             if seg < config.BOUNDARY_FINER * inner:
                 return GeometryError(
                     f"{head}: the boundary there is much finer than the node cloud (segments "
@@ -289,7 +292,7 @@ class _ExactCells:
 
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
                   progress: bool | None = None, neighbors: np.ndarray | None = None,
-                  only: ArrayLike | None = None, origin: ArrayLike | None = None
+                  only: ArrayLike | None = None, frame: Frame | None = None
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Constrained Voronoi cells of a (crack-split) constrained Delaunay triangulation.
 
@@ -307,9 +310,9 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
         Compute the cells of these nodes alone (default: of every node); a
         cell depends only on the triangulation, so these are the same cells
         as those of the whole diagram (`cnem.geometry.update` relies on it).
-    origin : (2,) array_like, optional
-        Where the origin of ``nodes`` lies in the caller's coordinates (when they
-        are given in a local frame): added to the points named in errors.
+    frame : cnem._predicates.Frame, optional
+        The local frame ``nodes`` are given in (`cnem._predicates.local_frame`): the
+        points and lengths named in errors are mapped back to the caller's coordinates.
 
     Returns
     -------
@@ -329,8 +332,7 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
                                           config.MERGE_TOL, max_deg, which)
     is_fast = np.flatnonzero(status == FAST)     # positions in `which`
     fast = which[is_fast]
-    origin = np.zeros(2) if origin is None else np.asarray(origin, dtype=float)
-    exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, origin)
+    exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, frame)
     slow = which[status != FAST]
     pairs = sorted({(int(i), int(r)) for i in slow
                     for r in region[star[offsets[i]:offsets[i + 1]]]})

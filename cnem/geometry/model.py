@@ -11,6 +11,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
+from .._predicates import Frame, local_frame
 from ..errors import GeometryError
 from ._kernels import polygon_moments
 from .cells import voronoi_cells
@@ -142,6 +143,17 @@ class Model:
         """Domain: the body this model discretises."""
         return self.cloud.domain
 
+    @property
+    def frame(self) -> Frame:
+        """Frame: the local frame (origin at the domain box's lower-left corner rounded
+        to a coarse grid, a power-of-two scale) in which the geometric computations
+        run, so that the model answers the same at any origin and in any units."""
+        return self._derive("frame", lambda: local_frame(self.domain.bounds))
+
+    def local_nodes(self) -> np.ndarray:
+        """The nodes in `frame`, ``(n, 2)``. Computed once."""
+        return self._derive("local nodes", lambda: self.frame.to_local(self.nodes))
+
     def neighbors(self, *, across_regions: bool = False) -> np.ndarray:
         """The triangle across each edge, ``(t, 3)`` int64: ``nb[t, k]`` faces vertex
         ``k``; -1 on the boundary, at crack faces and (unless ``across_regions``)
@@ -245,17 +257,17 @@ def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:
     timings = {}
     nodes, node_of_point, tri, region, segments, kind, neighbors = triangulate(cloud, timings)
     t2 = time.perf_counter()
-    shift = nodes.min(axis=0)        # a local frame keeps the snap grid above round-off
-    node, cell_region, offsets, vertices = voronoi_cells(nodes - shift, tri, region,
-                                                         progress=progress,
-                                                         neighbors=neighbors[0], origin=shift)
-    vertices += shift
+    frame = local_frame(cloud.domain.bounds)
+    local = frame.to_local(nodes)
+    node, cell_region, offsets, vertices = voronoi_cells(local, tri, region, progress=progress,
+                                                         neighbors=neighbors[0], frame=frame)
+    vertices = frame.to_global(vertices)
     timings["cells"] = time.perf_counter() - t2
     log.info("discretize: %d nodes, %s", len(nodes),
              ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
     cells = Cells(node, cell_region, offsets, vertices)
     return Model(cloud, nodes, node_of_point, tri, region, segments, kind, cells, timings,
-                 _derived={"neighbors": neighbors})
+                 _derived={"neighbors": neighbors, "frame": frame, "local nodes": local})
 
 
 def triangulate(cloud, timings, caller="discretize"):

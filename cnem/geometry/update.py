@@ -42,6 +42,7 @@ from scipy.spatial import cKDTree
 
 from .. import config
 from .._parallel import one_thread
+from .._predicates import local_frame
 from ..errors import GeometryError
 from .cells import voronoi_cells
 from .model import Cells, Model, triangulate
@@ -291,13 +292,12 @@ def update(model: Model, cloud: NodeCloud, *, progress: bool | None = None) -> M
     redo[old_node >= 0] |= touched[old_node[old_node >= 0]]
     timings["matching"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    shift = nodes.min(axis=0)
+    frame = local_frame(cloud.domain.bounds)           # the frame of `discretize`
     with one_thread():                  # a few cells
         node, cell_region, offsets, vertices = voronoi_cells(
-            nodes - shift, tri, region, progress=progress, neighbors=neighbors[0],
-            only=np.flatnonzero(redo), origin=shift)
-        vertices += shift
-        fresh = Cells(node, cell_region, offsets, vertices)
+            frame.to_local(nodes), tri, region, progress=progress, neighbors=neighbors[0],
+            only=np.flatnonzero(redo), frame=frame)
+        fresh = Cells(node, cell_region, offsets, frame.to_global(vertices))
     new_of_old_node = np.full(len(model.nodes), -1, dtype=np.int64)
     new_of_old_node[old_node[old_node >= 0]] = np.flatnonzero(old_node >= 0)
     owner = new_of_old_node[model.cells.node]

@@ -41,25 +41,33 @@ def path_order(pts, bounds, per_tile=4):
     return K.path_order(pts, lo[0], lo[1], scale[0], scale[1], k)
 
 
-def _locate_sorted(model, spts, tol):
-    """A triangle holding each of the path-ordered points ``spts`` (-1 outside):
-    a walk from each point to the next, started from a few points found with the
-    R-tree of the circumcircles (each holds its triangle); for the points the walk
-    cannot reach (across holes and cracks) the same tree, or one of the triangles
-    when they are many."""
+def _locate_sorted(model, nodes, spts, tol):
+    """A triangle holding each of the path-ordered points ``spts`` (-1 outside), all
+    in the model's local frame (``nodes``, ``tol`` too): a walk from each point to the
+    next, started from a few points found with the R-tree of the circumcircles (each
+    holds its triangle); for the points the walk cannot reach (across holes and
+    cracks) the same tree, or one of the triangles when they are many (the trees are
+    in global coordinates)."""
+    frame = model.frame
     nb_all = model.neighbors(across_regions=True)
     nch = work_chunks()
     starts = (np.arange(nch) * len(spts)) // nch
-    off, idx = model.circumcircles()[2].query(spts[starts] - tol, spts[starts] + tol)
-    seeds = K.locate(model.nodes, model.triangles, spts[starts], off, idx, tol)
-    tri_of = K.locate_walk(model.nodes, model.triangles, nb_all, spts, seeds, nch)
+    seeds = K.locate(nodes, model.triangles, spts[starts],
+                     *_candidates(model.circumcircles()[2], frame, spts[starts], tol), tol)
+    tri_of = K.locate_walk(nodes, model.triangles, nb_all, spts, seeds, nch)
     lost = np.flatnonzero(tri_of < 0)
     if lost.size:
         many = lost.size > config.TRIANGLE_TREE_AFTER * len(model.triangles)
         tree = model.triangle_tree() if many else model.circumcircles()[2]
-        off, idx = tree.query(spts[lost] - tol, spts[lost] + tol)
-        tri_of[lost] = K.locate(model.nodes, model.triangles, spts[lost], off, idx, tol)
+        tri_of[lost] = K.locate(nodes, model.triangles, spts[lost],
+                                *_candidates(tree, frame, spts[lost], tol), tol)
     return tri_of
+
+
+def _candidates(tree, frame, local_points, tol):
+    """The entries of a global R-tree whose boxes meet the boxes ``tol`` about local points."""
+    lo, hi = frame.to_global(local_points - tol), frame.to_global(local_points + tol)
+    return tree.query(lo, hi)
 
 
 def shape_functions(model: Any, points: ArrayLike, *, kind: Literal["sibson", "laplace"] = "sibson",
@@ -74,7 +82,9 @@ def shape_functions(model: Any, points: ArrayLike, *, kind: Literal["sibson", "l
     model : Model
         Or any triangulation like it: ``nodes``, ``triangles``, ``domain``
         (``diameter``, ``bounds``) and the methods ``neighbors``,
-        ``circumcircles`` and ``triangle_tree`` of `cnem.geometry.Model`.
+        ``circumcircles`` and ``triangle_tree`` of `cnem.geometry.Model`, and its
+        local frame (``frame``, ``local_nodes``) in which the coordinates are
+        computed.
     points : (p, 2) array_like
         Points of the closed domain.
     kind : {"sibson", "laplace"}
@@ -180,11 +190,14 @@ def _coordinates(model, pts, kind, triangles, gradient):
     """The kernel's rows for ``(p, 2)`` points (``p > 0``), in visit order ``order``:
     ``(order, start, size, cols, vals, gx, gy, kinds)`` (see `K.natural`)."""
     nb = model.neighbors()
-    tol = config.SHAPE_TOL * model.domain.diameter
-    order = path_order(pts, model.domain.bounds)
-    spts = K.gather_rows(pts, order)
+    frame, nodes = model.frame, model.local_nodes()
+    local = frame.to_local(pts)
+    tol = max(config.SHAPE_TOL * model.domain.diameter / frame.scale,
+              config.ROUNDOFF_ULPS * frame.resolution)
+    order = path_order(local, frame.to_local(np.reshape(model.domain.bounds, (2, 2))).ravel())
+    spts = K.gather_rows(local, order)
     if triangles is None:
-        tri_of = _locate_sorted(model, spts, tol)
+        tri_of = _locate_sorted(model, nodes, spts, tol)
     else:
         hint = np.asarray(triangles, dtype=np.int64).reshape(-1)
         if hint.shape != (len(pts),) or (hint < -1).any() or (hint >= len(model.triangles)).any():
@@ -194,10 +207,10 @@ def _coordinates(model, pts, kind, triangles, gradient):
         hint = hint[order]
         given = hint >= 0
         tri_of = np.full(len(pts), -1, dtype=np.int64)
-        tri_of[given] = K.locate(model.nodes, model.triangles, spts[given],
+        tri_of[given] = K.locate(nodes, model.triangles, spts[given],
                                  np.arange(given.sum() + 1, dtype=np.int64), hint[given], tol)
         if not given.all():
-            tri_of[~given] = _locate_sorted(model, spts[~given], tol)
+            tri_of[~given] = _locate_sorted(model, nodes, spts[~given], tol)
     outside = np.sort(order[tri_of < 0])
     if outside.size:
         where = "the domain" if triangles is None else "the domain (or their given triangles)"
@@ -207,11 +220,14 @@ def _coordinates(model, pts, kind, triangles, gradient):
     slots = config.ROW_SLOTS
     while True:                                # rows in path order, chunk by chunk
         start, size, cols, vals, gx, gy, kinds, full = K.natural(
-            model.nodes, model.triangles, nb, spts, tri_of, tol, tol, work_chunks(),
+            nodes, model.triangles, nb, spts, tri_of, tol, tol, work_chunks(),
             kind == "laplace", gradient, slots)
         if not full:
             break
         slots *= 2
+    if gradient:                                          # d/dx = d/dx_local / scale
+        gx /= frame.scale
+        gy /= frame.scale
     failed = np.sort(order[kinds == K.FAILED])            # kinds are in path order
     if failed.size:
         raise CNEMError(
