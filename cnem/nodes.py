@@ -421,6 +421,10 @@ def from_points(domain: Domain, points: ArrayLike, *, fill: bool = True) -> Node
     if not np.isfinite(pts).all():
         bad = np.flatnonzero(~np.isfinite(pts).all(axis=1))
         raise GeometryError(f"points: {len(bad)} rows are not finite, first {bad[:5].tolist()}")
+    if len(pts) and np.abs(pts).max() >= config.COORDINATE_LIMIT:
+        raise GeometryError(f"points: expected coordinates below {config.COORDINATE_LIMIT:g} in "
+                            f"magnitude, received {np.abs(pts).max():g}; express the model in "
+                            "other units (the domain's too)")
     tol = domain.tolerance
     v, edges = domain.pslg.vertices, domain.pslg.edges
     # snap onto vertices, then onto edges

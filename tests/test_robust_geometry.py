@@ -245,3 +245,17 @@ def test_cells_of_random_hexagons_are_valid_polygons(seed):
     assert not invalid, [shapely.validation.explain_validity(polys[k]) for k in invalid]
     assert c.area.sum() == pytest.approx(dom.area, rel=1e-12)
     assert dom.polygon.symmetric_difference(shapely.union_all(polys)).area < 1e-12 * dom.area
+
+
+def test_domain_and_cloud_in_huge_units_are_refused_by_name():
+    """Coordinates of 1e300 (their squared distances overflow) are refused where they
+    enter, the domain and a user's cloud, with the limit and the fix in the message
+    (before: errors from inside scipy)."""
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    with pytest.raises(GeometryError, match=r"regions: expected coordinates below .* other units"):
+        cnem.Domain([square * 1e300])
+    dom = cnem.Domain([square])
+    with pytest.raises(GeometryError, match=r"points: expected coordinates below .* other units"):
+        cnem.nodes.from_points(dom, [[0.5, 0.5], [1e300, 0.5]])
+    # the limit is the library's: just below it the domain is built
+    assert cnem.Domain([square * 1e149]).diameter > 1e149

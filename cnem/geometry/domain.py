@@ -150,6 +150,12 @@ class Domain:
             raise GeometryError("expected at least one region, received an empty list")
         raw = [_as_polygon(r, i, None) for i, r in enumerate(regions)]
         minx, miny, maxx, maxy = shapely.union_all(raw).bounds
+        top = max(abs(minx), abs(miny), abs(maxx), abs(maxy))
+        if not top < config.COORDINATE_LIMIT:
+            raise GeometryError(
+                f"regions: expected coordinates below {config.COORDINATE_LIMIT:g} in magnitude "
+                f"(squared distances must not overflow float64), received {top:g}; express the "
+                "model in other units")
         self._diameter = float(np.hypot(maxx - minx, maxy - miny))
         self._origin = np.array([minx, miny])    # buffers are computed in this local frame
         self._tol = config.SNAP_TOL * self._diameter
