@@ -290,14 +290,18 @@ def nodal_field(sol, field):
 def solution(sol: Any, path: str | os.PathLike | None = None, *, field: str | np.ndarray = "von_mises",
              scale: float | None = None, window_size: tuple[int, int] = (1200, 1200),
              show_edges: bool = False, cmap: str = "viridis",
-             title: str | None = None) -> pyvista.Plotter:
+             title: str | None = None, cellwise: bool = True) -> pyvista.Plotter:
     """The deformed body coloured by a field (off-screen).
 
     The solution's triangles (``sol.plot_mesh()``: C-NEM's constrained Delaunay
     triangles, the P1 mesh) are moved by ``scale * u`` (crack faces have their
     own nodes, so cracks open) and coloured by the field at the nodes
     (`nodal_field`), interpolated across the triangles; a solution without
-    triangles (peridynamics) is drawn as its moved points.
+    triangles (peridynamics) is drawn as its moved points. A field with one value
+    per integration cell (C-NEM stresses and strains) is drawn instead, with
+    ``cellwise``, on the cell polygons of the undeformed body, so that its jumps
+    across material interfaces and crack faces stay sharp; the deformed boundary,
+    interfaces and cracks are drawn over it as lines.
 
     Parameters
     ----------
@@ -318,12 +322,19 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *, field: str | np
         Matplotlib colour map name.
     title : str, optional
         Scalar-bar title (default the field name).
+    cellwise : bool
+        Draw a field given per cell on the cells (default); False averages it to
+        the nodes (`nodal_field`) and draws it on the deformed triangles.
 
     Returns
     -------
     pyvista.Plotter
     """
     pv = _pyvista()
+    per_cell = _cell_values(sol, field) if cellwise else None
+    if per_cell is not None:
+        return _cellwise(pv, sol, per_cell, path, field, scale, window_size, show_edges, cmap,
+                         title)
     nodes, triangles, diameter = sol.plot_mesh()
     values = nodal_field(sol, field)
     name = field if isinstance(field, str) else (title or "field")
@@ -347,6 +358,56 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *, field: str | np
                 scalar_bar_args={"title": f"{title or name} (deformation x{scale:.3g})",
                                  "color": "black", "vertical": False}, **points_only)
     lo, hi = moved[:, :2].min(axis=0), moved[:, :2].max(axis=0)
+    pad = 0.08 * (hi - lo).max()
+    _top_view(pl, (lo[0] - pad, lo[1] - 2 * pad, hi[0] + pad, hi[1] + pad), width, height,
+              diameter)
+    return _save(pl, path, "solution")
+
+
+def _cell_values(sol, field):
+    """``field`` as one value per integration cell of a C-NEM solution, or None (a
+    displacement, another kind of solution, or values at the nodes)."""
+    cells = getattr(sol, "cells", None)
+    model = getattr(sol, "model", None)
+    if getattr(sol, "stress_at", None) != "cells" or cells is None or model is None \
+            or len(sol.stress) != len(model.cells):
+        return None
+    if isinstance(field, str):
+        if field in ("ux", "uy", "|u|") or field not in SOLUTION_FIELDS:
+            return None
+        shear = sol.stress.shape[1] - 1
+        return {"von_mises": sol.von_mises, "sxx": sol.stress[:, 0], "syy": sol.stress[:, 1],
+                "sxy": sol.stress[:, shear], "exx": sol.strain[:, 0],
+                "eyy": sol.strain[:, 1], "gxy": sol.strain[:, shear]}[field]
+    values = np.asarray(field, dtype=float)
+    return values if values.shape == (len(model.cells),) and len(sol.u) != len(values) else None
+
+
+def _cellwise(pv, sol, values, path, field, scale, window_size, show_edges, cmap, title):
+    """`solution` for a field per cell: the cells coloured, undeformed; the deformed
+    constraint segments (boundary, interfaces, cracks) as lines."""
+    model = sol.model
+    name = field if isinstance(field, str) else (title or "field")
+    poly = cells_polydata(model)
+    poly.cell_data[name] = values
+    diameter = model.domain.diameter
+    umax = float(np.abs(sol.u).max())
+    if scale is None:
+        scale = 0.05 * diameter / umax if umax > 0 else 0.0
+    moved = model.nodes + scale * sol.u
+    width, height = map(int, window_size)
+    pl = _plotter(pv, width, height)
+    pl.add_mesh(poly, scalars=name, cmap=cmap, lighting=False, show_edges=show_edges,
+                edge_color=(0.4, 0.4, 0.4),
+                scalar_bar_args={"title": f"{title or name}, on the cells (undeformed)",
+                                 "color": "black", "vertical": False})
+    lift = 1e-3 * diameter
+    pl.add_mesh(_lines(pv, moved, np.asarray(model.segments), lift), color=(0.45, 0.45, 0.45),
+                line_width=max(1.0, width / 1200),
+                label=f"deformed boundary, interfaces, cracks (x{scale:.3g})")
+    pl.add_legend(bcolor="white", face="line", size=(0.45, 0.05), loc="upper left")
+    lo = np.minimum(model.nodes.min(axis=0), moved.min(axis=0))
+    hi = np.maximum(model.nodes.max(axis=0), moved.max(axis=0))
     pad = 0.08 * (hi - lo).max()
     _top_view(pl, (lo[0] - pad, lo[1] - 2 * pad, hi[0] + pad, hi[1] + pad), width, height,
               diameter)

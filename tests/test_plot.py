@@ -68,3 +68,24 @@ def test_bad_bounds(tmp_path):
     _, _, m = model("graded_inclined_crack")
     with pytest.raises(cnem.plot.PlotError, match="bounds"):
         cnem.plot.model(m, bounds=(1.0, 0.0, 0.0, 1.0))   # xmin > xmax
+
+
+def test_field_per_cell_keeps_its_jump_at_the_interface(tmp_path):
+    """A field with one value per cell is drawn on the cells (default): a field that
+    jumps from 0 to 1 at a material interface shows only the colour map's two ends in
+    the body, while averaged to the nodes (cellwise=False) the triangles across the
+    interface blend them (the colour bar holds the blend in both pictures)."""
+    _, _, m = model("annulus_sector_regular")
+    prob = cnem.Elasticity(m, [(1.0, 0.3), (2.0, 0.3)], plane="strain")
+    prob.add_dirichlet(lambda p: np.ones(len(p), dtype=bool), None, lambda p: 1e-3 * p)
+    sol = prob.solve(progress=False)
+    jump = np.asarray(sol.cells.region, dtype=float)
+    assert set(np.unique(jump)) == {0.0, 1.0}
+    middle = (33, 145, 140)                          # viridis at 0.5
+    counts = {}
+    for cellwise in (True, False):
+        path = tmp_path / f"jump_{cellwise}.png"
+        cnem.plot.solution(sol, path, field=jump, window_size=(400, 400), title="region",
+                           cellwise=cellwise).close()
+        counts[cellwise] = _has_color(_rgb(path), middle, tol=25)
+    assert counts[False] > 3 * counts[True] + 100, counts
