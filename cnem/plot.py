@@ -353,9 +353,10 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *, field: str | np
     mesh.point_data[name] = values
     width, height = map(int, window_size)
     pl = _plotter(pv, width, height)
+    # (the colour bars' titles end in a newline: it lifts them off the tick labels)
     pl.add_mesh(mesh, scalars=name, cmap=cmap, lighting=False, show_edges=show_edges,
                 edge_color=(0.4, 0.4, 0.4),
-                scalar_bar_args={"title": f"{title or name} (deformation x{scale:.3g})",
+                scalar_bar_args={"title": f"{title or name} (deformation x{scale:.3g})\n",
                                  "color": "black", "vertical": False}, **points_only)
     lo, hi = moved[:, :2].min(axis=0), moved[:, :2].max(axis=0)
     pad = 0.08 * (hi - lo).max()
@@ -399,7 +400,7 @@ def _cellwise(pv, sol, values, path, field, scale, window_size, show_edges, cmap
     pl = _plotter(pv, width, height)
     pl.add_mesh(poly, scalars=name, cmap=cmap, lighting=False, show_edges=show_edges,
                 edge_color=(0.4, 0.4, 0.4),
-                scalar_bar_args={"title": f"{title or name}, on the cells (undeformed)",
+                scalar_bar_args={"title": f"{title or name}, on the cells (undeformed)\n",
                                  "color": "black", "vertical": False})
     lift = 1e-3 * diameter
     pl.add_mesh(_lines(pv, moved, np.asarray(model.segments), lift), color=(0.45, 0.45, 0.45),
