@@ -16,6 +16,7 @@ import scipy.sparse as sp
 
 from .._parallel import one_thread
 from ..errors import CNEMError
+from . import _renumber_kernels as RK
 from .gradients import SmoothedGradient, smoothed_gradient
 
 if TYPE_CHECKING:
@@ -50,28 +51,21 @@ def renumber_rows(matrix: sp.spmatrix, rows: np.ndarray, columns: np.ndarray, sh
         A taken row has a non-zero in a column mapped to -1 (and not ``drop``).
     """
     matrix = sp.csr_matrix(matrix)
-    rows = np.asarray(rows, dtype=np.int64)
-    have = rows >= 0
-    counts = np.zeros(len(rows), dtype=np.int64)
-    counts[have] = np.diff(matrix.indptr)[rows[have]]
-    indptr = np.zeros(len(rows) + 1, dtype=np.int64)
-    np.cumsum(counts, out=indptr[1:])
-    starts = np.zeros(len(rows), dtype=np.int64)
-    starts[have] = matrix.indptr[rows[have]]
-    gather = np.repeat(starts - indptr[:-1], counts) + np.arange(indptr[-1])
-    cols = columns[matrix.indices[gather]]
-    data = matrix.data[gather]
-    keep = cols >= 0
-    if not keep.all():
-        if not drop:
-            raise CNEMError(f"{np.count_nonzero(~keep)} non-zeros of the copied rows fall on "
-                            "columns that have no new index; the rows must be recomputed instead")
-        cum = np.zeros(len(keep) + 1, dtype=np.int64)
-        np.cumsum(keep, out=cum[1:])
-        indptr, cols, data = cum[indptr], cols[keep], data[keep]
-    out = sp.csr_matrix((data, cols, indptr), shape=shape)
-    out.has_sorted_indices = False
-    out.sort_indices()
+    rows = np.ascontiguousarray(rows, dtype=np.int64)
+    columns = np.ascontiguousarray(columns, dtype=np.int64)
+    indptr = matrix.indptr.astype(np.int64, copy=False)
+    indices = matrix.indices.astype(np.int64, copy=False)
+    counts, dropped = RK.renumbered_counts(indptr, indices, rows, columns)
+    if dropped and not drop:
+        raise CNEMError(f"{dropped} non-zeros of the copied rows fall on columns that have "
+                        "no new index; the rows must be recomputed instead")
+    out_ptr = np.zeros(len(rows) + 1, dtype=np.int64)
+    np.cumsum(counts, out=out_ptr[1:])
+    out_idx = np.empty(out_ptr[-1], dtype=np.int64)
+    out_data = np.empty(out_ptr[-1], dtype=matrix.data.dtype)
+    RK.renumbered_fill(indptr, indices, matrix.data, rows, columns, out_ptr, out_idx, out_data)
+    out = sp.csr_matrix((out_data, out_idx, out_ptr), shape=shape)
+    out.has_sorted_indices = True
     return out
 
 
