@@ -13,7 +13,7 @@ True
 """
 
 __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "ROUNDOFF_ULPS",
-           "BOUNDARY_FINER", "CLEARANCE", "MIN_SPACING", "MAX_NODES", "FILL_SPACINGS",
+           "BOUNDARY_FINER", "SHALLOW_END", "CLEARANCE", "MIN_SPACING", "MAX_NODES", "FILL_SPACINGS",
            "SPACING_NEIGHBOURS", "SPACING_COUNT_TOL", "SPACING_BISECTIONS", "FANOUT",
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
@@ -46,6 +46,11 @@ GRID_TOL = 1e-13
 #: Relative distance (times the domain diameter) under which a query point is
 #: taken to be at a node or on a constraint edge in the shape functions.
 SHAPE_TOL = 1e-12
+
+#: A crack end that meets the boundary at a shallow angle lies within the snapping
+#: tolerance of it along ``tol / sin(angle)``: accepted up to this many tolerances
+#: (angles down to about 1 degree); `cnem.geometry.domain`.
+SHALLOW_END = 100.0
 
 #: A cell that the cloud cannot resolve is blamed on the boundary when the
 #: boundary segments at its node are shorter than this fraction of the distance

@@ -232,3 +232,27 @@ def test_repr_states_the_facts():
     dom = geometry.rectangle(cracks=[cases.EDGE_CRACK])
     text = repr(dom)
     assert re.search(r"1 region\b", text) and re.search(r"1 crack\b.*\b1 tip", text), text
+
+
+@pytest.mark.parametrize("degrees", [30.0, 5.0, 2.0])
+def test_crack_end_meeting_the_boundary_at_a_shallow_angle_is_an_edge_crack(degrees):
+    """A crack whose end reaches the top edge at a shallow angle (as a curving grown crack
+    does) is an edge crack: its approach within the snapping tolerance, tol / sin(angle)
+    long, belongs to the end (it was refused as touching the boundary away from its ends);
+    the model's cells still tile the plate."""
+    t = np.radians(degrees)
+    end = np.array([0.6, 1.0])
+    start = end - 0.3 * np.array([np.cos(t), np.sin(t)])
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[start, end]])
+    np.testing.assert_allclose(dom.tips, [start])
+    model = cnem.discretize(cnem.nodes.irregular(dom, 0.05, seed=0), progress=False)
+    assert abs(model.cells.area.sum() - 1.0) < 1e-12
+
+
+def test_crack_lying_along_the_boundary_at_its_end_is_refused():
+    """Below about one degree the end runs along the boundary: refused, saying so."""
+    t = np.radians(0.2)
+    end = np.array([0.6, 1.0])
+    with pytest.raises(cnem.GeometryError, match="less than about 1 degree"):
+        cnem.geometry.rectangle(1.0, 1.0, cracks=[[end - 0.3 * np.array([np.cos(t), np.sin(t)]),
+                                                   end]])

@@ -208,12 +208,19 @@ class Domain:
                 "cracks must lie inside the closure of the domain")
         touch = line.intersection(union.boundary.buffer(self._tol))
         ends = shapely.points(arr[[0, -1]] - self._origin)
-        bad = touch.difference(shapely.union_all(ends).buffer(2 * self._tol))
+        # an end that meets the boundary at a shallow angle theta runs within the
+        # tolerance of it for about tol / sin(theta): that approach is the end's, up to
+        # config.SHALLOW_END tolerances (angles down to about 1 degree)
+        parts = [g for g in getattr(touch, "geoms", [touch]) if not g.is_empty]
+        approach = [g for g in parts if min(g.distance(e) for e in ends) <= 2 * self._tol
+                    and g.length <= config.SHALLOW_END * self._tol]
+        bad = touch.difference(shapely.union_all(list(ends) + approach).buffer(2 * self._tol))
         if not bad.is_empty and bad.length > 2 * self._tol:
             where = np.asarray(bad.representative_point().coords[0]) + self._origin
             raise GeometryError(
                 f"{what} touches the outer boundary or a hole away from its ends near "
-                f"{_fmt(where)}; only crack ends may lie on it")
+                f"{_fmt(where)}; only crack ends may lie on it (an end that meets it at less "
+                f"than about 1 degree lies along it)")
         return arr
 
     def _check_crack_crossings(self):
