@@ -17,7 +17,7 @@ from ..assembly.conditions import per_point
 from ..errors import InputError
 from . import _kernels as K
 from .frames import FrameWriter
-from .guards import check_time_step, diverged, first_non_finite
+from .guards import checked_run, diverged, first_non_finite
 from .relaxation import relax
 from .solution import DynamicRun
 
@@ -114,11 +114,8 @@ class Dynamics:
         """
         self._linear_only("run_dynamic")
         b, d, n = self.body, self.dim, len(self.body)
-        dt, steps = float(dt), int(steps)
-        if not dt > 0 or steps < 1:
-            raise InputError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
         stable = self.stable_time_step(1.0)
-        check_time_step(dt, stable)
+        dt, steps = checked_run(dt, steps, stable)
         every = max(1, steps // 10) if every is None else int(every)
         rho = self.material.density
         limit = self.material.stretch_limit(d, self.plane, b.horizon)

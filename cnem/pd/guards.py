@@ -24,10 +24,10 @@ import numpy as np
 from .. import config
 from ..errors import DivergenceError, InputError, StabilityWarning
 
-__all__ = ["check_time_step", "first_non_finite", "diverged"]
+__all__ = ["check_time_step", "checked_run", "first_non_finite", "diverged"]
 
 
-def check_time_step(dt: float, stable: float) -> None:
+def check_time_step(dt: float, stable: float, *, stacklevel: int = 3) -> None:
     """Refuse ``dt`` above `cnem.config.DT_LIMIT` times the stable step, warn above it.
 
     Parameters
@@ -54,7 +54,22 @@ def check_time_step(dt: float, stable: float) -> None:
     warnings.warn(f"dt = {dt:.6g} is {ratio:.3g} times the stable time step {stable:.6g} "
                   f"(Silling & Askari's bound): the run may be unstable; the state is checked "
                   f"at every step. Use dt <= {stable:.6g} to be safe",
-                  StabilityWarning, stacklevel=3)
+                  StabilityWarning, stacklevel=stacklevel)
+
+
+def checked_run(dt: float, steps: int, stable: float) -> tuple[float, int]:
+    """``(dt, steps)`` of an explicit run as numbers, after `check_time_step`.
+
+    Raises
+    ------
+    InputError
+        ``dt <= 0``, ``steps < 1``, or ``dt`` above `cnem.config.DT_LIMIT` times ``stable``.
+    """
+    dt, steps = float(dt), int(steps)
+    if not dt > 0 or steps < 1:
+        raise InputError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
+    check_time_step(dt, stable, stacklevel=4)
+    return dt, steps
 
 
 def first_non_finite(*arrays: np.ndarray) -> int:

@@ -22,7 +22,7 @@ from ...assembly.conditions import Conditions, per_point
 from ...errors import InputError, MaterialError, OptionError
 from .._kernels import pmb_forces
 from ...material import PLANES
-from ..guards import check_time_step, diverged, first_non_finite
+from ..guards import checked_run, diverged, first_non_finite
 from ..solution import DynamicRun
 from . import _kernels as K
 from . import checkpoint as ckpt
@@ -268,11 +268,8 @@ class Problem(Conditions):
         DistributedRun
         """
         b, d, o = self.body, self.dim, self.body.n_owned
-        dt, steps = float(dt), int(steps)
-        if not dt > 0 or steps < 1:
-            raise InputError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
         stable = self.stable_time_step(1.0)
-        check_time_step(dt, stable)
+        dt, steps = checked_run(dt, steps, stable)
         every = max(1, steps // 10) if every is None else int(every)
         save_every = steps if checkpoint_every is None else int(checkpoint_every)
         rho = self.material.density
