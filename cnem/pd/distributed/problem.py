@@ -19,7 +19,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ...assembly.conditions import Conditions, per_point
-from ...errors import InputError, MaterialError, OptionError
+from ...errors import MaterialError, OptionError
 from .._kernels import pmb_forces
 from ...material import PLANES
 from ..guards import checked_run, diverged, first_non_finite
