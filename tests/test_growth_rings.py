@@ -115,3 +115,67 @@ def test_a_segment_grazing_a_hole_is_carried_onto_it():
     assert hit.kind == "hole"
     assert abs(hit.point[0] - 0.5) < 0.03
     assert shapely.Point(hit.point).distance(dom.polygon.interiors[0]) < 1e-9
+
+
+# ------------------------------------------------------------ refine="auto" (the default)
+def _centre_crack(gamma_deg=45.0, a=0.2):
+    d = a * np.array([np.cos(np.radians(gamma_deg)), np.sin(np.radians(gamma_deg))])
+    return cnem.geometry.rectangle(2.0, 2.0, origin=(-1, -1), cracks=[[-d, d]])
+
+
+def _pulled(model):
+    """Tension 1 along y on the top and bottom edges, rigid motions held at two corners."""
+    prob = cnem.Elasticity(model, (1.0, 0.3), plane="strain")
+    prob.add_traction(lambda x, n: np.abs(np.abs(x[:, 1]) - 1.0) < 1e-9, lambda x, n: n * [0.0, 1.0])
+    prob.add_dirichlet(lambda p: np.hypot(p[:, 0] + 1, p[:, 1] + 1) < 1e-9, None)
+    prob.add_dirichlet(lambda p: np.hypot(p[:, 0] - 1, p[:, 1] + 1) < 1e-9, 1)
+    return prob
+
+
+def test_auto_refinement_leaves_straight_cracks_alone_and_grades_kinked_tips():
+    from cnem.config import SIF_BEND_SPACINGS, SIF_REACH
+    from cnem.fracture.discs import clearance
+    from cnem.fracture.refine import AUTO_FRACTION, auto_refinement, background_spacing
+    straight = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.3, 0.5]]])
+    tips, ref = auto_refinement(cnem.nodes.irregular(straight, H, seed=0), straight.tips)
+    assert len(tips) == 0 and ref is None
+    # a 30 degree kink one segment of 0.05 behind the tip: the discs would span it
+    kinked = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.3, 0.5], [0.3433, 0.525]]])
+    cloud = cnem.nodes.irregular(kinked, H, seed=0)
+    tips, ref = auto_refinement(cloud, kinked.tips)
+    lim = clearance(kinked, *kinked.tip_frame(kinked.tips[0]))
+    assert SIF_REACH * lim.straight < SIF_BEND_SPACINGS * background_spacing(cloud, tips)
+    np.testing.assert_allclose(tips, kinked.tips)
+    assert ref.spacing == pytest.approx(AUTO_FRACTION * lim.straight, rel=1e-12)
+    # after the refinement the discs of `sif` stay on the last segment and hold enough spacings
+    model = cnem.discretize(refined_cloud(cloud, tips, ref), progress=False)
+    sol = _pulled_unit(model)
+    res = cnem.fracture.sif(sol, kinked.tips[0])
+    assert res.radius < lim.straight
+    assert res.radius >= SIF_BEND_SPACINGS * cnem.fracture.discs.local_spacing(model, kinked.tips[0])
+
+
+def _pulled_unit(model):
+    prob = cnem.Elasticity(model, (1.0, 0.3), plane="strain")
+    prob.add_traction(lambda x, n: np.abs(x[:, 1] - 1.0) < 1e-9, lambda x, n: n * [0.0, 1.0])
+    prob.add_dirichlet(lambda p: np.abs(p[:, 1]) < 1e-9, 1)
+    prob.add_dirichlet(lambda p: np.hypot(*p.T) < 1e-9, 0)
+    return prob.solve(progress=False)
+
+
+@pytest.mark.slow
+def test_kinked_growth_does_not_zig_zag():
+    """A centre crack at 45 degrees kinks by about -53 degrees (maximum hoop stress, K_I =
+    K_II) and then grows nearly straight: after a maximum-hoop-stress kink K_II is small at
+    the new tip (on a disc inside the new segment: K_II / K_I = 0.04 for a kink in a pure K
+    field, scale-free, i.e. a next kink of about -5 degrees). Discs that span the kink
+    (refine=None here: 6 spacings of 0.05 against segments of 0.02) get K_II of the wrong
+    sign and the path zig-zags with growing kinks (+13.6, -11.9, +10.2 degrees measured)."""
+    dom = _centre_crack()
+    cloud = cnem.nodes.irregular(dom, 0.05, seed=0)
+    hist = grow(dom, cloud, _pulled, increment=0.02, steps=4, progress=False)
+    angles = np.degrees(hist.array("angle"))
+    np.testing.assert_allclose(angles[0], -53.13, atol=1.0)          # both tips, closed form -53.13
+    assert np.abs(angles[1:]).max() < 5.0
+    off = grow(dom, cloud, _pulled, increment=0.02, steps=2, refine=None, progress=False)
+    assert np.abs(np.degrees(off.array("angle"))[1]).min() > 8.0     # the bias this avoids

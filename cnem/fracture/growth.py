@@ -40,7 +40,7 @@ from ..geometry.update import update
 from ..material import kappa as kolosov
 from ..nodes import irregular
 from . import advance
-from .refine import Refinement, as_refinement, refined_cloud
+from .refine import Refinement, as_refinement, auto_refinement, refined_cloud
 from .criteria import CRITERIA, kink
 from .history import CrackPath, GrowthEvent, Step
 from .interaction import sif
@@ -128,11 +128,16 @@ class _Run:
 
     def nodes(self):
         """The cloud of this increment: the background ``cloud``, refined about the
-        active tips when ``refine`` is set (`cnem.fracture.refine`)."""
+        active tips as ``refine`` says (`cnem.fracture.refine`)."""
         if self.refine is None:
             return self.cloud
-        tips = [self.cracks[c][e] for c, e, active in self.rows if active]
-        return refined_cloud(self.cloud, np.reshape(tips, (-1, 2)), self.refine)
+        tips = np.reshape([self.cracks[c][e] for c, e, active in self.rows if active], (-1, 2))
+        refinement = self.refine
+        if refinement == "auto":
+            tips, refinement = auto_refinement(self.cloud, tips)
+        if refinement is None:
+            return self.cloud
+        return refined_cloud(self.cloud, tips, refinement)
 
     def _problem(self):
         """``setup`` on the model of the current cloud: by a local update of the previous
@@ -321,7 +326,8 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
          max_kink: float | None = None, measure: Callable[..., np.ndarray] | None = None,
          radius: float | None = None, clearance: float = 0.5, keep: bool = True, local: bool = True,
          continue_with: Literal["largest"] | int | Callable[[list], int] | None = None,
-         refine: Refinement | float | None = None, progress: bool = True) -> CrackPath:
+         refine: Refinement | float | Literal["auto"] | None = "auto",
+         progress: bool = True) -> CrackPath:
     """Grow the cracks of a domain step by step (quasi-static LEFM).
 
     Parameters
@@ -364,12 +370,16 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         operators from scratch. A problem that refuses the update (enrichment, other
         settings than the previous one) falls back to the full build, said once through
         `logging`.
-    refine : Refinement or float, optional
-        Nodes graded towards every growing tip (`cnem.fracture.refine`): a disc
-        about each tip whose spacing falls to ``refine.spacing`` (a float: that
+    refine : "auto", Refinement, float or None
+        Nodes graded towards the growing tips (`cnem.fracture.refine`): a disc
+        about a tip whose spacing falls to ``refine.spacing`` (a float: that
         spacing) at the tip; the disc moves with the tip and the background nodes
         come back behind it, so the cloud keeps its size. ``cloud`` is then the
-        background cloud. Default none.
+        background cloud. ``"auto"`` (default): rings only about a tip whose crack
+        kinks too close behind it for the discs of `sif` to stay on the straight
+        last segment, graded to a tenth of that segment
+        (`cnem.fracture.refine.auto_refinement`); a straight crack gets none.
+        None: never.
     continue_with : "largest", int or callable, optional
         What to do when the cracks cut the body apart. None (default): stop with a
         `GeometryError` naming the pieces. Else go on with one piece: ``"largest"``,

@@ -15,6 +15,15 @@ away from the tips it is the background cloud. The local update
 (`cnem.geometry.update.update`) takes any cloud change, so the refined model
 equals `discretize` of the refined cloud.
 
+By default (``refine="auto"``) rings go only where the interaction integral needs
+them: about a tip whose own crack kinks closer behind it than the discs of `sif`
+should reach (`cnem.fracture.discs`: the largest disc stays on the straight last
+segment, ``SIF_REACH`` times its length, and holds ``SIF_BEND_SPACINGS`` node
+spacings). A disc that spans a kink biases K_II (a 53 degree kink, K_I = K_II: the
+sign of K_II flips on a disc three times the last segment), and the
+next kink with it, so the run zig-zags; `auto_refinement` grades such tips to
+`AUTO_FRACTION` of the straight length. A straight crack gets no rings.
+
 >>> import cnem
 >>> from cnem.geometry import rectangle
 >>> dom = rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.4, 0.5]]])
@@ -36,17 +45,21 @@ from scipy.spatial import cKDTree
 from .. import config
 from ..errors import GrowthError
 from ..nodes import from_points
+from .discs import clearance
 
 if TYPE_CHECKING:
     from ..geometry.cloud import NodeCloud
 
-__all__ = ["Refinement", "refined_cloud", "as_refinement"]
+__all__ = ["Refinement", "refined_cloud", "as_refinement", "auto_refinement"]
 
 #: Default patch radius, in background spacings.
 RADIUS_SPACINGS = 4.0
 #: A ring node closer than this many of its spacings to a kept background node (the
 #: seam) or to a finer ring node (the discs of two close tips) is dropped.
 SEAM = 0.5
+#: ``refine="auto"``: tip spacing as a fraction of the straight length behind the tip
+#: (the largest disc, ``SIF_REACH`` of it, then holds about nine spacings).
+AUTO_FRACTION = 0.1
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,15 +88,53 @@ class Refinement:
                                   f"{value!r}")
 
 
-def as_refinement(refine: Refinement | float | None) -> Refinement | None:
-    """``grow``'s ``refine`` argument as a `Refinement` (a number is the tip spacing)."""
-    if refine is None or isinstance(refine, Refinement):
+def as_refinement(refine: Refinement | float | str | None) -> Refinement | str | None:
+    """``grow``'s ``refine`` argument as a `Refinement` (a number is the tip spacing),
+    ``"auto"`` or None."""
+    if refine is None or isinstance(refine, Refinement) or (isinstance(refine, str)
+                                                             and refine == "auto"):
         return refine
     try:
         return Refinement(float(refine))
     except (TypeError, ValueError):
-        raise GrowthError("refine: expected None, a tip spacing or a cnem.fracture.Refinement, "
-                          f"received {refine!r}") from None
+        raise GrowthError("refine: expected \"auto\", None, a tip spacing or a "
+                          f"cnem.fracture.Refinement, received {refine!r}") from None
+
+
+def auto_refinement(background: NodeCloud, tips: np.ndarray) -> tuple[np.ndarray, Refinement | None]:
+    """The tips whose discs would span a kink of their own crack, and the rings they need.
+
+    A tip needs rings when ``SIF_REACH`` times the straight length behind it
+    (`cnem.fracture.discs.clearance`) holds fewer than ``SIF_BEND_SPACINGS``
+    background spacings there; its tip spacing is `AUTO_FRACTION` of that length.
+
+    Parameters
+    ----------
+    background : NodeCloud
+    tips : (t, 2) array_like
+        Crack tips of the background's domain.
+
+    Returns
+    -------
+    tips : (k, 2) ndarray
+        The tips that need rings (possibly none).
+    refinement : Refinement or None
+        The finest tip spacing over them (None when no tip needs rings).
+    """
+    dom = background.domain
+    need, spacings = [], []
+    for tip in np.asarray(tips, dtype=float).reshape(-1, 2):
+        at, d = dom.tip_frame(tip)
+        straight = clearance(dom, at, d).straight
+        if not np.isfinite(straight):
+            continue
+        h = background_spacing(background, at[None])
+        if config.SIF_REACH * straight < config.SIF_BEND_SPACINGS * h:
+            need.append(at)
+            spacings.append(AUTO_FRACTION * straight)
+    if not need:
+        return np.empty((0, 2)), None
+    return np.array(need), Refinement(min(spacings))
 
 
 def background_spacing(cloud: NodeCloud, tips: np.ndarray, k: int = 8) -> float:
