@@ -377,7 +377,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         come back behind it, so the cloud keeps its size. ``cloud`` is then the
         background cloud. ``"auto"`` (default): rings only about a tip whose crack
         kinks too close behind it for the discs of `sif` to stay on the straight
-        last segment, graded to a tenth of that segment
+        last segment, graded to a twentieth of that segment
         (`cnem.fracture.refine.auto_refinement`); a straight crack gets none.
         None: never.
     continue_with : "largest", int or callable, optional
