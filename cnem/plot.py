@@ -271,7 +271,7 @@ def _scale_bar(pl, pv, view, unit, z):
     ends = np.array([[x0, y0], [x0 + length, y0]])
     pl.add_mesh(_lines(pv, ends, [[0, 1]], z), color="black", line_width=6, lighting=False)
     label = f"{length:g} {unit}" if unit else f"{length:g} (length unit)"
-    pl.add_point_labels(_lift(ends.mean(axis=0)[None] + [[0.0, 0.03 * (by1 - by0)]], z),
+    pl.add_point_labels(_lift(ends[:1] + [[0.0, 0.03 * (by1 - by0)]], z),
                         [label], font_size=22, text_color="black", shape=None,
                         show_points=False, always_visible=True)
 
