@@ -126,7 +126,7 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
           bounds: tuple[float, float, float, float] | None = None,
           node_size: float | None = None, length_unit: str | None = None) -> pyvista.Plotter:
     """Top view of a model: constrained Voronoi cells, Delaunay triangles, nodes, cracks,
-    and a scale bar.
+    a legend and a scale bar.
 
     Cells are filled with their region's colour (`REGION_COLORS`, unlit so the
     colours in the picture are exact) with black edges; triangle edges are
@@ -185,8 +185,8 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
         pl.add_mesh(_lines(pv, mdl.nodes, _triangle_edges(mdl.triangles), lift),
                     color=(0.55, 0.55, 0.55), line_width=max(0.5, 0.5 * width / 1200),
                     lighting=False)
+    crack = np.asarray(mdl.segments)[np.asarray(mdl.segment_kind) == SegmentKind.CRACK]
     if show_cracks:
-        crack = np.asarray(mdl.segments)[np.asarray(mdl.segment_kind) == SegmentKind.CRACK]
         if len(crack):
             pl.add_mesh(_lines(pv, mdl.nodes, crack, 2 * lift), color="red",
                         line_width=max(3.0, 4.0 * width / 1200), lighting=False)
@@ -201,6 +201,11 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
         pl.add_mesh(pv.PolyData(_lift(nodes, 3 * lift)), color="black",
                     point_size=node_size, render_points_as_spheres=True, lighting=False)
     view = (bx0, by0 - 0.1 * (by1 - by0), bx1, by1)          # room below for the scale bar
+    entries = [("constrained Voronoi cells, a colour per region", "black")]
+    entries += [("constrained Delaunay triangles", (0.55, 0.55, 0.55))] * show_triangles
+    entries += [("crack faces", "red")] * (show_cracks and bool(len(crack)))
+    entries += [("nodes", "black")] * show_nodes
+    _legend(pl, entries)
     _top_view(pl, view, width, height, dom.diameter)
     _scale_bar(pl, pv, view, length_unit, 4 * lift)
     return _save(pl, path, "model")
@@ -292,7 +297,8 @@ BAR = {"vertical": True, "position_x": 0.84, "position_y": 0.2, "width": 0.05, "
 def _legend(pl, entries):
     """A legend of ``entries`` ((label, colour) pairs, drawn as lines) at the upper left."""
     legend = pl.add_legend(labels=[[text, colour] for text, colour in entries],
-                           bcolor="white", face="line", size=(0.7, 0.04 * len(entries)),
+                           bcolor="white", face="line", size=(0.7 / len(entries) ** 0.5,
+                                                              0.035 * len(entries) ** 0.5),
                            loc="upper left")
     use_font(legend.GetEntryTextProperty())
 
