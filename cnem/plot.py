@@ -375,7 +375,8 @@ def nodal_field(sol, field):
     return sol.nodal_average(per_place)
 
 
-def solution(sol: Any, path: str | os.PathLike | None = None, *, field: str | np.ndarray = "von_mises",
+def solution(sol: Any, path: str | os.PathLike | None = None, *,
+             field: str | np.ndarray = "von_mises",
              scale: float | None = None, window_size: tuple[int, int] = (1200, 1000),
              show_edges: bool = False, cmap: str = "viridis",
              title: str | None = None, cellwise: bool = True,

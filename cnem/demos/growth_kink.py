@@ -110,7 +110,8 @@ def main(angles: tuple = ANGLES, *, cloud: tuple = CLOUD, outdir: str = "results
         import matplotlib.pyplot as plt
         gg = np.linspace(0.0, 89.0, 200)
         fig, ax = plt.subplots(figsize=(6.0, 4.5))
-        ax.plot(gg, np.degrees(exact(gg)[2]), "k-", label=r"max hoop stress, exact $K_\mathrm{I}, K_\mathrm{II}$")
+        ax.plot(gg, np.degrees(exact(gg)[2]), "k-",
+                label=r"max hoop stress, exact $K_\mathrm{I}, K_\mathrm{II}$")
         g = [r["gamma"] for r in rows]
         ax.plot(g, [r["tips_deg"][0] for r in rows], "o", label="C-NEM, tip 0")
         ax.plot(g, [r["tips_deg"][1] for r in rows], "x", ms=8, label="C-NEM, tip 1")

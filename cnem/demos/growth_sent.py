@@ -114,7 +114,8 @@ def main(h: float = 0.01, *, a0: float = 0.2, a1: float = 0.6, increment: float 
                   title=f"SENT: $a/W$ = {a0} to {a1}\n({len(hist.model.nodes)} nodes)")
         aa = np.linspace(a0 * W, a1 * W, 100)
         hist.plot(out / "sent_sif.png", kind="sif", length_unit="$W$", sif_unit=r"$\sigma\sqrt{W}$",
-                  reference=(aa, handbook(aa)), title=r"SENT: $K_\mathrm{I}$ during growth vs the handbook")
+                  reference=(aa, handbook(aa)),
+                  title=r"SENT: $K_\mathrm{I}$ during growth vs the handbook")
         files = [out / "sent_path.png", out / "sent_sif.png"]
     return dict(rows=rows, max_error=max(abs(r["error"]) for r in rows),
                 max_kink_deg=max(abs(r["kink_deg"]) for r in rows),

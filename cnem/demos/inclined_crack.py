@@ -151,7 +151,7 @@ def _plots(rows, ahead, out):
     rr = np.linspace(max(r.min(), 1e-4), r.max(), 300)
     ax.plot(rr, muskhelishvili(rr), "k-", label="Muskhelishvili (eq. 45)")
     ax.plot(r, s22, "o", ms=4, label="C-NEM cells")
-    ax.set_xlabel("distance ahead of the tip r (mm)")
+    ax.set_xlabel(r"distance ahead of the tip $r$ (mm)")
     ax.set_ylabel(r"$\sigma_{22}$ (MPa)")
     ax.set_xscale("log")
     ax.set_title(r"Stress ahead of the tip, $\gamma = 0$ (paper Figure 18)")
@@ -165,7 +165,8 @@ def _plots(rows, ahead, out):
     gg = np.linspace(0, 90, 200)
     fig, ax = plt.subplots(figsize=(6, 4.5))
     ax.plot(gg, np.cos(np.deg2rad(gg)) ** 2, "k-", label=r"$K_\mathrm{I}$ exact (eq. 46)")
-    ax.plot(gg, np.sin(np.deg2rad(gg)) * np.cos(np.deg2rad(gg)), "k--", label=r"$K_\mathrm{II}$ exact")
+    ax.plot(gg, np.sin(np.deg2rad(gg)) * np.cos(np.deg2rad(gg)), "k--",
+            label=r"$K_\mathrm{II}$ exact")
     ax.plot(g, [row["right"][0] / k0 for row in rows], "o", label=r"$K_\mathrm{I}$ C-NEM")
     ax.plot(g, [row["right"][1] / k0 for row in rows], "s", label=r"$K_\mathrm{II}$ C-NEM")
     ax.set_xlabel(r"crack angle $\gamma$ (degrees)")

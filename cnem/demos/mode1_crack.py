@@ -198,7 +198,7 @@ def main(spacings: tuple = SPACINGS, *, methods: tuple = ("cnem", "enriched", "f
     if plot:
         _plot(rows, rates, out / "mode1_convergence.png")
         sol = solve_cnem(spacings[min(1, len(spacings) - 1)])
-        sol.plot(out / "mode1_crack_open.png", field="von_mises").close()   # lengths: the plate side 1
+        sol.plot(out / "mode1_crack_open.png", field="von_mises").close()   # plate side 1
         files = [out / "mode1_convergence.png", out / "mode1_crack_open.png"]
         for f in files:
             print(f"wrote {f}")

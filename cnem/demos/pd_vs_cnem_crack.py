@@ -164,7 +164,8 @@ def _plots(rows, out):
     diff = np.hypot(*(r["u_pd"] - r["u_cnem"]).T)
     fig, ax = plt.subplots(figsize=(5.6, 5))
     tri = ax.tripcolor(x[:, 0], x[:, 1], r["model"].triangles, diff, shading="gouraud")
-    fig.colorbar(tri, ax=ax, label=r"$|\mathbf{u}_\mathrm{PD} - \mathbf{u}_\mathrm{C{-}NEM}|$ ($\sigma W / E$)")
+    fig.colorbar(tri, ax=ax, label=r"$|\mathbf{u}_\mathrm{PD} - \mathbf{u}_\mathrm{C{-}NEM}|$"
+                                   r" ($\sigma W / E$)")
     ax.plot([-A, A], [0, 0], "r-", lw=2, label="crack")
     ax.set_xlabel(r"$x$ ($W$, the plate's half-width)")
     ax.set_ylabel(r"$y$ ($W$)")

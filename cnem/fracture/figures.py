@@ -123,12 +123,16 @@ def sif_curves(hist: Any, path: str | None = None, *, length_unit: str = "", sif
         ax.plot(reference[0], reference[1], "k-", lw=1.0, label=r"reference $K_\mathrm{I}$")
     for i in range(K.shape[1]):
         tag = f" tip {i}" if K.shape[1] > 1 else ""
-        ax.plot(length[:, i], K[:, i, 0], "o-", ms=3, label=rf"$K_\mathrm{{I}}${tag}")
-        ax.plot(length[:, i], K[:, i, 1], "s--", ms=3, label=rf"$K_\mathrm{{II}}${tag}")
-        ax.plot(length[:, i], K_eq[:, i], ":", lw=1.2, label=rf"$K_\mathrm{{eq}}${tag}")
+        # larger hollow markers and thinner lines for later tips: tips that coincide show
+        style = dict(ms=3 + 3 * i, mfc="none" if i else None, lw=1.5 / (1 + i))
+        ax.plot(length[:, i], K[:, i, 0], "o-", label=rf"$K_\mathrm{{I}}${tag}", **style)
+        ax.plot(length[:, i], K[:, i, 1], "s--", label=rf"$K_\mathrm{{II}}${tag}", **style)
+        ax.plot(length[:, i], K_eq[:, i], ":", lw=1.2 / (1 + i),
+                label=rf"$K_\mathrm{{eq}}${tag}")
     ax.set_xlabel(f"crack length{_unit(length_unit)}")
     ax.set_ylabel(f"$K$ at load factor 1{_unit(sif_unit)}")
-    ax.set_title(title or f"Stress intensity factors during growth ({hist.criterion})")
+    ax.set_title(title or f"Stress intensity factors during growth "
+                          f"({hist.criterion.replace('_', ' ')})")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     return _finish(fig, path)
@@ -153,7 +157,8 @@ def load_curves(hist: Any, path: str | None = None, *, length_unit: str = "", lo
     ax = axes[0, 0]
     for i in range(load.shape[1]):
         ax.plot(length[:, i], load[:, i], "o-", ms=3,
-                label=f"tip {i}" if load.shape[1] > 1 else r"load factor $K_\mathrm{Ic} / K_\mathrm{eq}$")
+                label=f"tip {i}" if load.shape[1] > 1
+                else r"load factor $K_\mathrm{Ic} / K_\mathrm{eq}$")
     ax.set_xlabel(f"crack length{_unit(length_unit)}")
     ax.set_ylabel(f"critical load factor{_unit(load_unit)}")
     ax.grid(alpha=0.3)
@@ -161,7 +166,8 @@ def load_curves(hist: Any, path: str | None = None, *, length_unit: str = "", lo
     ax.set_title(title or "Load for growth against crack length")
     if panels == 2:
         ax = axes[0, 1]
-        ax.plot(critical * measure, critical, "o-", ms=3, label=r"brittle growth ($K_\mathrm{eq} = K_\mathrm{Ic}$)")
+        ax.plot(critical * measure, critical, "o-", ms=3,
+                label=r"brittle growth ($K_\mathrm{eq} = K_\mathrm{Ic}$)")
         ax.plot([0, critical[0] * measure[0]], [0, critical[0]], "k:", lw=1.0,
                 label="elastic loading, initial crack")
         ax.set_xlabel(f"displacement (measure × load factor){_unit(displacement_unit)}")

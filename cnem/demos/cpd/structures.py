@@ -71,7 +71,8 @@ def cantilever(spacing: float = 0.04, *, C1s: tuple = (1.0, 2.0, 4.0), height: f
               f"{r['seconds']:>5.1f}s")
     def panels():
         return [dict(points=x + r["u"], counts=counts, values=r["u"][:, 1], reference=x,
-                     field=r"$u_y$", title=f"$C_1 = {C1:g}$, $\\delta = {m:g}h$") for C1, r in runs.items()]
+                     field=r"$u_y$", title=f"$C_1 = {C1:g}$, $\\delta = {m:g}h$")
+                for C1, r in runs.items()]
     return finish("cantilever", dict(force=force, runs=runs, tables=tables), outdir, plot,
                   panels, 2, window=(1500, 450))
 
@@ -213,8 +214,8 @@ def _profiles(out, distance, results, h):
         axes[0].plot(distance, r["row"], "o-", ms=3, label=f"$\\delta = {m:g}h$")
         axes[1].plot(distance[:len(r["column"])], r["column"], "o-", ms=3,
                      label=f"$\\delta = {m:g}h$")
-    for ax, what in zip(axes, ("leftwards from the corner (y = 1/2)",
-                               "downwards from the corner (x = 1/2)")):
+    for ax, what in zip(axes, (r"leftwards from the corner ($y = 1/2$)",
+                               r"downwards from the corner ($x = 1/2$)")):
         ax.set_xlabel(f"distance {what}")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
