@@ -215,7 +215,8 @@ def _paths_figure(runs, path):
 def _load_figure(r, path):
     """`CrackPath.plot` ``kind="load"`` with the straight crack of beam theory beside it."""
     import matplotlib.pyplot as plt
-    fig = r["history"].plot(None, kind="load", length_unit="$H$", load_unit=r"$K_\mathrm{Ic}\sqrt{H}$",
+    fig = r["history"].plot(None, kind="load", length_unit="$H$",
+                            load_unit=r"$K_\mathrm{Ic}\sqrt{H}$",
                             displacement_unit=r"$K_\mathrm{Ic} / E\sqrt{H}$",
                             title=rf"DCB, $\theta_0$ = {r['theta']:.2f}°: end force for growth")
     a = np.linspace(r["length"][0], r["length"][-1], 100)
