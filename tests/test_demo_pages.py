@@ -31,7 +31,7 @@ def test_every_printed_output_has_its_command():
 
 
 BASE = """$ cnem demo x
-    cloud  nodes       h    e/sqrt2  time s | FEM e  time s
+    cloud  nodes       h    e/sqrt2  time s |     FEM e  time s
   regular    147  0.0667  1.021e-04   68.24 | 1.768e-04    0.06
 sum of cell areas 3.99999999999978 vs plate area 4 (relative error 5.5e-14), in 4.79 s
 (50 s wall, one numba thread)

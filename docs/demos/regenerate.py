@@ -110,7 +110,7 @@ def _close(page: str, fresh: str) -> bool:
     mantissa, _, exponent = page.lower().partition("e")
     decimals = len(mantissa.partition(".")[2])
     unit = 10.0 ** (-decimals + (int(exponent) if exponent else 0))
-    return abs(a - b) <= max(unit, 1e-12 * abs(a))
+    return abs(a - b) <= max(unit * (1 + 1e-9), 1e-12 * abs(a))   # 1e-9: binary round-off
 
 
 def compare(page: str, fresh: str) -> list[str]:
