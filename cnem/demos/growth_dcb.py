@@ -194,7 +194,7 @@ def _paths_figure(runs, path):
     ax.plot([0, A0], [0, 0], "k-", lw=2.0, label="initial crack")
     ax.plot([0, L], [0, 0], "k:", lw=0.8)
     for r in runs:
-        xy = r["tips"]
+        xy = np.vstack([[A0, 0.0], r["tips"]])          # from the end of the straight crack
         ax.plot(xy[:, 0], xy[:, 1], "o-", ms=2.5, lw=1.5,
                 label=rf"$\theta_0$ = {r['theta']:.2f}°"
                 + (" (ends on the top face)" if xy[-1, 1] > 0.9 * H else ""))
@@ -202,6 +202,7 @@ def _paths_figure(runs, path):
                 arrowprops=dict(arrowstyle="->", color="tab:red"))
     ax.annotate("", xy=(0.0, -0.9 * H), xytext=(0.0, -0.45 * H),
                 arrowprops=dict(arrowstyle="->", color="tab:red"))
+    ax.plot([], [], color="tab:red", lw=1.0, label="end forces (opening the arms)")
     ax.set_aspect("equal")
     ax.set_xlabel(r"$x$ ($H$)")
     ax.set_ylabel(r"$y$ ($H$)")
