@@ -281,11 +281,10 @@ def _scale_bar(pl, pv, view, unit, z):
                         show_points=False, always_visible=True)
 
 
-def _colour_bar(pl, title):
-    """The last mesh's colour bar upright on the right (its title above it, its labels
-    beside it: they cannot overlap), in `font_file`."""
+def _colour_bar_font(pl):
+    """Write the last mesh's colour bar (upright on the right, `BAR`: its title above it,
+    its labels beside it, so they cannot overlap) in `font_file`."""
     bar = pl.scalar_bar
-    bar.SetTitle(title)
     use_font(bar.GetTitleTextProperty(), bar.GetLabelTextProperty())
 
 
@@ -454,9 +453,10 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *,
     points_only = ({"point_size": 8, "render_points_as_spheres": True}
                    if triangles is None and per_cell is None else {})
     pl.add_mesh(mesh, scalars=name, cmap=cmap, lighting=False, show_edges=show_edges,
-                edge_color=(0.4, 0.4, 0.4), scalar_bar_args=dict(BAR, title=label + "\n"),
+                edge_color=(0.4, 0.4, 0.4),               # "\n": lifts the title off the top label
+                scalar_bar_args=dict(BAR, title=label + "\n"),
                 **points_only)
-    _colour_bar(pl, label + "\n")   # the newline lifts it off the top label
+    _colour_bar_font(pl)
     lift = 1e-3 * diameter
     entries = []
     if model is not None and len(model.nodes) == len(nodes):
