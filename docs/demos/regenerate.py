@@ -30,7 +30,7 @@ IMAGES = ROOT / "docs" / "images" / "demos"
 PAGES = {
     "bimaterial_cylinder": ("demo", "cylinder"),
     "cracked_plate_geometry": ("demo", "cracked-plate"),
-    "inclined_crack": ("demo", "inclined-crack", "--angles", "30"),
+    "inclined_crack": ("demo", "inclined-crack"),
     "mode1_crack": ("demo", "mode1-crack", "--n", "8", "16", "32"),
     "pd_vs_cnem_crack": ("pd", "crack", "--n", "16", "32"),
     "pd_crack_branching": ("pd", "branching", "--quick"),
