@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from .geometry.model import Model
 
 __all__ = ["model", "solution", "cells_polydata", "region_color", "PlotError", "REGION_COLORS",
-           "SOLUTION_FIELDS"]
+           "SOLUTION_FIELDS", "FIELD_LABELS"]
 
 log = logging.getLogger(__name__)
 
@@ -124,8 +124,9 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
           show_nodes: bool = True, show_cracks: bool = True,
           window_size: tuple[int, int] = (1200, 1200),
           bounds: tuple[float, float, float, float] | None = None,
-          node_size: float | None = None) -> pyvista.Plotter:
-    """Top view of a model: constrained Voronoi cells, Delaunay triangles, nodes, cracks.
+          node_size: float | None = None, length_unit: str | None = None) -> pyvista.Plotter:
+    """Top view of a model: constrained Voronoi cells, Delaunay triangles, nodes, cracks,
+    a legend and a scale bar.
 
     Cells are filled with their region's colour (`REGION_COLORS`, unlit so the
     colours in the picture are exact) with black edges; triangle edges are
@@ -147,6 +148,8 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
         ``Domain.bounds``); default the whole domain.
     node_size : float, optional
         Node dot size in pixels; default from the smallest node spacing in view.
+    length_unit : str, optional
+        The unit of the coordinates, written on the scale bar (e.g. ``"mm"``).
 
     Returns
     -------
@@ -182,8 +185,8 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
         pl.add_mesh(_lines(pv, mdl.nodes, _triangle_edges(mdl.triangles), lift),
                     color=(0.55, 0.55, 0.55), line_width=max(0.5, 0.5 * width / 1200),
                     lighting=False)
+    crack = np.asarray(mdl.segments)[np.asarray(mdl.segment_kind) == SegmentKind.CRACK]
     if show_cracks:
-        crack = np.asarray(mdl.segments)[np.asarray(mdl.segment_kind) == SegmentKind.CRACK]
         if len(crack):
             pl.add_mesh(_lines(pv, mdl.nodes, crack, 2 * lift), color="red",
                         line_width=max(3.0, 4.0 * width / 1200), lighting=False)
@@ -197,7 +200,14 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
             node_size = float(np.clip(0.25 * h * scale, 2.0, 10.0))
         pl.add_mesh(pv.PolyData(_lift(nodes, 3 * lift)), color="black",
                     point_size=node_size, render_points_as_spheres=True, lighting=False)
-    _top_view(pl, (bx0, by0, bx1, by1), width, height, dom.diameter)
+    view = (bx0, by0 - 0.1 * (by1 - by0), bx1, by1)          # room below for the scale bar
+    entries = [("constrained Voronoi cells, a colour per region", "black")]
+    entries += [("constrained Delaunay triangles", (0.55, 0.55, 0.55))] * show_triangles
+    entries += [("crack faces", "red")] * (show_cracks and bool(len(crack)))
+    entries += [("nodes", "black")] * show_nodes
+    _legend(pl, entries)
+    _top_view(pl, view, width, height, dom.diameter)
+    _scale_bar(pl, pv, view, length_unit, 4 * lift)
     return _save(pl, path, "model")
 
 
@@ -213,9 +223,11 @@ def _plotter(pv, width, height):
     return pl
 
 
-def _top_view(pl, bounds, width, height, diameter):
-    """Parallel top view of ``bounds = (xmin, ymin, xmax, ymax)`` with a 4 % margin."""
+def _top_view(pl, bounds, width, height, diameter, right=0.0):
+    """Parallel top view of ``bounds = (xmin, ymin, xmax, ymax)`` with a 4 % margin,
+    and ``right`` (a fraction of the window's width) free on the right (a colour bar)."""
     bx0, by0, bx1, by1 = bounds
+    bx1 = bx0 + (bx1 - bx0) / (1.0 - right)
     pl.view_xy()
     pl.enable_parallel_projection()
     cx, cy = 0.5 * (bx0 + bx1), 0.5 * (by0 + by1)
@@ -225,6 +237,69 @@ def _top_view(pl, bounds, width, height, diameter):
     cam.up = (0.0, 1.0, 0.0)
     cam.parallel_scale = 0.5 * 1.04 * max(by1 - by0, (bx1 - bx0) * height / width)
     pl.reset_camera_clipping_range()
+
+
+def font_file() -> str | None:
+    """A TrueType font with Greek letters and subscripts (matplotlib's DejaVu Sans), or
+    None without matplotlib (VTK's own fonts then, which lack them)."""
+    try:
+        import matplotlib
+    except ImportError:  # pragma: no cover - depends on the environment
+        return None
+    path = pathlib.Path(matplotlib.get_data_path()) / "fonts" / "ttf" / "DejaVuSans.ttf"
+    return str(path) if path.exists() else None
+
+
+def use_font(*properties) -> None:
+    """Draw the VTK text properties ``properties`` in `font_file` (so σ, θ, δ show)."""
+    font = font_file()
+    if font is None:  # pragma: no cover - depends on the environment
+        return
+    for prop in properties:
+        prop.SetFontFamily(4)                     # VTK_FONT_FILE
+        prop.SetFontFile(font)
+
+
+def nice_length(span: float) -> float:
+    """A round length (1, 2 or 5 times a power of ten) near a fifth of ``span > 0``."""
+    target = 0.2 * span
+    power = 10.0 ** np.floor(np.log10(target))
+    return float(max(m * power for m in (1.0, 2.0, 5.0) if m * power <= target))
+
+
+def _scale_bar(pl, pv, view, unit, z):
+    """A black bar of a round length at the lower left of ``view`` (``(xmin, ymin,
+    xmax, ymax)``, the area shown), labelled with its length and ``unit``."""
+    bx0, by0, bx1, by1 = view
+    length = nice_length(bx1 - bx0)
+    x0, y0 = bx0 + 0.02 * (bx1 - bx0), by0 + 0.025 * (by1 - by0)
+    ends = np.array([[x0, y0], [x0 + length, y0]])
+    pl.add_mesh(_lines(pv, ends, [[0, 1]], z), color="black", line_width=6, lighting=False)
+    label = f"{length:g} {unit}" if unit else f"{length:g} (length unit)"
+    pl.add_point_labels(_lift(ends[:1] + [[0.0, 0.03 * (by1 - by0)]], z),
+                        [label], font_size=22, text_color="black", shape=None,
+                        show_points=False, always_visible=True)
+
+
+def _colour_bar_font(pl):
+    """Write the last mesh's colour bar (upright on the right, `BAR`: its title above it,
+    its labels beside it, so they cannot overlap) in `font_file`."""
+    bar = pl.scalar_bar
+    use_font(bar.GetTitleTextProperty(), bar.GetLabelTextProperty())
+
+
+#: Where the upright colour bars of `solution` sit (fractions of the window).
+BAR = {"vertical": True, "position_x": 0.84, "position_y": 0.2, "width": 0.05, "height": 0.6,
+       "title_font_size": 22, "label_font_size": 18, "fmt": "%.3g", "color": "black"}
+
+
+def _legend(pl, entries):
+    """A legend of ``entries`` ((label, colour) pairs, drawn as lines) at the upper left."""
+    legend = pl.add_legend(labels=[[text, colour] for text, colour in entries],
+                           bcolor="white", face="line", size=(0.7 / len(entries) ** 0.5,
+                                                              0.035 * len(entries) ** 0.5),
+                           loc="upper left")
+    use_font(legend.GetEntryTextProperty())
 
 
 def _save(pl, path, what):
@@ -245,6 +320,21 @@ def _save(pl, path, what):
 
 #: Fields `solution` can colour by.
 SOLUTION_FIELDS = ("von_mises", "sxx", "syy", "sxy", "exx", "eyy", "gxy", "ux", "uy", "|u|")
+
+
+def _per_place(sol, name):
+    """The field ``name`` (a stress or strain name of `SOLUTION_FIELDS`) at the places
+    of ``sol.stress``."""
+    shear = sol.stress.shape[1] - 1                     # the xy entry of the Voigt order
+    return {"von_mises": sol.von_mises, "sxx": sol.stress[:, 0], "syy": sol.stress[:, 1],
+            "sxy": sol.stress[:, shear], "exx": sol.strain[:, 0], "eyy": sol.strain[:, 1],
+            "gxy": sol.strain[:, shear]}[name]
+
+
+#: How `solution` names its fields on the colour bar (symbols; stresses in the unit of E).
+FIELD_LABELS = {"von_mises": "σ_vM", "sxx": "σ_xx", "syy": "σ_yy", "sxy": "σ_xy",
+                "exx": "ε_xx", "eyy": "ε_yy", "gxy": "γ_xy", "ux": "u_x", "uy": "u_y",
+                "|u|": "|u|"}
 
 
 def nodal_field(sol, field):
@@ -280,28 +370,30 @@ def nodal_field(sol, field):
     elif field in ("ux", "uy", "|u|"):
         return {"ux": sol.u[:, 0], "uy": sol.u[:, 1], "|u|": np.linalg.norm(sol.u, axis=1)}[field]
     else:
-        shear = sol.stress.shape[1] - 1                     # the xy entry of the Voigt order
-        per_place = {"von_mises": sol.von_mises, "sxx": sol.stress[:, 0], "syy": sol.stress[:, 1],
-                     "sxy": sol.stress[:, shear], "exx": sol.strain[:, 0],
-                     "eyy": sol.strain[:, 1], "gxy": sol.strain[:, shear]}[field]
+        per_place = _per_place(sol, field)
     return sol.nodal_average(per_place)
 
 
-def solution(sol: Any, path: str | os.PathLike | None = None, *, field: str | np.ndarray = "von_mises",
-             scale: float | None = None, window_size: tuple[int, int] = (1200, 1200),
+def solution(sol: Any, path: str | os.PathLike | None = None, *,
+             field: str | np.ndarray = "von_mises",
+             scale: float | None = None, window_size: tuple[int, int] = (1200, 1000),
              show_edges: bool = False, cmap: str = "viridis",
-             title: str | None = None, cellwise: bool = True) -> pyvista.Plotter:
-    """The deformed body coloured by a field (off-screen).
+             title: str | None = None, cellwise: bool = True,
+             length_unit: str | None = None) -> pyvista.Plotter:
+    """The body coloured by a field, its deformed and undeformed outlines and a scale
+    bar (off-screen).
 
     The solution's triangles (``sol.plot_mesh()``: C-NEM's constrained Delaunay
     triangles, the P1 mesh) are moved by ``scale * u`` (crack faces have their
     own nodes, so cracks open) and coloured by the field at the nodes
-    (`nodal_field`), interpolated across the triangles; a solution without
-    triangles (peridynamics) is drawn as its moved points. A field with one value
-    per integration cell (C-NEM stresses and strains) is drawn instead, with
+    (`nodal_field`), interpolated across the triangles, with the undeformed
+    boundary, interfaces and cracks drawn over them as thin black lines; a solution
+    without triangles (peridynamics) is drawn as its moved points. A field with one
+    value per integration cell (C-NEM stresses and strains) is drawn instead, with
     ``cellwise``, on the cell polygons of the undeformed body, so that its jumps
     across material interfaces and crack faces stay sharp; the deformed boundary,
-    interfaces and cracks are drawn over it as lines.
+    interfaces and cracks are drawn over it as grey lines. A legend says which is
+    which and the magnification; the colour bar stands on the right.
 
     Parameters
     ----------
@@ -321,10 +413,13 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *, field: str | np
     cmap : str
         Matplotlib colour map name.
     title : str, optional
-        Scalar-bar title (default the field name).
+        Colour-bar title, with its unit, e.g. ``"σ_θθ (MPa)"`` (default the field's
+        symbol, `FIELD_LABELS`).
     cellwise : bool
         Draw a field given per cell on the cells (default); False averages it to
         the nodes (`nodal_field`) and draws it on the deformed triangles.
+    length_unit : str, optional
+        The unit of the coordinates, written on the scale bar (e.g. ``"mm"``).
 
     Returns
     -------
@@ -332,36 +427,60 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *, field: str | np
     """
     pv = _pyvista()
     per_cell = _cell_values(sol, field) if cellwise else None
+    name = field if isinstance(field, str) else "field"
+    label = title or FIELD_LABELS.get(name, name)
+    model = getattr(sol, "model", None)
     if per_cell is not None:
-        return _cellwise(pv, sol, per_cell, path, field, scale, window_size, show_edges, cmap,
-                         title)
-    nodes, triangles, diameter = sol.plot_mesh()
-    values = nodal_field(sol, field)
-    name = field if isinstance(field, str) else (title or "field")
+        nodes, triangles, diameter = model.nodes, None, model.domain.diameter
+    else:
+        nodes, triangles, diameter = sol.plot_mesh()
     umax = float(np.abs(sol.u).max())
     if scale is None:
         scale = 0.05 * diameter / umax if umax > 0 else 0.0
     moved = nodes + scale * sol.u
-    lifted = _lift(moved[:, :2], 0.0) if moved.shape[1] == 2 else moved
-    points_only = {}
-    if triangles is None:
-        mesh = pv.PolyData(lifted)
-        points_only = {"point_size": 8, "render_points_as_spheres": True}
-    else:
-        faces = np.column_stack([np.full(len(triangles), 3), triangles]).ravel()
-        mesh = pv.PolyData(lifted, faces=faces)
-    mesh.point_data[name] = values
     width, height = map(int, window_size)
     pl = _plotter(pv, width, height)
-    # (the colour bars' titles end in a newline: it lifts them off the tick labels)
+    if per_cell is not None:
+        mesh = cells_polydata(model)
+        mesh.cell_data[name] = per_cell
+    elif triangles is None:
+        mesh = pv.PolyData(moved if moved.shape[1] == 3 else _lift(moved, 0.0))
+        mesh.point_data[name] = nodal_field(sol, field)
+    else:
+        faces = np.column_stack([np.full(len(triangles), 3), triangles]).ravel()
+        mesh = pv.PolyData(_lift(moved[:, :2], 0.0), faces=faces)
+        mesh.point_data[name] = nodal_field(sol, field)
+    points_only = ({"point_size": 8, "render_points_as_spheres": True}
+                   if triangles is None and per_cell is None else {})
     pl.add_mesh(mesh, scalars=name, cmap=cmap, lighting=False, show_edges=show_edges,
-                edge_color=(0.4, 0.4, 0.4),
-                scalar_bar_args={"title": f"{title or name} (deformation x{scale:.3g})\n",
-                                 "color": "black", "vertical": False}, **points_only)
-    lo, hi = moved[:, :2].min(axis=0), moved[:, :2].max(axis=0)
-    pad = 0.08 * (hi - lo).max()
-    _top_view(pl, (lo[0] - pad, lo[1] - 2 * pad, hi[0] + pad, hi[1] + pad), width, height,
-              diameter)
+                edge_color=(0.4, 0.4, 0.4),               # "\n": lifts the title off the top label
+                scalar_bar_args=dict(BAR, title=label + "\n"),
+                **points_only)
+    _colour_bar_font(pl)
+    lift = 1e-3 * diameter
+    entries = []
+    if model is not None and len(model.nodes) == len(nodes):
+        segments = np.asarray(model.segments)
+        grey = (0.35, 0.35, 0.35)
+        if per_cell is not None:
+            pl.add_mesh(_lines(pv, moved, segments, lift), color=grey,
+                        line_width=max(1.5, 1.5 * width / 1200), lighting=False)
+            entries = [(f"deformed outline ×{scale:.3g}; colours on the undeformed cells",
+                        grey)]
+        else:
+            pl.add_mesh(_lines(pv, model.nodes, segments, lift), color="black",
+                        line_width=max(1.0, width / 1200), lighting=False)
+            entries = [(f"undeformed outline; colours on the body deformed ×{scale:.3g}",
+                        "black")]
+    else:
+        entries = [(f"points moved ×{scale:.3g}", "black")]
+    _legend(pl, entries)
+    lo = np.minimum(nodes[:, :2].min(axis=0), moved[:, :2].min(axis=0))
+    hi = np.maximum(nodes[:, :2].max(axis=0), moved[:, :2].max(axis=0))
+    pad = 0.06 * (hi - lo).max()
+    view = (lo[0] - pad, lo[1] - 2.5 * pad, hi[0] + pad, hi[1] + 2.5 * pad)
+    _top_view(pl, view, width, height, diameter, right=0.2)
+    _scale_bar(pl, pv, view, length_unit, 2 * lift)
     return _save(pl, path, "solution")
 
 
@@ -376,40 +495,6 @@ def _cell_values(sol, field):
     if isinstance(field, str):
         if field in ("ux", "uy", "|u|") or field not in SOLUTION_FIELDS:
             return None
-        shear = sol.stress.shape[1] - 1
-        return {"von_mises": sol.von_mises, "sxx": sol.stress[:, 0], "syy": sol.stress[:, 1],
-                "sxy": sol.stress[:, shear], "exx": sol.strain[:, 0],
-                "eyy": sol.strain[:, 1], "gxy": sol.strain[:, shear]}[field]
+        return _per_place(sol, field)
     values = np.asarray(field, dtype=float)
     return values if values.shape == (len(model.cells),) and len(sol.u) != len(values) else None
-
-
-def _cellwise(pv, sol, values, path, field, scale, window_size, show_edges, cmap, title):
-    """`solution` for a field per cell: the cells coloured, undeformed; the deformed
-    constraint segments (boundary, interfaces, cracks) as lines."""
-    model = sol.model
-    name = field if isinstance(field, str) else (title or "field")
-    poly = cells_polydata(model)
-    poly.cell_data[name] = values
-    diameter = model.domain.diameter
-    umax = float(np.abs(sol.u).max())
-    if scale is None:
-        scale = 0.05 * diameter / umax if umax > 0 else 0.0
-    moved = model.nodes + scale * sol.u
-    width, height = map(int, window_size)
-    pl = _plotter(pv, width, height)
-    pl.add_mesh(poly, scalars=name, cmap=cmap, lighting=False, show_edges=show_edges,
-                edge_color=(0.4, 0.4, 0.4),
-                scalar_bar_args={"title": f"{title or name}, on the cells (undeformed)\n",
-                                 "color": "black", "vertical": False})
-    lift = 1e-3 * diameter
-    pl.add_mesh(_lines(pv, moved, np.asarray(model.segments), lift), color=(0.45, 0.45, 0.45),
-                line_width=max(1.0, width / 1200),
-                label=f"deformed boundary, interfaces, cracks (x{scale:.3g})")
-    pl.add_legend(bcolor="white", face="line", size=(0.45, 0.05), loc="upper left")
-    lo = np.minimum(model.nodes.min(axis=0), moved.min(axis=0))
-    hi = np.maximum(model.nodes.max(axis=0), moved.max(axis=0))
-    pad = 0.08 * (hi - lo).max()
-    _top_view(pl, (lo[0] - pad, lo[1] - 2 * pad, hi[0] + pad, hi[1] + pad), width, height,
-              diameter)
-    return _save(pl, path, "solution")

@@ -48,13 +48,17 @@ def test_readme_links_resolve():
 @pytest.mark.slow
 def test_first_model_tutorial_balances_its_load(tmp_path, monkeypatch, capsys):
     """The tutorial's script: the clamped edge's reactions balance the end load (10 N/mm down)
-    to the solver's tolerance, and it writes its file and picture."""
+    to the solver's tolerance, it prints what the tutorial shows, and it writes its file and
+    picture."""
     monkeypatch.chdir(tmp_path)
     pyvista = importlib.util.find_spec("pyvista") is not None
     script = ROOT / "docs" / "examples" / "first_model.py"
     if not pyvista:
         pytest.skip("the plot extra is not installed")
     names = runpy.run_path(str(script), run_name="__main__")
+    pages = runpy.run_path(str(ROOT / "docs" / "demos" / "regenerate.py"))
+    printed = (ROOT / "docs" / "examples" / "first_model.out").read_text()
+    assert pages["compare"](printed, capsys.readouterr().out) == [], "first_model.out is stale"
     np.testing.assert_allclose(names["reaction"], [0.0, 10.0], atol=1e-6 * 10.0)
     assert names["dom"].area == pytest.approx(3.0 - names["hole"].area, rel=1e-12)
     for f in ("l_plate.vtu", "l_plate_von_mises.png"):

@@ -89,3 +89,17 @@ def test_field_per_cell_keeps_its_jump_at_the_interface(tmp_path):
                            cellwise=cellwise).close()
         counts[cellwise] = _has_color(_rgb(path), middle, tol=25)
     assert counts[False] > 3 * counts[True] + 100, counts
+
+
+@pytest.mark.parametrize("span", [3e-6, 1.0, 2.0, 4.99, 5.0, 7.3, 1e4 / 3])
+def test_scale_bar_length_is_round_and_about_a_fifth(span):
+    """The scale bar: 1, 2 or 5 times a power of ten, between a twelfth and a fifth of the
+    width shown, at any size of model."""
+    length = cnem.plot.nice_length(span)
+    mantissa = length / 10.0 ** np.floor(np.log10(length) + 1e-12)
+    assert min(abs(mantissa - m) for m in (1.0, 2.0, 5.0)) < 1e-9, length
+    assert span / 12.5 < length <= span / 5 * (1 + 1e-12)
+
+
+def test_every_field_has_a_symbol():
+    assert set(cnem.plot.FIELD_LABELS) == set(cnem.plot.SOLUTION_FIELDS)

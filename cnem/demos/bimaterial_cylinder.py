@@ -240,8 +240,9 @@ def plot_convergence(rows, path):
             nf = np.array([r["fem_nodes"] for r in sel])
             ef = np.array([r["fem_error"] for r in sel]) / np.sqrt(2.0)
             ax.loglog(1 / np.sqrt(nf), ef, "^:", label=f"FEM P1 (rate {rate(nf, ef):.2f})")
-    ax.set_xlabel("1 / sqrt(nodes)  (~ h)")
-    ax.set_ylabel("error in the energy norm, sqrt(½ ∫ e·C⁻¹e)")
+    ax.set_xlabel(r"$1/\sqrt{\mathrm{nodes}}$  ($\propto h$)")
+    ax.set_ylabel(r"$\sqrt{\frac{1}{2}\int \mathbf{e}\cdot\mathbf{C}^{-1}\mathbf{e}\;"
+                  r"\mathrm{d}A}$  (energy-norm error)")
     ax.set_title("Bimaterial cylinder: convergence (paper Figure 13)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
@@ -275,16 +276,18 @@ def plot_profiles(sol, path):
         r = np.linspace(RADII[i], RADII[i + 1], 100)
         axes[0].plot(r, exact.radial_displacement(r) * 1e6, "k-")
         axes[1].plot(r, exact.radial_stress(r), "k-")
-        axes[2].plot(r, exact.hoop_stress(r), "k-", label="exact" if i == 0 else None)
+        axes[2].plot(r, exact.hoop_stress(r), "k-")
     axes[0].plot(rn, ur * 1e6, ".", ms=3, label="C-NEM nodes")
-    axes[1].plot(rc, srr, ".", ms=3, label="C-NEM cells")
-    axes[2].plot(rc, stt, ".", ms=3, label="C-NEM cells")
-    for ax, name in zip(axes, ("u_r (1e-6 mm)", "sigma_rr (MPa)", "sigma_tt (MPa)")):
-        ax.axvline(RADII[1], color="grey", lw=0.8, ls=":")
+    axes[1].plot(rc, srr, ".", ms=3, label="C-NEM cells (centroids)")
+    axes[2].plot(rc, stt, ".", ms=3, label="C-NEM cells (centroids)")
+    names = (r"$u_r$ ($10^{-6}$ mm)", r"$\sigma_{rr}$ (MPa)", r"$\sigma_{\theta\theta}$ (MPa)")
+    for ax, name in zip(axes, names):
+        ax.lines[0].set_label("exact")
+        ax.axvline(RADII[1], color="grey", lw=0.8, ls=":", label=f"interface, r = {RADII[1]:g} mm")
         ax.set_xlabel("r (mm)")
         ax.set_ylabel(name)
         ax.grid(alpha=0.3)
-    axes[2].legend()
+        ax.legend(fontsize=8)
     fig.suptitle(f"Across the interface, {len(x)} nodes (paper Figures 11-12)")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
@@ -314,7 +317,8 @@ def main(grids: tuple = GRIDS, *, irregular: tuple = (False, True), fem: bool = 
         plot_convergence(rows, out / "cylinder_convergence.png")
         plot_profiles(regular[min(1, len(regular) - 1)]["solution"], out / "cylinder_profiles.png")
         _, _, stt = polar_stress(finest)
-        finest.plot(out / "cylinder_hoop_stress.png", field=stt, title="sigma_tt (MPa)").close()
+        finest.plot(out / "cylinder_hoop_stress.png", field=stt, title="σ_θθ (MPa)",
+                    length_unit="mm").close()
         files += [out / "cylinder_convergence.png", out / "cylinder_profiles.png",
                   out / "cylinder_hoop_stress.png"]
     rates = {}

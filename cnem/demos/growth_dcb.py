@@ -194,17 +194,18 @@ def _paths_figure(runs, path):
     ax.plot([0, A0], [0, 0], "k-", lw=2.0, label="initial crack")
     ax.plot([0, L], [0, 0], "k:", lw=0.8)
     for r in runs:
-        xy = r["tips"]
+        xy = np.vstack([[A0, 0.0], r["tips"]])          # from the end of the straight crack
         ax.plot(xy[:, 0], xy[:, 1], "o-", ms=2.5, lw=1.5,
-                label=f"theta0 = {r['theta']:.2f} deg"
+                label=rf"$\theta_0$ = {r['theta']:.2f}°"
                 + (" (ends on the top face)" if xy[-1, 1] > 0.9 * H else ""))
     ax.annotate("", xy=(0.0, 0.9 * H), xytext=(0.0, 0.45 * H),
                 arrowprops=dict(arrowstyle="->", color="tab:red"))
     ax.annotate("", xy=(0.0, -0.9 * H), xytext=(0.0, -0.45 * H),
                 arrowprops=dict(arrowstyle="->", color="tab:red"))
+    ax.plot([], [], color="tab:red", lw=1.0, label="end forces (opening the arms)")
     ax.set_aspect("equal")
-    ax.set_xlabel("x (H)")
-    ax.set_ylabel("y (H)")
+    ax.set_xlabel(r"$x$ ($H$)")
+    ax.set_ylabel(r"$y$ ($H$)")
     ax.set_title("DCB: paths of slightly kinked cracks (max hoop stress)")
     ax.legend(loc="lower right", fontsize=8, framealpha=0.9)
     fig.tight_layout()
@@ -215,16 +216,17 @@ def _paths_figure(runs, path):
 def _load_figure(r, path):
     """`CrackPath.plot` ``kind="load"`` with the straight crack of beam theory beside it."""
     import matplotlib.pyplot as plt
-    fig = r["history"].plot(None, kind="load", length_unit="H", load_unit="K_Ic sqrt(H)",
-                            displacement_unit="K_Ic / (E sqrt(H))",
-                            title=f"DCB, theta0 = {r['theta']:.2f} deg: end force for growth")
+    fig = r["history"].plot(None, kind="load", length_unit="$H$",
+                            load_unit=r"$K_\mathrm{Ic}\sqrt{H}$",
+                            displacement_unit=r"$K_\mathrm{Ic} / E\sqrt{H}$",
+                            title=rf"DCB, $\theta_0$ = {r['theta']:.2f}°: end force for growth")
     a = np.linspace(r["length"][0], r["length"][-1], 100)
     load, opening = fig.axes[0], fig.axes[1]
     load.plot(a, beam_load(a), "k--", lw=1.0, label="beam theory, straight crack")
-    load.plot(a, beam_load(a, ROOT), "k-", lw=1.0, label=f"beam theory, a + {ROOT} h")
+    load.plot(a, beam_load(a, ROOT), "k-", lw=1.0, label=f"beam theory, $a$ + {ROOT} $h$")
     load.legend(fontsize=8)
     opening.plot(beam_load(a, ROOT) * beam_compliance(a), beam_load(a, ROOT), "k-", lw=1.0,
-                 label=f"beam theory, a + {ROOT} h, straight crack")
+                 label=f"beam theory, $a$ + {ROOT} $h$, straight crack")
     opening.legend(fontsize=8)
     fig.savefig(path, dpi=130)
     plt.close(fig)

@@ -110,12 +110,13 @@ def main(angles: tuple = ANGLES, *, cloud: tuple = CLOUD, outdir: str = "results
         import matplotlib.pyplot as plt
         gg = np.linspace(0.0, 89.0, 200)
         fig, ax = plt.subplots(figsize=(6.0, 4.5))
-        ax.plot(gg, np.degrees(exact(gg)[2]), "k-", label="max hoop stress, exact K's")
+        ax.plot(gg, np.degrees(exact(gg)[2]), "k-",
+                label=r"max hoop stress, exact $K_\mathrm{I}, K_\mathrm{II}$")
         g = [r["gamma"] for r in rows]
         ax.plot(g, [r["tips_deg"][0] for r in rows], "o", label="C-NEM, tip 0")
         ax.plot(g, [r["tips_deg"][1] for r in rows], "x", ms=8, label="C-NEM, tip 1")
-        ax.set_xlabel("crack angle gamma (degrees)")
-        ax.set_ylabel("kink angle theta (degrees)")
+        ax.set_xlabel(r"crack angle $\gamma$ (degrees)")
+        ax.set_ylabel(r"kink angle $\theta$ (degrees)")
         ax.set_title("First kink of an inclined centre crack")
         ax.grid(alpha=0.3)
         ax.legend()
@@ -124,9 +125,9 @@ def main(angles: tuple = ANGLES, *, cloud: tuple = CLOUD, outdir: str = "results
         plt.close(fig)
         files.append(out / "kink_angles.png")
         if keep is not None:
-            fig = keep.plot(None, kind="paths", title="gamma = 45 degrees after one increment "
+            fig = keep.plot(None, kind="paths", title=r"$\gamma$ = 45° after one increment "
                             "(zoom on the crack; a = 0.1)",
-                            stress_unit="sigma")
+                            stress_unit=r"$\sigma$")
             ax = fig.axes[0]
             ax.set_xlim(-2.5 * HALF_CRACK, 2.5 * HALF_CRACK)
             ax.set_ylim(-2.0 * HALF_CRACK, 2.0 * HALF_CRACK)

@@ -250,13 +250,16 @@ def _plot(results, path):
             ax.plot(*cp.T, "o-", color="tab:blue", ms=3, lw=2,
                     label="C-NEM (max hoop, 1 mm steps)" if k == 0 else None, zorder=3)
             ax.plot(*pp.T, "s-", color="tab:red", ms=2.5, lw=1.5,
-                    label="PD ridge of damage >= 0.5" if k == 0 else None, zorder=4)
+                    label="PD ridge of damage ≥ 0.5" if k == 0 else None, zorder=4)
         ax.set_aspect("equal")
         ax.set_xlim(-0.3, plate.L + 0.3)
         ax.set_ylim(-0.3, plate.B + 0.3)
-        ax.set_title(f"h = {r['h']:g} mm, PD horizon {r['horizon']:.3g} mm, {r['nodes']} nodes",
-                     fontsize=10)
-        ax.legend(loc="upper center", fontsize=8, framealpha=0.9)
+        ax.set_title(f"$h$ = {r['h']:g} mm, PD horizon $\\delta$ = {r['horizon']:.3g} mm, "
+                     f"{r['nodes']} nodes", fontsize=10)
+        ax.set_xlabel(r"$x$ (mm)")
+        ax.set_ylabel(r"$y$ (mm)")
+        ax.plot([], [], "k-", lw=2.5, label="initial notches")
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=3, fontsize=8)
         fig.colorbar(sc, ax=ax, label="PD damage", shrink=0.8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)

@@ -110,11 +110,12 @@ def main(h: float = 0.01, *, a0: float = 0.2, a1: float = 0.6, increment: float 
           "(wall time, the first solve included)")
     files = []
     if plot:
-        hist.plot(out / "sent_path.png", kind="paths", length_unit="W", stress_unit="sigma",
-                  title=f"SENT: a/W = {a0} to {a1}\n({len(hist.model.nodes)} nodes)")
+        hist.plot(out / "sent_path.png", kind="paths", length_unit="$W$", stress_unit=r"$\sigma$",
+                  title=f"SENT: $a/W$ = {a0} to {a1}\n({len(hist.model.nodes)} nodes)")
         aa = np.linspace(a0 * W, a1 * W, 100)
-        hist.plot(out / "sent_sif.png", kind="sif", length_unit="W", sif_unit="sigma sqrt(W)",
-                  reference=(aa, handbook(aa)), title="SENT: K_I during growth vs the handbook")
+        hist.plot(out / "sent_sif.png", kind="sif", length_unit="$W$", sif_unit=r"$\sigma\sqrt{W}$",
+                  reference=(aa, handbook(aa)),
+                  title=r"SENT: $K_\mathrm{I}$ during growth vs the handbook")
         files = [out / "sent_path.png", out / "sent_sif.png"]
     return dict(rows=rows, max_error=max(abs(r["error"]) for r in rows),
                 max_kink_deg=max(abs(r["kink_deg"]) for r in rows),

@@ -227,9 +227,10 @@ def main(h: float = 0.25, *, increment: float = 1.0, steps: int = 12,
         for k, p in enumerate(PUBLISHED_PATHS):
             fig.axes[0].plot(*p.T, "--x", color="tab:orange", lw=1.2, ms=4,
                              label="published XFEM path" if k == 0 else None)
-        fig.axes[0].legend(loc="upper center", fontsize=8, framealpha=0.9)
-        fig.savefig(out / "two_holes_paths.png", dpi=130)
-        hist.plot(out / "two_holes_sif.png", kind="sif", length_unit="mm", sif_unit="MPa sqrt(mm)")
+        fig.axes[0].legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=4, fontsize=8)
+        fig.savefig(out / "two_holes_paths.png", dpi=130, bbox_inches="tight")
+        hist.plot(out / "two_holes_sif.png", kind="sif", length_unit="mm",
+                  sif_unit=r"MPa$\sqrt{\mathrm{mm}}$")
         files = [out / "two_holes_paths.png", out / "two_holes_sif.png"]
     return dict(tips=tips, final=tips[-1], distance=distance, published=published, lengths=lengths,
                 hausdorff=haus,
@@ -309,8 +310,8 @@ def study(runs: Sequence[tuple] = STUDY, outdir: str = "results/growth_two_holes
     for k, p in enumerate(PUBLISHED_PATHS):
         ax.plot(*p.T, "--x", color="black", ms=4, lw=1, label="published XFEM" if k == 0 else None)
     ax.set_aspect("equal")
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
+    ax.set_xlabel(r"$x$ (mm)")
+    ax.set_ylabel(r"$y$ (mm)")
     ax.set_title("Two holes, two edge cracks: paths against spacing and increment")
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=2)
     fig.tight_layout()

@@ -3,6 +3,8 @@
 * `paths`: the geometry, the final von Mises field (at load factor 1) and the
   crack paths with a dot at every increment's tip;
 * `sif_curves`: K_I, K_II and K_eq of every tip against its crack length;
+
+Labels are matplotlib mathtext (``$K_\\mathrm{I}$``); units given by the caller may be too.
 * `load_curves`: the critical load factor against crack length and, with a
   ``measure``, the load-displacement curve of brittle growth.
 """
@@ -13,7 +15,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..plot import nodal_field
+from ..io import cell_topology
 
 if TYPE_CHECKING:
     from typing import Any
@@ -72,13 +74,18 @@ def paths(hist: Any, path: str | None = None, *, length_unit: str = "", stress_u
     fig, ax = plt.subplots(figsize=(min(12.0, max(5.0, 5.0 * aspect + 2.2)), 5.5))
     sol = hist.solution
     if field and sol is not None:
-        mdl = sol.model
-        vm = nodal_field(sol, "von_mises")
+        from matplotlib.collections import PolyCollection
+        points, offsets, connectivity = cell_topology(sol.model.cells)
+        polygons = [points[connectivity[a:b]] for a, b in zip(offsets[:-1], offsets[1:])]
+        vm = np.asarray(sol.von_mises)                 # one value per cell: no smoothing
         top = np.percentile(vm, 99)                    # the tip singularity would wash out the rest
-        art = ax.tripcolor(mdl.nodes[:, 0], mdl.nodes[:, 1], mdl.triangles, vm, shading="gouraud",
-                           cmap="viridis", vmin=0.0, vmax=top)
+        art = PolyCollection(polygons, array=vm, cmap="viridis", edgecolors="face",
+                             linewidths=0.2)
+        art.set_clim(0.0, top)
+        ax.add_collection(art)
         bar = fig.colorbar(art, ax=ax, shrink=0.8, extend="max")
-        bar.set_label(f"von Mises stress at load factor 1{_unit(stress_unit)}")
+        bar.set_label(r"von Mises stress $\sigma_\mathrm{vM}$ on the cells, at load factor 1"
+                      f"{_unit(stress_unit)}")
     _outline(ax, hist.domain)
     first = True
     for crack in hist.cracks:
@@ -89,8 +96,8 @@ def paths(hist: Any, path: str | None = None, *, length_unit: str = "", stress_u
     ax.plot(tips[..., 0].ravel(), tips[..., 1].ravel(), "o", ms=3, color="white", mec="black",
             mew=0.6, label="tip at each increment")
     ax.set_aspect("equal")
-    ax.set_xlabel(f"x{_unit(length_unit)}")
-    ax.set_ylabel(f"y{_unit(length_unit)}")
+    ax.set_xlabel(f"$x${_unit(length_unit)}")
+    ax.set_ylabel(f"$y${_unit(length_unit)}")
     ax.set_title(title or f"Crack paths, {len(hist.steps)} increments ({hist.criterion})")
     ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
     return _finish(fig, path)
@@ -113,15 +120,19 @@ def sif_curves(hist: Any, path: str | None = None, *, length_unit: str = "", sif
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     length, K, K_eq = hist.array("crack_length"), hist.array("K"), hist.array("K_eq")
     if reference is not None:
-        ax.plot(reference[0], reference[1], "k-", lw=1.0, label="reference K_I")
+        ax.plot(reference[0], reference[1], "k-", lw=1.0, label=r"reference $K_\mathrm{I}$")
     for i in range(K.shape[1]):
         tag = f" tip {i}" if K.shape[1] > 1 else ""
-        ax.plot(length[:, i], K[:, i, 0], "o-", ms=3, label=f"K_I{tag}")
-        ax.plot(length[:, i], K[:, i, 1], "s--", ms=3, label=f"K_II{tag}")
-        ax.plot(length[:, i], K_eq[:, i], ":", lw=1.2, label=f"K_eq{tag}")
+        # larger hollow markers and thinner lines for later tips: tips that coincide show
+        style = dict(ms=3 + 3 * i, mfc="none" if i else None, lw=1.5 / (1 + i))
+        ax.plot(length[:, i], K[:, i, 0], "o-", label=rf"$K_\mathrm{{I}}${tag}", **style)
+        ax.plot(length[:, i], K[:, i, 1], "s--", label=rf"$K_\mathrm{{II}}${tag}", **style)
+        ax.plot(length[:, i], K_eq[:, i], ":", lw=1.2 / (1 + i),
+                label=rf"$K_\mathrm{{eq}}${tag}")
     ax.set_xlabel(f"crack length{_unit(length_unit)}")
-    ax.set_ylabel(f"K at load factor 1{_unit(sif_unit)}")
-    ax.set_title(title or f"Stress intensity factors during growth ({hist.criterion})")
+    ax.set_ylabel(f"$K$ at load factor 1{_unit(sif_unit)}")
+    ax.set_title(title or f"Stress intensity factors during growth "
+                          f"({hist.criterion.replace('_', ' ')})")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     return _finish(fig, path)
@@ -146,7 +157,8 @@ def load_curves(hist: Any, path: str | None = None, *, length_unit: str = "", lo
     ax = axes[0, 0]
     for i in range(load.shape[1]):
         ax.plot(length[:, i], load[:, i], "o-", ms=3,
-                label=f"tip {i}" if load.shape[1] > 1 else "load factor K_Ic / K_eq")
+                label=f"tip {i}" if load.shape[1] > 1
+                else r"load factor $K_\mathrm{Ic} / K_\mathrm{eq}$")
     ax.set_xlabel(f"crack length{_unit(length_unit)}")
     ax.set_ylabel(f"critical load factor{_unit(load_unit)}")
     ax.grid(alpha=0.3)
@@ -154,10 +166,11 @@ def load_curves(hist: Any, path: str | None = None, *, length_unit: str = "", lo
     ax.set_title(title or "Load for growth against crack length")
     if panels == 2:
         ax = axes[0, 1]
-        ax.plot(critical * measure, critical, "o-", ms=3, label="brittle growth (K_eq = K_Ic)")
+        ax.plot(critical * measure, critical, "o-", ms=3,
+                label=r"brittle growth ($K_\mathrm{eq} = K_\mathrm{Ic}$)")
         ax.plot([0, critical[0] * measure[0]], [0, critical[0]], "k:", lw=1.0,
                 label="elastic loading, initial crack")
-        ax.set_xlabel(f"displacement (measure x load factor){_unit(displacement_unit)}")
+        ax.set_xlabel(f"displacement (measure × load factor){_unit(displacement_unit)}")
         ax.set_ylabel(f"load factor{_unit(load_unit)}")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)

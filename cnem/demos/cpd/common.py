@@ -16,15 +16,14 @@ if TYPE_CHECKING:
     from ...pd.body import Body
     from ...pd.cpd import CPD
 
-__all__ = ["solve", "convergence_table", "picture", "finish", "RATIO", "TOL", "EPS"]
+__all__ = ["solve", "convergence_table", "picture", "picture_3d", "finish", "RATIO", "TOL", "EPS"]
 
 #: Stiffness ratio of the ">> C1" cases: lambda added per shear modulus of the bonds.
 RATIO = 100.0
 TOL = 1e-10
 EPS = 1e-9
-#: Scalar-bar placement: below the 2-D bodies, right of the 3-D ones.
-BAR = {2: dict(position_x=0.15, position_y=0.04, width=0.7, height=0.09),
-       3: dict(position_x=0.8, position_y=0.15, height=0.65)}
+#: Scalar-bar placement right of the 3-D bodies (`picture_3d`).
+BAR = dict(position_x=0.8, position_y=0.15, height=0.65)
 
 
 def solve(body: Body, material: CPD, conditions: list[tuple], *, steps: int = 1,
@@ -65,53 +64,101 @@ def convergence_table(title: str, history: Sequence[float], labels: Sequence[str
 
 
 def picture(path: str, panels: list[dict], *, dim: int,
-            window: tuple = (1200, 600)) -> str | np.ndarray:
-    """The deformed bodies of ``panels`` side by side, at one scale (pyvista, off-screen).
+            window: tuple = (1200, 600)) -> str:
+    """The deformed bodies of ``panels`` side by side, at one scale.
 
     Each panel is a dict with ``points`` (deformed, (n, d), in `cnem.pd.lattice.lattice` order),
-    ``counts`` (the lattice shape), ``values`` (n,) of the field named ``field``,
-    ``title`` and optionally ``hidden`` (n,) bool (lattice points not in the body) and
-    ``reference`` (the undeformed points, drawn light grey behind)."""
-    from cnem.plot import _pyvista
-    pv = _pyvista()
+    ``counts`` (the lattice shape), ``values`` (n,) of the field named ``field`` (a label,
+    mathtext in 2-D), ``title`` and optionally ``hidden`` (n,) bool (lattice points not in the
+    body) and ``reference`` (the undeformed points, drawn light grey behind). 2-D bodies are
+    drawn by matplotlib (axes, a colour bar and a legend per panel), 3-D ones by pyvista
+    (`picture_3d`). ``window`` is the size in pixels."""
+    if dim == 3:
+        return picture_3d(path, panels, window=window)
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
+    from matplotlib.ticker import MaxNLocator
+    from mpl_toolkits.axes_grid1 import make_axes_locatable
+    dpi = 100
+    fig, axes = plt.subplots(1, len(panels), figsize=(window[0] / dpi, window[1] / dpi),
+                             sharex=True, sharey=True, squeeze=False)
+    for ax, panel in zip(axes[0], panels):
+        counts = tuple(panel["counts"])
+        index = np.arange(int(np.prod(counts))).reshape(counts)
+        quads = np.stack([index[:-1, :-1], index[1:, :-1], index[1:, 1:], index[:-1, 1:]],
+                         axis=-1).reshape(-1, 4)
+        if "hidden" in panel:
+            quads = quads[~np.asarray(panel["hidden"])[quads].any(axis=1)]
+        triangles = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+        if "reference" in panel:
+            ref = np.asarray(panel["reference"])
+            ax.tripcolor(ref[:, 0], ref[:, 1], triangles, np.zeros(len(ref)),
+                         cmap="Greys", vmin=-1.0, vmax=4.0, shading="flat", zorder=0)
+            ax.fill([], [], color=(0.88, 0.88, 0.88), label="undeformed")
+        p, values = np.asarray(panel["points"]), np.asarray(panel["values"])
+        top = np.abs(values).max()
+        signed = values.min() < 0 < values.max()
+        shaded = ax.tripcolor(p[:, 0], p[:, 1], triangles, values, shading="gouraud",
+                              cmap="viridis", vmin=-top if signed else None,
+                              vmax=top if signed else None, zorder=1)
+        deformed = "deformed" if "reference" in panel else "deformed, ×1"
+        if max(counts) <= 40:
+            edges = np.concatenate([quads[:, [0, 1]], quads[:, [1, 2]], quads[:, [2, 3]],
+                                    quads[:, [3, 0]]])
+            ax.add_collection(LineCollection(p[edges], colors=[(0.3, 0.3, 0.3)],
+                                             linewidths=0.5, zorder=2))
+            ax.plot([], [], color=(0.3, 0.3, 0.3), lw=0.8, label=f"lattice ({deformed})")
+        else:
+            ax.fill([], [], color=plt.get_cmap("viridis")(0.5), label=f"body ({deformed})")
+        ax.set_aspect("equal")
+        ax.set_title(panel["title"])
+        ax.set_xlabel(r"$x$ (length unit)")
+        ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+        room = make_axes_locatable(ax).append_axes("bottom", size=0.15, pad=0.55)
+        bar = fig.colorbar(shaded, cax=room, orientation="horizontal", label=panel["field"])
+        bar.ax.xaxis.set_major_locator(MaxNLocator(5))
+    axes[0][0].set_ylabel(r"$y$ (length unit)")
+    fig.savefig(str(path), dpi=dpi, bbox_inches="tight")
+    plt.close(fig)
+    return str(path)
 
-    def grid_of(points, counts, z=0.0):
-        grid = pv.StructuredGrid()
-        grid.points = np.column_stack([points, np.full((len(points), 3 - dim), z)])
-        grid.dimensions = (tuple(counts[::-1]) + (1,))[:3]      # C order: last axis fastest
-        return grid
+
+def picture_3d(path: str, panels: list[dict], *, window: tuple = (1200, 600)) -> str:
+    """`picture` of 3-D lattices (pyvista, off-screen, one camera): each body shaded, the
+    colour bar upright beside it, axes with the body's coordinates (length 1 = the cube's
+    side) and the panel's title on top."""
+    from cnem.plot import _pyvista, use_font
+    pv = _pyvista()
     pl = pv.Plotter(off_screen=True, window_size=window, shape=(1, len(panels)),
                     border=False)
     for k, panel in enumerate(panels):
         pl.subplot(0, k)
         pl.set_background("white")
-        grid = grid_of(panel["points"], panel["counts"])
+        grid = pv.StructuredGrid()
+        grid.points = np.asarray(panel["points"])
+        grid.dimensions = tuple(panel["counts"][::-1])      # C order: last axis fastest
         name = panel["field"] + " " * k          # pyvista shares the bars of equal titles
         grid.point_data[name] = panel["values"]
-        if "hidden" in panel:
-            grid.hide_points(np.flatnonzero(panel["hidden"]))
-        if "reference" in panel:                  # below the deformed body in a 2-D view
-            pl.add_mesh(grid_of(panel["reference"], panel["counts"], z=-1.0),
-                        color=(0.88, 0.88, 0.88), lighting=False)
         top = np.abs(panel["values"]).max()
         signed = panel["values"].min() < 0 < panel["values"].max()
         pl.add_mesh(grid, scalars=name, cmap="viridis", show_edges=max(panel["counts"]) <= 40,
-                    clim=(-top, top) if signed else None,
-                    edge_color=(0.3, 0.3, 0.3), lighting=dim == 3,
-                    scalar_bar_args=dict(title=name + "\n" * (dim == 3),   # room above
-                                         color="black", vertical=dim == 3,
+                    clim=(-top, top) if signed else None, edge_color=(0.3, 0.3, 0.3),
+                    scalar_bar_args=dict(title=name + "\n", color="black", vertical=True,
                                          title_font_size=14, label_font_size=12, fmt="%.3g",
-                                         **BAR[dim]))
-        if dim == 2:                                      # the labels under the bar
-            pl.scalar_bars[name].SetTextPositionToPrecedeScalarBar()
-        pl.add_text(panel["title"], position="upper_edge", font_size=11, color="black")
+                                         **BAR))
+        bar = pl.scalar_bars[name + "\n"]
+        use_font(bar.GetTitleTextProperty(), bar.GetLabelTextProperty())
+        pl.show_bounds(grid="back", location="outer", color="black", font_size=10,
+                       xtitle="x", ytitle="y", ztitle="z", fmt="%.1f")
+        title = pl.add_text(panel["title"], position="upper_left", font_size=9,
+                            color="black")
+        use_font(title.GetTextProperty())
     pl.link_views()                                       # one camera: one scale
-    if dim == 2:
-        pl.view_xy()
-        pl.enable_parallel_projection()
-    else:
-        pl.view_isometric()
+    pl.view_isometric()
     pl.reset_camera()
+    pl.camera.zoom(0.85)                                   # room for the title on top
     pl.screenshot(str(path))
     pl.close()
     return str(path)

@@ -14,6 +14,10 @@ from cnem.pd.lattice import lattice, lattice_measure
 __all__ = ["tension2d", "cube"]
 
 
+#: The cases of `tension2d` in symbols (picture titles).
+SYMBOLS = {"C2=0": r"$C_2 = 0$", "C2>>C1": r"$C_2 \gg C_1$"}
+
+
 def tension2d(spacing: float = 0.02, *, m: float = 3.0, steps: int = 10, ratio: float = RATIO,
               outdir: str = "results/cpd_examples", plot: bool = True) -> dict:
     """§6.1, Figure 5: a unit square stretched to twice its length (n = 1), C2 = 0 and
@@ -55,8 +59,9 @@ def tension2d(spacing: float = 0.02, *, m: float = 3.0, steps: int = 10, ratio: 
         print(f"{name:>8} {c['C2']:>10.4g} {c['area_ratio']:>11.4f} "
               f"{c['central_area_ratio']:>8.4f} {c['lateral_stretch']:>7.4f} {c['seconds']:>5.1f}s")
     return finish("tension2d", dict(cases=cases, tables=tables), outdir, plot, lambda: [
-        dict(points=x + c["u"], counts=counts, values=c["u"][:, 1], reference=x, field="u_y",
-             title=f"{k}, stretch 2") for k, c in cases.items()], 2)
+        dict(points=x + c["u"], counts=counts, values=c["u"][:, 1], reference=x,
+             field=r"$u_y$", title=f"{SYMBOLS[k]}, stretch 2, $\\delta = {m:g}h$")
+        for k, c in cases.items()], 2)
 
 
 def cube(n: int = 7, *, m: float = 2.0, steps: int = 8, ratio: float = RATIO,
@@ -107,4 +112,4 @@ def cube(n: int = 7, *, m: float = 2.0, steps: int = 8, ratio: float = RATIO,
               f"{c['central_volume_ratio']:>8.4f} {c['seconds']:>5.1f}s")
     return finish("cube", dict(cases=cases, tables=tables), outdir, plot, lambda: [
         dict(points=x + c["u"], counts=counts, values=c["u"][:, 0], field="u_x",
-             title=f"{k}-neighbour, stretch 2") for k, c in cases.items()], 3)
+             title=f"{k}-neighbour,\nstretch 2, δ = {m:g}h") for k, c in cases.items()], 3)

@@ -71,7 +71,8 @@ def cantilever(spacing: float = 0.04, *, C1s: tuple = (1.0, 2.0, 4.0), height: f
               f"{r['seconds']:>5.1f}s")
     def panels():
         return [dict(points=x + r["u"], counts=counts, values=r["u"][:, 1], reference=x,
-                     field="u_y", title=f"C1 = {C1:g}") for C1, r in runs.items()]
+                     field=r"$u_y$", title=f"$C_1 = {C1:g}$, $\\delta = {m:g}h$")
+                for C1, r in runs.items()]
     return finish("cantilever", dict(force=force, runs=runs, tables=tables), outdir, plot,
                   panels, 2, window=(1500, 450))
 
@@ -126,7 +127,7 @@ def torsion(n: int = 7, *, slenderness: int = 2, m: float = 1.5, angle: float = 
 
     def panels():
         return [dict(points=x + u, counts=counts, values=u[:, 1], field="u_y",
-                     title=f"{angle:g} degrees")]
+                     title=f"top turned {angle:g}°, δ = {m:g}h")]
     result = dict(C3=C3, z=ref[0, 0, :, 2], rotation=rotation, u=u, history=history,
                   seconds=seconds, tables=[table])
     return finish("torsion", result, outdir, plot, panels, 3, window=(700, 700))
@@ -195,7 +196,8 @@ def lshape(spacing: float = 1 / 40, *, ratios: tuple = (2.0, 3.0, 4.0, 5.0), pul
         values = np.zeros(len(full))
         values[inside] = results[m]["von_mises"]
         return dict(points=full, counts=(n, n), values=values, hidden=~inside,
-                    field="von Mises", title=f"delta = {m:g}D")
+                    field=r"von Mises stress $\sigma_\mathrm{vM}$ ($\mu = 1$)",
+                    title=f"$\\delta = {m:g}h$ ($h$ = {h:.4g})")
     return finish("lshape", out, outdir, plot, lambda: [panel(ratios[0]), panel(ratios[-1])],
                   2, window=(1200, 560))
 
@@ -209,15 +211,17 @@ def _profiles(out, distance, results, h):
     out.mkdir(parents=True, exist_ok=True)
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), sharey=True)
     for m, r in results.items():
-        axes[0].plot(distance, r["row"], "o-", ms=3, label=f"delta = {m:g}D")
-        axes[1].plot(distance[:len(r["column"])], r["column"], "o-", ms=3)
-    for ax, what in zip(axes, ("leftwards from the corner (y = 1/2)",
-                               "downwards from the corner (x = 1/2)")):
+        axes[0].plot(distance, r["row"], "o-", ms=3, label=f"$\\delta = {m:g}h$")
+        axes[1].plot(distance[:len(r["column"])], r["column"], "o-", ms=3,
+                     label=f"$\\delta = {m:g}h$")
+    for ax, what in zip(axes, (r"leftwards from the corner ($y = 1/2$)",
+                               r"downwards from the corner ($x = 1/2$)")):
         ax.set_xlabel(f"distance {what}")
         ax.grid(alpha=0.3)
-    axes[0].set_ylabel("von Mises stress (mu = 1)")
-    axes[0].legend()
-    fig.suptitle(f"L-shape, D = {h:.4g}: larger horizons smooth the corner's concentration")
+        ax.legend(fontsize=8)
+    axes[0].set_ylabel(r"von Mises stress $\sigma_\mathrm{vM}$ ($\mu = 1$)")
+    fig.suptitle(f"L-shape, lattice spacing $h$ = {h:.4g} (plate side 1): larger horizons "
+                 f"smooth the corner's concentration")
     fig.tight_layout()
     fig.savefig(out / "cpd_lshape_profiles.png", dpi=100)
     plt.close(fig)
