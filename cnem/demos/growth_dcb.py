@@ -44,25 +44,21 @@ Expected result
   with crack length) and the offset at a given crack length grows with the
   initial angle; the paths end on the top face of the upper arm, which they
   cut off (`cnem.GeometryError`, the path so far in its ``history``).
-  Measured with the defaults (h = 0.05, 5036 nodes, increment 0.1): tip y at
-  crack length 2.6 / 2.8 / 3.0 / 3.2 is 0.030 / 0.072 / 0.167 / 0.327 (1.43
-  deg), 0.061 / 0.143 / 0.293 / 0.480 (2.86 deg), 0.116 / 0.245 / 0.424 /
-  0.617 (5.71 deg); the top face is reached at crack lengths 3.9, 3.7, 3.6
-  (these runs were made when the `Domain` check still refused a crack end
-  meeting a face at a shallow angle: the 1.43 deg run stopped there, its last
-  segment meeting the face at 14 degrees; such ends are now edge cracks).
-* The critical end force within 0.2 % (first increment) to 1.5 % (third) of
-  the root-rotation-corrected beam theory while the path is still nearly
-  straight, 22 % below the uncorrected one; the compliance 3 % above the
-  corrected bending-only beam (shear adds to it). Both part from beam theory
-  as the crack turns into the arm.
-* Convergence is loose, the deviation being an instability that amplifies
-  the K_II error of every step: for 2.86 deg, h / 2 and increment / 2 give an
-  offset at crack length 2.8 of 0.190 instead of 0.143 (the curved part then
-  runs about 0.08 H higher, the same shape); halving the increment alone gives
-  0.274 (the interaction-integral disc of six spacings then spans six kinked
-  segments). The qualitative result, curving away growing with the angle, is
-  the same in every run.
+  Measured with the defaults (h = 0.05, about 5040 nodes, increment 0.1,
+  rings after the kink, ``grow``'s ``refine="auto"``): tip y at crack length
+  2.6 / 2.8 / 3.0 / 3.2 is 0.029 / 0.065 / 0.142 / 0.279 (1.43 deg), 0.055 /
+  0.118 / 0.239 / 0.411 (2.86 deg), 0.106 / 0.216 / 0.380 / 0.570 (5.71 deg);
+  the top face is cut off after 17, 15 and 14 increments.
+* The critical end force 0.5 % below the root-rotation-corrected beam theory
+  at the first increment (5.71 deg), 23 % below the uncorrected one; the
+  compliance 3 % above the corrected bending-only beam (shear adds to it).
+  Both part from beam theory as the crack turns into the arm.
+* Convergence (2.86 deg, tip y at crack length 2.8): 0.1732 (h = 0.05) and
+  0.1746 (h = 0.025) at increment 0.05 -- converged in the spacing; 0.118 /
+  0.173 / 0.217 at increments 0.1 / 0.05 / 0.025 -- converging slowly with
+  the increment (steps of 0.055 then 0.044: the instability amplifies the lag
+  of every straight step). The qualitative result, curving away growing with
+  the angle, is the same in every run.
 * ``dcb_paths.png``: the three paths over the beam; ``dcb_load.png``: load
   against crack length and load-displacement (opening of the arm ends) for
   the largest angle.
