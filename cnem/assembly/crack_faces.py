@@ -8,7 +8,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 import shapely
 
-from .. import config
 from ..geometry.pslg import CRACK
 from ..geometry.topology import constraint_edges
 from ..spatial.rtree import RTree
@@ -57,6 +56,9 @@ def slit_edges(model: Model, faces: tuple, cells: Cells
     frame = model.frame                    # O(1) coordinates at any origin and in any units
     p, q, vertices = (frame.to_local(x) for x in (p, q, cells.vertices))
     area = cells.area / frame.scale ** 2
+    # the cell vertices are known only to the domain's tolerance (their global round-off
+    # far from the origin): a vertex on the face may stand that far off its line
+    tol = model.domain.tolerance / frame.scale
     first = np.repeat(np.arange(len(cells.area)), np.diff(cells.offsets))
     lo = np.full((len(cells.area), 2), np.inf)
     hi = np.full((len(cells.area), 2), -np.inf)
@@ -68,7 +70,7 @@ def slit_edges(model: Model, faces: tuple, cells: Cells
         face = shapely.LineString([p[f], q[f]])
         for c in idx[off[f]:off[f + 1]]:
             polygon = shapely.Polygon(vertices[cells.offsets[c]:cells.offsets[c + 1]])
-            eps = 1e-6 * np.sqrt(area[c])
+            eps = max(1e-6 * np.sqrt(area[c]), tol)
             for piece in _line_parts(face.intersection(polygon)):
                 xy = np.asarray(piece.coords)
                 d = xy[-1] - xy[0]

@@ -118,7 +118,8 @@ class Enrichment:
         """The functions ``F_k`` about one tip, ``(p, size)``; ``sides`` are points on
         the side wanted for points on the crack faces. With ``gradient=True`` also
         their gradients ``(p, size, 2)`` (points off the tip)."""
-        r, theta = sided_polar(points, self.tips[tip], self.directions[tip], sides)
+        r, theta = sided_polar(points, self.tips[tip], self.directions[tip], sides,
+                               self.model.domain.tolerance)
         root = np.sqrt(r)
         if self.functions == "sqrt":
             angular, slope = np.ones((len(r), 1)), np.zeros((len(r), 1))
