@@ -165,12 +165,14 @@ class Model:
         return tables[1 if across_regions else 0]
 
     def circumcircles(self) -> tuple[np.ndarray, np.ndarray, RTree]:
-        """The circumcircles of the triangles: centres ``(t, 2)``, squared radii
-        ``(t,)`` and an R-tree over their boxes (which also holds every triangle:
-        point location). Computed on first call, then kept."""
+        """The circumcircles of the triangles in the local `frame` (centres to
+        relative round-off at any origin): centres ``(t, 2)``, squared radii ``(t,)``
+        and an R-tree over their boxes (which also holds every triangle: point
+        location), all in local coordinates. Computed on first call, then kept."""
         def build():
-            centre = circumcenters(self.nodes, self.triangles)
-            radius2 = ((self.nodes[self.triangles[:, 0]] - centre) ** 2).sum(axis=1)
+            nodes = self.local_nodes()
+            centre = circumcenters(nodes, self.triangles)
+            radius2 = ((nodes[self.triangles[:, 0]] - centre) ** 2).sum(axis=1)
             radius = np.sqrt(radius2)[:, None]
             return centre, radius2, RTree(centre - radius, centre + radius)
         return self._derive("circumcircles", build)
@@ -183,10 +185,10 @@ class Model:
         Returns
         -------
         RTree
-            Entry ``i`` is the bounding box of ``triangles[i]``.
+            Entry ``i`` is the bounding box of ``triangles[i]`` in the local `frame`.
         """
         def build():
-            corners = self.nodes[self.triangles]
+            corners = self.local_nodes()[self.triangles]
             return RTree(corners.min(axis=1), corners.max(axis=1))
         return self._derive("triangle tree", build)
 

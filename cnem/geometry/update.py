@@ -283,7 +283,7 @@ def update(model: Model, cloud: NodeCloud, *, progress: bool | None = None) -> M
     gone = (match < 0) & ~new_flip
     discs = np.concatenate([_disc_boxes(model.nodes, model.triangles[~kept_old]),
                             _disc_boxes(nodes, tri[gone])])
-    pad = config.SNAP_TOL * size
+    pad = cloud.domain.tolerance
     touched = np.zeros(len(model.nodes), dtype=bool)
     touched[model.cells.node[_boxes_meet(_cell_boxes(model.cells), discs, pad)]] = True
     redo = old_node < 0
