@@ -130,3 +130,19 @@ def test_points_on_the_faces_within_the_tolerance_take_their_side():
     assert theta[0] == -np.pi and theta[1] == np.pi
     assert 0 < theta[2] < np.pi
     np.testing.assert_allclose(r, np.hypot(*pts.T))
+
+
+def test_far_shape_functions_are_those_of_its_nodes_at_the_origin():
+    """What differs at 1e8 is the input (nodes and points rounded to 1.5e-8), not
+    the arithmetic: the shape functions of the moved body equal, bit for bit, those
+    of its own rounded nodes shifted back to the origin (exact shifts)."""
+    o = 1e8
+    far = cnem.nodes.from_points(_moved(1.0, o), _points("irregular") + o)
+    back = cnem.Domain([(OUTLINE + o - o, [HOLE + o - o])], cracks=[KINK + o - o])
+    near = cnem.nodes.NodeCloud(back, far.points - o, far.segments, far.segment_kind, far.spacing)
+    rng = np.random.default_rng(2)
+    query = rng.random((600, 2)) + o
+    query = query[far.domain.contains(query)]
+    got = cnem.discretize(far, progress=False).shape_functions(query)
+    ref = cnem.discretize(near, progress=False).shape_functions(query - o)
+    assert (got != ref).nnz == 0
