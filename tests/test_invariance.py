@@ -119,6 +119,18 @@ def test_tolerance_covers_the_coordinates_round_off():
     assert len(_points("irregular")) in crack
 
 
+def test_far_body_refuses_a_spacing_below_its_round_off():
+    """At 1e8 a body 1 across resolves no spacing below ten tolerances (3.6e-6): a
+    graded cloud asking for 1e-6 at the tips is refused by name, as at the origin only
+    below 1e-8 times the diameter."""
+    far = _moved(1.0, 1e8)
+    with pytest.raises(cnem.errors.GeometryError, match="h_min = 1e-06 is below the smallest "
+                       "spacing this domain resolves.*nearer the origin"):
+        cnem.nodes.graded(far, 0.05, near=far.tips, h_min=1e-6)
+    body = _moved(1.0, 0.0)
+    assert cnem.nodes.graded(body, 0.05, near=body.tips, h_min=1e-6, growth=1.0).points.size
+
+
 def test_points_on_the_faces_within_the_tolerance_take_their_side():
     """`sided_polar`: a point behind the tip off the crack line by less than the
     tolerance (a face point's round-off far away) gets theta = +-pi from its side,
