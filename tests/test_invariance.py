@@ -24,6 +24,7 @@ import cnem
 from cnem import config
 from cnem.errors import SIFWarning
 from cnem.fracture import sif
+from cnem.fracture.opening import crack_opening
 from cnem.fracture.williams import sided_polar
 
 KINK = np.array([[0.2, 0.62], [0.45, 0.7], [0.62, 0.66]])
@@ -69,8 +70,9 @@ def _solved(cloud, s, o, functions=None):
         warnings.simplefilter("ignore", SIFWarning)          # coarse near the tips: same K
         K = np.array([sif(sol, tip) for tip in body.tips]) / np.sqrt(s)     # (KI, KII) each
     cells = model.cells
+    at, opening, _ = crack_opening(model, sol.u, KINK[1:] * s + o)      # the last segment
     return dict(nodes=(model.nodes - o) / s, segments=model.segments, offsets=cells.offsets,
-                area=cells.area / s**2, u=sol.u / s, K=K)
+                area=cells.area / s**2, u=sol.u / s, K=K, at=(at - o) / s, opening=opening / s)
 
 
 def _round(s, o):
@@ -80,7 +82,8 @@ def _round(s, o):
 @pytest.mark.parametrize("o, s", FAR)
 def test_far_body_gives_the_model_and_K_of_the_origin(o, s):
     """Same nodes (count exact, positions to round-off), segments, cells (count and
-    vertices per cell exact, areas), displacements and K_I, K_II at both tips."""
+    vertices per cell exact, areas), displacements, K_I, K_II at both tips and the
+    crack's opening at its face nodes."""
     ref, got, tol = _solved("irregular", 1.0, 0.0), _solved("irregular", s, o), _round(s, o)
     assert len(got["nodes"]) == len(ref["nodes"])
     np.testing.assert_array_equal(got["segments"], ref["segments"])
@@ -89,6 +92,10 @@ def test_far_body_gives_the_model_and_K_of_the_origin(o, s):
     np.testing.assert_allclose(got["area"], ref["area"], rtol=0, atol=10 * tol)
     np.testing.assert_allclose(got["u"], ref["u"], rtol=0, atol=10 * tol * np.abs(ref["u"]).max())
     np.testing.assert_allclose(got["K"], ref["K"], rtol=0, atol=10 * tol * np.abs(ref["K"]).max())
+    assert len(ref["at"]) >= 3                        # the face nodes of the last segment
+    np.testing.assert_allclose(got["at"], ref["at"], rtol=0, atol=4 * tol)
+    np.testing.assert_allclose(got["opening"], ref["opening"], rtol=0,
+                               atol=10 * tol * np.abs(ref["opening"]).max())
 
 
 @pytest.mark.parametrize("o", [1e8, 1e6])
