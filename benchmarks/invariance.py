@@ -6,7 +6,8 @@ A unit square with a circular hole (a 32-gon of radius 0.15 about (0.7, 0.3)) an
 internal crack, an irregular cloud of spacing ``h`` (``--h``, default 0.03; ``--quick`` 0.06)
 built once at the origin, then every point, vertex and length mapped by ``x -> s x + o`` for
 the offsets ``o`` in (0, 1e6, 1e8) (both coordinates; 1e8 is UTM-like) and the scales ``s`` in
-(1e-6, 1, 1e6), the cloud rebuilt with ``cnem.nodes.from_points``. The elastic problem:
+(1e-6, 1, 1e6), and a UTM-like body 100 m across at 5e6 (``o = 5e6, s = 100``), the cloud
+rebuilt with ``cnem.nodes.from_points``. The elastic problem:
 ``E = 1, nu = 0.3``, plane strain, the bottom edge held vertically, its left corner also
 horizontally, a unit traction pulling the top edge up (the traction does not scale, so the
 displacements scale with ``s`` and K_I with ``sqrt(s)``).
@@ -38,6 +39,7 @@ from cnem.spatial import family_search
 
 OFFSETS = (0.0, 1e6, 1e8)
 SCALES = (1e-6, 1.0, 1e6)
+UTM = (5e6, 100.0)                  # offset, scale: a body 100 m across in UTM metres
 CRACK = np.array([[0.2, 0.62], [0.45, 0.7], [0.62, 0.66]])
 SHELL = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
 DIAMETER = np.sqrt(2.0)
@@ -126,7 +128,7 @@ def main(argv=None):
           f"K_I = {ref['K']:.6f} at the origin")
     cols = ("cells", "shape", "family", "u", "K_I")
     print(f"{'offset':>8} {'scale':>8} " + " ".join(f"{c:>9}" for c in cols) + f" {'time s':>8}")
-    for o, s in [(o, 1.0) for o in OFFSETS] + [(0.0, s) for s in SCALES if s != 1.0]:
+    for o, s in [(o, 1.0) for o in OFFSETS] + [(0.0, s) for s in SCALES if s != 1.0] + [UTM]:
         try:
             d = _compare(_run(points, queries, h, s, o), ref, len(points))
             row = " ".join(f"{d[c]:9.1e}" for c in cols) + f" {d['time']:8.2f}"

@@ -38,13 +38,17 @@ def _check_spacing(dom, h, name="h"):
     if h >= dom.diameter:
         raise GeometryError(f"{name} = {h:g} is not smaller than the domain diameter "
                             f"{dom.diameter:g}; choose a spacing that fits several nodes")
-    smallest = config.MIN_SPACING * dom.diameter
+    # ten snapping tolerances: the tolerance grows with the coordinates' round-off far
+    # from the origin (a body 1 across at 1e8 resolves no spacing below ~4e-6)
+    smallest = max(config.MIN_SPACING * dom.diameter, 10 * dom.tolerance)
     if h < smallest:
         raise GeometryError(
             f"{name} = {h:g} is below the smallest spacing this domain resolves, {smallest:.3g} "
             f"(cnem.config.MIN_SPACING = {config.MIN_SPACING:g} times the diameter "
-            f"{dom.diameter:.3g}; nodes closer are within a few snapping tolerances "
-            f"{dom.tolerance:.3g} of each other); expected {name} >= {smallest:.3g}")
+            f"{dom.diameter:.3g}, or ten snapping tolerances {dom.tolerance:.3g}, which far "
+            f"from the origin cover the coordinates' round-off; nodes closer are within a few "
+            f"tolerances of each other); expected {name} >= {smallest:.3g}, or coordinates "
+            f"nearer the origin")
     return h
 
 

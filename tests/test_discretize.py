@@ -336,13 +336,13 @@ def test_neighbors_are_the_triangulation_adjacency(name):
 
 @all_cases
 def test_circumcircles_and_their_tree(name):
-    """`Model.circumcircles`: every vertex of a triangle at the radius from its
-    centre, and the R-tree of their boxes finds each triangle from its centroid
-    (it serves point location)."""
+    """`Model.circumcircles` (in the model's local frame): every vertex of a
+    triangle at the radius from its centre, and the R-tree of their boxes finds
+    each triangle from its centroid (it serves point location)."""
     _, _, model = cases.model(name)
     centre, radius2, tree = model.circumcircles()
     assert model.circumcircles()[2] is tree
-    corners = model.nodes[model.triangles]
+    corners = model.frame.to_local(model.nodes)[model.triangles]
     dist2 = ((corners - centre[:, None, :]) ** 2).sum(axis=2)
     np.testing.assert_allclose(dist2, np.repeat(radius2[:, None], 3, axis=1), rtol=1e-9)
     centroid = corners.mean(axis=1)

@@ -8,7 +8,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 import shapely
 
-from .. import config
 from ..geometry.pslg import CRACK
 from ..geometry.topology import constraint_edges
 from ..spatial.rtree import RTree
@@ -54,18 +53,24 @@ def slit_edges(model: Model, faces: tuple, cells: Cells
     p, q, owner = faces
     if len(p) == 0:
         return np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0, np.int64)
+    frame = model.frame                    # O(1) coordinates at any origin and in any units
+    p, q, vertices = (frame.to_local(x) for x in (p, q, cells.vertices))
+    area = cells.area / frame.scale ** 2
+    # the cell vertices are known only to the domain's tolerance (their global round-off
+    # far from the origin): a vertex on the face may stand that far off its line
+    tol = model.domain.tolerance / frame.scale
     first = np.repeat(np.arange(len(cells.area)), np.diff(cells.offsets))
     lo = np.full((len(cells.area), 2), np.inf)
     hi = np.full((len(cells.area), 2), -np.inf)
-    np.minimum.at(lo, first, cells.vertices)
-    np.maximum.at(hi, first, cells.vertices)
+    np.minimum.at(lo, first, vertices)
+    np.maximum.at(hi, first, vertices)
     off, idx = RTree(lo, hi).query(np.minimum(p, q), np.maximum(p, q))
     out = []
     for f in range(len(p)):
         face = shapely.LineString([p[f], q[f]])
         for c in idx[off[f]:off[f + 1]]:
-            polygon = shapely.Polygon(cells.polygon(c))
-            eps = 1e-6 * np.sqrt(cells.area[c])
+            polygon = shapely.Polygon(vertices[cells.offsets[c]:cells.offsets[c + 1]])
+            eps = max(1e-6 * np.sqrt(area[c]), tol)
             for piece in _line_parts(face.intersection(polygon)):
                 xy = np.asarray(piece.coords)
                 d = xy[-1] - xy[0]
@@ -80,7 +85,8 @@ def slit_edges(model: Model, faces: tuple, cells: Cells
     if not out:
         return np.zeros(0, np.int64), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0, np.int64)
     cell, a, b, hint = zip(*out)
-    return np.array(cell, np.int64), np.array(a), np.array(b), np.array(hint, np.int64)
+    return (np.array(cell, np.int64), frame.to_global(np.array(a)), frame.to_global(np.array(b)),
+            np.array(hint, np.int64))
 
 
 def _line_parts(geom):
@@ -102,7 +108,9 @@ def face_triangles(model: Model, a: np.ndarray, b: np.ndarray, faces: tuple) -> 
     """
     hint = np.full(len(a), -1, dtype=np.int64)
     p, q, owner = faces
-    tol = config.SNAP_TOL * model.domain.diameter
+    frame = model.frame                    # O(1) coordinates at any origin and in any units
+    p, q, a, b = (frame.to_local(x) for x in (p, q, a, b))
+    tol = model.domain.tolerance / frame.scale
     mid = 0.5 * (a + b)
     off, idx = RTree(np.minimum(p, q) - tol, np.maximum(p, q) + tol).query(mid, mid)
     row = np.repeat(np.arange(len(a)), np.diff(off))

@@ -14,7 +14,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.sparse as sp
 
-from .. import config
 from ..errors import InputError
 from ..geometry.pslg import CRACK
 from ..shape.natural import PointRows, point_rows
@@ -246,7 +245,7 @@ def edge_points(model: Model, rows: np.ndarray, hint: np.ndarray, whole: np.ndar
     s, w = 0.5 * (s + 1.0), 0.5 * w
     S, W = s[None], w[None]                   # one rule for every piece
     if singular is not None:                  # pieces that begin or end at a singular point
-        tol = config.SNAP_TOL * model.domain.diameter
+        tol = model.domain.tolerance
         d = b - a
         first, last = a[edge] + t0[:, None] * d[edge], a[edge] + t1[:, None] * d[edge]
         start, end = np.zeros(len(edge), dtype=bool), np.zeros(len(edge), dtype=bool)

@@ -52,10 +52,10 @@ def circle_pieces(model: Model, a: np.ndarray, b: np.ndarray, whole: np.ndarray 
     t0, t1 : (q,) ndarray
         Piece ``i`` is ``t0[i] <= t <= t1[i]`` along edge ``edge[i]``.
     """
-    centre, radius2, tree = model.circumcircles()
+    centre, radius2, tree = model.circumcircles()          # in the model's local frame
     ne = len(a)
     cut = np.arange(ne) if whole is None else np.flatnonzero(~np.asarray(whole, dtype=bool))
-    ca, cb = a[cut], b[cut]
+    ca, cb = model.frame.to_local(a[cut]), model.frame.to_local(b[cut])
     lo, hi = np.minimum(ca, cb), np.maximum(ca, cb)
     gid = np.arange(len(cut))
     if group is not None and len(cut):

@@ -267,4 +267,5 @@ def tip_cells(model: Model) -> np.ndarray:
     x = model.nodes[model.cells.node]
     if len(tips) == 0:
         return np.zeros(len(x), dtype=bool)
-    return (np.hypot(*(x[:, None, :] - tips[None]).transpose(2, 0, 1)) < 1e-12).any(axis=1)
+    return (np.hypot(*(x[:, None, :] - tips[None]).transpose(2, 0, 1))
+            <= model.domain.tolerance).any(axis=1)

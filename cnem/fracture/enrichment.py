@@ -118,7 +118,8 @@ class Enrichment:
         """The functions ``F_k`` about one tip, ``(p, size)``; ``sides`` are points on
         the side wanted for points on the crack faces. With ``gradient=True`` also
         their gradients ``(p, size, 2)`` (points off the tip)."""
-        r, theta = sided_polar(points, self.tips[tip], self.directions[tip], sides)
+        r, theta = sided_polar(points, self.tips[tip], self.directions[tip], sides,
+                               self.model.domain.tolerance)
         root = np.sqrt(r)
         if self.functions == "sqrt":
             angular, slope = np.ones((len(r), 1)), np.zeros((len(r), 1))
@@ -264,7 +265,9 @@ class Enrichment:
             length = np.hypot(*(b - a).T)
             for sk, wk in zip(s, w):
                 pts = a + sk * (b - a)
-                sides = pts - 1e-6 * length[:, None] * nrm        # just inside the body
+                # just inside the body, farther than the round-off of the coordinates
+                inward = np.maximum(1e-6 * length, 4 * self.model.domain.tolerance)
+                sides = pts - inward[:, None] * nrm
                 phi = sk if end == 1 else 1.0 - sk
                 tr = per_point(t(pts, nrm) if callable(t) else t, pts, 2, what)
                 F = np.zeros((len(pts), self.size))

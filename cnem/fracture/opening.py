@@ -56,8 +56,9 @@ def crack_opening(model: Model, u: np.ndarray,
     copies = np.bincount(model.node_of_point)[model.node_of_point] == 2
     idx = np.flatnonzero(copies)
     rel = model.nodes[idx] - a
-    on = np.abs(rel @ n) <= 1e-9 * length
-    on &= (rel @ t >= -1e-9 * length) & (rel @ t <= length * (1 + 1e-9))
+    tol = model.domain.tolerance            # far from the origin: the nodes' round-off
+    on = np.abs(rel @ n) <= tol
+    on &= (rel @ t >= -tol) & (rel @ t <= length + tol)
     idx = idx[on]
     plus = (model.node_sides()[idx] - a) @ n > 0
     pairs = {}

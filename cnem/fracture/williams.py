@@ -85,12 +85,14 @@ def polar(points: np.ndarray, tip: np.ndarray, direction: np.ndarray) -> tuple:
 
 
 def sided_polar(points: np.ndarray, tip: np.ndarray, direction: np.ndarray,
-                sides: np.ndarray) -> tuple:
-    """`polar`, with ``theta = ±pi`` on the crack line behind the tip chosen by
-    the side of a reference point per point (``sides``, ``(p, 2)``)."""
+                sides: np.ndarray, tol: float) -> tuple:
+    """`polar`, with ``theta = ±pi`` on the crack line behind the tip (points within
+    the distance ``tol`` of it, the domain's tolerance: far from the origin a point
+    on a face stands off the line by the coordinates' round-off) chosen by the side
+    of a reference point per point (``sides``, ``(p, 2)``)."""
     r, theta = polar(points, tip, direction)
     _, side = polar(sides, tip, direction)
-    behind = np.abs(np.abs(theta) - np.pi) < 1e-9
+    behind = (np.abs(theta) > 0.5 * np.pi) & (r * np.abs(np.sin(theta)) <= tol)
     theta[behind] = np.pi * np.where(side[behind] < 0, -1.0, 1.0)
     return r, theta
 
@@ -116,7 +118,7 @@ def nodal_williams(model: Model, tip: np.ndarray, KI: float, KII: float, E: floa
     (n, 2) ndarray
     """
     at, d = model.domain.tip_frame(tip)
-    r, theta = sided_polar(model.nodes, at, d, model.node_sides())
+    r, theta = sided_polar(model.nodes, at, d, model.node_sides(), model.domain.tolerance)
     with np.errstate(divide="ignore", invalid="ignore"):
         u = williams(r, theta, KI, KII, E, nu, plane)[0]
     u[r == 0.0] = 0.0

@@ -25,6 +25,8 @@ from __future__ import annotations
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
@@ -290,6 +292,25 @@ class _ExactCells:
                              "node: refine it there")
 
 
+def _shared_centres(cc, nb, nodes):
+    """The circumcentres with those of neighbouring triangles closer than
+    ``MERGE_TOL`` times the nodes' extent made one (the lowest triangle's): the two
+    centres of a cocircular quad are one point, but round-off puts them apart, by
+    more than the merge tolerance of the cells in a thin one (a 1e-2 x 1e-6 quad:
+    2e-15), and two cells beside it would keep different ones (a gap between them)."""
+    t, k = np.nonzero(nb > np.arange(len(nb))[:, None])
+    u = nb[t, k]
+    tol = config.MERGE_TOL * float(np.hypot(*np.ptp(nodes, axis=0)))
+    close = np.hypot(*(cc[t] - cc[u]).T) <= tol
+    if not close.any():
+        return cc
+    graph = coo_matrix((np.ones(close.sum()), (t[close], u[close])), shape=(len(cc), len(cc)))
+    _, label = connected_components(graph, directed=False)
+    first = np.full(label.max() + 1, len(cc))
+    np.minimum.at(first, label, np.arange(len(cc)))
+    return np.ascontiguousarray(cc[first[label]])
+
+
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
                   progress: bool | None = None, neighbors: np.ndarray | None = None,
                   only: ArrayLike | None = None, frame: Frame | None = None
@@ -328,8 +349,9 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     cc = circumcenters(nodes, triangles)
     max_deg = int(np.diff(offsets).max())
     which = np.arange(n, dtype=np.int64) if only is None else np.unique(np.asarray(only, dtype=np.int64))
-    status, poff, poly, rtri = fast_cells(nodes, triangles, nb, offsets, star, cc,
-                                          config.MERGE_TOL, max_deg, which)
+    status, poff, poly, rtri = fast_cells(nodes, triangles, nb, offsets, star,
+                                          _shared_centres(cc, nb, nodes), config.MERGE_TOL,
+                                          max_deg, which)
     is_fast = np.flatnonzero(status == FAST)     # positions in `which`
     fast = which[is_fast]
     exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, frame)

@@ -18,6 +18,7 @@ from shapely.validation import explain_validity
 from numpy.typing import ArrayLike
 
 from .. import config
+from .._predicates import Frame, local_frame
 from ..errors import GeometryError
 from .pslg import CRACK, PSLG, build_pslg, ring_coordinates
 
@@ -158,7 +159,10 @@ class Domain:
                 "model in other units")
         self._diameter = float(np.hypot(maxx - minx, maxy - miny))
         self._origin = np.array([minx, miny])    # buffers are computed in this local frame
-        self._tol = config.SNAP_TOL * self._diameter
+        self._frame = local_frame((minx, miny, maxx, maxy))
+        # far from the origin the vertices themselves are known only to their round-off
+        self._tol = max(config.SNAP_TOL * self._diameter,
+                        config.ROUNDOFF_ULPS * self._frame.resolution * self._frame.scale)
         self._regions = tuple(_as_polygon(r, i, self._tol) for i, r in enumerate(regions))
         self._union = shapely.union_all(self._regions)
         self._check_overlaps()
@@ -292,8 +296,15 @@ class Domain:
 
     @property
     def tolerance(self) -> float:
-        """float: absolute snapping tolerance ``SNAP_TOL * diameter``."""
+        """float: absolute snapping tolerance, ``SNAP_TOL * diameter`` or, far from the
+        origin, `cnem.config.ROUNDOFF_ULPS` times the coordinates' round-off if larger
+        (a domain 1 across at 1e8 is known only to 1.5e-8)."""
         return self._tol
+
+    @property
+    def frame(self) -> Frame:
+        """`cnem._predicates.Frame`: the local frame of the domain's bounding box."""
+        return self._frame
 
     @property
     def tips(self) -> np.ndarray:

@@ -11,7 +11,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
-from .._predicates import Frame, local_frame
+from .._predicates import Frame
 from ..errors import GeometryError
 from ._kernels import polygon_moments
 from .cells import voronoi_cells
@@ -148,7 +148,7 @@ class Model:
         """Frame: the local frame (origin at the domain box's lower-left corner rounded
         to a coarse grid, a power-of-two scale) in which the geometric computations
         run, so that the model answers the same at any origin and in any units."""
-        return self._derive("frame", lambda: local_frame(self.domain.bounds))
+        return self.domain.frame
 
     def local_nodes(self) -> np.ndarray:
         """The nodes in `frame`, ``(n, 2)``. Computed once."""
@@ -165,12 +165,14 @@ class Model:
         return tables[1 if across_regions else 0]
 
     def circumcircles(self) -> tuple[np.ndarray, np.ndarray, RTree]:
-        """The circumcircles of the triangles: centres ``(t, 2)``, squared radii
-        ``(t,)`` and an R-tree over their boxes (which also holds every triangle:
-        point location). Computed on first call, then kept."""
+        """The circumcircles of the triangles in the local `frame` (centres to
+        relative round-off at any origin): centres ``(t, 2)``, squared radii ``(t,)``
+        and an R-tree over their boxes (which also holds every triangle: point
+        location), all in local coordinates. Computed on first call, then kept."""
         def build():
-            centre = circumcenters(self.nodes, self.triangles)
-            radius2 = ((self.nodes[self.triangles[:, 0]] - centre) ** 2).sum(axis=1)
+            nodes = self.local_nodes()
+            centre = circumcenters(nodes, self.triangles)
+            radius2 = ((nodes[self.triangles[:, 0]] - centre) ** 2).sum(axis=1)
             radius = np.sqrt(radius2)[:, None]
             return centre, radius2, RTree(centre - radius, centre + radius)
         return self._derive("circumcircles", build)
@@ -183,10 +185,10 @@ class Model:
         Returns
         -------
         RTree
-            Entry ``i`` is the bounding box of ``triangles[i]``.
+            Entry ``i`` is the bounding box of ``triangles[i]`` in the local `frame`.
         """
         def build():
-            corners = self.nodes[self.triangles]
+            corners = self.local_nodes()[self.triangles]
             return RTree(corners.min(axis=1), corners.max(axis=1))
         return self._derive("triangle tree", build)
 
@@ -257,7 +259,7 @@ def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:
     timings = {}
     nodes, node_of_point, tri, region, segments, kind, neighbors = triangulate(cloud, timings)
     t2 = time.perf_counter()
-    frame = local_frame(cloud.domain.bounds)
+    frame = cloud.domain.frame
     local = frame.to_local(nodes)
     node, cell_region, offsets, vertices = voronoi_cells(local, tri, region, progress=progress,
                                                          neighbors=neighbors[0], frame=frame)
@@ -267,7 +269,7 @@ def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:
              ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
     cells = Cells(node, cell_region, offsets, vertices)
     return Model(cloud, nodes, node_of_point, tri, region, segments, kind, cells, timings,
-                 _derived={"neighbors": neighbors, "frame": frame, "local nodes": local})
+                 _derived={"neighbors": neighbors, "local nodes": local})
 
 
 def triangulate(cloud, timings, caller="discretize"):

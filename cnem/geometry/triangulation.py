@@ -21,6 +21,18 @@ def _orient(points, tri):
     return (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
 
 
+def _canonical(tri, region):
+    """The triangles in an order that depends on them alone: each from its smallest
+    node on (counter-clockwise kept), sorted by their nodes. `triangle` numbers them
+    as its flips went, and those change with the triangles it removes afterwards (in
+    holes: the same body moved elsewhere may triangulate a cocircular hole otherwise),
+    and so would the crack faces' node copies and every cell's first vertex."""
+    first = np.argmin(tri, axis=1)[:, None]
+    tri = np.take_along_axis(tri, (first + np.arange(3)) % 3, axis=1)
+    order = np.lexsort((tri[:, 2], tri[:, 1], tri[:, 0]))
+    return tri[order], region[order]
+
+
 def _steiner_error(points, segments, extra, tol):
     """Name the constraint segments that meet at inserted (Steiner) points."""
     a, b = points[segments[:, 0]], points[segments[:, 1]]
@@ -67,7 +79,7 @@ def constrained_delaunay(cloud: NodeCloud) -> tuple[np.ndarray, np.ndarray]:
     tri[flip] = tri[flip][:, [0, 2, 1]]
     centroid = points[tri].mean(axis=1)
     region = cloud.domain.region_of(centroid)
-    tri, region = tri[region >= 0], region[region >= 0]
+    tri, region = _canonical(tri[region >= 0], region[region >= 0])
     used = np.zeros(len(points), dtype=bool)
     used[tri.ravel()] = True
     if not used.all():

@@ -42,7 +42,6 @@ from scipy.spatial import cKDTree
 
 from .. import config
 from .._parallel import one_thread
-from .._predicates import local_frame
 from ..errors import GeometryError
 from .cells import voronoi_cells
 from .model import Cells, Model, triangulate
@@ -284,7 +283,7 @@ def update(model: Model, cloud: NodeCloud, *, progress: bool | None = None) -> M
     gone = (match < 0) & ~new_flip
     discs = np.concatenate([_disc_boxes(model.nodes, model.triangles[~kept_old]),
                             _disc_boxes(nodes, tri[gone])])
-    pad = config.SNAP_TOL * size
+    pad = cloud.domain.tolerance
     touched = np.zeros(len(model.nodes), dtype=bool)
     touched[model.cells.node[_boxes_meet(_cell_boxes(model.cells), discs, pad)]] = True
     redo = old_node < 0
@@ -292,7 +291,7 @@ def update(model: Model, cloud: NodeCloud, *, progress: bool | None = None) -> M
     redo[old_node >= 0] |= touched[old_node[old_node >= 0]]
     timings["matching"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    frame = local_frame(cloud.domain.bounds)           # the frame of `discretize`
+    frame = cloud.domain.frame                         # the frame of `discretize`
     with one_thread():                  # a few cells
         node, cell_region, offsets, vertices = voronoi_cells(
             frame.to_local(nodes), tri, region, progress=progress, neighbors=neighbors[0],

@@ -47,27 +47,25 @@ def _locate_sorted(model, nodes, spts, tol):
     next, started from a few points found with the R-tree of the circumcircles (each
     holds its triangle); for the points the walk cannot reach (across holes and
     cracks) the same tree, or one of the triangles when they are many (the trees are
-    in global coordinates)."""
-    frame = model.frame
+    in the local frame too)."""
     nb_all = model.neighbors(across_regions=True)
     nch = work_chunks()
     starts = (np.arange(nch) * len(spts)) // nch
     seeds = K.locate(nodes, model.triangles, spts[starts],
-                     *_candidates(model.circumcircles()[2], frame, spts[starts], tol), tol)
+                     *_candidates(model.circumcircles()[2], spts[starts], tol), tol)
     tri_of = K.locate_walk(nodes, model.triangles, nb_all, spts, seeds, nch)
     lost = np.flatnonzero(tri_of < 0)
     if lost.size:
         many = lost.size > config.TRIANGLE_TREE_AFTER * len(model.triangles)
         tree = model.triangle_tree() if many else model.circumcircles()[2]
         tri_of[lost] = K.locate(nodes, model.triangles, spts[lost],
-                                *_candidates(tree, frame, spts[lost], tol), tol)
+                                *_candidates(tree, spts[lost], tol), tol)
     return tri_of
 
 
-def _candidates(tree, frame, local_points, tol):
-    """The entries of a global R-tree whose boxes meet the boxes ``tol`` about local points."""
-    lo, hi = frame.to_global(local_points - tol), frame.to_global(local_points + tol)
-    return tree.query(lo, hi)
+def _candidates(tree, local_points, tol):
+    """The entries of a local R-tree whose boxes meet the boxes ``tol`` about local points."""
+    return tree.query(local_points - tol, local_points + tol)
 
 
 def shape_functions(model: Any, points: ArrayLike, *, kind: Literal["sibson", "laplace"] = "sibson",
