@@ -23,6 +23,7 @@ from contextlib import contextmanager
 
 import numba
 
+from . import _compile  # noqa: F401  (says once when the kernels compile)
 from . import config
 
 __all__ = ["work_chunks", "one_thread", "parallel_kernel", "ParallelKernel", "always_parallel"]
