@@ -93,7 +93,7 @@ class ParallelKernel:
 
     def __call__(self, *args, **kwargs):
         item = args[self._position] if self._position < len(args) else kwargs[self._work]
-        size = item if isinstance(item, int) else len(item)
+        size = len(item) if hasattr(item, "__len__") else int(item)
         kernel = self.parallel if size >= config.PARALLEL_MIN else self.serial
         return kernel(*args, **kwargs)
 

@@ -40,7 +40,7 @@ def test_an_integer_counts_as_its_value(monkeypatch):
     monkeypatch.setattr(config, "PARALLEL_MIN", 5)
     kernel = ParallelKernel(_first, "count")
     x = np.arange(10.0)
-    np.testing.assert_array_equal(kernel(4, x), x[:4])
+    np.testing.assert_array_equal(kernel(np.int64(4), x), x[:4])      # a NumPy integer too
     assert not kernel.parallel.signatures
     with always_parallel():
         np.testing.assert_array_equal(kernel(2, x), x[:2])
