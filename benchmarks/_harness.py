@@ -1,4 +1,4 @@
-"""Helpers shared by the benchmark scripts: peak memory, medians, size labels."""
+"""Helpers shared by the benchmark scripts: peak memory, medians, size labels, warm-ups."""
 
 import resource
 import statistics
@@ -60,6 +60,17 @@ def warm_median(fn, repeat):
         out = fn()
         times.append(time.perf_counter() - t0)
     return median(times), out
+
+
+def warm_both(fn):
+    """``fn()`` twice: as is, and with every `cnem._parallel.ParallelKernel` on its
+    parallel copy, so that a tiny warm-up compiles (or loads) both copies of the kernels
+    (below ``cnem.config.PARALLEL_MIN`` work items a kernel runs its serial copy, which
+    the timed large problems do not use)."""
+    from cnem._parallel import always_parallel
+    fn()
+    with always_parallel():
+        return fn()
 
 
 def fmt_n(n):

@@ -19,8 +19,9 @@ on Linux because the kernel carries the parent's peak over into a spawned child 
 keeps the high-water mark), which would add the driver's own peak to every child.  The
 figure is the whole process: interpreter, imports, the cloud and the timed runs.
 
-**ours** -- in a child that first warms numba up with a few calls on tiny clouds (compile
-time excluded; the warm-up time is printed):
+**ours** -- in a child that first warms numba up with a few calls on tiny clouds, for the
+serial and the parallel copies of the kernels (``_harness.warm_both``; compile time
+excluded; the warm-up time is printed):
 
 * ``cells``: ``family_search(points, 3.0001, method="cells")`` (what ``method="auto"``
   picks for this uniform workload);
@@ -101,7 +102,7 @@ from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
 
-from _harness import fmt_n, median, mem_available_bytes, peak_rss_bytes
+from _harness import fmt_n, median, mem_available_bytes, peak_rss_bytes, warm_both
 
 HORIZON = 3.0001
 DEFAULT_SIZES = [27_000, 125_000, 343_000, 1_000_000]
@@ -280,11 +281,13 @@ def _ours_child(task):
 
     method, repeat = task["method"], task["repeat"]
     t0 = time.perf_counter()           # warm-up: compile (or load from cache) every kernel used
-    for spec in (("lattice", 6, False), ("lattice", 8, True), ("graded", 500)):
-        wp, wh, wper = make_cloud(spec)
-        family_search(wp, wh, period=wper, method=method)
-        if method == "rtree":
-            RTree.from_points(wp, period=wper)
+    def tiny():
+        for spec in (("lattice", 6, False), ("lattice", 8, True), ("graded", 500)):
+            wp, wh, wper = make_cloud(spec)
+            family_search(wp, wh, period=wper, method=method)
+            if method == "rtree":
+                RTree.from_points(wp, period=wper)
+    warm_both(tiny)
     warmup = time.perf_counter() - t0
 
     pts, horizon, period = make_cloud(task["cloud"])

@@ -3,6 +3,7 @@ empty numba cache (a fresh machine) and with the warm cache the first run left b
 
     python benchmarks/first_run.py            # the README's main demo, cold then warm
     python benchmarks/first_run.py --quick    # import cnem and cnem --help only (seconds)
+    python benchmarks/first_run.py --root DIR # another checkout (e.g. a copy of an earlier commit)
 
 Each row is one fresh process (``NUMBA_CACHE_DIR`` pointed at a new empty folder for
 the cold rows, at the same folder afterwards for the warm ones); wall time and the CPU
@@ -25,17 +26,18 @@ import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
-#: label -> command (run from a temporary folder, this checkout first on the path).
-COMMANDS = {
-    "import cnem": [sys.executable, "-c", "import cnem"],
-    "cnem --help": [sys.executable, "-m", "cnem", "--help"],
-    "main demo": [sys.executable, str(ROOT / "demos" / "bimaterial_cylinder.py")],
-}
+
+def commands(root):
+    """label -> command (run from a temporary folder, checkout ``root`` first on the path)."""
+    return {"import cnem": [sys.executable, "-c", "import cnem"],
+            "cnem --help": [sys.executable, "-m", "cnem", "--help"],
+            "main demo": [sys.executable, str(root / "demos" / "bimaterial_cylinder.py")]}
 
 
-def _run(command, cache, cwd):
-    """Wall and CPU seconds of one fresh process (``None`` if it failed)."""
-    env = dict(os.environ, PYTHONPATH=str(ROOT), NUMBA_CACHE_DIR=str(cache),
+def _run(command, cache, cwd, root):
+    """Wall and CPU seconds of one fresh process and how many times it announced compiling
+    (``None`` if it failed)."""
+    env = dict(os.environ, PYTHONPATH=str(root), NUMBA_CACHE_DIR=str(cache),
                PYVISTA_OFF_SCREEN="true")
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
@@ -47,14 +49,18 @@ def _run(command, cache, cwd):
         print(done.stderr[-2000:], file=sys.stderr)
         return None
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    return wall, cpu, "compiling numba kernels" in done.stderr
+    return wall, cpu, done.stderr.count("compiling numba kernels")
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
                         help="import cnem and cnem --help only (no demo)")
+    parser.add_argument("--root", type=pathlib.Path, default=ROOT,
+                        help="the checkout to measure (default this one)")
     args = parser.parse_args(argv)
+    root = args.root.resolve()
+    print(f"checkout {root}, numba threads {os.environ.get('NUMBA_NUM_THREADS', 'default')}")
     labels = ["import cnem", "cnem --help"] + ([] if args.quick else ["main demo"])
     print(f"{'run':<24} {'wall s':>8} {'CPU s':>8} {'load before':>12} {'after':>6}  notice")
     with tempfile.TemporaryDirectory() as tmp:
@@ -63,14 +69,14 @@ def main(argv=None):
         for state in ("empty cache", "warm cache"):
             for label in labels:
                 load = os.getloadavg()[0]
-                res = _run(COMMANDS[label], cache, tmp)
+                res = _run(commands(root)[label], cache, tmp, root)
                 name = f"{label}, {state}"
                 if res is None:
                     print(f"{name:<24} {'fails':>8}")
                     continue
                 wall, cpu, notice = res
                 print(f"{name:<24} {wall:8.2f} {cpu:8.2f} {load:12.2f} {os.getloadavg()[0]:6.2f}"
-                      f"  {'compiling announced' if notice else '-'}", flush=True)
+                      f"  {f'compiling announced x{notice}' if notice else '-'}", flush=True)
 
 
 if __name__ == "__main__":

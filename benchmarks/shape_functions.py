@@ -23,7 +23,8 @@ start method).
 with two threads.  Each child
 
 1. warms numba up: discretizes a tiny cloud of the same domain and evaluates its shape
-   functions at a few points, so JIT compile time (or loading from numba's cache) is
+   functions at a few points, twice (the serial and the parallel copies of the kernels,
+   ``_harness.warm_both``), so JIT compile time (or loading from numba's cache) is
    excluded; the warm-up time is printed;
 2. builds the model (``discretize`` runs with numba's default thread count and is timed on
    its own; it is *not* part of the rate);
@@ -96,7 +97,7 @@ from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
 
-from _harness import fmt_n, median, peak_rss_bytes, reset_peak_rss
+from _harness import fmt_n, median, peak_rss_bytes, reset_peak_rss, warm_both
 
 DOMAINS = {
     "square": dict(),
@@ -154,9 +155,10 @@ def _cnem_child(task):
     dom = cnem.geometry.rectangle(**DOMAINS[task["domain"]])
 
     t0 = time.perf_counter()       # warm-up: compile (or load from cache) every kernel used
-    wmodel = cnem.discretize(cnem.nodes.irregular(dom, h=WARMUP_H, seed=0), progress=False)
-    wmodel.shape_functions(query_points(WARMUP_POINTS), kind="sibson")
-    del wmodel
+    def tiny():
+        wmodel = cnem.discretize(cnem.nodes.irregular(dom, h=WARMUP_H, seed=0), progress=False)
+        wmodel.shape_functions(query_points(WARMUP_POINTS), kind="sibson")
+    warm_both(tiny)
     warmup = time.perf_counter() - t0
 
     cloud = cnem.nodes.irregular(dom, h=1.0 / np.sqrt(task["n"]), seed=0)

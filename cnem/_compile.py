@@ -1,7 +1,7 @@
 """Say once when numba compiles cnem's kernels (an empty or stale cache: first run only).
 
 The kernels are ``@numba.njit(cache=True)``: the first call in a fresh
-environment compiles them (about a minute of CPU for the main demo) and writes
+environment compiles them (about 30 s of CPU for the main demo) and writes
 them to numba's on-disk cache; later runs load them in a moment. Each kernel
 module imports this one, which registers a numba compile listener: the first
 time a cnem kernel is compiled rather than loaded, it logs `NOTICE` at INFO on
@@ -20,7 +20,7 @@ from numba.core import event
 __all__ = ["NOTICE", "compiled"]
 
 #: The line logged once, at the first compilation of a cnem kernel.
-NOTICE = ("compiling numba kernels, first run only (about a minute of CPU for the main demo; "
+NOTICE = ("compiling numba kernels, first run only (about 40 s of CPU for the main demo; "
           "cached on disk for the next runs; `cnem warmup` does it ahead)")
 
 logger = logging.getLogger(__name__)

@@ -8,6 +8,7 @@
     cnem pd branching --help                         # dynamic crack branching
     cnem pd cpd --example tension2d                  # CPD examples (Javili et al. §6)
     cnem warmup                                      # compile every kernel now (first run only)
+    cnem warmup --parallel                           # and their parallel copies (large models)
     cnem info                                        # versions, threads
 
 Each demo keeps its own options (``cnem demo cylinder --help``, defaults shown); the
@@ -212,9 +213,11 @@ WARMUP = (
 )
 
 
-def warmup(progress: bool = True) -> list[str]:
+def warmup(progress: bool = True, parallel: bool = False) -> list[str]:
     """Compile (or load from numba's cache) every kernel the demos use, by running each
-    demo of `WARMUP` once at its smallest size, without pictures, into a temporary folder.
+    demo of `WARMUP` once at its smallest size, without pictures, into a temporary folder;
+    with ``parallel``, once more with every kernel on its parallel copy (the one models
+    above `cnem.config.PARALLEL_MIN` work items use, `cnem._parallel.parallel_kernel`).
 
     Returns
     -------
@@ -228,19 +231,24 @@ def warmup(progress: bool = True) -> list[str]:
     from tqdm.auto import tqdm
 
     from . import _compile
+    from ._parallel import always_parallel
     before = len(_compile.compiled)
+    passes = ((False, True) if parallel else (False,))
+    jobs = [(copy, job) for copy in passes for job in WARMUP]
     with tempfile.TemporaryDirectory() as tmp:
-        for module, args, kwargs in tqdm(WARMUP, desc="warmup", disable=not progress, unit="demo"):
+        for copy, (module, args, kwargs) in tqdm(jobs, desc="warmup", disable=not progress,
+                                                 unit="demo"):
             demo = importlib.import_module(f"{PACKAGE}.{module}")
-            with contextlib.redirect_stdout(io.StringIO()):
+            with (always_parallel() if copy else contextlib.nullcontext()), \
+                    contextlib.redirect_stdout(io.StringIO()):
                 demo.main(*args, **kwargs, outdir=pathlib.Path(tmp) / module, plot=False)
     return _compile.compiled[before:]
 
 
-def _warmup():
+def _warmup(parallel: bool):
     import time
     t0 = time.perf_counter()
-    names = warmup(progress=sys.stderr.isatty())
+    names = warmup(progress=sys.stderr.isatty(), parallel=parallel)
     print(f"cnem warmup: {len(names)} kernels compiled in {time.perf_counter() - t0:.0f} s"
           if names else f"cnem warmup: every kernel was cached already "
                         f"({time.perf_counter() - t0:.0f} s)")
@@ -267,6 +275,10 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         formatter_class=HelpFormatter,
         description="Compile every numba kernel the demos use, once, into numba's cache "
                     "(about 2 min of CPU in a fresh environment; a warm cache only loads them).")
+    commands["warmup"].add_argument(
+        "--parallel", action="store_true",
+        help="also the kernels' parallel copies, which models above cnem.config.PARALLEL_MIN "
+             "work items (points, cells, rows) use")
     commands["info"] = sub.add_parser("info", help="versions, threads and the numba cache",
                                       formatter_class=HelpFormatter,
                                       description="Versions, threads and the numba cache.")
@@ -282,7 +294,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command in ("info", "warmup"):
         if rest:
             commands[args.command].error(f"unrecognised arguments: {' '.join(rest)}")
-        _info() if args.command == "info" else _warmup()
+        _info() if args.command == "info" else _warmup(args.parallel)
         return 0
     if args.name is None:
         if not {"-h", "--help"} & set(rest):

@@ -21,7 +21,7 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "ROU
            "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER",
            "DT_LIMIT", "COORDINATE_LIMIT", "DIRECT_MEMORY", "DIRECT_FILL",
            "CG_MAXITER", "SIF_DISCS", "SIF_REACH", "SIF_INNER", "SIF_STRAIGHTNESS",
-           "SIF_BEND_SPACINGS", "SIF_SPREAD", "SIF_SPACINGS"]
+           "SIF_BEND_SPACINGS", "SIF_SPREAD", "SIF_SPACINGS", "PARALLEL_MIN"]
 
 # ---------------------------------------------------------------- geometry tolerances
 #: Coordinates (and their extent) must stay below this in magnitude: squared distances
@@ -90,6 +90,13 @@ SPACING_COUNT_TOL = 0.01
 
 #: ... or after this many bisections (then `cnem.errors.LimitError`).
 SPACING_BISECTIONS = 200
+
+# ---------------------------------------------------------------- numba kernels
+#: Work items (points, cells, rows, queries) from which a kernel with parallel loops
+#: runs its ``parallel=True`` copy; below, its serial copy (`cnem._parallel.parallel_kernel`).
+#: Small models then never compile the parallel copies (several times the compile cost)
+#: nor wait for a parallel region.
+PARALLEL_MIN = 100_000
 
 # ---------------------------------------------------------------- spatial search
 #: Children per R-tree node (and boxes per leaf); a tree keeps the value it was

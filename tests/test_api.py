@@ -92,18 +92,20 @@ def test_frozen_data_objects():
 def test_no_kernel_compiles_at_import():
     """Every numba kernel compiles (or loads from its cache) on its first call, not when
     its module is imported: a fresh interpreter imports every module and finds no kernel
-    with a compiled signature."""
+    (nor serial or parallel copy of a `ParallelKernel`) with a compiled signature."""
     import subprocess
     import sys
     code = ("import importlib, pkgutil, sys, cnem\n"
             "from numba.core.dispatcher import Dispatcher\n"
+            "from cnem._parallel import ParallelKernel\n"
             "for info in pkgutil.walk_packages(cnem.__path__, prefix='cnem.'):\n"
             "    try:\n"
             "        importlib.import_module(info.name)\n"
             "    except ImportError as exc:\n"
             "        if (exc.name or 'cnem').startswith('cnem'): raise\n"
-            "kernels = [(n, k, v) for n, m in list(sys.modules.items()) if n.split('.')[0] == 'cnem'"
-            " for k, v in vars(m).items() if isinstance(v, Dispatcher)]\n"
+            "kernels = [(n, k, d) for n, m in list(sys.modules.items()) if n.split('.')[0] == 'cnem'"
+            " for k, v in vars(m).items() for d in ([v.serial, v.parallel]"
+            " if isinstance(v, ParallelKernel) else [v]) if isinstance(d, Dispatcher)]\n"
             "print(len(kernels), sorted(f'{n}.{k}' for n, k, v in kernels if v.signatures))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.split(maxsplit=1)

@@ -209,6 +209,22 @@ def test_every_kernel_module_announces_compiling():
             assert "import _compile" in source, path
 
 
+def test_warmup_parallel_runs_the_list_again_on_the_parallel_copies(monkeypatch):
+    """`cnem warmup --parallel`: each demo once as the first run would (serial copies of
+    small kernels), then once more with every kernel on its parallel copy."""
+    from cnem import config
+    seen = []
+    for module, _, _ in cli.WARMUP:
+        demo = importlib.import_module(f"cnem.demos.{module}")
+        monkeypatch.setattr(demo, "main", lambda *a, _m=module, **k:
+                            seen.append((_m, config.PARALLEL_MIN)))
+    monkeypatch.setattr(config, "PARALLEL_MIN", 123)
+    assert cli.main(["warmup", "--parallel"]) == 0
+    modules = [module for module, _, _ in cli.WARMUP]
+    assert seen == [(m, 123) for m in modules] + [(m, 0) for m in modules]
+    assert config.PARALLEL_MIN == 123
+
+
 @pytest.mark.slow
 def test_warmup_runs_every_listed_demo(monkeypatch):
     """`cnem warmup` runs each demo of its list once, quietly, and reports what compiled."""

@@ -4,6 +4,7 @@ import numba
 import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
+from .._parallel import parallel_kernel
 
 
 @numba.njit(cache=True)
@@ -18,7 +19,7 @@ def _min_fan(ax, ay, verts, lo, hi):
     return least
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("offsets")
 def fan_apexes(offsets, verts, centroid, node_xy, node_first, area):
     """The apex of every cell's fan.
 

@@ -4,9 +4,10 @@ import numba
 import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
+from .._parallel import parallel_kernel
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("a")
 def circle_crossings(a, b, centre, radius2, cand_off, cand_idx, group, out_off, out_t, fill):
     """Parameters ``t`` in (0, 1) where segments ``a + t (b - a)`` cross circles.
 
@@ -41,7 +42,7 @@ def circle_crossings(a, b, centre, radius2, cand_off, cand_idx, group, out_off, 
             out_off[k + 1] = count
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("offsets")
 def edge_pieces(offsets, t):
     """Pieces of every edge between its crossings, in order along the edge.
 
@@ -171,7 +172,7 @@ def piece_points(a, b, edge, t0, t1, S, W, single):
     return points, wx, wy, indptr
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("a")
 def canonical_rows(a, b, hint):
     """Every edge from its lexicographically smaller end, as one row of numbers.
 

@@ -9,6 +9,7 @@ import numba
 import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
+from .._parallel import parallel_kernel
 
 
 @numba.njit(cache=True, inline="always")
@@ -20,7 +21,8 @@ def _chunk(ch, nch, n):
 def _offsets(counts):
     """CSR row pointers ``(n + 1,)`` from row counts ``(n,)``."""
     indptr = np.zeros(counts.shape[0] + 1, dtype=np.int64)
-    indptr[1:] = np.cumsum(counts)
+    for i in range(counts.shape[0]):     # a loop: a slice assignment compiles numba's
+        indptr[i + 1] = indptr[i] + counts[i]    # shape-mismatch message (seconds)
     return indptr
 
 
@@ -43,7 +45,7 @@ def _sort_slots(indices, start, end, slot):
         slot[indices[p]] = p
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("ptr")
 def weighted_row_sums(ptr, item, wx, wy, row_of, v_start, v_end, v_idx, vx, vy, ncol, nch):
     """``X[i] = sum_p wx[p] Vx[row_of[item[p]]]`` over ``p`` in ``ptr[i]:ptr[i + 1]``,
     and ``Y`` alike with ``wy``, ``Vy``: two CSR matrices with one pattern.
@@ -128,7 +130,7 @@ def _sort_row(indices, x, y, start, end):
         indices[k + 1], x[k + 1], y[k + 1] = j, a, b
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("q_ptr")
 def weighted_gram(q_ptr, q_idx, q_val, t_ptr, t_row, t_val, coeff, m, ncol, nch):
     """``K = Q^T W Q`` for stacked descriptor operators ``Q`` (``c m`` rows: row
     ``a m + k`` is descriptor ``a`` at cell ``k``) and per-cell couplings
@@ -224,7 +226,7 @@ def _transpose_pattern(ptr, idx, ncol):
     return t_ptr, t_row, t_pos
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("ncol")
 def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
     """``K`` of a vector form that sees only gradients, by 2 x 2 node blocks.
 
@@ -310,7 +312,7 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
     return out_ptr, out_idx, data
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("target")
 def place_rows(indptr, indices, x, y, target, out_ptr, out_idx, out_x, out_y):
     """Copy row ``r`` of a CSR (values ``x`` and ``y`` on one pattern) into row
     ``target[r]`` of another whose row pointers ``out_ptr`` are already set."""

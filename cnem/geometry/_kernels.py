@@ -15,6 +15,7 @@ import numba
 import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
+from .._parallel import parallel_kernel
 from .._predicates import orient2d as _orient
 
 #: Status codes of the fast path.
@@ -192,7 +193,7 @@ def _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly
     return count if count >= 3 else -1
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("which")
 def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg, which):
     """Cells of the nodes ``which`` that need no clipping.
 
@@ -248,11 +249,13 @@ def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg, which):
         path = np.empty((max_deg + 2, 2))
         poly = np.empty((max_deg + 3, 2))
         c = _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly)
-        out[poly_offsets[s]:poly_offsets[s] + c] = poly[:c]
+        for k in range(c):               # not a slice assignment: see `_offsets` of
+            out[poly_offsets[s] + k, 0] = poly[k, 0]     # cnem.assembly._sparse_kernels
+            out[poly_offsets[s] + k, 1] = poly[k, 1]
     return status, poly_offsets, out, region_tri
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("vertices")
 def polygon_moments(offsets, vertices):
     """Areas and centroids of polygons by the shoelace formula, each relative to
     its first vertex (no cancellation far from the origin).

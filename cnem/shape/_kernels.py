@@ -21,6 +21,7 @@ import numba
 import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
+from .._parallel import parallel_kernel
 from .._predicates import orient2d as _orient
 
 #: Row kinds returned by the counting pass.
@@ -257,7 +258,7 @@ def _row(nodes, tri, nb, t, x, y, node_tol, edge_tol, cav, cols, vals, gx, gy, s
     return CAVITY, count
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("points")
 def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace, gradient,
             slots):
     """Sibson (or Laplace) coordinates of many points, one pass, rows in visit order.
@@ -343,7 +344,7 @@ def natural(nodes, tri, nb, points, tri_of, node_tol, edge_tol, nch, laplace, gr
     return start, size, out_cols, out_vals, out_gx, out_gy, kinds, full.any()
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("points")
 def locate(nodes, tri, points, cand_off, cand_idx, tol):
     """The candidate triangle that contains each point best (-1 if none within ``tol``).
 
@@ -390,7 +391,7 @@ def _walk(nodes, tri, nb, t, x, y, max_steps):
     return -1
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("points")
 def locate_walk(nodes, tri, nb, points, seeds, nch):
     """Triangles holding points by walking from one point to the next.
 
@@ -412,7 +413,7 @@ def locate_walk(nodes, tri, nb, points, seeds, nch):
     return out
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("order")
 def permute_rows(start, size, cols, vals, gx, gy, order):
     """Rows ``s`` (``cols[start[s]:start[s] + size[s]]``) moved to CSR rows ``order[s]``.
 
@@ -475,7 +476,7 @@ def path_order(points, x0, y0, sx, sy, k):
     return order
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("order")
 def gather_rows(points, order):
     """``points[order]`` for a ``(p, 2)`` array, in parallel."""
     out = np.empty((order.shape[0], 2))

@@ -11,6 +11,7 @@ import numba
 import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
+from .._parallel import parallel_kernel
 
 #: Query kinds.
 INTERSECT, BALL_CLOSED, BALL_OPEN = 0, 1, 2
@@ -38,7 +39,7 @@ def _wrap_any(d, period):
     return d
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("perm")
 def sort_within(keys, perm, size):
     """Sort ``perm`` by ``keys[perm]`` inside consecutive runs of ``size`` items."""
     n = perm.shape[0]
@@ -52,7 +53,7 @@ def sort_within(keys, perm, size):
             perm[a + k] = idx[order[k]]
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("count")
 def build_level(cen, half, first, cnt, start, count, fanout, out_start, period):
     """Parent boxes of ``count`` consecutive entries starting at ``start``.
 
@@ -189,7 +190,7 @@ def _traverse(cen, half, first, cnt, nbox, qc, qh, i, r2, kind, period, out, wri
     return hits
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("qcen")
 def query(cen, half, first, cnt, nbox, depth, fanout, order, qcen, qhalf, radius, kind,
           period, exclude_zero, nch, blo, bhi, qlo, qhi):
     """Bulk query: CSR ``(offsets, indices)`` of the boxes hit by each query.
@@ -206,8 +207,9 @@ def query(cen, half, first, cnt, nbox, depth, fanout, order, qcen, qhalf, radius
         stack = np.empty((depth + 2) * fanout + 1, dtype=np.int64)
         for i in range(ch * q // nch, (ch + 1) * q // nch):
             r2 = radius[i] * radius[i]
-            counts[i] = _traverse(cen, half, first, cnt, nbox, qcen, qhalf, i, r2, kind,
-                                  period, dummy, -1, exclude_zero, stack, blo, bhi, qlo, qhi)
+            counts[i] = _traverse(cen, half, first, cnt, nbox, qcen, qhalf, i, r2, kind,  # an int64
+                                  period, dummy, np.int64(-1), exclude_zero, stack,  # -1: one
+                                  blo, bhi, qlo, qhi)             # compiled _traverse, not two
     offsets = np.zeros(q + 1, dtype=np.int64)
     for i in range(q):
         offsets[i + 1] = offsets[i] + counts[i]
@@ -261,7 +263,7 @@ def _nearest_one(cen, half, first, cnt, nbox, order, points, i, period, root, st
     return bi, bd
 
 
-@numba.njit(cache=True, parallel=True)
+@parallel_kernel("points")
 def nearest(cen, half, first, cnt, nbox, depth, fanout, order, points, period, nch):
     """Index of the nearest box to each point and its distance (branch and bound)."""
     q = points.shape[0]
