@@ -25,6 +25,7 @@ import numba
 
 from . import _compile  # noqa: F401  (says once when the kernels compile)
 from . import config
+from .errors import InputError
 
 __all__ = ["work_chunks", "one_thread", "parallel_kernel", "ParallelKernel", "always_parallel"]
 
@@ -83,7 +84,7 @@ class ParallelKernel:
     def __init__(self, py_func: Callable, work: str) -> None:
         names = list(inspect.signature(py_func).parameters)
         if work not in names:
-            raise ValueError(f"parallel_kernel: {py_func.__qualname__} has no parameter "
+            raise InputError(f"parallel_kernel: {py_func.__qualname__} has no parameter "
                              f"{work!r} (parameters {names})")
         self._position = names.index(work)
         self._work = work
