@@ -256,11 +256,18 @@ class Problem(Conditions, SurfaceCorrection, Dynamics):
         live = self.alive.astype(float)
         Vi = b.volumes[b.bond_i]
         if self.material.kind == "bond":
-            w = 0.5 * self.bond_stiffness * self.factor * self.weight * Vi / b.length * live
+            w = self.pmb_weights() * live
             return (self.A.T @ sp.diags(w) @ self.A).tocsr()
         w = self.alpha[b.bond_i] * self.factor * self.weight * Vi * live
         dil = self.T.T @ sp.diags(self.bulk * b.volumes) @ self.T
         return (dil + self.Edev.T @ sp.diags(w) @ self.Edev).tocsr()
+
+    def pmb_weights(self) -> np.ndarray:
+        """``(b,)`` the PMB stiffness of every bond, live or not: the stiffness is
+        ``A^T diag(w alive) A`` (`stiffness`)."""
+        b = self.body
+        return 0.5 * self.bond_stiffness * self.factor * self.weight * b.volumes[b.bond_i] / \
+            b.length
 
     def stress_tensor(self, u: np.ndarray) -> np.ndarray:
         """Stress of every point from its bonds, ``(n, d, d)`` (``dW_i / d eps`` for a
