@@ -60,6 +60,7 @@ from cnem.demos import growth_two_holes as plate
 from cnem.geometry.ridge import ridge_path
 from cnem.pd.critical_stretch import fracture_energy
 from cnem.pd.quasistatic import load_drop, quasistatic
+from cnem.pd.sequential import sequential
 
 if TYPE_CHECKING:
     from typing import Sequence
@@ -114,15 +115,20 @@ def _first_breaking_factor(prob):
     return prob.material.stretch_limit(2, prob.plane, b.horizon) / float(stretch.max())
 
 
-def _pd(cloud, model, horizon_factor, factor_step, factor_max, max_rounds, load_steps):
+def _pd(cloud, model, horizon_factor, factor_step, factor_max, max_rounds, load_steps,
+        solver="adr", max_solves=100_000):
     body, prob = _pd_problem(cloud, model, horizon_factor)
     start = _first_breaking_factor(prob)
-    factors = start * np.arange(1.0, factor_max / start + 1e-9, factor_step)[:load_steps]
-    # the PMB kernel on one thread: on a shared, busy machine two threads stall each
-    # other (measured 20x slower per force evaluation at a load average of 18)
-    with one_thread():
-        run = quasistatic(prob, factors, stop=load_drop(0.2), max_rounds=max_rounds,
-                          progress=False)
+    if solver == "sequential":
+        run = sequential(prob, factor_max, stop=load_drop(0.2), max_solves=max_solves,
+                         tol=1e-8, progress=False)
+    else:
+        factors = start * np.arange(1.0, factor_max / start + 1e-9, factor_step)[:load_steps]
+        # the PMB kernel on one thread: on a shared, busy machine two threads stall each
+        # other (measured 20x slower per force evaluation at a load average of 18)
+        with one_thread():
+            run = quasistatic(prob, factors, stop=load_drop(0.2), max_rounds=max_rounds,
+                              progress=False)
     started = next((s.factor for s in run.steps if s.broken), np.nan)
     paths = []
     for tip in TIPS:
@@ -192,15 +198,18 @@ def compare(cnem_path: np.ndarray, pd_path: np.ndarray, other_cnem: np.ndarray,
 
 def study(h: float, *, model: str = "bond", horizon_factor: float = 3.0, increment: float = 1.0,
           steps: int = 12, factor_step: float = 0.02, factor_max: float = 1.5,
-          max_rounds: int = 100, load_steps: int | None = None) -> dict:
-    """Both methods on the regular cloud of spacing ``h``; one dict."""
+          max_rounds: int = 100, load_steps: int | None = None, solver: str = "adr",
+          max_solves: int = 100_000) -> dict:
+    """Both methods on the irregular cloud of spacing ``h``; one dict. ``solver``: the PD
+    load stepping, ``"adr"`` (`cnem.pd.quasistatic`, load steps of ``factor_step``) or
+    ``"sequential"`` (`cnem.pd.sequential`, event by event, at most ``max_solves``)."""
     dom = plate.domain(h)
     cloud = cnem.nodes.irregular(dom, h, seed=0)
     t0 = time.perf_counter()
     cpaths, c_factor, hist = _cnem(dom, cloud, increment, steps)
     t1 = time.perf_counter()
     body, run, ppaths, start, started = _pd(cloud, model, horizon_factor, factor_step, factor_max,
-                                            max_rounds, load_steps)
+                                            max_rounds, load_steps, solver, max_solves)
     t2 = time.perf_counter()
     rows = [compare(cpaths[i], ppaths[i], cpaths[1 - i], ppaths[1 - i], DIRECTIONS[i], increment,
                     h) for i in range(2)]
@@ -211,6 +220,54 @@ def study(h: float, *, model: str = "bond", horizon_factor: float = 3.0, increme
                 pd_broken=int(run.array("broken").sum()),
                 critical_stretch=run.problem.material.stretch_limit(2, "strain", body.horizon),
                 points=body.points, damage=run.damage, seconds=(t1 - t0, t2 - t1))
+
+
+def first_breaks(h: float, *, model: str = "bond", horizon_factor: float = 3.0) -> dict:
+    """Where the PD body breaks first, against C-NEM, on the cloud of spacing ``h``.
+
+    From the elastic PD solution at factor 1 (the linearised stretches ``s_1``): the load
+    factor ``s_c / max s_1`` at which the first bond breaks among the bonds whose midpoint
+    lies within one horizon of each notch tip, and of a hole's edge; and C-NEM's critical
+    load factor of the initial cracks (``K_eq = K_Ic``).
+
+    Returns
+    -------
+    dict
+        ``h``, ``horizon``, ``nodes``, ``critical_stretch``, ``hole``, ``notch`` (the two
+        tips), ``cnem``, ``seconds``.
+    """
+    t0 = time.perf_counter()
+    dom = plate.domain(h)
+    cloud = cnem.nodes.irregular(dom, h, seed=0)
+    _, c_factor, _ = _cnem(dom, cloud, 1.0, 1)
+    body, prob = _pd_problem(cloud, model, horizon_factor)
+    b, u = body, prob.solve().u
+    s1 = (prob.unit * (u[b.bond_j] - u[b.bond_i])).sum(axis=1) / b.length
+    limit = prob.material.stretch_limit(2, prob.plane, b.horizon)
+    mid = b.points[b.bond_i] + 0.5 * b.xi
+    edge = np.min([np.hypot(*(mid - c).T) - plate.R for c in plate.HOLES], axis=0)
+    notch = [limit / s1[np.hypot(*(mid - tip).T) < b.horizon].max() for tip in TIPS]
+    return dict(h=h, horizon=b.horizon, nodes=len(b), critical_stretch=limit,
+                hole=limit / s1[edge < b.horizon].max(), notch=notch, cnem=c_factor,
+                seconds=time.perf_counter() - t0)
+
+
+def breaks_table(rows: list) -> str:
+    """`first_breaks` of several spacings, one line each."""
+    lines = [f"{'h':>6} {'delta':>6} {'nodes':>6} {'s_c':>7} | {'first break: hole':>17} "
+             f"{'notch L':>7} {'notch R':>7} {'C-NEM':>6} | {'hole/notch':>10} "
+             f"{'hole/C-NEM':>10} {'notch/C-NEM':>11}"]
+    for r in rows:
+        notch = min(r["notch"])
+        lines.append(f"{r['h']:>6.4f} {r['horizon']:>6.3f} {r['nodes']:>6d} "
+                     f"{r['critical_stretch']:>7.4f} | {r['hole']:>17.4f} {r['notch'][0]:>7.4f} "
+                     f"{r['notch'][1]:>7.4f} {r['cnem']:>6.4f} | {r['hole'] / notch:>10.3f} "
+                     f"{r['hole'] / r['cnem']:>10.3f} {notch / r['cnem']:>11.3f}")
+    lines.append("load factors (multiples of the 0.1 mm pull) of the first broken bond within one "
+                 "horizon of a hole's edge / of each notch tip (elastic PD solution), and C-NEM's "
+                 "critical load factor; the notch (and growth from it) comes first where "
+                 "hole/notch > 1")
+    return "\n".join(lines)
 
 
 def table(results: list) -> str:
@@ -266,24 +323,34 @@ def _plot(results, path):
 def main(spacings: Sequence[float] = (0.25,), *, model: str = "bond", steps: int = 12,
          factor_step: float = 0.02, factor_max: float = 1.5, max_rounds: int = 100,
          load_steps: int | None = None, outdir: str = "results/growth_pd_vs_cnem",
-         plot: bool = True) -> dict:
+         plot: bool = True, solver: str = "adr", max_solves: int = 100_000,
+         scaling: bool = False) -> dict:
     """Run `study` at every spacing; print the table, draw the paths.
 
     ``load_steps`` caps the PD load steps (from the first-breaking factor up by
     ``factor_step`` of it to ``factor_max``); ``max_rounds`` bounds each step's
-    break-and-settle rounds.
+    break-and-settle rounds; ``solver``, ``max_solves``: see `study`. With ``scaling``,
+    only `first_breaks` at every spacing (`breaks_table`, ``breaks.txt``).
 
     Returns
     -------
     dict
-        ``results`` (one dict per spacing, see `study`), ``table`` (str), ``files``.
+        ``results`` (one dict per spacing, see `study` or `first_breaks`), ``table`` (str),
+        ``files``.
     """
     out = pathlib.Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
+    if scaling:
+        rows = [first_breaks(h, model=model) for h in spacings]
+        text = breaks_table(rows)
+        print(text)
+        (out / "breaks.txt").write_text(text + "\n")
+        return dict(results=rows, table=text, files=[])
     results = []
     for h in spacings:
         r = study(h, model=model, steps=steps, factor_step=factor_step, factor_max=factor_max,
-                  max_rounds=max_rounds, load_steps=load_steps)
+                  max_rounds=max_rounds, load_steps=load_steps, solver=solver,
+                  max_solves=max_solves)
         print(f"h = {h:g}: C-NEM {r['seconds'][0]:.0f} s, PD {r['seconds'][1]:.0f} s "
               f"({r['pd_steps']} load steps, {r['pd_broken']} bonds broken, "
               f"{r['pd_incomplete']} steps cut at max_rounds, stopped: {r['pd_stopped']}; "
@@ -311,9 +378,18 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> dict:
     parser.add_argument("--factor-step", type=float, default=0.02,
                         help="PD load step, a fraction of the first-breaking factor")
     parser.add_argument("--factor-max", type=float, default=1.5, help="largest PD load factor")
+    parser.add_argument("--solver", choices=("adr", "sequential"), default="adr",
+                        help="PD load stepping: ADR load steps, or event by event with linear "
+                             "solves (cnem.pd.sequential)")
+    parser.add_argument("--max-solves", type=int, default=100_000,
+                        help="most linear solves of --solver sequential")
+    parser.add_argument("--scaling", action="store_true",
+                        help="only the first-break load factors at holes and notches against "
+                             "C-NEM's, at every --h")
     args = parser.parse_args(argv)
     return main(args.h, model=args.model, steps=args.steps, factor_step=args.factor_step,
-                factor_max=args.factor_max, outdir=args.out, plot=not args.no_plot)
+                factor_max=args.factor_max, outdir=args.out, plot=not args.no_plot,
+                solver=args.solver, max_solves=args.max_solves, scaling=args.scaling)
 
 
 if __name__ == "__main__":
