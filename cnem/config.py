@@ -17,7 +17,8 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "ROU
            "SPACING_NEIGHBOURS", "SPACING_COUNT_TOL", "SPACING_BISECTIONS", "FANOUT",
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
            "MESH_NODES_TRIES", "MESH_NODES_RTOL", "DIRECT_NNZ", "NEWTON_FORCING",
-           "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "MAX_INTERACTIONS",
+           "NEWTON_INNER_FLOOR", "MIN_GAUSS", "CPD_CHUNK", "CPD_DEGENERATE", "LIVE_MOMENT_CUTOFF",
+           "MAX_INTERACTIONS",
            "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER",
            "DT_LIMIT", "COORDINATE_LIMIT", "DIRECT_MEMORY", "DIRECT_FILL",
            "CG_MAXITER", "SIF_DISCS", "SIF_REACH", "SIF_INNER", "SIF_STRAIGHTNESS",
@@ -177,6 +178,13 @@ CPD_CHUNK = 1 << 18
 #: stretch is undefined and their reference measure, the energy's weight,
 #: vanishes; they are left out.
 CPD_DEGENERATE = 1e-8
+
+#: A point of the state-based solid whose bonds broke takes its dilatation from the
+#: moment tensor of its live bonds (`cnem.pd.moments.live_inverse`), restricted to the
+#: directions in which that tensor keeps at least this fraction of the largest eigenvalue
+#: of the reference one: a direction almost emptied of bonds carries no dilatation
+#: (instead of a stiffness growing as 1 / eigenvalue).
+LIVE_MOMENT_CUTOFF = 0.1
 
 #: Most CPD pairs or triplets a body may hold (about 64 bytes each are stored);
 #: above it `cnem.errors.LimitError`.

@@ -39,7 +39,8 @@ def setup(pd, case, **body_options):
       breaking;
     * ``cube``: a bond-based 3-D block of 8^3 points blown apart by a radial velocity,
       bonds breaking;
-    * ``relax``: a state-based plate clamped on the left and stretched on the right.
+    * ``relax``: a state-based plate clamped on the left and stretched on the right
+      (with every bond across ``x = CUT`` broken: the ``cut`` launch, `cut_forces`).
     """
     pts = plate()
     horizon = 3.015 * H
@@ -69,6 +70,27 @@ def setup(pd, case, **body_options):
     return prob
 
 
+def cut(prob, points_i, points_j):
+    """Break every bond of ``prob`` from one side of ``x = CUT`` to the other (``points_i``,
+    ``points_j`` the two ends of its bonds); returns the number broken."""
+    crossing = (points_i[:, 0] < CUT) != (points_j[:, 0] < CUT)
+    prob.alive[crossing] = 0
+    if hasattr(prob, "alive_reverse"):
+        prob.alive_reverse[crossing] = 0
+    return int(crossing.sum())
+
+
+CUT = 0.5 * LENGTH + 0.3 * H     # the line of the ``cut`` case (between two columns of points)
+
+
+def cut_field(p):
+    """A displacement field of the ``cut`` case, different on the two sides, m."""
+    x, y = p[:, 0] / LENGTH, p[:, 1] / LENGTH
+    left = (p[:, 0] < CUT)[:, None]
+    return 1e-5 * np.where(left, np.column_stack([np.sin(3 * x + y), x * y]),
+                           np.column_stack([y * y - x, np.cos(2 * y - 5 * x)]))
+
+
 def blast(p):
     """Initial velocity of the cube: radial from its centre, m/s."""
     return 0.4 * (p - 4.0 * H) / H                 # the centre of the 8^3 block
@@ -89,10 +111,11 @@ def run(prob, case, **options):
 
 def main(out, cases):
     """The ``cases`` with `cnem.pd.distributed` (``"restart"``: a checkpointed and a resumed
-    bond-based run, with VTU frames); rank 0 saves the results to ``out``."""
+    bond-based run, with VTU frames; ``"cut"``: `cut_forces`); rank 0 saves the results to
+    ``out``."""
     import cnem.pd.distributed as dpd
     results = {}
-    for case in (c for c in cases if c != "restart"):
+    for case in (c for c in cases if c not in ("restart", "cut")):
         prob = setup(dpd, case)
         res = run(prob, case)
         results[f"{case}_u"] = res.u
@@ -101,9 +124,24 @@ def main(out, cases):
             results[f"{case}_energy"] = res.energy
     if "restart" in cases:
         results.update(restart(dpd, os.path.dirname(out)))
+    if "cut" in cases:
+        results.update(cut_forces(dpd))
     from mpi4py import MPI
     if MPI.COMM_WORLD.rank == 0:
         np.savez(out, **results)
+
+
+def cut_forces(dpd):
+    """The ``relax`` plate with every bond across ``x = CUT`` broken: its internal force
+    (per unit volume) and dilatation at `cut_field`, gathered."""
+    prob = setup(dpd, "relax")
+    b = prob.body
+    cut(prob, b.points[b.bond_i], b.points[b.bond_j])
+    prob.ops.follow_breaking(prob.alive)
+    u = np.ascontiguousarray(cut_field(b.points))
+    force, _ = prob.internal_force(u, np.inf)
+    return {"cut_force": prob.gather(force),
+            "cut_theta": prob.gather(prob.ops.dilatation(u, prob.alive))}
 
 
 def restart(dpd, folder):

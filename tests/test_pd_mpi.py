@@ -4,7 +4,8 @@ The cases of `pd_mpi_cases` run under ``mpiexec -n 2``, ``-n 3`` and ``-n 4``
 (oversubscribed on small machines) in subprocesses, and on one rank in this
 process; each is compared with the serial `cnem.pd` run of the same problem:
 the dynamic runs (bond- and state-based with bond breaking, a periodic body) give
-the serial displacements to 1e-12 relative and the same broken bonds, the
+the serial displacements to 1e-12 relative and the same broken bonds, a state-based
+body cut in two by broken bonds the serial forces and dilatations, the
 relaxation the serial equilibrium to its tolerance, a resumed run the
 uninterrupted one, and the VTU pieces with their ``.pvtu`` index the gathered
 displacements.
@@ -56,7 +57,7 @@ def serial():
 
 
 #: what each launch runs (4 ranks, oversubscribed on 2 cores: the bond-based case only)
-LAUNCHES = {2: C.CASES + ("restart",), 3: C.CASES + ("restart",), 4: ("bond",)}
+LAUNCHES = {2: C.CASES + ("restart", "cut"), 3: C.CASES + ("restart", "cut"), 4: ("bond",)}
 
 
 def _skip_unless_run(ranks, case):
@@ -127,6 +128,37 @@ def test_relaxation_reaches_the_serial_equilibrium(serial, distributed):
     scale = np.abs(static).max()
     assert np.abs(ref.u - static).max() <= 1e-6 * scale          # the serial ADR itself
     assert np.abs(res["relax_u"] - static).max() <= 1e-6 * scale
+
+
+def _serial_cut():
+    """Force per unit volume and dilatation of the serial ``cut`` case at `C.cut_field`."""
+    prob = C.setup(pd, "relax")
+    b = prob.body
+    assert C.cut(prob, b.points[b.bond_i], b.points[b.bond_j]) > 50
+    u = C.cut_field(b.points).reshape(-1)
+    return -(prob.stiffness() @ u).reshape(-1, 2) / b.volumes[:, None], prob.T @ u
+
+
+def _assert_same_cut(force, theta):
+    ref_force, ref_theta = _serial_cut()
+    assert np.abs(force - ref_force).max() <= 1e-12 * np.abs(ref_force).max()
+    assert np.abs(theta - ref_theta).max() <= 1e-12 * np.abs(ref_theta).max()
+
+
+@pytest.mark.slow
+@needs_mpi
+def test_one_rank_gives_the_serial_forces_of_a_cut_body():
+    import cnem.pd.distributed as dpd
+    res = C.cut_forces(dpd)
+    _assert_same_cut(res["cut_force"], res["cut_theta"])
+
+
+@pytest.mark.slow
+@needs_mpi
+def test_ranks_give_the_serial_forces_of_a_cut_body(distributed):
+    ranks, res = distributed
+    _skip_unless_run(ranks, "cut")
+    _assert_same_cut(res["cut_force"], res["cut_theta"])
 
 
 @pytest.mark.slow

@@ -31,15 +31,46 @@ boundary or the other crack, and the load factor at which growth starts.
 Expected result
 ---------------
 C-NEM sends the two cracks between the holes (its growth is LEFM, independent of
-K_Ic except for the load factor). PD has a material length, the horizon: at
-delta = 1.4 mm (h = 0.5 mm), longer than the 1 mm notches and of the order of the
-hole radius, its first bonds break at about 0.4 of C-NEM's critical load, between
-the holes rather than at the notches, and the plate fails through a diffuse
-damage band from hole to hole: no PD crack runs from a notch, and the table says
-so (NaN rows). The PD paths follow the notches only where delta is well below the
-notch length (finer clouds; more PD load steps). The picture
-(``pd_cnem_paths.png``) draws both paths over the geometry on the PD damage
-field, one panel per spacing.
+K_Ic except for the load factor). PD has a material length, the horizon, and so an
+intrinsic strength ``~ E s_c`` with ``s_c ~ delta^-1/2``: where it breaks first is
+a race between the holes (a stress concentration: first break at a load
+``~ delta^-1/2``) and the notches (a crack: a load that does not scale with delta
+once delta is below the notch length). ``--scaling`` measures it from the elastic
+PD solution (PMB, m = 3, seed 0; load factors of the 0.1 mm pull; C-NEM's critical
+factor 0.51 - 0.56):
+
+======  =====  ======  ==========  ============  ==========
+h (mm)  delta  nodes   hole/notch  hole/C-NEM    notch/C-NEM
+======  =====  ======  ==========  ============  ==========
+0.5     1.41   795     0.44        0.38          0.86
+0.25    0.73   2995    0.74        0.57          0.77
+0.125   0.37   11573   0.83        0.76          0.91
+0.0625  0.19   45487   1.22        1.19          0.98
+======  =====  ======  ==========  ============  ==========
+
+(the notch column takes the weaker tip; the hole factors are 0.211, 0.301, 0.389,
+0.610). The hole's factor grows as delta^-0.54 over the three finer clouds (0.5
+expected); the notch's scatters by up to 40 % between the two tips of one cloud
+(0.665 / 0.467 at h = 0.125), with no trend in delta: it is set by the shortest
+bond at the tip node (0.21 against 0.07 mm long there), the K field being
+singular. No bond crosses either notch. The largest notch-tip stretch is 0.12 -
+0.30 of the one the LEFM (Williams) field with C-NEM's K gives on the same bonds:
+within a horizon of the tip PD is not the K field.
+Above h = 0.1 the holes break first and no PD crack runs from a notch (the table
+says so, NaN rows); at h = 0.0625 (45k nodes) both cracks start at the notches.
+ADR load steps are then too slow (1300 - 2200 iterations per settle at 11k nodes
+already, 70 - 100 s each at a load average of 6.5), the event-by-event linear
+solves of ``--solver sequential`` (`cnem.pd.sequential`, about 2 s a solve at 45k
+nodes) grew the PD cracks in 19 minutes (30 load factors, 0.50 to 0.66) by about
+2 mm from each notch, with the ridge threshold 0.35 (``--threshold``: a clean PD
+crack's face points lose about 40 % of their bonds, so no point reaches 0.5 near
+the tips). Measured then (C-NEM on the same 45k nodes, 6 increments): first kink
+C-NEM 16.8 / 16.8 degrees, PD 28.3 / 25.0 (left / right); Hausdorff distance
+0.38 / 0.19 mm over the first 2.1 / 1.7 mm; neither path had reached a hole. PD
+starts at factor 0.50 (first bond), C-NEM's critical factor is 0.51; the PD
+crack needs 0.64 to run. A full PD path to the holes is not reached in 20
+minutes. The picture (``pd_cnem_paths.png``) draws both paths over the geometry
+on the PD damage field, one panel per spacing.
 """
 
 from __future__ import annotations
@@ -60,6 +91,7 @@ from cnem.demos import growth_two_holes as plate
 from cnem.geometry.ridge import ridge_path
 from cnem.pd.critical_stretch import fracture_energy
 from cnem.pd.quasistatic import load_drop, quasistatic
+from cnem.pd.sequential import sequential
 
 if TYPE_CHECKING:
     from typing import Sequence
@@ -114,21 +146,26 @@ def _first_breaking_factor(prob):
     return prob.material.stretch_limit(2, prob.plane, b.horizon) / float(stretch.max())
 
 
-def _pd(cloud, model, horizon_factor, factor_step, factor_max, max_rounds, load_steps):
+def _pd(cloud, model, horizon_factor, factor_step, factor_max, max_rounds, load_steps,
+        solver="adr", max_solves=100_000, threshold=0.5):
     body, prob = _pd_problem(cloud, model, horizon_factor)
     start = _first_breaking_factor(prob)
-    factors = start * np.arange(1.0, factor_max / start + 1e-9, factor_step)[:load_steps]
-    # the PMB kernel on one thread: on a shared, busy machine two threads stall each
-    # other (measured 20x slower per force evaluation at a load average of 18)
-    with one_thread():
-        run = quasistatic(prob, factors, stop=load_drop(0.2), max_rounds=max_rounds,
-                          progress=False)
+    if solver == "sequential":
+        run = sequential(prob, factor_max, stop=load_drop(0.2), max_solves=max_solves,
+                         tol=1e-8, progress=False)
+    else:
+        factors = start * np.arange(1.0, factor_max / start + 1e-9, factor_step)[:load_steps]
+        # the PMB kernel on one thread: on a shared, busy machine two threads stall each
+        # other (measured 20x slower per force evaluation at a load average of 18)
+        with one_thread():
+            run = quasistatic(prob, factors, stop=load_drop(0.2), max_rounds=max_rounds,
+                              progress=False)
     started = next((s.factor for s in run.steps if s.broken), np.nan)
     paths = []
     for tip in TIPS:
         near = np.hypot(*(body.points - tip).T) < body.horizon
-        paths.append(ridge_path(body.points, run.damage, tip) if (run.damage[near] >= 0.5).any()
-                     else tip[None].copy())
+        paths.append(ridge_path(body.points, run.damage, tip, threshold=threshold)
+                     if (run.damage[near] >= threshold).any() else tip[None].copy())
     return body, run, paths, start, started
 
 
@@ -192,25 +229,79 @@ def compare(cnem_path: np.ndarray, pd_path: np.ndarray, other_cnem: np.ndarray,
 
 def study(h: float, *, model: str = "bond", horizon_factor: float = 3.0, increment: float = 1.0,
           steps: int = 12, factor_step: float = 0.02, factor_max: float = 1.5,
-          max_rounds: int = 100, load_steps: int | None = None) -> dict:
-    """Both methods on the regular cloud of spacing ``h``; one dict."""
+          max_rounds: int = 100, load_steps: int | None = None, solver: str = "adr",
+          max_solves: int = 100_000, threshold: float = 0.5) -> dict:
+    """Both methods on the irregular cloud of spacing ``h``; one dict. ``solver``: the PD
+    load stepping, ``"adr"`` (`cnem.pd.quasistatic`, load steps of ``factor_step``) or
+    ``"sequential"`` (`cnem.pd.sequential`, event by event, at most ``max_solves``);
+    ``threshold``: the damage of the PD ridge paths."""
     dom = plate.domain(h)
     cloud = cnem.nodes.irregular(dom, h, seed=0)
     t0 = time.perf_counter()
     cpaths, c_factor, hist = _cnem(dom, cloud, increment, steps)
     t1 = time.perf_counter()
     body, run, ppaths, start, started = _pd(cloud, model, horizon_factor, factor_step, factor_max,
-                                            max_rounds, load_steps)
+                                            max_rounds, load_steps, solver, max_solves,
+                                            threshold)
     t2 = time.perf_counter()
     rows = [compare(cpaths[i], ppaths[i], cpaths[1 - i], ppaths[1 - i], DIRECTIONS[i], increment,
                     h) for i in range(2)]
     return dict(h=h, horizon=body.horizon, nodes=len(body), rows=rows, cnem_paths=cpaths,
+                threshold=threshold,
                 pd_paths=ppaths, cnem_factor=c_factor, pd_first_bond=start, pd_started=started,
                 pd_steps=len(run.steps), pd_stopped=run.stopped,
                 pd_incomplete=int(sum(not s.complete for s in run.steps)),
                 pd_broken=int(run.array("broken").sum()),
                 critical_stretch=run.problem.material.stretch_limit(2, "strain", body.horizon),
                 points=body.points, damage=run.damage, seconds=(t1 - t0, t2 - t1))
+
+
+def first_breaks(h: float, *, model: str = "bond", horizon_factor: float = 3.0) -> dict:
+    """Where the PD body breaks first, against C-NEM, on the cloud of spacing ``h``.
+
+    From the elastic PD solution at factor 1 (the linearised stretches ``s_1``): the load
+    factor ``s_c / max s_1`` at which the first bond breaks among the bonds whose midpoint
+    lies within one horizon of each notch tip, and of a hole's edge; and C-NEM's critical
+    load factor of the initial cracks (``K_eq = K_Ic``).
+
+    Returns
+    -------
+    dict
+        ``h``, ``horizon``, ``nodes``, ``critical_stretch``, ``hole``, ``notch`` (the two
+        tips), ``cnem``, ``seconds``.
+    """
+    t0 = time.perf_counter()
+    dom = plate.domain(h)
+    cloud = cnem.nodes.irregular(dom, h, seed=0)
+    _, c_factor, _ = _cnem(dom, cloud, 1.0, 1)
+    body, prob = _pd_problem(cloud, model, horizon_factor)
+    b, u = body, prob.solve().u
+    s1 = (prob.unit * (u[b.bond_j] - u[b.bond_i])).sum(axis=1) / b.length
+    limit = prob.material.stretch_limit(2, prob.plane, b.horizon)
+    mid = b.points[b.bond_i] + 0.5 * b.xi
+    edge = np.min([np.hypot(*(mid - c).T) - plate.R for c in plate.HOLES], axis=0)
+    notch = [limit / s1[np.hypot(*(mid - tip).T) < b.horizon].max() for tip in TIPS]
+    return dict(h=h, horizon=b.horizon, nodes=len(b), critical_stretch=limit,
+                hole=limit / s1[edge < b.horizon].max(), notch=notch, cnem=c_factor,
+                seconds=time.perf_counter() - t0)
+
+
+def breaks_table(rows: list) -> str:
+    """`first_breaks` of several spacings, one line each."""
+    lines = [f"{'h':>6} {'delta':>6} {'nodes':>6} {'s_c':>7} | {'first break: hole':>17} "
+             f"{'notch L':>7} {'notch R':>7} {'C-NEM':>6} | {'hole/notch':>10} "
+             f"{'hole/C-NEM':>10} {'notch/C-NEM':>11}"]
+    for r in rows:
+        notch = min(r["notch"])
+        lines.append(f"{r['h']:>6.4f} {r['horizon']:>6.3f} {r['nodes']:>6d} "
+                     f"{r['critical_stretch']:>7.4f} | {r['hole']:>17.4f} {r['notch'][0]:>7.4f} "
+                     f"{r['notch'][1]:>7.4f} {r['cnem']:>6.4f} | {r['hole'] / notch:>10.3f} "
+                     f"{r['hole'] / r['cnem']:>10.3f} {notch / r['cnem']:>11.3f}")
+    lines.append("load factors (multiples of the 0.1 mm pull) of the first broken bond within one "
+                 "horizon of a hole's edge / of each notch tip (elastic PD solution), and C-NEM's "
+                 "critical load factor; the notch (and growth from it) comes first where "
+                 "hole/notch > 1")
+    return "\n".join(lines)
 
 
 def table(results: list) -> str:
@@ -250,7 +341,8 @@ def _plot(results, path):
             ax.plot(*cp.T, "o-", color="tab:blue", ms=3, lw=2,
                     label="C-NEM (max hoop, 1 mm steps)" if k == 0 else None, zorder=3)
             ax.plot(*pp.T, "s-", color="tab:red", ms=2.5, lw=1.5,
-                    label="PD ridge of damage ≥ 0.5" if k == 0 else None, zorder=4)
+                    label=f"PD ridge of damage ≥ {r.get('threshold', 0.5):g}" if k == 0 else None,
+                    zorder=4)
         ax.set_aspect("equal")
         ax.set_xlim(-0.3, plate.L + 0.3)
         ax.set_ylim(-0.3, plate.B + 0.3)
@@ -269,24 +361,34 @@ def _plot(results, path):
 def main(spacings: Sequence[float] = (0.25,), *, model: str = "bond", steps: int = 12,
          factor_step: float = 0.02, factor_max: float = 1.5, max_rounds: int = 100,
          load_steps: int | None = None, outdir: str = "results/growth_pd_vs_cnem",
-         plot: bool = True) -> dict:
+         plot: bool = True, solver: str = "adr", max_solves: int = 100_000,
+         scaling: bool = False, threshold: float = 0.5) -> dict:
     """Run `study` at every spacing; print the table, draw the paths.
 
     ``load_steps`` caps the PD load steps (from the first-breaking factor up by
     ``factor_step`` of it to ``factor_max``); ``max_rounds`` bounds each step's
-    break-and-settle rounds.
+    break-and-settle rounds; ``solver``, ``max_solves``: see `study`. With ``scaling``,
+    only `first_breaks` at every spacing (`breaks_table`, ``breaks.txt``).
 
     Returns
     -------
     dict
-        ``results`` (one dict per spacing, see `study`), ``table`` (str), ``files``.
+        ``results`` (one dict per spacing, see `study` or `first_breaks`), ``table`` (str),
+        ``files``.
     """
     out = pathlib.Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
+    if scaling:
+        rows = [first_breaks(h, model=model) for h in spacings]
+        text = breaks_table(rows)
+        print(text)
+        (out / "breaks.txt").write_text(text + "\n")
+        return dict(results=rows, table=text, files=[])
     results = []
     for h in spacings:
         r = study(h, model=model, steps=steps, factor_step=factor_step, factor_max=factor_max,
-                  max_rounds=max_rounds, load_steps=load_steps)
+                  max_rounds=max_rounds, load_steps=load_steps, solver=solver,
+                  max_solves=max_solves, threshold=threshold)
         print(f"h = {h:g}: C-NEM {r['seconds'][0]:.0f} s, PD {r['seconds'][1]:.0f} s "
               f"({r['pd_steps']} load steps, {r['pd_broken']} bonds broken, "
               f"{r['pd_incomplete']} steps cut at max_rounds, stopped: {r['pd_stopped']}; "
@@ -314,9 +416,22 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> dict:
     parser.add_argument("--factor-step", type=float, default=0.02,
                         help="PD load step, a fraction of the first-breaking factor")
     parser.add_argument("--factor-max", type=float, default=1.5, help="largest PD load factor")
+    parser.add_argument("--solver", choices=("adr", "sequential"), default="adr",
+                        help="PD load stepping: ADR load steps, or event by event with linear "
+                             "solves (cnem.pd.sequential)")
+    parser.add_argument("--max-solves", type=int, default=100_000,
+                        help="most linear solves of --solver sequential")
+    parser.add_argument("--scaling", action="store_true",
+                        help="only the first-break load factors at holes and notches against "
+                             "C-NEM's, at every --h")
+    parser.add_argument("--threshold", type=float, default=0.5,
+                        help="damage of the PD ridge paths (a clean PD crack between two rows "
+                             "leaves its face points at about 0.4)")
     args = parser.parse_args(argv)
     return main(args.h, model=args.model, steps=args.steps, factor_step=args.factor_step,
-                factor_max=args.factor_max, outdir=args.out, plot=not args.no_plot)
+                factor_max=args.factor_max, outdir=args.out, plot=not args.no_plot,
+                solver=args.solver, max_solves=args.max_solves, scaling=args.scaling,
+                threshold=args.threshold)
 
 
 if __name__ == "__main__":

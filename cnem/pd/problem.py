@@ -19,6 +19,7 @@ from ..errors import (ConvergenceError, InputError, MaterialError, SolveError, U
 from . import _kernels as K
 from .correction import SurfaceCorrection
 from .dynamics import Dynamics
+from .moments import moment_tensors, live_inverse
 from ..material import PLANES
 from .solution import StaticSolution
 
@@ -109,26 +110,57 @@ class Problem(Conditions, SurfaceCorrection, Dynamics):
         return sp.csr_matrix((vals, (rows, cols)), shape=(nb, d * n))
 
     @cached_property
-    def gradient_weights(self) -> np.ndarray:
-        """``(b, d)`` ``g_b = w_b M_i^-1 xi_b`` of every bond ``b = (i, j)``, with the moment
-        tensors ``M_i = sum_b w_b xi_b xi_b^T`` (``w = beta V_j``): the nonlocal
-        displacement gradient of point ``i`` is ``sum_b (u_j - u_i) g_b^T``, exact for
-        linear fields also where the horizon is cut by a boundary.
+    def moments(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(M, M^-1)``, ``(n, d, d)`` each: the moment tensors ``M_i = sum_b w_b xi_b
+        xi_b^T`` of every point's reference family (``w = beta V_j``) and their inverses.
 
         Raises
         ------
-        ValueError
+        InputError
             A point whose bonds do not span every direction.
         """
-        b, d, n = self.body, self.dim, len(self.body)
-        w = self.weight
-        M = np.zeros((n, d, d))
-        np.add.at(M, b.bond_i, w[:, None, None] * b.xi[:, :, None] * b.xi[:, None, :])
+        b = self.body
+        M = moment_tensors(b.bond_i, b.xi, self.weight, len(b))
         if (np.linalg.det(M) <= 0).any():
             raise InputError(f"expected bonds spanning every direction at each point, received "
                              f"{int((np.linalg.det(M) <= 0).sum())} points with too few bonds; "
                              f"enlarge the horizon")
-        return np.einsum("bij,bj->bi", np.linalg.inv(M)[b.bond_i], b.xi) * w[:, None]
+        return M, np.linalg.inv(M)
+
+    @cached_property
+    def gradient_weights(self) -> np.ndarray:
+        """``(b, d)`` ``g_b = w_b M_i^-1 xi_b`` of every bond ``b = (i, j)``, with the moment
+        tensors ``M_i`` of the reference family (`moments`): the nonlocal displacement
+        gradient of point ``i`` is ``sum_b (u_j - u_i) g_b^T``, exact for linear fields
+        also where the horizon is cut by a boundary.
+
+        Raises
+        ------
+        InputError
+            A point whose bonds do not span every direction.
+        """
+        b = self.body
+        return np.einsum("bij,bj->bi", self.moments[1][b.bond_i], b.xi) * self.weight[:, None]
+
+    def live_gradient_weights(self) -> np.ndarray:
+        """``(b, d)`` `gradient_weights` of the live bonds: ``alive_b w_b M_i^+ xi_b`` with the
+        moment tensor of the live bonds of ``i`` (`cnem.pd.moments.live_inverse`) at the
+        points that lost bonds, the reference ``M_i^-1`` elsewhere."""
+        b = self.body
+        g = self.gradient_weights * self.alive[:, None]
+        dead = self.alive == 0
+        if not dead.any():
+            return g
+        hit = np.zeros(len(b), dtype=bool)
+        hit[b.bond_i[dead]] = True
+        rows = np.flatnonzero(hit)
+        w = self.weight * self.alive
+        live = moment_tensors(b.bond_i, b.xi, w, len(b))[rows]
+        inv = np.zeros_like(self.moments[1])
+        inv[rows] = live_inverse(live, self.moments[0][rows])
+        sel = hit[b.bond_i]
+        g[sel] = np.einsum("bij,bj->bi", inv[b.bond_i[sel]], b.xi[sel]) * w[sel, None]
+        return g
 
     def displacement_gradient(self, u: np.ndarray) -> np.ndarray:
         """Nonlocal displacement gradient of every point, ``(n, d, d)``,
@@ -148,22 +180,48 @@ class Problem(Conditions, SurfaceCorrection, Dynamics):
     def _state_operators(self):
         b, d, n = self.body, self.dim, len(self.body)
         w = self.weight
-        # the dilatation theta_i = sum w (u_j - u_i) . M_i^-1 xi: the trace of the gradient
-        g = self.gradient_weights
-        rows = np.repeat(b.bond_i, 2 * d)
-        cols = np.concatenate([d * b.bond_j[:, None] + np.arange(d),
-                               d * b.bond_i[:, None] + np.arange(d)], axis=1).reshape(-1)
-        vals = np.concatenate([g, -g], axis=1).reshape(-1)
-        #: dilatation operator theta = T u, (n, d n)
-        self.T = sp.csr_matrix((vals, (rows, cols)), shape=(n, d * n))
+        # the weighted volume m is of the reference family and stays so when bonds break
+        # (Silling et al. 2007, as Peridigm): damage softens the deviatoric energy through
+        # its live bonds only. The dilatation `T` sums the live bonds with their own moment
+        # tensors (`live_gradient_weights`): with the reference ones a rotation would dilate.
         self.m = np.bincount(b.bond_i, weights=w * b.length ** 2, minlength=n)
         k, mu = self.material.moduli(d, self.plane)
         self.bulk, self.shear = k, mu
         self.alpha = mu * d * (d + 2) / self.m
+        self._live_operators = None
+
+    def _state_live(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """``(T, Edev)`` of the bonds alive now (built again only after a bond broke)."""
+        cached = self._live_operators
+        if cached is not None and np.array_equal(cached[0], self.alive):
+            return cached[1], cached[2]
+        b, d, n = self.body, self.dim, len(self.body)
+        # the dilatation theta_i = sum over the live bonds of w (u_j - u_i) . M_i^-1 xi,
+        # M_i of the live bonds: the trace of their nonlocal gradient
+        g = self.live_gradient_weights()
+        rows = np.repeat(b.bond_i, 2 * d)
+        cols = np.concatenate([d * b.bond_j[:, None] + np.arange(d),
+                               d * b.bond_i[:, None] + np.arange(d)], axis=1).reshape(-1)
+        vals = np.concatenate([g, -g], axis=1).reshape(-1)
+        T = sp.csr_matrix((vals, (rows, cols)), shape=(n, d * n))
         # deviatoric extension e^d = E u = A u - (L / d) theta_i
         S = sp.csr_matrix((b.length / d, (np.arange(len(b.bond_i)), b.bond_i)),
                           shape=(len(b.bond_i), n))
-        self.Edev = (self.A - S @ self.T).tocsr()
+        Edev = (self.A - S @ T).tocsr()
+        self._live_operators = (self.alive.copy(), T, Edev)
+        return T, Edev
+
+    @property
+    def T(self) -> sp.csr_matrix:
+        """Dilatation operator ``theta = T u`` of the live bonds, sparse ``(n, d n)``: a broken
+        bond carries no dilatation (nor force) across a crack."""
+        return self._state_live()[0]
+
+    @property
+    def Edev(self) -> sp.csr_matrix:
+        """Deviatoric extension operator ``e^d = Edev u = A u - (L / d) theta_i`` (``theta``
+        of the live bonds), sparse ``(b, d n)``."""
+        return self._state_live()[1]
 
     def _linear_only(self, what):
         """Refuse CPD in the methods of the linear (bond- and state-based) models."""
@@ -198,11 +256,18 @@ class Problem(Conditions, SurfaceCorrection, Dynamics):
         live = self.alive.astype(float)
         Vi = b.volumes[b.bond_i]
         if self.material.kind == "bond":
-            w = 0.5 * self.bond_stiffness * self.factor * self.weight * Vi / b.length * live
+            w = self.pmb_weights() * live
             return (self.A.T @ sp.diags(w) @ self.A).tocsr()
         w = self.alpha[b.bond_i] * self.factor * self.weight * Vi * live
         dil = self.T.T @ sp.diags(self.bulk * b.volumes) @ self.T
         return (dil + self.Edev.T @ sp.diags(w) @ self.Edev).tocsr()
+
+    def pmb_weights(self) -> np.ndarray:
+        """``(b,)`` the PMB stiffness of every bond, live or not: the stiffness is
+        ``A^T diag(w alive) A`` (`stiffness`)."""
+        b = self.body
+        return 0.5 * self.bond_stiffness * self.factor * self.weight * b.volumes[b.bond_i] / \
+            b.length
 
     def stress_tensor(self, u: np.ndarray) -> np.ndarray:
         """Stress of every point from its bonds, ``(n, d, d)`` (``dW_i / d eps`` for a

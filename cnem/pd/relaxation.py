@@ -8,7 +8,8 @@ reached as the steady state of the damped fictitious dynamics
 
 * the time step ``dt = 1`` and the diagonal fictitious density
   ``lambda_ii = dt^2 / 4 sum_j |K_ij|`` (eq. 21; Gershgorin: every frequency
-  of ``Lambda^-1 K`` is at most 2, so the central difference is stable),
+  of ``Lambda^-1 K`` is at most 2, so the central difference is stable; raised
+  where a state-based stiffness row grows after bonds broke),
 * the damping ``c^n = 2 sqrt(u^T K^n_loc u / u^T u)`` from the diagonal
   local stiffness ``K^n_loc,ii = -(F^n_i - F^(n-1)_i) / (lambda_ii dt v^(n-1/2)_i)``
   (eqs. 17-18; ``c = 0`` when the quotient is not positive),
@@ -137,6 +138,7 @@ def load_steps(x: np.ndarray, forces: Callable[..., np.ndarray], density: np.nda
     forces : callable (breaking=inf) -> ((f,) ndarray, int)
         Out-of-balance force at ``x`` and the bonds broken beyond ``breaking``.
     density : (f,) ndarray
+        Fictitious density (``forces`` may raise it in place).
     external, load : (f,) ndarray
         The applied force of the step (filled here) and the full load.
     prescribe : callable (float) -> None
@@ -329,6 +331,12 @@ class System:
         bonds stretched beyond ``breaking`` (broken by this call)."""
         self.flat[self.free] = self.x
         force, count = self._nodal_force(breaking)
+        if count and "K" in self.state:
+            # a state-based point that lost bonds takes the moment tensor of the live ones
+            # (`cnem.pd.Problem.live_gradient_weights`): its stiffness rows may grow, and
+            # the fictitious density follows them (in place: the settle holds the array)
+            rows = 0.25 * np.asarray(abs(self.state["K"]).sum(axis=1)).reshape(-1)
+            np.maximum(self.density, rows[self.free], out=self.density)
         return self.external + force[self.free], count
 
     def prescribe(self, fraction: float) -> None:

@@ -60,14 +60,16 @@ def break_bonds(u, xi, length, offsets, bond_j, limit, alive, alive_reverse):
 
 
 @numba.njit(cache=True, parallel=True)
-def dilatation(u, offsets, bond_j, g, theta):
-    """``theta_i = sum_b g_b . (u_j - u_i)`` over every bond of owned ``i`` (broken or not,
-    as the serial operator ``T``)."""
+def dilatation(u, offsets, bond_j, g, alive, theta):
+    """``theta_i = sum_b g_b . (u_j - u_i)`` over the live bonds of owned ``i`` (as the
+    serial operator ``T``: a broken bond carries no dilatation)."""
     n = len(offsets) - 1
     d = u.shape[1]
     for i in numba.prange(n):
         t = 0.0
         for b in range(offsets[i], offsets[i + 1]):
+            if not alive[b]:
+                continue
             j = bond_j[b]
             for k in range(d):
                 t += g[b, k] * (u[j, k] - u[i, k])
@@ -106,7 +108,7 @@ def lps_forces(u, xi, length, offsets, bond_j, volumes, g, g_reverse, theta, P, 
 
     ``(K u)_i = -P_i sum_b g_b + sum_b P_j g'_b - sum_b c_b e^d_b n_b
     + sum_b c'_b e'^d_b (-n_b)`` over the bonds ``b = (i, j)``, primes for the reverse
-    bonds ``(j, i)``.
+    bonds ``(j, i)``; each term only while its bond (or reverse bond) lives.
     """
     n = len(offsets) - 1
     d = u.shape[1]
@@ -114,8 +116,12 @@ def lps_forces(u, xi, length, offsets, bond_j, volumes, g, g_reverse, theta, P, 
         f = np.zeros(d)
         for b in range(offsets[i], offsets[i + 1]):
             j = bond_j[b]
-            for k in range(d):
-                f[k] += -P[i] * g[b, k] + P[j] * g_reverse[b, k]
+            if alive[b]:
+                for k in range(d):
+                    f[k] -= P[i] * g[b, k]
+            if alive_reverse[b]:
+                for k in range(d):
+                    f[k] += P[j] * g_reverse[b, k]
             if alive[b]:
                 e = c[b] * _deviatoric(u, xi, length, b, i, j, theta[i], d)
                 for k in range(d):

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import _kernels as PK
+from ..moments import live_inverse, moment_tensors
 from ...errors import InputError
 from ..problem import Problem as SerialProblem
 from . import _kernels as K
@@ -77,16 +78,13 @@ class LocalOperators:
         d = self.dim
         #: unit bond directions (state-based only)
         self.unit = b.xi / b.length[:, None]
-        M = np.zeros((o, d, d))
-        np.add.at(M, b.bond_i, self.weight[:, None, None] * b.xi[:, :, None] * b.xi[:, None, :])
-        _agree(b.comm, (np.linalg.det(M) > 0).all(),
+        #: the owned points' moment tensors of the reference family, ``(o, d, d)``
+        self.moments = moment_tensors(b.bond_i, b.xi, self.weight, o)
+        _agree(b.comm, (np.linalg.det(self.moments) > 0).all(),
                "a point has too few bonds to span every direction: enlarge the horizon")
         Minv = np.zeros((len(b.points), d, d))
-        Minv[:o] = np.linalg.inv(M)
-        b.halo.exchange(Minv)
-        self.g = np.einsum("bij,bj->bi", Minv[b.bond_i], b.xi) * self.weight[:, None]
-        self.g_reverse = np.einsum("bij,bj->bi", Minv[b.bond_j], -b.xi) * \
-            (b.beta * b.volumes[b.bond_i])[:, None]
+        Minv[:o] = np.linalg.inv(self.moments)
+        self._set_gradient_weights(b.halo.exchange(Minv))
         m = np.bincount(b.bond_i, weights=self.weight * b.length ** 2, minlength=o)
         self.bulk, self.shear = material.moduli(d, plane)
         self.alpha = np.zeros(len(b.points))
@@ -99,6 +97,34 @@ class LocalOperators:
         self.c_reverse = np.ascontiguousarray(self.alpha[b.bond_j] * self.factor *
                                               (b.beta * Vi) * Vj)
         self.bulk_volume = self.bulk * b.volumes[:o]
+
+    def _set_gradient_weights(self, Minv):
+        """``g`` and ``g_reverse`` from the inverse moment tensors of owned and ghost points."""
+        b = self.body
+        self.g = np.einsum("bij,bj->bi", Minv[b.bond_i], b.xi) * self.weight[:, None]
+        self.g_reverse = np.einsum("bij,bj->bi", Minv[b.bond_j], -b.xi) * \
+            (b.beta * b.volumes[b.bond_i])[:, None]
+
+    def follow_breaking(self, alive: np.ndarray) -> None:
+        """After bonds broke (on any rank; collective): the owned points that lost bonds take
+        the moment tensors of their live bonds (`cnem.pd.moments.live_inverse`, as the
+        serial `cnem.pd.Problem.live_gradient_weights`), copied to the ghosts; ``g`` and
+        ``g_reverse`` follow.
+
+        Parameters
+        ----------
+        alive : (b,) uint8 ndarray
+            The owned bonds alive.
+        """
+        b, o = self.body, self.body.n_owned
+        w = self.weight * alive
+        hit = np.zeros(o, dtype=bool)
+        hit[b.bond_i[alive == 0]] = True
+        rows = np.flatnonzero(hit)
+        Minv = np.zeros((len(b.points), self.dim, self.dim))
+        Minv[:o] = np.linalg.inv(self.moments)
+        Minv[rows] = live_inverse(moment_tensors(b.bond_i, b.xi, w, o)[rows], self.moments[rows])
+        self._set_gradient_weights(b.halo.exchange(Minv))
 
     # -- the energy method, as in cnem.pd.Problem, with the ghosts' coefficients copied
     def _coefficients(self, Q, target):
@@ -145,11 +171,15 @@ class LocalOperators:
         return 0.5 * (gi + gj)
 
     # -- state-based fields ------------------------------------------------------------
-    def dilatation(self, u: np.ndarray) -> np.ndarray:
-        """``theta`` of the owned points ``(o,)`` from local displacements ``(o + g, d)``."""
-        theta = np.empty(self.body.n_owned)
-        K.dilatation(np.ascontiguousarray(u), self.body.offsets[:self.body.n_owned + 1],
-                     self.body.bond_j, self.g, theta)
+    def dilatation(self, u: np.ndarray, alive: np.ndarray | None = None) -> np.ndarray:
+        """``theta`` of the owned points ``(o,)`` from local displacements ``(o + g, d)``,
+        over the live bonds (``alive (b,)`` uint8 of the owned bonds; default all)."""
+        b = self.body
+        if alive is None:
+            alive = np.ones(len(b.bond_j), dtype=np.uint8)
+        theta = np.empty(b.n_owned)
+        K.dilatation(np.ascontiguousarray(u), b.offsets[:b.n_owned + 1], b.bond_j, self.g,
+                     alive, theta)
         return theta
 
     def deviatoric(self, u: np.ndarray, theta: np.ndarray) -> np.ndarray:

@@ -168,8 +168,10 @@ class Problem(Conditions):
             return out[:o], int(broken)
         broken = K.break_bonds(u, b.xi, b.length, b.offsets[:o + 1], b.bond_j, limit,
                                self.alive, self.alive_reverse)
+        if self.comm.allreduce(int(broken)):
+            ops.follow_breaking(self.alive)
         fields = np.zeros((len(b.points), 2))          # theta and P, copied to the ghosts
-        fields[:o, 0] = ops.dilatation(u)
+        fields[:o, 0] = ops.dilatation(u, self.alive)
         theta = np.ascontiguousarray(fields[:o, 0])
         P = np.empty(o)
         K.pressure(u, b.xi, b.length, b.offsets[:o + 1], b.bond_j, theta, ops.bulk_volume,
@@ -200,7 +202,7 @@ class Problem(Conditions):
                 elastic += float(b.volumes[start:stop] @ np.bincount(
                     i - start, weights=per, minlength=stop - start))
         else:
-            theta = ops.dilatation(u)
+            theta = ops.dilatation(u, self.alive)
             ed = ops.deviatoric(u, theta)
             elastic = 0.5 * float(ops.bulk_volume @ (theta * theta)) + \
                 0.5 * float((ops.c * self.alive) @ (ed * ed))
@@ -288,6 +290,8 @@ class Problem(Conditions):
             first, earlier = int(state["step"]), int(state["broken"])
             owned_u[:], v[:] = state["u"], state["velocity"]
             self.alive[:], self.alive_reverse[:] = state["alive"], state["alive_reverse"]
+            if self.material.kind == "state":
+                self.ops.follow_breaking(self.alive)
         fext = self.load() / b.volumes[:o, None]
         b.halo.exchange(u)
         force, broken_here = self.internal_force(u, limit)

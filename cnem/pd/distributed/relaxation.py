@@ -5,7 +5,9 @@ rank updates the free dofs of its own points, and the norms and the two dot
 products of the adaptive damping are summed over the ranks (allreduce). The
 fictitious density is a quarter of the stiffness rows' absolute sums, exact for
 the PMB and bounded from above for the state-based solid
-(`LocalOperators.row_bound`); the settled equilibrium is the same.
+(`LocalOperators.row_bound`), raised where it grows after bonds broke (a state-based
+point that lost bonds takes the moment tensor of its live bonds); the settled
+equilibrium is the same.
 """
 
 from __future__ import annotations
@@ -63,7 +65,10 @@ def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: i
         flat[free] = x
         body.halo.exchange(u)
         force, count = problem.internal_force(u, breaking)
-        return external + volumes * force.reshape(-1)[free], problem.comm.allreduce(count)
+        count = problem.comm.allreduce(count)
+        if count and problem.material.kind == "state":      # the rows may grow (as serial)
+            np.maximum(density, 0.25 * problem.ops.row_bound().reshape(-1)[free], out=density)
+        return external + volumes * force.reshape(-1)[free], count
 
     body.halo.exchange(u)
     noise = 10.0 * problem.norm(volumes * problem.internal_force(u, np.inf)[0].reshape(-1)[free])
