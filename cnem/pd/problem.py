@@ -21,6 +21,7 @@ from .correction import SurfaceCorrection
 from .dynamics import Dynamics
 from ..material import PLANES
 from .solution import StaticSolution
+from .velocity import VelocityConditions
 
 if TYPE_CHECKING:
     from typing import Callable
@@ -35,7 +36,7 @@ __all__ = ["Problem"]
 log = logging.getLogger(__name__)
 
 
-class Problem(Conditions, SurfaceCorrection, Dynamics):
+class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
     """A peridynamic body with a material, loads and displacement conditions.
 
     Parameters
@@ -328,6 +329,7 @@ class Problem(Conditions, SurfaceCorrection, Dynamics):
         if steps < 1 or max_iterations < 1:
             raise InputError(f"expected steps >= 1 and max_iterations >= 1, received "
                              f"steps={steps}, max_iterations={max_iterations}")
+        self.static_only("solve")
         evaluate, pattern = self._static_system()
         D, values = self.prescribed()
         free = free_rigid_motions(pattern, self.body.points, D)

@@ -24,6 +24,7 @@ from .._kernels import pmb_forces
 from ...material import PLANES
 from ..guards import checked_run, diverged, first_non_finite
 from ..solution import DynamicRun
+from ..velocity import VelocityConditions
 from . import _kernels as K
 from . import checkpoint as ckpt
 from .operators import LocalOperators
@@ -67,7 +68,7 @@ class DistributedRun(DynamicRun):
 ENERGY_BLOCK = 65536
 
 
-class Problem(Conditions):
+class Problem(Conditions, VelocityConditions):
     """`cnem.pd.Problem` for a `cnem.pd.distributed.Body`: the same conditions and the
     same dynamic solvers (`run_dynamic`, `relax`, `stable_time_step`, `damage`), every
     rank computing its own points.
@@ -118,9 +119,10 @@ class Problem(Conditions):
         """All points of the body (every rank): what Dirichlet predicates see."""
         return self.body.global_points
 
-    def owned_prescribed(self) -> tuple:
-        """Owned local dofs ``d * row + component`` and their values."""
-        dofs, values = self.prescribed()
+    def owned_prescribed(self, velocity: bool = False) -> tuple:
+        """Owned local dofs ``d * row + component`` and their values: of the Dirichlet
+        conditions, or of the velocity conditions."""
+        dofs, values = self.prescribed_velocity() if velocity else self.prescribed()
         d, body = self.dim, self.body
         node = dofs // d
         mine = body.part[node] == self.comm.rank
@@ -275,13 +277,16 @@ class Problem(Conditions):
         rho = self.material.density
         limit = self.material.stretch_limit(d, self.plane, b.horizon)
         D, values = self.owned_prescribed()
+        M, speeds = self.owned_prescribed(velocity=True)
         u = np.zeros((len(b.points), d))
         owned_u = u[:o]
         owned_u.reshape(-1)[D] = values
+        owned_u.reshape(-1)[M] = 0.0
         v = np.zeros((o, d))
         if velocity is not None:
             v[:] = per_point(velocity, b.points[:o], d, "velocity")
         v.reshape(-1)[D] = 0.0
+        v.reshape(-1)[M] = speeds
         first, earlier, broken_here = 0, 0, 0      # earlier: broken before a restart
         if restart is not None:
             state = ckpt.load(restart, self.comm, b.owned)
@@ -318,12 +323,14 @@ class Problem(Conditions):
             v += 0.5 * dt * acc
             owned_u += dt * v
             owned_u.reshape(-1)[D] = values
+            owned_u.reshape(-1)[M] = speeds * (step * dt)
             b.halo.exchange(u)
             force, broken = self.internal_force(u, limit)
             broken_here += broken
             acc = (force + fext) / rho
             v += 0.5 * dt * acc
             v.reshape(-1)[D] = 0.0
+            v.reshape(-1)[M] = speeds
             self._check_finite(step, dt, owned_u, v, stable)
             if step % every == 0 or step == steps:
                 store(step)
@@ -352,6 +359,7 @@ class Problem(Conditions):
               every: int | None = None, progress: bool | None = None) -> Relaxation:
         """Adaptive dynamic relaxation over the ranks (`cnem.pd.distributed.relaxation.relax`);
         ``u``, ``damage`` gathered on rank 0."""
+        self.static_only("relax")
         return relax(self, tol=tol, max_steps=max_steps, steps=steps, every=every,
                      progress=progress)
 
