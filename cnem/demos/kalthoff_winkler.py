@@ -395,6 +395,8 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> dict:
     """Command line: ``python -m cnem.demos.kalthoff_winkler --help`` or
     ``cnem demo kalthoff-winkler``; under ``mpiexec -n N`` it runs on the N ranks."""
     parser = demo_parser(__file__, __doc__, prog)
+    parser.epilog = ("Distributed: mpiexec -n 2 python -m cnem.demos.kalthoff_winkler [options] "
+                     "(the same run on 2 MPI ranks; needs cnem[mpi]).")
     parser.add_argument("--h", type=float, nargs="+", default=[1.0, 0.5],
                         help="grid spacings in mm (each dividing 25 mm), one run each")
     parser.add_argument("--m", type=float, default=4.0, help="horizon / spacing")
