@@ -3,7 +3,9 @@
 Each rank computes the bonds of its own points from its and its ghosts'
 displacements (no reverse force exchange): one halo exchange of the
 displacements per force evaluation, and for the state-based solid one more of
-the dilatations and "pressures" ``dW/dtheta`` of the points. Bond breaking is
+the dilatations and "pressures" ``dW/dtheta`` of the points. The bond-based
+exchange is non-blocking: the bonds of the points with no ghost in their families
+are computed while it runs (`Problem.internal_force`). Bond breaking is
 decided by the stretch as in serial, and the reverse of a bond is judged by the
 same formula on both of its ranks, so the broken bonds are those of the serial
 run.
@@ -20,7 +22,7 @@ from tqdm.auto import tqdm
 
 from ...assembly.conditions import Conditions, per_point
 from ...errors import MaterialError, OptionError
-from .._kernels import pmb_forces
+from .._kernels import pmb_forces_rows
 from ...material import PLANES
 from ..guards import checked_run, diverged, first_non_finite
 from ..solution import DynamicRun
@@ -159,15 +161,27 @@ class Problem(Conditions, VelocityConditions):
     # -- forces --------------------------------------------------------------------------
     def internal_force(self, u: np.ndarray, limit: float) -> tuple[np.ndarray, int]:
         """Force per unit volume of the owned points ``(o, d)`` from local displacements
-        ``(o + g, d)`` whose ghost rows are current; bonds beyond ``limit`` break.
-        Returns the force and the number of owned bonds broken."""
+        ``(o + g, d)`` whose owned rows are current (the ghost rows are exchanged here);
+        bonds beyond ``limit`` break. Returns the force and the number of owned bonds
+        broken.
+
+        Bond-based: the exchange runs while the bonds of the interior points
+        (`Body.interior`, no ghost in their families) are computed, and the boundary
+        points follow it. State-based: the exchange first, then the dilatations, one
+        more exchange (of them and the pressures) and the forces.
+        """
         b, ops = self.body, self.ops
         o = b.n_owned
+        pending = b.halo.start(u)
         if self.material.kind == "bond":
-            out = np.empty_like(u)
-            broken = pmb_forces(u, b.xi, b.length, b.offsets, b.bond_j, ops.stiffness,
-                                b.volumes, self.alive, limit, out)
-            return out[:o], int(broken)
+            out = np.empty((o, self.dim))
+            args = (u, b.xi, b.length, b.offsets, b.bond_j, ops.stiffness, b.volumes,
+                    self.alive, limit, out)
+            broken = pmb_forces_rows(b.interior, *args)
+            b.halo.finish(pending)
+            broken += pmb_forces_rows(b.boundary, *args)
+            return out, int(broken)
+        b.halo.finish(pending)
         broken = K.break_bonds(u, b.xi, b.length, b.offsets[:o + 1], b.bond_j, limit,
                                self.alive, self.alive_reverse)
         fields = np.zeros((len(b.points), 2))          # theta and P, copied to the ghosts
@@ -294,7 +308,6 @@ class Problem(Conditions, VelocityConditions):
             owned_u[:], v[:] = state["u"], state["velocity"]
             self.alive[:], self.alive_reverse[:] = state["alive"], state["alive_reverse"]
         fext = self.load() / b.volumes[:o, None]
-        b.halo.exchange(u)
         force, broken_here = self.internal_force(u, limit)
         acc = (force + fext) / rho
         writer = None if output is None else PieceWriter(output, self.comm, b.points[:o], steps)
@@ -324,7 +337,6 @@ class Problem(Conditions, VelocityConditions):
             owned_u += dt * v
             owned_u.reshape(-1)[D] = values
             owned_u.reshape(-1)[M] = speeds * (step * dt)
-            b.halo.exchange(u)
             force, broken = self.internal_force(u, limit)
             broken_here += broken
             acc = (force + fext) / rho
