@@ -102,3 +102,18 @@ def test_two_ranks_give_the_serial_run(tmp_path):
     frames = sorted((tmp_path / "mpi" / "frames_h2.5mm").glob("*.pvtu"))
     assert len(frames) == len(serial["rows"][0]["files"]) - 1 > 2    # the .npz is listed too
     assert len(list((tmp_path / "mpi" / "frames_h2.5mm").glob("kw_r0001_*.vtu"))) == len(frames)
+
+
+def test_bad_times_and_spacings_are_refused(tmp_path):
+    from cnem.errors import InputError
+    with pytest.raises(InputError, match="t_end: expected a positive time"):
+        kw.main(h=(2.5e-3,), t_end=-1e-6, outdir=tmp_path)
+    with pytest.raises(InputError, match="frame_every: expected a time in"):
+        kw.main(h=(2.5e-3,), t_end=1e-6, frame_every=2e-6, outdir=tmp_path)
+    with pytest.raises(InputError, match="divides 25 mm"):
+        kw.plate(0.3e-3)
+    with pytest.raises(InputError, match="at most a quarter"):
+        kw.build(2.5e-3, 6.0)                             # delta = 15 mm
+    with pytest.raises(SystemExit) as done:
+        kw.cli(["--h", "0.3", "--out", str(tmp_path)])
+    assert done.value.code == 2
