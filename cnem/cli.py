@@ -44,6 +44,7 @@ DEMOS = {
     "growth-two-holes": "growth_two_holes",
     "growth-pd-vs-cnem": "growth_pd_vs_cnem",
     "growth-dcb": "growth_dcb",
+    "kalthoff-winkler": "kalthoff_winkler",
 }
 
 #: ``cnem pd <name>`` -> module of `cnem.demos` (add a PD demo here).
@@ -51,6 +52,7 @@ PD_DEMOS = {
     "crack": "pd_vs_cnem_crack",
     "branching": "pd_crack_branching",
     "cpd": "cpd_examples",
+    "kalthoff-winkler": "kalthoff_winkler",
 }
 
 #: Subcommand -> its table of demos.

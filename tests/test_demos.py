@@ -168,6 +168,31 @@ def check_pd_crack_branching(demo, out, outdir):
         assert pathlib.Path(f).stat().st_size > 1000
 
 
+def check_kalthoff_winkler(demo, out, outdir):
+    """The struck plate (quick size): the struck points move at 32 m/s, the critical
+    stretch is the plane-stress closed form, and a crack runs from each notch tip forwards
+    and away from the struck middle (an angle in (30, 90) degrees to the notch)."""
+    (row,) = out["rows"]
+    delta = row["horizon"]
+    assert delta == pytest.approx(3.0 * 2.5e-3, rel=1e-12)
+    assert row["stretch"] == pytest.approx(np.sqrt(4 * np.pi * 2.2e4 / (9 * 191e9 * delta)),
+                                           rel=1e-12)
+    with np.load(outdir / "kalthoff_winkler_h2.5mm.npz") as f:
+        points, u, damage = f["points"], f["u"], f["damage"]
+    assert len(points) == row["nodes"] == 40 * 80      # no slot cell at h = 2.5 mm > 1.5 mm
+    struck = (points[:, 0] < 2 * 2.5e-3) & (np.abs(points[:, 1]) < 0.025 - 2 * delta)
+    assert struck.sum() == 2 * 8                       # 2 rows, |y| < 10 mm
+    np.testing.assert_allclose(u[struck, 0], 32.0 * row["steps"] * row["dt"], rtol=1e-12)
+    assert damage.min() >= 0.0 and damage.max() <= 1.0
+    for key in ("upper", "lower"):
+        assert 30.0 < row[key] < 90.0, (key, row[key])
+    assert out["table"].count("\n") >= 3 and "nan" not in out["table"]
+    frames = [f for f in row["files"] if f.endswith(".vtu")]
+    assert len(frames) >= 3 and all(pathlib.Path(f).stat().st_size > 0 for f in frames)
+    for f in (f for f in row["files"] if f.endswith(".png")):
+        assert pathlib.Path(f).stat().st_size > 1000
+
+
 def _cpd_histories(result):
     """Every Newton history of one CPD example's result."""
     runs = result.get("cases") or result.get("runs") or result.get("results")
@@ -326,6 +351,8 @@ CASES = [
     Case("pd-vs-cnem-crack", "pd_vs_cnem_crack", check_pd_vs_cnem_crack,
          args=((1 / 16, 1 / 32),), plot=True),
     Case("pd-crack-branching", "pd_crack_branching", check_pd_crack_branching,
+         sizes=lambda demo: dict(demo.QUICK, progress=False), plot=True),
+    Case("kalthoff-winkler", "kalthoff_winkler", check_kalthoff_winkler,
          sizes=lambda demo: dict(demo.QUICK, progress=False), plot=True),
     Case("cpd-examples", "cpd_examples", check_cpd_examples, sizes=dict(quick=True)),
     Case("growth-sent", "growth_sent", check_growth_sent, args=(0.05,),

@@ -31,7 +31,7 @@ from .basis import select_nodes
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-__all__ = ["Conditions", "Traction", "per_point", "traction_at", "dirichlet_dofs"]
+__all__ = ["Conditions", "Traction", "per_point", "traction_at", "dirichlet_dofs", "last_wins"]
 
 #: What `where` may be: a predicate over points, a boolean mask or indices.
 Where = Union[Callable[[np.ndarray], np.ndarray], np.ndarray, list]
@@ -70,7 +70,8 @@ def traction_at(t: ArrayLike | Callable[..., np.ndarray], points: np.ndarray, no
 
 def dirichlet_dofs(points: np.ndarray, where: Where, component: int | None,
                    value: float | Callable[..., np.ndarray], *,
-                   where_to_look: str = "the nodes") -> tuple[np.ndarray, np.ndarray]:
+                   where_to_look: str = "the nodes",
+                   what: str = "add_dirichlet") -> tuple[np.ndarray, np.ndarray]:
     """Dofs (interleaved: ``d * node + component``) and values of a Dirichlet condition.
 
     Parameters
@@ -82,6 +83,8 @@ def dirichlet_dofs(points: np.ndarray, where: Where, component: int | None,
     value : float or callable ``(p, d) -> (p,)`` (``(p, d)`` for every component)
     where_to_look : str
         Named in the error when nothing is selected.
+    what : str
+        The method named in the errors.
 
     Returns
     -------
@@ -94,10 +97,10 @@ def dirichlet_dofs(points: np.ndarray, where: Where, component: int | None,
                              f"{component!r}")
     nodes = select_nodes(points, where)
     if nodes.size == 0:
-        raise ConditionError(f"add_dirichlet: `where` selects no node; check the predicate against "
+        raise ConditionError(f"{what}: `where` selects no node; check the predicate against "
                          f"{where_to_look} (boundary nodes lie exactly on the boundary)")
     comps = np.arange(d) if component is None else np.array([component])
-    vals = per_point(value, points[nodes], len(comps), "add_dirichlet value")
+    vals = per_point(value, points[nodes], len(comps), f"{what} value")
     return (d * nodes[:, None] + comps[None, :]).reshape(-1), np.ascontiguousarray(vals).reshape(-1)
 
 
@@ -238,9 +241,22 @@ class Conditions:
             Sorted, distinct.
         values : (k,) ndarray
         """
-        dofs = np.zeros(0, dtype=np.int64)
-        values = np.zeros(0)
-        for d, v in self.dirichlet:
-            dofs, values = np.concatenate([dofs, d]), np.concatenate([values, v])
-        last = len(dofs) - 1 - np.unique(dofs[::-1], return_index=True)[1]
-        return dofs[last], values[last]
+        return last_wins(self.dirichlet)
+
+
+def last_wins(conditions: list) -> tuple[np.ndarray, np.ndarray]:
+    """The dofs of a list of ``(dofs, values)`` conditions (`dirichlet_dofs`) and their
+    values, the last condition winning where several prescribe one dof.
+
+    Returns
+    -------
+    dofs : (k,) int64 ndarray
+        Sorted, distinct.
+    values : (k,) ndarray
+    """
+    dofs = np.zeros(0, dtype=np.int64)
+    values = np.zeros(0)
+    for d, v in conditions:
+        dofs, values = np.concatenate([dofs, d]), np.concatenate([values, v])
+    last = len(dofs) - 1 - np.unique(dofs[::-1], return_index=True)[1]
+    return dofs[last], values[last]

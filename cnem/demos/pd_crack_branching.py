@@ -82,6 +82,7 @@ from cnem.cli import demo_parser
 from cnem.errors import InputError
 from cnem.exact import rayleigh_speed
 from cnem.pd import cracks
+from cnem.pd.guards import checked_schedule
 
 if TYPE_CHECKING:
     from typing import Literal, Sequence
@@ -343,12 +344,7 @@ def main(h: float = 0.25e-3, m: float = 4.0, t_end: float = 46e-6, *,
         branching), ``broken, energy_error, dissipated, griffith, dt, steps, bonds,
         seconds, files``.
     """
-    t_end, frame_every = float(t_end), float(frame_every)
-    if not np.isfinite(t_end) or t_end <= 0:
-        raise InputError(f"t_end: expected a positive time in seconds, received {t_end}")
-    if not 0 < frame_every <= t_end:
-        raise InputError(f"frame_every: expected a time in (0, t_end = {t_end:g}] s, received "
-                         f"{frame_every}")
+    t_end, frame_every = checked_schedule(t_end, frame_every)
     start = time.perf_counter()
     problem, shape = build(h, m, material, stress)
     body, mat = problem.body, problem.material

@@ -6,6 +6,41 @@ import numpy as np
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
 
 
+@numba.njit(cache=True, fastmath=True)
+def _pmb_point(i, u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit, out):
+    """The PMB force density of point ``i`` into ``out[i]`` (see `pmb_forces`); returns
+    the number of its bonds broken."""
+    d = u.shape[1]
+    broken = 0
+    f0 = 0.0
+    f1 = 0.0
+    f2 = 0.0
+    for b in range(offsets[i], offsets[i + 1]):
+        if not alive[b]:
+            continue
+        j = bond_j[b]
+        y0 = xi[b, 0] + u[j, 0] - u[i, 0]
+        y1 = xi[b, 1] + u[j, 1] - u[i, 1]
+        y2 = 0.0
+        if d == 3:
+            y2 = xi[b, 2] + u[j, 2] - u[i, 2]
+        ly = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+        s = ly / length[b] - 1.0
+        if s > limit:
+            alive[b] = 0
+            broken += 1
+            continue
+        g = stiffness[b] * s * volumes[j] / ly
+        f0 += g * y0
+        f1 += g * y1
+        f2 += g * y2
+    out[i, 0] = f0
+    out[i, 1] = f1
+    if d == 3:
+        out[i, 2] = f2
+    return broken
+
+
 @numba.njit(cache=True, parallel=True, fastmath=True)
 def pmb_forces(u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit, out):
     """Bond-based PMB force density at every point, breaking bonds beyond ``limit``.
@@ -15,35 +50,22 @@ def pmb_forces(u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit,
     A bond whose stretch exceeds ``limit`` is marked dead (``alive[b] = 0``)
     and carries no force from then on. Returns the number of bonds broken.
     """
-    n, d = u.shape
+    n = u.shape[0]
     broken = np.zeros(n, dtype=np.int64)
     for i in numba.prange(n):
-        f0 = 0.0
-        f1 = 0.0
-        f2 = 0.0
-        for b in range(offsets[i], offsets[i + 1]):
-            if not alive[b]:
-                continue
-            j = bond_j[b]
-            y0 = xi[b, 0] + u[j, 0] - u[i, 0]
-            y1 = xi[b, 1] + u[j, 1] - u[i, 1]
-            y2 = 0.0
-            if d == 3:
-                y2 = xi[b, 2] + u[j, 2] - u[i, 2]
-            ly = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-            s = ly / length[b] - 1.0
-            if s > limit:
-                alive[b] = 0
-                broken[i] += 1
-                continue
-            g = stiffness[b] * s * volumes[j] / ly
-            f0 += g * y0
-            f1 += g * y1
-            f2 += g * y2
-        out[i, 0] = f0
-        out[i, 1] = f1
-        if d == 3:
-            out[i, 2] = f2
+        broken[i] = _pmb_point(i, u, xi, length, offsets, bond_j, stiffness, volumes, alive,
+                               limit, out)
+    return broken.sum()
+
+
+@numba.njit(cache=True, parallel=True, fastmath=True)
+def pmb_forces_rows(rows, u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit,
+                    out):
+    """`pmb_forces` at the points ``rows`` only (``out`` written at those rows)."""
+    broken = np.zeros(len(rows), dtype=np.int64)
+    for k in numba.prange(len(rows)):
+        broken[k] = _pmb_point(rows[k], u, xi, length, offsets, bond_j, stiffness, volumes,
+                               alive, limit, out)
     return broken.sum()
 
 

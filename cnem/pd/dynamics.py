@@ -91,7 +91,8 @@ class Dynamics:
             `cnem.config.DT_LIMIT` times it, refused (`cnem.pd.guards`).
         steps : int
         velocity : (n, d) array_like or callable ``(n, d) -> (n, d)``, optional
-            Initial velocity.
+            Initial velocity (zero at Dirichlet components; the velocity conditions,
+            `cnem.pd.velocity`, hold theirs through the run).
         every : int, optional
             Store a frame (u, damage, energy) every so many steps (default: 10 frames),
             and at the first and last steps.
@@ -121,12 +122,15 @@ class Dynamics:
         limit = self.material.stretch_limit(d, self.plane, b.horizon)
         state = self._force_state()
         D, values = self.prescribed()
+        M, speeds = self.prescribed_velocity()
         u = np.zeros((n, d))
         u.reshape(-1)[D] = values
+        u.reshape(-1)[M] = 0.0
         v = np.zeros((n, d))
         if velocity is not None:
             v[:] = per_point(velocity, b.points, d, "velocity")
         v.reshape(-1)[D] = 0.0
+        v.reshape(-1)[M] = speeds
         fext = self.load().reshape(n, d) / b.volumes[:, None]
         force, broken = self._internal_force(u, limit, state)
         acc = (force + fext) / rho
@@ -147,11 +151,13 @@ class Dynamics:
             v += 0.5 * dt * acc
             u += dt * v
             u.reshape(-1)[D] = values
+            u.reshape(-1)[M] = speeds * (step * dt)
             force, broken = self._internal_force(u, limit, state)
             total_broken += broken
             acc = (force + fext) / rho
             v += 0.5 * dt * acc
             v.reshape(-1)[D] = 0.0
+            v.reshape(-1)[M] = speeds
             if (bad := first_non_finite(u, v)) >= 0:
                 raise diverged(step, dt, bad, b.points[bad], stable)
             if step % every == 0 or step == steps:
@@ -171,6 +177,7 @@ class Dynamics:
             ``u (n, d)``, ``damage (n,)``, ``residual_history``, ``iterations``.
         """
         self._linear_only("relax")
+        self.static_only("relax")
         return relax(self, tol=tol, max_steps=max_steps, steps=steps, every=every,
                      progress=progress)
 

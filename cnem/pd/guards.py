@@ -24,7 +24,8 @@ import numpy as np
 from .. import config
 from ..errors import DivergenceError, InputError, StabilityWarning
 
-__all__ = ["check_time_step", "checked_run", "first_non_finite", "diverged"]
+__all__ = ["check_time_step", "checked_run", "checked_schedule", "first_non_finite",
+           "diverged"]
 
 
 def check_time_step(dt: float, stable: float, *, stacklevel: int = 3) -> None:
@@ -70,6 +71,27 @@ def checked_run(dt: float, steps: int, stable: float) -> tuple[float, int]:
         raise InputError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
     check_time_step(dt, stable, stacklevel=4)
     return dt, steps
+
+
+def checked_schedule(t_end: float, frame_every: float) -> tuple[float, float]:
+    """The simulated time of a run and the time between its stored frames, checked.
+
+    Returns
+    -------
+    t_end, frame_every : float
+
+    Raises
+    ------
+    InputError
+        ``t_end`` not positive, or ``frame_every`` outside ``(0, t_end]``.
+    """
+    t_end, frame_every = float(t_end), float(frame_every)
+    if not np.isfinite(t_end) or t_end <= 0:
+        raise InputError(f"t_end: expected a positive time in seconds, received {t_end}")
+    if not 0 < frame_every <= t_end:
+        raise InputError(f"frame_every: expected a time in (0, t_end = {t_end:g}] s, received "
+                         f"{frame_every}")
+    return t_end, frame_every
 
 
 def first_non_finite(*arrays: np.ndarray) -> int:

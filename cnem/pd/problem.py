@@ -22,6 +22,7 @@ from .dynamics import Dynamics
 from .moments import moment_tensors, live_inverse
 from ..material import PLANES
 from .solution import StaticSolution
+from .velocity import VelocityConditions
 
 if TYPE_CHECKING:
     from typing import Callable
@@ -36,7 +37,7 @@ __all__ = ["Problem"]
 log = logging.getLogger(__name__)
 
 
-class Problem(Conditions, SurfaceCorrection, Dynamics):
+class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
     """A peridynamic body with a material, loads and displacement conditions.
 
     Parameters
@@ -393,6 +394,7 @@ class Problem(Conditions, SurfaceCorrection, Dynamics):
         if steps < 1 or max_iterations < 1:
             raise InputError(f"expected steps >= 1 and max_iterations >= 1, received "
                              f"steps={steps}, max_iterations={max_iterations}")
+        self.static_only("solve")
         evaluate, pattern = self._static_system()
         D, values = self.prescribed()
         free = free_rigid_motions(pattern, self.body.points, D)

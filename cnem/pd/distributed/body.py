@@ -51,6 +51,9 @@ class Body:
     bond_i, bond_j, xi, length, beta
         As in `cnem.pd.Body`, for the bonds of the owned points (local numbering).
     halo : Halo
+    interior, boundary : int64 ndarray
+        Owned rows without / with a ghost in their family: the forces of the interior
+        ones need no exchanged value.
     """
 
     def __init__(self, points: np.ndarray, volumes: float | ArrayLike, horizon: float, *,
@@ -95,6 +98,9 @@ class Body:
         bond_geometry(self.points, self.offsets, self.bond_j, np.ascontiguousarray(self.period),
                       spacing, horizon, self.xi, self.length, self.beta)
         self.halo = Halo(self.comm, owned, ghosts, self.part)
+        near_ghost = np.bincount(self.bond_i[self.bond_j >= len(owned)], minlength=len(owned)) > 0
+        self.interior = np.flatnonzero(~near_ghost)
+        self.boundary = np.flatnonzero(near_ghost)
 
     def _owned_rows(self, part, rank):
         """Families of the points of ``part == rank``: CSR offsets and global member ids,

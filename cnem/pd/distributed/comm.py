@@ -80,20 +80,30 @@ class Halo:
     def exchange(self, values: np.ndarray) -> np.ndarray:
         """Overwrite the ghost rows of ``values`` (``(o + g, ...)``, C-contiguous) with
         their owners' values."""
-        MPI = mpi()
+        return self.finish(self.start(values))
+
+    def start(self, values: np.ndarray) -> tuple:
+        """Post the receives and the sends of `exchange` and return at once; the ghost
+        rows of ``values`` are current after `finish` (the owned rows must not change
+        before then)."""
         tail = values.shape[1:]
-        requests, inbox = [], []
+        requests, inbox, outbox = [], [], []
         for r, rows in self.receives.items():
             buf = np.empty((len(rows),) + tail, dtype=values.dtype)
             requests.append(self.comm.Irecv(buf, source=r, tag=7))
             inbox.append((rows, buf))
-        outbox = []
         for r, rows in self.sends.items():
             buf = np.ascontiguousarray(values[rows])
-            outbox.append(buf)
+            outbox.append(buf)                 # kept alive until the sends complete
             requests.append(self.comm.Isend(buf, dest=r, tag=7))
             self.bytes += buf.nbytes
-        MPI.Request.Waitall(requests)
+        return values, requests, inbox, outbox
+
+    def finish(self, pending: tuple) -> np.ndarray:
+        """Wait for an exchange begun by `start`; copy the received ghost rows in and
+        return the values."""
+        values, requests, inbox, _ = pending
+        mpi().Request.Waitall(requests)
         for rows, buf in inbox:
             values[rows] = buf
         return values

@@ -3,7 +3,9 @@
 Each rank computes the bonds of its own points from its and its ghosts'
 displacements (no reverse force exchange): one halo exchange of the
 displacements per force evaluation, and for the state-based solid one more of
-the dilatations and "pressures" ``dW/dtheta`` of the points. Bond breaking is
+the dilatations and "pressures" ``dW/dtheta`` of the points. The bond-based
+exchange is non-blocking: the bonds of the points with no ghost in their families
+are computed while it runs (`Problem.internal_force`). Bond breaking is
 decided by the stretch as in serial, and the reverse of a bond is judged by the
 same formula on both of its ranks, so the broken bonds are those of the serial
 run.
@@ -20,10 +22,11 @@ from tqdm.auto import tqdm
 
 from ...assembly.conditions import Conditions, per_point
 from ...errors import MaterialError, OptionError
-from .._kernels import pmb_forces
+from .._kernels import pmb_forces_rows
 from ...material import PLANES
 from ..guards import checked_run, diverged, first_non_finite
 from ..solution import DynamicRun
+from ..velocity import VelocityConditions
 from . import _kernels as K
 from . import checkpoint as ckpt
 from .operators import LocalOperators
@@ -67,7 +70,7 @@ class DistributedRun(DynamicRun):
 ENERGY_BLOCK = 65536
 
 
-class Problem(Conditions):
+class Problem(Conditions, VelocityConditions):
     """`cnem.pd.Problem` for a `cnem.pd.distributed.Body`: the same conditions and the
     same dynamic solvers (`run_dynamic`, `relax`, `stable_time_step`, `damage`), every
     rank computing its own points.
@@ -118,9 +121,10 @@ class Problem(Conditions):
         """All points of the body (every rank): what Dirichlet predicates see."""
         return self.body.global_points
 
-    def owned_prescribed(self) -> tuple:
-        """Owned local dofs ``d * row + component`` and their values."""
-        dofs, values = self.prescribed()
+    def owned_prescribed(self, velocity: bool = False) -> tuple:
+        """Owned local dofs ``d * row + component`` and their values: of the Dirichlet
+        conditions, or of the velocity conditions."""
+        dofs, values = self.prescribed_velocity() if velocity else self.prescribed()
         d, body = self.dim, self.body
         node = dofs // d
         mine = body.part[node] == self.comm.rank
@@ -157,15 +161,27 @@ class Problem(Conditions):
     # -- forces --------------------------------------------------------------------------
     def internal_force(self, u: np.ndarray, limit: float) -> tuple[np.ndarray, int]:
         """Force per unit volume of the owned points ``(o, d)`` from local displacements
-        ``(o + g, d)`` whose ghost rows are current; bonds beyond ``limit`` break.
-        Returns the force and the number of owned bonds broken."""
+        ``(o + g, d)`` whose owned rows are current (the ghost rows are exchanged here);
+        bonds beyond ``limit`` break. Returns the force and the number of owned bonds
+        broken.
+
+        Bond-based: the exchange runs while the bonds of the interior points
+        (`Body.interior`, no ghost in their families) are computed, and the boundary
+        points follow it. State-based: the exchange first, then the dilatations, one
+        more exchange (of them and the pressures) and the forces.
+        """
         b, ops = self.body, self.ops
         o = b.n_owned
+        pending = b.halo.start(u)
         if self.material.kind == "bond":
-            out = np.empty_like(u)
-            broken = pmb_forces(u, b.xi, b.length, b.offsets, b.bond_j, ops.stiffness,
-                                b.volumes, self.alive, limit, out)
-            return out[:o], int(broken)
+            out = np.empty((o, self.dim))
+            args = (u, b.xi, b.length, b.offsets, b.bond_j, ops.stiffness, b.volumes,
+                    self.alive, limit, out)
+            broken = pmb_forces_rows(b.interior, *args)
+            b.halo.finish(pending)
+            broken += pmb_forces_rows(b.boundary, *args)
+            return out, int(broken)
+        b.halo.finish(pending)
         broken = K.break_bonds(u, b.xi, b.length, b.offsets[:o + 1], b.bond_j, limit,
                                self.alive, self.alive_reverse)
         if self.comm.allreduce(int(broken)):
@@ -277,13 +293,16 @@ class Problem(Conditions):
         rho = self.material.density
         limit = self.material.stretch_limit(d, self.plane, b.horizon)
         D, values = self.owned_prescribed()
+        M, speeds = self.owned_prescribed(velocity=True)
         u = np.zeros((len(b.points), d))
         owned_u = u[:o]
         owned_u.reshape(-1)[D] = values
+        owned_u.reshape(-1)[M] = 0.0
         v = np.zeros((o, d))
         if velocity is not None:
             v[:] = per_point(velocity, b.points[:o], d, "velocity")
         v.reshape(-1)[D] = 0.0
+        v.reshape(-1)[M] = speeds
         first, earlier, broken_here = 0, 0, 0      # earlier: broken before a restart
         if restart is not None:
             state = ckpt.load(restart, self.comm, b.owned)
@@ -293,7 +312,6 @@ class Problem(Conditions):
             if self.material.kind == "state":
                 self.ops.follow_breaking(self.alive)
         fext = self.load() / b.volumes[:o, None]
-        b.halo.exchange(u)
         force, broken_here = self.internal_force(u, limit)
         acc = (force + fext) / rho
         writer = None if output is None else PieceWriter(output, self.comm, b.points[:o], steps)
@@ -322,12 +340,13 @@ class Problem(Conditions):
             v += 0.5 * dt * acc
             owned_u += dt * v
             owned_u.reshape(-1)[D] = values
-            b.halo.exchange(u)
+            owned_u.reshape(-1)[M] = speeds * (step * dt)
             force, broken = self.internal_force(u, limit)
             broken_here += broken
             acc = (force + fext) / rho
             v += 0.5 * dt * acc
             v.reshape(-1)[D] = 0.0
+            v.reshape(-1)[M] = speeds
             self._check_finite(step, dt, owned_u, v, stable)
             if step % every == 0 or step == steps:
                 store(step)
@@ -356,6 +375,7 @@ class Problem(Conditions):
               every: int | None = None, progress: bool | None = None) -> Relaxation:
         """Adaptive dynamic relaxation over the ranks (`cnem.pd.distributed.relaxation.relax`);
         ``u``, ``damage`` gathered on rank 0."""
+        self.static_only("relax")
         return relax(self, tol=tol, max_steps=max_steps, steps=steps, every=every,
                      progress=progress)
 

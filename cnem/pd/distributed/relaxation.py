@@ -63,14 +63,12 @@ def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: i
 
     def forces(breaking=np.inf):
         flat[free] = x
-        body.halo.exchange(u)
         force, count = problem.internal_force(u, breaking)
         count = problem.comm.allreduce(count)
         if count and problem.material.kind == "state":      # the rows may grow (as serial)
             np.maximum(density, 0.25 * problem.ops.row_bound().reshape(-1)[free], out=density)
         return external + volumes * force.reshape(-1)[free], count
 
-    body.halo.exchange(u)
     noise = 10.0 * problem.norm(volumes * problem.internal_force(u, np.inf)[0].reshape(-1)[free])
     def prescribe(fraction):
         flat[fixed] = fraction * values

@@ -1,0 +1,72 @@
+"""Prescribed velocities of explicit peridynamic dynamics (an impactor, a moving grip).
+
+A velocity condition holds some displacement components at ``u = value t`` and
+their velocities at ``value`` through a run of `cnem.pd.Problem.run_dynamic` (and
+of its distributed counterpart), from ``t = 0``: in every velocity Verlet step the
+prescribed components are overwritten after the position and the velocity
+updates, as Dirichlet components are held at their values. Where a velocity and a
+Dirichlet condition prescribe one component, the velocity wins. The static solvers
+have no time and refuse velocity conditions (`VelocityConditions.static_only`).
+
+>>> import numpy as np, cnem.pd as pd
+>>> pts = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+>>> prob = pd.Problem(pd.Body(pts, 1.0, 1.5), pd.BondBased(1.0, density=1.0))
+>>> prob.add_velocity(lambda p: p[:, 0] < 0.5, 0, 2.0)
+>>> prob.prescribed_velocity()
+(array([0]), array([2.]))
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..assembly.conditions import dirichlet_dofs, last_wins
+from ..errors import ConditionError
+
+if TYPE_CHECKING:
+    from typing import Any
+
+__all__ = ["VelocityConditions"]
+
+
+class VelocityConditions:
+    """``add_velocity`` for a problem with ``condition_points`` (a mixin of the PD problems)."""
+
+    #: ``(dofs, values)`` of each velocity condition, in the order given.
+    velocities: tuple = ()
+
+    def add_velocity(self, where: Any, component: int | None, value: Any = 0.0) -> None:
+        """Prescribe velocities at points for the dynamic runs: ``u = value t``.
+
+        Parameters
+        ----------
+        where : callable ``(n, d) -> (n,) bool``, or a boolean mask / index array over
+            the points (``condition_points``)
+        component : {0, ..., d - 1, None}
+            ``None`` prescribes every component.
+        value : float, or callable ``(p, d) -> (p,)`` (``(p, d)`` for every component)
+            Velocity (length / time), constant in time.
+        """
+        self.velocities = self.velocities + (
+            dirichlet_dofs(self.condition_points, where, component, value,
+                           where_to_look=self.points_name, what="add_velocity"),)
+
+    def prescribed_velocity(self) -> tuple[np.ndarray, np.ndarray]:
+        """The dofs (``d * point + component``, sorted) with a prescribed velocity and
+        its values (the last condition winning)."""
+        return last_wins(self.velocities)
+
+    def static_only(self, what: str) -> None:
+        """Refuse a static solve (``what``) of a problem with velocity conditions.
+
+        Raises
+        ------
+        ConditionError
+        """
+        if self.velocities:
+            raise ConditionError(f"{what}: expected no velocity condition (a static solve has "
+                                 f"no time), received {len(self.velocities)} (add_velocity); "
+                                 f"run them with run_dynamic, or prescribe displacements with "
+                                 f"add_dirichlet")
