@@ -146,13 +146,39 @@ def _first_breaking_factor(prob):
     return prob.material.stretch_limit(2, prob.plane, b.horizon) / float(stretch.max())
 
 
+class _Report:
+    """Every `REPORT_EVERY` load factors of a sequential PD run: one line on the
+    terminal (factor, bonds broken, time) and the damage so far in ``snapshot`` (an
+    ``.npz`` of ``points``, ``damage``, ``factor``), so a long run shows its progress
+    and leaves its crack behind if it is stopped."""
+
+    def __init__(self, prob, snapshot):
+        self.prob, self.snapshot, self.count, self.broken = prob, snapshot, 0, 0
+        self.t0 = time.perf_counter()
+
+    def __call__(self, step, u):
+        self.count += 1
+        self.broken += step.broken
+        if self.count % REPORT_EVERY:
+            return
+        print(f"PD: load factor {step.factor:.4f}, {self.broken} bonds broken after "
+              f"{self.count} factors, {time.perf_counter() - self.t0:.0f} s", flush=True)
+        if self.snapshot is not None:
+            np.savez(self.snapshot, points=self.prob.body.points, damage=self.prob.damage(),
+                     factor=step.factor)
+
+
+#: Load factors between two progress lines (and damage snapshots) of a sequential run.
+REPORT_EVERY = 25
+
+
 def _pd(cloud, model, horizon_factor, factor_step, factor_max, max_rounds, load_steps,
-        solver="adr", max_solves=100_000, threshold=0.5):
+        solver="adr", max_solves=100_000, threshold=0.5, snapshot=None):
     body, prob = _pd_problem(cloud, model, horizon_factor)
     start = _first_breaking_factor(prob)
     if solver == "sequential":
         run = sequential(prob, factor_max, stop=load_drop(0.2), max_solves=max_solves,
-                         tol=1e-8, progress=False)
+                         tol=1e-8, progress=False, callback=_Report(prob, snapshot))
     else:
         factors = start * np.arange(1.0, factor_max / start + 1e-9, factor_step)[:load_steps]
         # the PMB kernel on one thread: on a shared, busy machine two threads stall each
@@ -230,19 +256,23 @@ def compare(cnem_path: np.ndarray, pd_path: np.ndarray, other_cnem: np.ndarray,
 def study(h: float, *, model: str = "bond", horizon_factor: float = 3.0, increment: float = 1.0,
           steps: int = 12, factor_step: float = 0.02, factor_max: float = 1.5,
           max_rounds: int = 100, load_steps: int | None = None, solver: str = "adr",
-          max_solves: int = 100_000, threshold: float = 0.5) -> dict:
+          max_solves: int = 100_000, threshold: float = 0.5, snapshot=None) -> dict:
     """Both methods on the irregular cloud of spacing ``h``; one dict. ``solver``: the PD
     load stepping, ``"adr"`` (`cnem.pd.quasistatic`, load steps of ``factor_step``) or
-    ``"sequential"`` (`cnem.pd.sequential`, event by event, at most ``max_solves``);
-    ``threshold``: the damage of the PD ridge paths."""
+    ``"sequential"`` (`cnem.pd.sequential`, event by event, at most ``max_solves``,
+    reporting its progress and saving the damage so far to the ``.npz`` path
+    ``snapshot`` every `REPORT_EVERY` load factors); ``threshold``: the damage of the PD
+    ridge paths."""
     dom = plate.domain(h)
     cloud = cnem.nodes.irregular(dom, h, seed=0)
     t0 = time.perf_counter()
     cpaths, c_factor, hist = _cnem(dom, cloud, increment, steps)
     t1 = time.perf_counter()
+    print(f"h = {h:g}: C-NEM grown in {t1 - t0:.0f} s on {len(cloud)} nodes; PD next",
+          flush=True)
     body, run, ppaths, start, started = _pd(cloud, model, horizon_factor, factor_step, factor_max,
                                             max_rounds, load_steps, solver, max_solves,
-                                            threshold)
+                                            threshold, snapshot)
     t2 = time.perf_counter()
     rows = [compare(cpaths[i], ppaths[i], cpaths[1 - i], ppaths[1 - i], DIRECTIONS[i], increment,
                     h) for i in range(2)]
@@ -388,7 +418,8 @@ def main(spacings: Sequence[float] = (0.25,), *, model: str = "bond", steps: int
     for h in spacings:
         r = study(h, model=model, steps=steps, factor_step=factor_step, factor_max=factor_max,
                   max_rounds=max_rounds, load_steps=load_steps, solver=solver,
-                  max_solves=max_solves, threshold=threshold)
+                  max_solves=max_solves, threshold=threshold,
+                  snapshot=out / f"pd_damage_h{h:g}.npz")
         print(f"h = {h:g}: C-NEM {r['seconds'][0]:.0f} s, PD {r['seconds'][1]:.0f} s "
               f"({r['pd_steps']} load steps, {r['pd_broken']} bonds broken, "
               f"{r['pd_incomplete']} steps cut at max_rounds, stopped: {r['pd_stopped']}; "
