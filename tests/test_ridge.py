@@ -7,7 +7,7 @@ import pytest
 import shapely
 
 from cnem.errors import GeometryError
-from cnem.geometry.ridge import ridge_path
+from cnem.geometry.ridge import ridge_bands, ridge_path
 
 #: A kinked crack (+37 and -37 degrees) in units of the scale.
 KINKED = np.array([[0.0, 0.0], [0.4, 0.0], [0.7, 0.25], [0.9, 0.1]])
@@ -92,3 +92,30 @@ def test_no_band_is_named():
         ridge_path(points, np.full(50, 0.2), (0.5, 0.5))
     with pytest.raises(GeometryError, match="expected points \\(n, d\\), field \\(n,\\)"):
         ridge_path(points, np.zeros(49), (0.5, 0.5))
+
+
+@pytest.mark.parametrize("scale, origin", [(1.0, (0.0, 0.0)), (1e-3, (5e6, -3e6))])
+def test_separate_bands_are_told_apart(scale, origin):
+    """Three bands a few spacings wide around known segments (two of them 2 spacings
+    apart: separate; the third touching one: the same crack) are labelled as two cracks,
+    at any origin and scale; the labels are those of a brute-force flood fill."""
+    h = 0.01 * scale
+    points, place = cloud(scale, 20.0, origin, h, perturb=0.2)
+    segments = [((0.0, 0.2), (0.8, 0.2)), ((0.1, 0.25), (0.9, 0.25)), ((0.5, 0.25), (0.5, 0.8))]
+    near = [shapely.distance(shapely.LineString(place(np.array(s) * scale)),
+                             shapely.points(points)) < 0.6 * h for s in segments]
+    damage = np.where(near[0], 1.0, 0.0) + np.where(near[1] | near[2], 0.7, 0.0)
+    labels = ridge_bands(points, damage, threshold=0.5, spacing=h)
+    assert set(labels[near[0]]) == {1} and set(labels[near[1] | near[2]]) == {0}
+    assert np.all(labels[~(near[0] | near[1] | near[2])] == -1)
+    # flood fill over links shorter than 1.5 h, point by point
+    band = np.flatnonzero(damage >= 0.5)
+    seen = {int(band[0])}
+    front = [int(band[0])]
+    while front:
+        i = front.pop()
+        for j in band[np.hypot(*(points[band] - points[i]).T) < 1.5 * h]:
+            if int(j) not in seen:
+                seen.add(int(j))
+                front.append(int(j))
+    assert len(set(labels[sorted(seen)])) == 1

@@ -88,7 +88,7 @@ from cnem._parallel import one_thread
 from cnem.cli import demo_parser
 from cnem.errors import GeometryError
 from cnem.demos import growth_two_holes as plate
-from cnem.geometry.ridge import ridge_path
+from cnem.geometry.ridge import ridge_bands, ridge_path
 from cnem.pd.critical_stretch import fracture_energy
 from cnem.pd.quasistatic import load_drop, quasistatic
 from cnem.pd.sequential import sequential
@@ -147,24 +147,28 @@ def _first_breaking_factor(prob):
 
 
 class _Report:
-    """Every `REPORT_EVERY` load factors of a sequential PD run: one line on the
-    terminal (factor, bonds broken, time) and the damage so far in ``snapshot`` (an
-    ``.npz`` of ``points``, ``damage``, ``factor``), so a long run shows its progress
-    and leaves its crack behind if it is stopped."""
+    """After every load factor of a PD run, the factor at which each point's damage first
+    reached ``threshold`` (``reached``, (n,), NaN where it has not); every `REPORT_EVERY`
+    factors, one line on the terminal (factor, bonds broken, time) and the damage so far
+    in ``snapshot`` (an ``.npz`` of ``points``, ``damage``, ``factor``; None: not saved),
+    so a long run shows its progress and leaves its crack behind if it is stopped."""
 
-    def __init__(self, prob, snapshot):
-        self.prob, self.snapshot, self.count, self.broken = prob, snapshot, 0, 0
-        self.t0 = time.perf_counter()
+    def __init__(self, prob, snapshot, threshold):
+        self.prob, self.snapshot, self.threshold = prob, snapshot, threshold
+        self.count, self.broken, self.t0 = 0, 0, time.perf_counter()
+        self.reached = np.full(len(prob.body), np.nan)
 
     def __call__(self, step, u):
         self.count += 1
         self.broken += step.broken
+        damage = self.prob.damage() if step.damage is None else step.damage
+        self.reached[np.isnan(self.reached) & (damage >= self.threshold)] = step.factor
         if self.count % REPORT_EVERY:
             return
         print(f"PD: load factor {step.factor:.4f}, {self.broken} bonds broken after "
               f"{self.count} factors, {time.perf_counter() - self.t0:.0f} s", flush=True)
         if self.snapshot is not None:
-            np.savez(self.snapshot, points=self.prob.body.points, damage=self.prob.damage(),
+            np.savez(self.snapshot, points=self.prob.body.points, damage=damage,
                      factor=step.factor)
 
 
@@ -176,23 +180,59 @@ def _pd(cloud, model, horizon_factor, factor_step, factor_max, max_rounds, load_
         solver="adr", max_solves=100_000, threshold=0.5, snapshot=None):
     body, prob = _pd_problem(cloud, model, horizon_factor)
     start = _first_breaking_factor(prob)
+    report = _Report(prob, snapshot, threshold)
     if solver == "sequential":
         run = sequential(prob, factor_max, stop=load_drop(0.2), max_solves=max_solves,
-                         tol=1e-8, progress=False, callback=_Report(prob, snapshot))
+                         tol=1e-8, progress=False, callback=report)
     else:
         factors = start * np.arange(1.0, factor_max / start + 1e-9, factor_step)[:load_steps]
         # the PMB kernel on one thread: on a shared, busy machine two threads stall each
         # other (measured 20x slower per force evaluation at a load average of 18)
         with one_thread():
             run = quasistatic(prob, factors, stop=load_drop(0.2), max_rounds=max_rounds,
-                              progress=False)
+                              progress=False, callback=report)
     started = next((s.factor for s in run.steps if s.broken), np.nan)
     paths = []
     for tip in TIPS:
         near = np.hypot(*(body.points - tip).T) < body.horizon
         paths.append(ridge_path(body.points, run.damage, tip, threshold=threshold)
                      if (run.damage[near] >= threshold).any() else tip[None].copy())
-    return body, run, paths, start, started
+    return body, run, paths, start, started, report.reached
+
+
+def _other_cracks(body, run, notch_paths, threshold, reached):
+    """The PD cracks that did not grow from a notch: the bands of damage >= ``threshold``
+    (`ridge_bands`) with no point within a horizon of a notch path and a ridge longer than
+    a horizon, each from its end nearest a hole or the outer boundary along its ridge
+    (`ridge_path`). One dict each,
+    largest first: ``path`` (k, 2), ``length``, ``start`` (what it starts at) and
+    ``factor``, the first load factor at which a point of the band reached the threshold
+    (``reached``: that factor per point, see `_Report`)."""
+    if not (run.damage >= threshold).any():
+        return []
+    labels = ridge_bands(body.points, run.damage, threshold=threshold)
+    notches = shapely.MultiLineString([p if len(p) > 1 else np.vstack([p, p])
+                                       for p in notch_paths])
+    holes = [shapely.Point(c).buffer(plate.R, 256).exterior for c in plate.HOLES]
+    outer = shapely.box(0.0, 0.0, plate.L, plate.B).exterior
+    edges = {f"hole ({c[0]:g}, {c[1]:g})": hole for c, hole in zip(plate.HOLES, holes)}
+    edges["boundary"] = outer
+    cracks = []
+    for k in range(labels.max() + 1):
+        band = labels == k
+        where = shapely.points(body.points[band])
+        if shapely.distance(notches, where).min() < body.horizon:
+            continue
+        gaps = {name: shapely.distance(edge, where) for name, edge in edges.items()}
+        name = min(gaps, key=lambda e: gaps[e].min())
+        start = body.points[band][int(np.argmin(gaps[name]))]
+        field = np.where(band, run.damage, 0.0)
+        first = np.nanmin(reached[band]) if np.isfinite(reached[band]).any() else np.nan
+        path = ridge_path(body.points, field, start, threshold=threshold)
+        if _length(path) < body.horizon:                # a speck of damage, not a crack
+            continue
+        cracks.append(dict(path=path, length=_length(path), start=name, factor=float(first)))
+    return cracks
 
 
 def _length(path):
@@ -270,16 +310,19 @@ def study(h: float, *, model: str = "bond", horizon_factor: float = 3.0, increme
     t1 = time.perf_counter()
     print(f"h = {h:g}: C-NEM grown in {t1 - t0:.0f} s on {len(cloud)} nodes; PD next",
           flush=True)
-    body, run, ppaths, start, started = _pd(cloud, model, horizon_factor, factor_step, factor_max,
-                                            max_rounds, load_steps, solver, max_solves,
-                                            threshold, snapshot)
+    body, run, ppaths, start, started, reached = _pd(
+        cloud, model, horizon_factor, factor_step, factor_max, max_rounds, load_steps, solver,
+        max_solves, threshold, snapshot)
     t2 = time.perf_counter()
+    others = _other_cracks(body, run, ppaths, threshold, reached)
     rows = [compare(cpaths[i], ppaths[i], cpaths[1 - i], ppaths[1 - i], DIRECTIONS[i], increment,
                     h) for i in range(2)]
     return dict(h=h, horizon=body.horizon, nodes=len(body), rows=rows, cnem_paths=cpaths,
                 threshold=threshold,
-                pd_paths=ppaths, cnem_factor=c_factor, pd_first_bond=start, pd_started=started,
+                pd_paths=ppaths, pd_other=others, cnem_factor=c_factor, pd_first_bond=start,
+                pd_started=started,
                 pd_steps=len(run.steps), pd_stopped=run.stopped,
+                pd_last_factor=run.steps[-1].factor if run.steps else np.nan,
                 pd_incomplete=int(sum(not s.complete for s in run.steps)),
                 pd_broken=int(run.array("broken").sum()),
                 critical_stretch=run.problem.material.stretch_limit(2, "strain", body.horizon),
@@ -346,6 +389,12 @@ def table(results: list) -> str:
                          f"{row['hausdorff']:>9.3f} {row['compared_length']:>5.1f} | "
                          f"{row['kink_cnem']:>10.2f} {row['kink_pd']:>7.2f} | {c:>18} {p:>18} | "
                          f"{r['cnem_factor']:>18.4f} {r['pd_started']:>6.4f}")
+    for r in results:
+        for c in r.get("pd_other", []):
+            lines.append(f"h = {r['h']:g}: a PD crack not from a notch, from the {c['start']} at "
+                         f"({c['path'][0, 0]:.2f}, {c['path'][0, 1]:.2f}) to "
+                         f"({c['path'][-1, 0]:.2f}, {c['path'][-1, 1]:.2f}), {c['length']:.2f} mm "
+                         f"long, started at load factor {c['factor']:.4f}")
     lines.append("lengths in mm; Hausdorff over the first 'over' mm of both paths; kink: chord over "
                  "the first increment, degrees; reaches: crack growth when the path comes within h "
                  "of a hole / the boundary / the other crack; start factor: the multiple of the "
@@ -373,6 +422,9 @@ def _plot(results, path):
             ax.plot(*pp.T, "s-", color="tab:red", ms=2.5, lw=1.5,
                     label=f"PD ridge of damage ≥ {r.get('threshold', 0.5):g}" if k == 0 else None,
                     zorder=4)
+        for k, c in enumerate(r.get("pd_other", [])):
+            ax.plot(*c["path"].T, "^-", color="tab:orange", ms=2.5, lw=1.5, zorder=4,
+                    label="PD crack not from a notch" if k == 0 else None)
         ax.set_aspect("equal")
         ax.set_xlim(-0.3, plate.L + 0.3)
         ax.set_ylim(-0.3, plate.B + 0.3)
@@ -420,6 +472,8 @@ def main(spacings: Sequence[float] = (0.25,), *, model: str = "bond", steps: int
                   max_rounds=max_rounds, load_steps=load_steps, solver=solver,
                   max_solves=max_solves, threshold=threshold,
                   snapshot=out / f"pd_damage_h{h:g}.npz")
+        np.savez(out / f"pd_damage_h{h:g}.npz", points=r["points"], damage=r["damage"],
+                 factor=r["pd_last_factor"])
         print(f"h = {h:g}: C-NEM {r['seconds'][0]:.0f} s, PD {r['seconds'][1]:.0f} s "
               f"({r['pd_steps']} load steps, {r['pd_broken']} bonds broken, "
               f"{r['pd_incomplete']} steps cut at max_rounds, stopped: {r['pd_stopped']}; "

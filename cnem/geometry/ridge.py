@@ -19,7 +19,7 @@ from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
 
-__all__ = ["ridge_path"]
+__all__ = ["ridge_path", "ridge_bands"]
 
 
 def _spacing(points):
@@ -28,6 +28,69 @@ def _spacing(points):
     k = 2 * points.shape[1]
     distance, _ = cKDTree(points).query(points, k=k + 1)
     return float(np.median(distance[:, k]))
+
+
+def _band(points, field, threshold, h):
+    """The indices of the points with ``field >= threshold`` and their links (distances,
+    CSR) to those of them within ``1.5 h``."""
+    band = np.flatnonzero(field >= threshold)
+    if len(band) == 0:
+        raise GeometryError(f"field: expected some values >= threshold = {threshold:g}, "
+                            f"received a largest value of {field.max():g}; lower the threshold")
+    where = points[band]
+    links = cKDTree(where).sparse_distance_matrix(cKDTree(where), 1.5 * h, output_type="coo_matrix")
+    return band, sparse.csr_matrix((links.data, (links.row, links.col)), shape=links.shape)
+
+
+def ridge_bands(points: ArrayLike, field: ArrayLike, *, threshold: float = 0.5,
+                spacing: float | None = None) -> np.ndarray:
+    """The separate bands of ``field >= threshold``: the cracks of a damage field.
+
+    Two points of the band belong to the same crack when a chain of band points, each
+    within 1.5 spacings of the next, joins them (the links of `ridge_path`).
+
+    Parameters
+    ----------
+    points : (n, d) array_like
+        Where the field is sampled.
+    field : (n,) array_like
+        Damage (or any scalar whose high values mark the crack).
+    threshold : float
+        The band is ``field >= threshold``.
+    spacing : float, optional
+        Point spacing (default as in `ridge_path`).
+
+    Returns
+    -------
+    (n,) ndarray of int
+        The band of every point, numbered from 0 by decreasing size; -1 outside the band.
+
+    Raises
+    ------
+    GeometryError
+        If no point has ``field >= threshold``, or the shapes do not match.
+
+    >>> import numpy as np
+    >>> g = np.arange(0.0, 10.0, 0.25)
+    >>> pts = np.array([(x, y) for x in g for y in g])
+    >>> damage = ((np.abs(pts[:, 1] - 2.0) < 0.1) & (pts[:, 0] < 6)) * 1.0
+    >>> damage[(np.abs(pts[:, 1] - 7.0) < 0.1) & (pts[:, 0] > 3)] = 1.0
+    >>> bands = ridge_bands(pts, damage)
+    >>> [int((bands == k).sum()) for k in range(bands.max() + 1)], int(bands.min())
+    ([27, 24], -1)
+    """
+    points = np.asarray(points, dtype=float)
+    field = np.asarray(field, dtype=float)
+    if points.ndim != 2 or field.shape != (len(points),):
+        raise GeometryError(f"expected points (n, d) and field (n,), received shapes "
+                            f"{points.shape} and {field.shape}")
+    h = _spacing(points) if spacing is None else float(spacing)
+    band, links = _band(points, field, threshold, h)
+    _, piece = csgraph.connected_components(links, directed=False)
+    rank = np.argsort(np.argsort(-np.bincount(piece), kind="stable"), kind="stable")
+    labels = np.full(len(points), -1)
+    labels[band] = rank[piece]
+    return labels
 
 
 def ridge_path(points: ArrayLike, field: ArrayLike, start: ArrayLike, *, threshold: float = 0.5,
@@ -77,15 +140,10 @@ def ridge_path(points: ArrayLike, field: ArrayLike, start: ArrayLike, *, thresho
     if points.ndim != 2 or field.shape != (len(points),) or start.shape != points.shape[1:]:
         raise GeometryError(f"expected points (n, d), field (n,) and start (d,), received "
                             f"shapes {points.shape}, {field.shape} and {start.shape}")
-    band = np.flatnonzero(field >= threshold)
-    if len(band) == 0:
-        raise GeometryError(f"field: expected some values >= threshold = {threshold:g}, "
-                            f"received a largest value of {field.max():g}; lower the threshold")
     h = _spacing(points) if spacing is None else float(spacing)
+    band, links = _band(points, field, threshold, h)
     step = 3.0 * h if step is None else float(step)
     where, weight = points[band], field[band]
-    links = cKDTree(where).sparse_distance_matrix(cKDTree(where), 1.5 * h, output_type="coo_matrix")
-    links = sparse.csr_matrix((links.data, (links.row, links.col)), shape=links.shape)
     seed = int(np.argmin(np.linalg.norm(where - start, axis=1)))
     geodesic, previous = csgraph.dijkstra(links, indices=seed, return_predecessors=True)
     far = int(np.argmax(np.where(np.isfinite(geodesic), geodesic, -1.0)))
