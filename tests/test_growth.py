@@ -68,12 +68,16 @@ def williams_setup(KI, KII):
     return setup
 
 
-def transformed_cloud(cloud, domain, matrix):
-    """The same nodes mapped by ``matrix`` (2 x 2) as a cloud of the mapped domain."""
-    regions = [np.asarray(p.exterior.coords)[:-1] @ matrix.T for p in domain.regions]
-    dom = cnem.Domain(regions, cracks=[c @ matrix.T for c in domain.cracks])
-    mapped = cnem.nodes.from_points(dom, cloud.points @ matrix.T)
-    return dom, dataclasses.replace(mapped, spacing=cloud.spacing)
+def transformed_cloud(cloud, domain, matrix, offset=(0.0, 0.0)):
+    """The same nodes mapped by ``x -> matrix x + offset`` (``matrix`` 2 x 2) as a cloud of
+    the mapped domain (spacing scaled with the map)."""
+    def place(x):
+        return np.asarray(x) @ matrix.T + offset
+    regions = [place(np.asarray(p.exterior.coords)[:-1]) for p in domain.regions]
+    dom = cnem.Domain(regions, cracks=[place(c) for c in domain.cracks])
+    mapped = cnem.nodes.from_points(dom, place(cloud.points))
+    scale = np.sqrt(abs(np.linalg.det(matrix)))
+    return dom, dataclasses.replace(mapped, spacing=cloud.spacing * scale)
 
 
 @pytest.fixture(scope="module")
@@ -112,6 +116,23 @@ def test_transformed_problem_gives_the_transformed_path(williams_runs, name):
     sign = np.sign(np.linalg.det(m))
     assert hist.array("angle")[:-1, 0] == pytest.approx(sign * williams_runs["base"][1].array("angle")[:-1, 0],
                                                          abs=1e-4)
+
+
+@pytest.mark.parametrize("offset, scale", [((1e6, -3e6), 1.0), ((5e6, 4e6), 100.0),
+                                           ((0.0, 0.0), 1e-3)])
+def test_moved_and_scaled_problem_gives_the_moved_and_scaled_path(williams_runs, offset, scale):
+    """Far from the origin (UTM-like coordinates) and in other units, the path is the
+    base path moved and scaled, to a small multiple of the coordinates' round-off; the
+    kink angles are the base's."""
+    dom = cnem.geometry.rectangle(1.0, 1.0, origin=(-0.5, -0.5), cracks=[[[-0.5, 0.0], [0.0, 0.0]]])
+    cloud = cnem.nodes.irregular(dom, 0.06, seed=3)
+    m = scale * np.eye(2)
+    d, cl = transformed_cloud(cloud, dom, m, offset)
+    hist = grow(d, cl, williams_setup(1.0, 0.4), increment=0.05 * scale, steps=2, progress=False)
+    base = williams_runs["base"][1]
+    moved = base.paths()[:, 0] / 0.05
+    assert np.abs((hist.paths()[:, 0] - offset) / (0.05 * scale) - moved).max() < 1e-6
+    assert hist.array("angle")[:-1, 0] == pytest.approx(base.array("angle")[:-1, 0], abs=1e-8)
 
 
 # ----------------------------------------------------------------- SENT in tension

@@ -292,15 +292,20 @@ class _ExactCells:
                              "node: refine it there")
 
 
-def _shared_centres(cc, nb, nodes):
+def _shared_centres(cc, nb, nodes, resolution=0.0):
     """The circumcentres with those of neighbouring triangles closer than
-    ``MERGE_TOL`` times the nodes' extent made one (the lowest triangle's): the two
+    ``MERGE_TOL`` times the nodes' extent, or than ``ROUNDOFF_ULPS`` times the
+    coordinates' round-off ``resolution``, made one (the lowest triangle's): the two
     centres of a cocircular quad are one point, but round-off puts them apart, by
     more than the merge tolerance of the cells in a thin one (a 1e-2 x 1e-6 quad:
-    2e-15), and two cells beside it would keep different ones (a gap between them)."""
+    2e-15) or far from the origin (nodes at 1e6 known to 1e-10), and the cells beside
+    it would keep different ones (a gap between them) or a vertex twice (which
+    of the quad's diagonals the triangulation took decides it, and a fan sub-cell of
+    no area beside the pair changed the stabilised stiffness by 5 %)."""
     t, k = np.nonzero(nb > np.arange(len(nb))[:, None])
     u = nb[t, k]
-    tol = config.MERGE_TOL * float(np.hypot(*np.ptp(nodes, axis=0)))
+    tol = max(config.MERGE_TOL * float(np.hypot(*np.ptp(nodes, axis=0))),
+              config.ROUNDOFF_ULPS * resolution)
     close = np.hypot(*(cc[t] - cc[u]).T) <= tol
     if not close.any():
         return cc
@@ -347,10 +352,12 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     nb = triangle_neighbors(triangles, region) if neighbors is None else neighbors
     offsets, star = vertex_triangles(triangles, n)
     cc = circumcenters(nodes, triangles)
+    resolution = 0.0 if frame is None else frame.resolution
     max_deg = int(np.diff(offsets).max())
     which = np.arange(n, dtype=np.int64) if only is None else np.unique(np.asarray(only, dtype=np.int64))
     status, poff, poly, rtri = fast_cells(nodes, triangles, nb, offsets, star,
-                                          _shared_centres(cc, nb, nodes), config.MERGE_TOL,
+                                          _shared_centres(cc, nb, nodes, resolution),
+                                          config.MERGE_TOL,
                                           max_deg, which)
     is_fast = np.flatnonzero(status == FAST)     # positions in `which`
     fast = which[is_fast]
