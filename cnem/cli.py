@@ -29,8 +29,8 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from typing import Sequence
 
-__all__ = ["main", "DEMOS", "PD_DEMOS", "HelpFormatter", "demo_parser", "output_folder",
-           "show_compile_notice", "warmup", "build_parser"]
+__all__ = ["main", "DEMOS", "PD_DEMOS", "HelpFormatter", "demo_parser", "dynamic_run_options",
+           "output_folder", "show_compile_notice", "warmup", "build_parser"]
 
 #: Command-line name -> module of `cnem.demos`.
 DEMOS = {
@@ -124,6 +124,28 @@ def demo_parser(module_file: str, doc: str, prog: str | None = None) -> argparse
     parser.add_argument("--no-plot", action="store_true", help="skip the pictures")
     show_compile_notice()
     return parser
+
+
+def dynamic_run_options(parser: argparse.ArgumentParser, frames: float, quick_h: float,
+                        quick_m: float, quick_t_end: float) -> None:
+    """Add the options of a dynamic (time-stepped) demo: ``--frames``, ``--quick`` and
+    ``--no-progress``.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The demo's parser (`demo_parser`), which holds ``--h``, ``--m`` and ``--time``.
+    frames : float
+        Default time between damage frames in µs.
+    quick_h, quick_m, quick_t_end : float
+        The small run of ``--quick``: grid spacing in m, horizon / spacing and simulated time
+        in s (shown in the help in mm and µs).
+    """
+    parser.add_argument("--frames", type=float, default=frames, help="µs between damage frames")
+    parser.add_argument("--quick", action="store_true",
+                        help=f"a small run: h = {quick_h * 1e3:g} mm, m = {quick_m:g}, "
+                             f"{quick_t_end * 1e6:g} µs (overrides --h, --m, --time)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
 def show_compile_notice() -> None:

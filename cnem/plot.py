@@ -281,11 +281,18 @@ def _scale_bar(pl, pv, view, unit, z):
                         show_points=False, always_visible=True)
 
 
-def _colour_bar_font(pl):
-    """Write the last mesh's colour bar (upright on the right, `BAR`: its title above it,
-    its labels beside it, so they cannot overlap) in `font_file`."""
-    bar = pl.scalar_bar
+#: Pixels between an upright colour bar's title and the top of the bar: more than half a
+#: label's height (labels of ``label_font_size`` 18 stand centred on their values), so the
+#: title clears the top label (a plain or a ``$...$`` mathtext title alike).
+BAR_TITLE_GAP = 24
+
+
+def colour_bar_font(bar) -> None:
+    """Write a VTK scalar bar's title and labels in `font_file` and lift its title
+    `BAR_TITLE_GAP` pixels off the bar (upright bars: the title above, the labels beside it,
+    so they cannot overlap)."""
     use_font(bar.GetTitleTextProperty(), bar.GetLabelTextProperty())
+    bar.SetVerticalTitleSeparation(BAR_TITLE_GAP)
 
 
 #: Where the upright colour bars of `solution` sit (fractions of the window).
@@ -331,10 +338,13 @@ def _per_place(sol, name):
             "gxy": sol.strain[:, shear]}[name]
 
 
-#: How `solution` names its fields on the colour bar (symbols; stresses in the unit of E).
-FIELD_LABELS = {"von_mises": "σ_vM", "sxx": "σ_xx", "syy": "σ_yy", "sxy": "σ_xy",
-                "exx": "ε_xx", "eyy": "ε_yy", "gxy": "γ_xy", "ux": "u_x", "uy": "u_y",
-                "|u|": "|u|"}
+#: How `solution` names its fields on the colour bar (stresses in the unit of E): the symbols
+#: in matplotlib's mathtext, as the matplotlib pictures write them (VTK draws ``$...$``
+#: through matplotlib, so the pyvista pictures show the same symbols).
+FIELD_LABELS = {"von_mises": r"$\sigma_\mathrm{vM}$", "sxx": r"$\sigma_{xx}$",
+                "syy": r"$\sigma_{yy}$", "sxy": r"$\sigma_{xy}$", "exx": r"$\varepsilon_{xx}$",
+                "eyy": r"$\varepsilon_{yy}$", "gxy": r"$\gamma_{xy}$", "ux": "$u_x$",
+                "uy": "$u_y$", "|u|": "$|u|$"}
 
 
 def nodal_field(sol, field):
@@ -413,8 +423,8 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *,
     cmap : str
         Matplotlib colour map name.
     title : str, optional
-        Colour-bar title, with its unit, e.g. ``"σ_θθ (MPa)"`` (default the field's
-        symbol, `FIELD_LABELS`).
+        Colour-bar title, with its unit; symbols in matplotlib's mathtext, e.g.
+        ``r"$\sigma_{\theta\theta}$ (MPa)"`` (default the field's symbol, `FIELD_LABELS`).
     cellwise : bool
         Draw a field given per cell on the cells (default); False averages it to
         the nodes (`nodal_field`) and draws it on the deformed triangles.
@@ -453,10 +463,9 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *,
     points_only = ({"point_size": 8, "render_points_as_spheres": True}
                    if triangles is None and per_cell is None else {})
     pl.add_mesh(mesh, scalars=name, cmap=cmap, lighting=False, show_edges=show_edges,
-                edge_color=(0.4, 0.4, 0.4),               # "\n": lifts the title off the top label
-                scalar_bar_args=dict(BAR, title=label + "\n"),
+                edge_color=(0.4, 0.4, 0.4), scalar_bar_args=dict(BAR, title=label),
                 **points_only)
-    _colour_bar_font(pl)
+    colour_bar_font(pl.scalar_bar)
     lift = 1e-3 * diameter
     entries = []
     if model is not None and len(model.nodes) == len(nodes):

@@ -236,3 +236,16 @@ def test_warmup_runs_every_listed_demo(monkeypatch):
     compiled = cli.warmup(progress=False)
     assert ran == [module for module, _, _ in cli.WARMUP]
     assert all(name.startswith("cnem.") for name in compiled)
+
+
+@pytest.mark.parametrize("command, name", [("pd", "branching"), ("pd", "kalthoff-winkler")])
+def test_dynamic_demos_describe_their_quick_run(command, name, monkeypatch, capsys):
+    """The time-stepped demos share ``--frames``, ``--quick`` and ``--no-progress``
+    (`cli.dynamic_run_options`); ``--quick``'s help states the demo's own small run."""
+    parser = _demo_parser(command, name, monkeypatch, capsys)
+    options = {o: a for a in parser._actions for o in a.option_strings}
+    assert {"--frames", "--quick", "--no-progress"} <= set(options)
+    quick = importlib.import_module(f"cnem.demos.{cli.PD_DEMOS[name]}").QUICK
+    h = np.atleast_1d(quick["h"])[0]
+    assert options["--quick"].help.startswith(
+        f"a small run: h = {h * 1e3:g} mm, m = {quick['m']:g}, {quick['t_end'] * 1e6:g} µs")

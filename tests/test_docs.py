@@ -29,6 +29,27 @@ def test_site_builds_strict(tmp_path):
     for page in ("index.html", "tutorial/index.html", "api/geometry/index.html",
                  "demos/bimaterial_cylinder/index.html", "api-contract/index.html"):
         assert (tmp_path / "site" / page).stat().st_size > 1000, page
+    site = tmp_path / "site"
+    api = sorted((site / "api").glob("*/index.html"))
+    assert api
+    for page in api:              # a bare doctest in a docstring is code, not nested quotes
+        assert "<blockquote>" not in page.read_text(), page
+    assert 'class="arithmatex"' in (site / "fracture" / "index.html").read_text()
+
+
+@pytest.mark.skipif(importlib.util.find_spec("griffe") is None,
+                    reason='the docs extra is not installed (pip install -e ".[docs]")')
+def test_bare_doctests_become_code_blocks():
+    """docs/doctest_blocks.py fences a doctest in a docstring's text (at its indentation, up
+    to the blank line), leaves an ``Examples`` section to griffe and other text alone."""
+    fence = runpy.run_path(str(ROOT / "docs" / "doctest_blocks.py"))["fence_doctests"]
+    assert fence("Text.\n\n>>> x = 1\n>>> x\n1\n\nMore.") == (
+        "Text.\n\n```pycon\n>>> x = 1\n>>> x\n1\n```\n\nMore.")
+    assert fence("a : int\n    >>> f(\n    ... 2)\n") == (
+        "a : int\n    ```pycon\n    >>> f(\n    ... 2)\n    ```\n")
+    examples = "Examples\n--------\n>>> 1 + 1\n2"
+    assert fence("Sum.\n\n" + examples) == "Sum.\n\n" + examples
+    assert fence("No doctest; a > b.") == "No doctest; a > b."
 
 
 def test_every_docs_page_is_in_the_navigation():

@@ -103,3 +103,18 @@ def test_scale_bar_length_is_round_and_about_a_fifth(span):
 
 def test_every_field_has_a_symbol():
     assert set(cnem.plot.FIELD_LABELS) == set(cnem.plot.SOLUTION_FIELDS)
+
+
+def test_field_symbols_are_mathtext_that_vtk_draws():
+    """The colour-bar symbols are matplotlib mathtext (``$\\sigma_{xx}$``, as the matplotlib
+    pictures write them) that parses, and VTK has its matplotlib math-text renderer, so the
+    pyvista pictures show symbols, not ``$`` and underscores."""
+    from matplotlib.mathtext import MathTextParser
+    from vtkmodules.vtkRenderingFreeType import vtkMathTextUtilities
+
+    parser = MathTextParser("path")
+    for label in cnem.plot.FIELD_LABELS.values():
+        assert label.startswith("$") and label.endswith("$") and label.count("$") == 2, label
+        parser.parse(label)                       # raises on TeX that mathtext cannot draw
+    cnem.plot._pyvista().Plotter(off_screen=True).close()
+    assert vtkMathTextUtilities.GetInstance() is not None

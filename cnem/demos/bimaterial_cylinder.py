@@ -317,8 +317,8 @@ def main(grids: tuple = GRIDS, *, irregular: tuple = (False, True), fem: bool = 
         plot_convergence(rows, out / "cylinder_convergence.png")
         plot_profiles(regular[min(1, len(regular) - 1)]["solution"], out / "cylinder_profiles.png")
         _, _, stt = polar_stress(finest)
-        finest.plot(out / "cylinder_hoop_stress.png", field=stt, title="σ_θθ (MPa)",
-                    length_unit="mm").close()
+        finest.plot(out / "cylinder_hoop_stress.png", field=stt,
+                    title=r"$\sigma_{\theta\theta}$ (MPa)", length_unit="mm").close()
         files += [out / "cylinder_convergence.png", out / "cylinder_profiles.png",
                   out / "cylinder_hoop_stress.png"]
     rates = {}

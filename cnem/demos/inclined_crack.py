@@ -204,8 +204,8 @@ def main(angles: tuple = ANGLES, *, sif_cloud: tuple = SIF_CLOUD, paper_cloud: t
         _plots(rows, ahead, out)
         model, d = build(30.0, paper_cloud)
         sol = solve(model, paper_cloud[0])
-        sol.plot(out / "inclined_crack_open.png", field="von_mises", title="σ_vM (MPa)",
-                 length_unit="mm").close()
+        sol.plot(out / "inclined_crack_open.png", field="von_mises",
+                 title=r"$\sigma_\mathrm{vM}$ (MPa)", length_unit="mm").close()
         files = [out / "inclined_sigma22.png", out / "inclined_sif.png", out / "inclined_crack_open.png"]
         for f in files:
             print(f"wrote {f}")

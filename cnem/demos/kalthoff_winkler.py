@@ -86,7 +86,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cnem.pd as pd
-from cnem.cli import demo_parser
+from cnem.cli import demo_parser, dynamic_run_options
 from cnem.errors import InputError, MissingExtraError
 from cnem.pd.critical_stretch import bond_based
 from cnem.pd.guards import checked_schedule
@@ -409,11 +409,8 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> dict:
                         help="grid spacings in mm (each dividing 25 mm), one run each")
     parser.add_argument("--m", type=float, default=4.0, help="horizon / spacing")
     parser.add_argument("--time", type=float, default=50.0, help="simulated time in µs")
-    parser.add_argument("--frames", type=float, default=5.0, help="µs between damage frames")
-    parser.add_argument("--quick", action="store_true",
-                        help=f"a small run: h = {QUICK['h'][0] * 1e3:g} mm, m = {QUICK['m']:g}, "
-                             f"{QUICK['t_end'] * 1e6:g} µs (overrides --h, --m, --time)")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    dynamic_run_options(parser, frames=5.0, quick_h=QUICK["h"][0], quick_m=QUICK["m"],
+                        quick_t_end=QUICK["t_end"])
     args = parser.parse_args(argv)
     size = QUICK if args.quick else dict(h=[s * 1e-3 for s in args.h], m=args.m,
                                          t_end=args.time * 1e-6)

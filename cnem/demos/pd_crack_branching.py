@@ -78,7 +78,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cnem.pd as pd
-from cnem.cli import demo_parser
+from cnem.cli import demo_parser, dynamic_run_options
 from cnem.errors import InputError
 from cnem.exact import rayleigh_speed
 from cnem.pd import cracks
@@ -410,11 +410,8 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
                         help="the glass (see the module docstring)")
     parser.add_argument("--stress", type=float, help="edge traction in MPa (default: 2 for "
                         "soda-lime, 12 for duran50)")
-    parser.add_argument("--frames", type=float, default=1.0, help="µs between damage frames")
-    parser.add_argument("--quick", action="store_true",
-                        help=f"a small run: h = {QUICK['h'] * 1e3:g} mm, m = {QUICK['m']:g}, "
-                             f"{QUICK['t_end'] * 1e6:g} µs (overrides --h, --m, --time)")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    dynamic_run_options(parser, frames=1.0, quick_h=QUICK["h"], quick_m=QUICK["m"],
+                        quick_t_end=QUICK["t_end"])
     args = parser.parse_args(argv)
     size = QUICK if args.quick else dict(h=args.h * 1e-3, m=args.m, t_end=args.time * 1e-6)
     try:

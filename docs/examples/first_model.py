@@ -40,5 +40,5 @@ print(f"reaction ({reaction[0]:+.4f}, {reaction[1]:+.4f}) N/mm balances the load
 # a file for ParaView and a picture
 pathlib.Path("results/first_model").mkdir(parents=True, exist_ok=True)
 sol.write("results/first_model/l_plate.vtu")
-sol.plot("results/first_model/l_plate_von_mises.png", field="von_mises", title="σ_vM (MPa)",
-         length_unit="mm").close()
+sol.plot("results/first_model/l_plate_von_mises.png", field="von_mises",
+         title=r"$\sigma_\mathrm{vM}$ (MPa)", length_unit="mm").close()

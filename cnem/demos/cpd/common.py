@@ -129,7 +129,7 @@ def picture_3d(path: str, panels: list[dict], *, window: tuple = (1200, 600)) ->
     """`picture` of 3-D lattices (pyvista, off-screen, one camera): each body shaded, the
     colour bar upright beside it, axes with the body's coordinates (length 1 = the cube's
     side) and the panel's title on top."""
-    from cnem.plot import _pyvista, use_font
+    from cnem.plot import _pyvista, colour_bar_font, use_font
     pv = _pyvista()
     pl = pv.Plotter(off_screen=True, window_size=window, shape=(1, len(panels)),
                     border=False)
@@ -145,11 +145,10 @@ def picture_3d(path: str, panels: list[dict], *, window: tuple = (1200, 600)) ->
         signed = panel["values"].min() < 0 < panel["values"].max()
         pl.add_mesh(grid, scalars=name, cmap="viridis", show_edges=max(panel["counts"]) <= 40,
                     clim=(-top, top) if signed else None, edge_color=(0.3, 0.3, 0.3),
-                    scalar_bar_args=dict(title=name + "\n", color="black", vertical=True,
+                    scalar_bar_args=dict(title=name, color="black", vertical=True,
                                          title_font_size=14, label_font_size=12, fmt="%.3g",
                                          **BAR))
-        bar = pl.scalar_bars[name + "\n"]
-        use_font(bar.GetTitleTextProperty(), bar.GetLabelTextProperty())
+        colour_bar_font(pl.scalar_bars[name])
         pl.show_bounds(grid="back", location="outer", color="black", font_size=10,
                        xtitle="x", ytitle="y", ztitle="z", fmt="%.1f")
         title = pl.add_text(panel["title"], position="upper_left", font_size=9,

@@ -111,5 +111,5 @@ def cube(n: int = 7, *, m: float = 2.0, steps: int = 8, ratio: float = RATIO,
         print(f"{name:>6} {c['lateral_stretch']:>7.4f} {c['volume_ratio']:>7.4f} "
               f"{c['central_volume_ratio']:>8.4f} {c['seconds']:>5.1f}s")
     return finish("cube", dict(cases=cases, tables=tables), outdir, plot, lambda: [
-        dict(points=x + c["u"], counts=counts, values=c["u"][:, 0], field="u_x",
+        dict(points=x + c["u"], counts=counts, values=c["u"][:, 0], field="$u_x$",
              title=f"{k}-neighbour,\nstretch 2, δ = {m:g}h") for k, c in cases.items()], 3)

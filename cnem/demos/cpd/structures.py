@@ -126,7 +126,7 @@ def torsion(n: int = 7, *, slenderness: int = 2, m: float = 1.5, angle: float = 
     print("rotation (deg):  " + " ".join(f"{a:6.1f}" for a in rotation) + f"   ({seconds:.1f}s)")
 
     def panels():
-        return [dict(points=x + u, counts=counts, values=u[:, 1], field="u_y",
+        return [dict(points=x + u, counts=counts, values=u[:, 1], field="$u_y$",
                      title=f"top turned {angle:g}°, δ = {m:g}h")]
     result = dict(C3=C3, z=ref[0, 0, :, 2], rotation=rotation, u=u, history=history,
                   seconds=seconds, tables=[table])
