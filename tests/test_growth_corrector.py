@@ -80,30 +80,36 @@ def circle_kink(self, sol, tip):
     return np.array([1.0, 0.0]), theta, 1.0, False
 
 
-def circle_error(monkeypatch, scheme, increment, length=1.2):
-    """Distance of the tip from the circle after ``length`` of growth."""
+def circle_errors(monkeypatch, scheme, increment, length=1.2):
+    """Distance of the tip from the circle, and from the circle's point at arc length
+    ``length`` from the start, after ``length`` of growth."""
     monkeypatch.setattr(growth_module._Run, "tip_kink", circle_kink)
     dom = cnem.geometry.rectangle(4.0, 4.0, cracks=[[[0.0, 2.0], [1.5, 2.0]]])
     hist = grow(dom, cnem.nodes.regular(dom, 0.25), uniaxial_setup(1.0), increment=increment,
                 steps=int(round(length / increment)), scheme=scheme, refine=None, keep=False,
                 progress=False)
     assert hist.array("crack_length")[-1, 0] == pytest.approx(1.5 + length, rel=1e-12)
-    return abs(np.hypot(*(hist.cracks[0][-1] - CENTRE)) - R)
+    tip, phi = hist.cracks[0][-1], -0.5 * np.pi + length / R
+    exact = CENTRE + R * np.array([np.cos(phi), np.sin(phi)])
+    return abs(np.hypot(*(tip - CENTRE)) - R), np.hypot(*(tip - exact))
 
 
 def test_corrector_converges_faster_than_first_order_on_a_known_path(monkeypatch):
     """Explicit steps along the tangent of a circle of radius R leave it by exactly
     sqrt(R^2 + n da^2) - R after n steps (each step along the tangent at its start):
     first order at a fixed length. The corrector's chord is the mean of the end
-    tangents: its error falls at least 4x when the increment halves."""
-    explicit = [circle_error(monkeypatch, "explicit", da) for da in (0.2, 0.1)]
-    for err, da in zip(explicit, (0.2, 0.1)):
+    tangents, off the exact chord by O(da^3): it leaves the circle by O(da^3) (8x per
+    halved increment), and its tip lags the exact point at the same length by the arc
+    minus chord, O(da^2) (4x)."""
+    explicit = np.array([circle_errors(monkeypatch, "explicit", da) for da in (0.2, 0.1)])
+    for (off, _), da in zip(explicit, (0.2, 0.1)):
         n = int(round(1.2 / da))
-        assert err == pytest.approx(np.sqrt(R ** 2 + n * da ** 2) - R, rel=1e-9)
-    corrected = [circle_error(monkeypatch, "corrector", da) for da in (0.2, 0.1)]
-    assert explicit[0] / explicit[1] == pytest.approx(2.0, rel=0.1)
-    assert corrected[0] / corrected[1] > 4.0
-    assert corrected[0] < 0.1 * explicit[0]
+        assert off == pytest.approx(np.sqrt(R ** 2 + n * da ** 2) - R, rel=1e-9)
+    corrected = np.array([circle_errors(monkeypatch, "corrector", da) for da in (0.2, 0.1)])
+    assert explicit[0] / explicit[1] == pytest.approx([2.0, 2.0], rel=0.1)
+    off, along = corrected[0] / corrected[1]
+    assert off > 7.0 and along > 3.5
+    assert np.all(corrected[0] < 0.1 * explicit[0])
 
 
 # ------------------------------------------------------------ events, update
@@ -143,3 +149,24 @@ def test_bad_scheme_raises_a_growth_error():
     dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.4, 0.5]]])
     with pytest.raises(GrowthError, match="scheme.*corrector.*received 'heun'"):
         grow(dom, 0.2, uniaxial_setup(1.0), increment=0.1, steps=1, scheme="heun", progress=False)
+
+
+def test_tip_dependent_increments_are_those_of_the_accepted_tips():
+    """Paris-type increments da_i = increment (K_eq,i / K_eq,max)^2 from the accepted
+    K's; each accepted segment has that length and leaves at angle + correction."""
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.25, 0.45], [0.55, 0.55]]])
+    hist = grow(dom, cnem.nodes.irregular(dom, 0.07, seed=1), uniaxial_setup(1.0), increment=0.06,
+                steps=2, exponent=2.0, scheme="corrector", progress=False)
+    tips = hist.paths()
+    start = np.array([[0.55, 0.55], [0.25, 0.45]])          # the other end of each tip's crack
+    if np.hypot(*(tips[0, 0] - start[0])) < 1e-9:
+        start = start[::-1]
+    for k, s in enumerate(hist.steps):
+        assert s.increment == pytest.approx(0.06 * (s.K_eq / s.K_eq.max()) ** 2, rel=1e-12)
+        assert s.increment.min() < 0.99 * s.increment.max()            # the tips differ
+        step = tips[k + 1] - tips[k]
+        assert np.hypot(*step.T) == pytest.approx(s.increment, rel=1e-9)
+        d = tips[k] - (start if k == 0 else tips[k - 1])
+        turn = np.arctan2(d[:, 0] * step[:, 1] - d[:, 1] * step[:, 0], np.sum(d * step, axis=1))
+        assert turn == pytest.approx(s.angle + s.correction, abs=1e-9)
+        assert np.abs(s.correction).min() > 0
