@@ -39,7 +39,7 @@ import numpy as np
 from ..errors import CNEMError
 
 if TYPE_CHECKING:
-    from .growth import _Run
+    from typing import Any
 
 __all__ = ["SCHEMES", "corrections"]
 
@@ -51,14 +51,15 @@ SCHEMES = {
 }
 
 
-def corrections(run: _Run, state: dict, increments: np.ndarray, step: int,
+def corrections(run: Any, state: dict, increments: np.ndarray, step: int,
                 clearance: float) -> np.ndarray:
     """Turn of every tip's accepted segment from its predictor, by a trial step.
 
     Parameters
     ----------
     run : cnem.fracture.growth._Run
-        The run in the accepted configuration; it is left there.
+        The run in the accepted configuration (its ``snapshot``, ``restore``,
+        ``advance``, ``solve`` and ``tip_kink``); it is left there.
     state : dict
         `_Run.state` of the accepted configuration (``"angle"`` the predictor kinks).
     increments : (t,) ndarray
