@@ -50,7 +50,8 @@ def test_corrected_path_is_rotated_and_mirrored_with_the_problem(williams_correc
     assert np.abs(hist.paths()[:, 0] - base.paths()[:, 0] @ m.T).max() < 1e-3 * 0.05
     sign = np.sign(np.linalg.det(m))
     for field in ("angle", "correction"):
-        assert hist.array(field)[:-1, 0] == pytest.approx(sign * base.array(field)[:-1, 0], abs=1e-4)
+        expect = sign * base.array(field)[:-1, 0]
+        assert hist.array(field)[:-1, 0] == pytest.approx(expect, abs=1e-4)
 
 
 def test_accepted_segment_leaves_the_tip_at_angle_plus_correction(williams_corrector_runs):
@@ -138,7 +139,8 @@ def test_corrected_local_update_equals_full_rebuilds_with_rings(caplog):
     rings = cnem.fracture.Refinement(spacing=0.02, radius=0.24)
     with caplog.at_level("INFO", logger="cnem.fracture.growth"):
         local, full = [grow(dom, cloud, uniaxial_setup(1.0), increment=0.06, steps=2, refine=rings,
-                            scheme="corrector", progress=False, local=flag) for flag in (True, False)]
+                            scheme="corrector", progress=False, local=flag)
+                       for flag in (True, False)]
     assert not [r for r in caplog.records if "refuses" in r.getMessage()]   # updated locally
     assert np.abs(local.array("correction")[:-1, 0]).min() > 1e-3         # the corrector turned
     _assert_equal_models(local.model, cnem.discretize(local.model.cloud, progress=False))

@@ -3,10 +3,11 @@
 Each increment solves the user's problem on the current model, takes K_I and
 K_II at every growing tip by the interaction integral (`sif`), turns them into
 a kink angle and an equivalent SIF by a criterion (`cnem.fracture.criteria`),
-and appends a straight segment at every tip (``scheme="corrector"``: turned by half
-the kink found at the end of a trial segment, `cnem.fracture.corrector`). The node cloud stays: the new
-crack vertices become nodes, the nodes too close to a new segment are dropped
-(`cnem.fracture.advance`), and the grown domain is discretized again. A body
+and appends a straight segment at every tip (``scheme="corrector"``: turned by
+half the kink found at the end of a trial segment, `cnem.fracture.corrector`).
+The node cloud stays: the new crack vertices become nodes, the nodes too close
+to a new segment are dropped (`cnem.fracture.advance`), and the grown domain is
+discretized again. A body
 that the cracks cut apart stops the run, or, with ``continue_with``, loses its
 loose pieces and goes on growing.
 
