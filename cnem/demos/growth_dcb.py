@@ -123,8 +123,9 @@ def beam_compliance(a, root=ROOT):
                                                      * H ** 3)
 
 
-def run(theta_deg, h, increment, steps, progress=False):
-    """Grow one kinked crack until ``steps`` increments or until it cuts an arm off.
+def run(theta_deg, h, increment, steps, progress=False, scheme="explicit"):
+    """Grow one kinked crack until ``steps`` increments or until it cuts an arm off
+    (``scheme``: the increment of `cnem.fracture.grow`).
 
     Returns
     -------
@@ -137,7 +138,7 @@ def run(theta_deg, h, increment, steps, progress=False):
         try:
             hist = cnem.fracture.grow(dom, cnem.nodes.regular(dom, h), setup, increment=increment,
                                       steps=steps, K_Ic=K_IC, measure=opening, keep=False,
-                                      progress=progress)
+                                      scheme=scheme, progress=progress)
             return hist, None
         except cnem.GeometryError as err:
             return err.history, str(err)

@@ -129,17 +129,18 @@ def setup(model, corners=False):
     return prob
 
 
-def run(h=0.25, increment=1.0, steps=None, refine="auto", corners=False, progress=True):
+def run(h=0.25, increment=1.0, steps=None, refine="auto", corners=False, progress=True,
+        scheme="explicit"):
     """`cnem.fracture.grow` on the plate; ``steps`` default: 12 mm of growth per crack;
     ``refine``: ``"auto"`` (grow's default), None (no rings) or the ring tip spacing in
-    background spacings. A run whose cracks cut the plate in two returns the path up to
-    there (the event ``"split"`` says so)."""
+    background spacings; ``scheme``: the increment of `cnem.fracture.grow`. A run whose
+    cracks cut the plate in two returns the path up to there (the event ``"split"`` says so)."""
     dom = domain(h)
     steps = int(round(12.0 / increment)) if steps is None else steps
     rings = refine if refine is None or refine == "auto" else refine * h
     try:
         return cnem.fracture.grow(dom, h, lambda m: setup(m, corners), increment=increment,
-                                  steps=steps, refine=rings, progress=progress)
+                                  steps=steps, refine=rings, scheme=scheme, progress=progress)
     except cnem.GeometryError as err:
         if getattr(err, "history", None) is None:
             raise

@@ -3,9 +3,11 @@
 Each increment solves the user's problem on the current model, takes K_I and
 K_II at every growing tip by the interaction integral (`sif`), turns them into
 a kink angle and an equivalent SIF by a criterion (`cnem.fracture.criteria`),
-and appends a straight segment at every tip. The node cloud stays: the new
-crack vertices become nodes, the nodes too close to a new segment are dropped
-(`cnem.fracture.advance`), and the grown domain is discretized again. A body
+and appends a straight segment at every tip (``scheme="corrector"``: turned by
+half the kink found at the end of a trial segment, `cnem.fracture.corrector`).
+The node cloud stays: the new crack vertices become nodes, the nodes too close
+to a new segment are dropped (`cnem.fracture.advance`), and the grown domain is
+discretized again. A body
 that the cracks cut apart stops the run, or, with ``continue_with``, loses its
 loose pieces and goes on growing.
 
@@ -40,6 +42,7 @@ from ..geometry.update import update
 from ..material import kappa as kolosov
 from ..nodes import irregular
 from . import advance
+from .corrector import SCHEMES, corrections
 from .refine import Refinement, as_refinement, auto_refinement, refined_cloud
 from .criteria import CRITERIA, kink
 from .history import CrackPath, GrowthEvent, Step
@@ -100,14 +103,37 @@ class _Run:
         self.rows = _tip_rows(domain)
         self.model = self.problem = None
         self.steps, self.events = [], []
+        self.trial_events = None              # a list while a trial step runs (`corrector`)
 
     def event(self, kind, step, tip, point, message):
         e = GrowthEvent(kind, step, tip, np.asarray(point, dtype=float).copy(), message)
+        if self.trial_events is not None:     # a trial segment's: neither recorded nor warned
+            self.trial_events.append(e)
+            return e
         self.events.append(e)
         log.info("%s", e)
         if kind in _WARN:
             warnings.warn(str(e), GrowthWarning, stacklevel=4)
         return e
+
+    def snapshot(self):
+        """The geometry, cloud, model and problem of the accepted configuration, for
+        `restore` after a trial step (the arrays are replaced by `advance`, never changed)."""
+        return dict(domain=self.domain, cloud=self.cloud, cracks=list(self.cracks),
+                    rows=[list(r) for r in self.rows], retired=dict(self.retired),
+                    split=self.split, model=self.model, problem=self.problem)
+
+    def restore(self, saved):
+        """Back to a `snapshot`."""
+        for name, value in saved.items():
+            setattr(self, name, value)
+
+    def tip_kink(self, sol, tip):
+        """``(K (2,) SIFResult, kink angle, K_eq, at_bound)`` of the criterion at a tip."""
+        res = sif(sol, tip, radius=self.radius)
+        E, nu = sol.problem.materials[res.region]
+        theta, K_eq, at_bound = kink(self.criterion, res[0], res[1], kappa=kolosov(nu, sol.plane))
+        return res, theta, K_eq, at_bound
 
     def solve(self):
         """Re-discretise the grown cloud, set the problem up and solve it."""
@@ -170,11 +196,8 @@ class _Run:
         active = np.array([a for *_, a in self.rows], dtype=bool)
         K, K_eq, angle = np.full((t, 2), np.nan), np.full(t, np.nan), np.full(t, np.nan)
         for i in np.flatnonzero(active):
-            res = sif(sol, tips[i], radius=self.radius)
-            E, nu = sol.problem.materials[res.region]
+            res, theta, K_eq[i], at_bound = self.tip_kink(sol, tips[i])
             K[i] = res
-            theta, K_eq[i], at_bound = kink(self.criterion, res[0], res[1],
-                                            kappa=kolosov(nu, sol.plane))
             angle[i] = theta
             if at_bound:
                 self.event("sharp_kink", step, i, tips[i],
@@ -193,8 +216,9 @@ class _Run:
                     crack_length=lengths,
                     measure=float(self.measure(sol)) if self.measure else np.nan)
 
-    def advance(self, state, increments, step, clearance):
-        """Append the new segments; update the domain and the cloud."""
+    def advance(self, state, increments, step, clearance, correction=None):
+        """Append the new segments, turned by ``correction`` (radians, per tip) from
+        the kink angles of ``state``; update the domain and the cloud."""
         segments, spacings = [], []
         for i in np.flatnonzero(increments > 0):
             c, end, active = self.rows[i]
@@ -203,7 +227,7 @@ class _Run:
             crack = self.cracks[c]
             start = crack[end].copy()
             d = advance.tip_direction(crack, end)
-            th = state["angle"][i]
+            th = state["angle"][i] + (0.0 if correction is None else correction[i])
             e = np.array([np.cos(th) * d[0] - np.sin(th) * d[1], np.sin(th) * d[0] + np.cos(th) * d[1]])
             h = advance.local_spacing(self.cloud, start)
             reach = clearance * h
@@ -327,6 +351,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
          radius: float | None = None, clearance: float = 0.5, keep: bool = True, local: bool = True,
          continue_with: Literal["largest"] | int | Callable[[list], int] | None = None,
          refine: Refinement | float | Literal["auto"] | None = "auto",
+         scheme: Literal["explicit", "corrector"] = "explicit",
          progress: bool = True) -> CrackPath:
     """Grow the cracks of a domain step by step (quasi-static LEFM).
 
@@ -389,6 +414,17 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         boundary, the cracks in a dropped piece go with it (their tips stop), and the
         event ``"split"`` names what was dropped. The remaining body is discretized
         afresh and ``setup`` must still find its supports and loads on it.
+    scheme : {"explicit", "corrector"}
+        The increment (`cnem.fracture.corrector`). ``"explicit"`` (default): a
+        straight segment in the criterion's direction at the tip; the path
+        converges to first order in ``increment``. ``"corrector"``: that segment
+        is a trial (all tips at once); the trial model is solved and the accepted
+        segment is turned by half the kink the criterion finds at the trial tip
+        (Heun's predictor-corrector: second order on a smooth path, two solves
+        per increment). Each step's turn is ``Step.correction``; the increments,
+        load factors and cycles are those of the accepted tips; a tip whose trial
+        segment meets the boundary, a hole or a crack takes the predictor's
+        direction in that step (event ``"predictor"``).
     progress : bool
         A progress bar over the steps.
 
@@ -405,6 +441,8 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         ``continue_with``, or ``setup`` fails on the piece kept (with the run so far
         as the error's ``history``).
     """
+    if not isinstance(scheme, str) or scheme not in SCHEMES:
+        raise GrowthError(f"scheme: expected one of {sorted(SCHEMES)}, received {scheme!r}")
     if criterion not in CRITERIA:
         raise GrowthError(f"criterion: expected one of {sorted(CRITERIA)}, received {criterion!r}")
     if len(domain.tips) == 0:
@@ -452,7 +490,9 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
                 break
             k_max = now["K_eq"][growing].max()
             increments[growing] = increment * (now["K_eq"][growing] / k_max) ** exponent
-            grew = run.advance(now, increments, step, clearance)
+            turn = (corrections(run, now, increments, step, clearance) if scheme == "corrector"
+                    else np.zeros(len(run.rows)))
+            grew = run.advance(now, increments, step, clearance, turn)
             prev, sol_prev, events = now, sol, tuple(run.events[mark:])
             mark = len(run.events)
             if grew:
@@ -460,7 +500,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
                 now = run.state(sol, step + 1)
             cycles = _cycles(paris, prev, now, increments) if paris else np.nan
             run.steps.append(Step(**prev, increment=increments, cycles=cycles, events=events,
-                                  solution=sol_prev if keep else None))
+                                  solution=sol_prev if keep else None, correction=turn))
             bar.update()
             bar.set_postfix(K_eq=f"{k_max:.4g}")
             step += 1
@@ -476,7 +516,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
 
 def _history(run, now, sol, mark):
     final = Step(**now, increment=np.zeros(len(run.rows)), events=tuple(run.events[mark:]),
-                 solution=sol if run.keep else None)
+                 solution=sol if run.keep else None, correction=np.zeros(len(run.rows)))
     return CrackPath(steps=run.steps, final=final, cracks=[c.copy() for c in run.cracks],
                      domain=run.domain, model=run.model, solution=sol, criterion=run.criterion,
                      events=list(run.events))

@@ -33,6 +33,9 @@ EVENT_KINDS = {
     "left_domain": "the increment would leave the domain: it was cut where it meets the boundary",
     "split": "the cracks cut the body apart and, with continue_with, the loose pieces were "
              "dropped (tip -1: the whole body)",
+    "predictor": "scheme=\"corrector\": the tip's trial segment met the boundary, a hole or a "
+                 "crack, or its trial tip found no direction; the step took the predictor's "
+                 "(explicit) direction",
 }
 
 
@@ -90,6 +93,10 @@ class Step:
     events : tuple of GrowthEvent
     solution : ElasticSolution or None
         The solution of this step (kept with ``keep=True``).
+    correction : (t,) ndarray
+        Turn of each new segment from ``angle`` (radians): half the kink at the
+        trial tip with ``scheme="corrector"``, 0 otherwise; the segment leaves the
+        tip at ``angle + correction`` from the crack direction.
     """
 
     tips: np.ndarray
@@ -104,6 +111,7 @@ class Step:
     measure: float = np.nan
     events: tuple = ()
     solution: object = None
+    correction: np.ndarray = None
 
     @property
     def critical_load_factor(self) -> float:
