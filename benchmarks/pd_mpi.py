@@ -24,6 +24,11 @@ largest over the ranks. ``halo``: ghosts over owned points, summed over the rank
 and waiting for them after the interior bonds (the part the overlap does not hide). ``peak GB``:
 each process's high-water RSS (``VmHWM``, set-up included), the largest rank.
 
+Memory-bandwidth bound: each round also times a read kernel over synthetic bond arrays of
+the case's size (``benchmarks/_bandwidth.py``: what the force loop must read each step) in
+one single-threaded process, then split between two processes running at once; the ratio of
+the rates bounds the 2-rank / 1-rank speed-up of a bandwidth-bound step, printed beside it.
+
 Targets (issue; printed MET / MISSED, never asserted): 2 ranks >= 1.8x one rank;
 2 ranks >= 0.9x the 2-thread serial code; peak memory per rank <= 0.6x the serial peak.
 
@@ -58,7 +63,8 @@ import time
 
 import numpy as np
 
-from _harness import mem_available_bytes, peak_rss_bytes
+import _bandwidth as stream
+from _harness import mem_available_bytes, median, peak_rss_bytes
 
 HORIZON_FACTOR = 3.015
 CASES = {"2d-40k": (2, 200), "2d-1M": (2, 1000), "3d-1M": (3, 100)}
@@ -193,10 +199,11 @@ def main(argv=None):
     cases = args.cases or (QUICK_CASES if args.quick else DEFAULT_CASES)
     print(f"benchmarks/pd_mpi.py: cases {cases}; {os.cpu_count()} CPUs, load average "
           f"{os.getloadavg()[0]:.2f} (other processes slow every configuration)")
-    results = {}
+    results, streams = {}, {}
     for case in cases:
         d, k = CASES[case]
         rounds = {}
+        streams[case] = {1: [], 2: []}
         for round_ in range(max(1, args.repeat)):
             for mode, ranks in (("serial", 1), ("dist", 1), ("dist", 2)):
                 need = BYTES_PER_BOND[mode] * MEMBERS[d] * k ** d
@@ -211,12 +218,39 @@ def main(argv=None):
                       f" (load {os.getloadavg()[0]:.2f})", flush=True)
                 if r is not None:
                     rounds.setdefault((mode, ranks), []).append(r)
+            for procs in streams[case]:
+                streams[case][procs].append(stream.concurrent_read(MEMBERS[d] * k ** d, d, procs))
+            print(f"  round {round_ + 1}: {case} read bandwidth, 1 process "
+                  f"{streams[case][1][-1]:.1f} GB/s, 2 at once {streams[case][2][-1]:.1f} GB/s "
+                  f"(load {os.getloadavg()[0]:.2f})", flush=True)
         # the run of median step time of each configuration
         results[case] = {key: sorted(rs, key=lambda r: r["step"])[(len(rs) - 1) // 2]
                          for key, rs in rounds.items()}
     print(f"load average after: {os.getloadavg()[0]:.2f}")
     report(results)
+    report_bandwidth(results, streams)
     return results
+
+
+def report_bandwidth(results, streams):
+    """The memory-bandwidth bound on the ranks' speed-up beside the measured one."""
+    print()
+    print("memory-bandwidth bound (benchmarks/_bandwidth.py: single-threaded processes reading "
+          "synthetic bond arrays of the case's size, split between them, all at once; "
+          "medians over the rounds):")
+    for case, bw in streams.items():
+        d, k = CASES[case]
+        per_bond = stream.nbytes(stream.bond_arrays(1, d))
+        b1, b2 = median(bw[1]), median(bw[2])
+        r1, r2 = results[case].get(("dist", 1)), results[case].get(("dist", 2))
+        line = (f"  {case}: {per_bond} bytes per bond; 1 process {b1:.1f} GB/s, 2 at once "
+                f"{b2:.1f} GB/s -> 2 ranks / 1 rank at most {b2 / b1:.2f}x")
+        if r1 and r2:
+            line += f", measured {r1['step'] / r2['step']:.2f}x"
+            floor = r1["bonds"] * per_bond / (b1 * 1e9)
+            line += (f"; 1 rank s/step at least {floor:.4f} (bonds x bytes / read rate), "
+                     f"measured {r1['step']:.4f}")
+        print(line)
 
 
 def report(results):

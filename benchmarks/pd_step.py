@@ -37,6 +37,13 @@ spinning workers (GNU OpenMP's default wait policy) can make two threads slower 
   the kernel's (``max |F_np - F_kernel| / max |F_kernel|``, printed).
   ``speed-up`` = NumPy s/step / kernel (2 threads) s/step.
 
+* ``stream``: the memory-bandwidth bound (``benchmarks/_bandwidth.py``): a read kernel
+  over the step's own bond arrays (``xi``, lengths, partner indices, stiffness, alive
+  flags: what the force loop must read every step) and STREAM's triad, at 1 and 2
+  threads, medians over ``--repeat`` calls; printed beside the kernel as the bond updates
+  per second the read rate allows (read GB/s over bytes per bond) and the 2-thread /
+  1-thread speed-up it allows (ratio of the read rates).
+
 Peak memory: the process's high-water RSS (``VmHWM``) is reset before each stage (where
 ``/proc/self/clear_refs`` allows) and the stage's growth over the RSS at its start is reported
 in bytes per bond (``peak GB`` in the table is the whole process during the setup).  On small
@@ -68,6 +75,7 @@ import time
 
 import numpy as np
 
+import _bandwidth as stream
 from _harness import median, mem_available_bytes, peak_rss_bytes, reset_peak_rss, warm_median
 
 HORIZON_FACTOR = 3.015                  # horizon / h (delta = 3h)
@@ -313,6 +321,9 @@ def run_case(name, args, guard, problem_class):
             lambda: kernel_forces(u, body, stiffness, alive, out), args.repeat)
     numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
     r["alive"] = bool(alive.all())
+    print(" stream", end="", flush=True)
+    r["stream"] = stream.measure((body.xi, body.length, body.bond_j, stiffness, alive),
+                                 available_threads(), args.repeat)
 
     if args.no_numpy:
         r["numpy_skipped"] = "--no-numpy"
@@ -343,6 +354,32 @@ def verdict(good):
 def rate(r, t):
     s = r.get("kernel", {}).get(t)
     return r["bonds"] / s if s else None
+
+
+def report_bandwidth(results):
+    """The memory-bandwidth bound beside the measured step (see `_bandwidth`)."""
+    print("  memory-bandwidth bound (streaming kernels over the step's own bond arrays, "
+          "medians of --repeat calls):")
+    for r in results:
+        if "stream" not in r:
+            continue
+        st = r["stream"]
+        per_bond = st["bytes"] / r["bonds"]
+        parts = []
+        for t in sorted(k for k in st if k != "bytes"):
+            bound = st[t]["read"] * 1e9 / per_bond
+            got = rate(r, t)
+            parts.append(f"{t}T read {st[t]['read']:.1f} GB/s, triad {st[t]['triad']:.1f} GB/s "
+                         f"-> at most {bound / 1e6:.0f} M bond updates/s, measured "
+                         f"{got / 1e6:.0f} ({got / bound * 100:.0f} % of the bound)")
+        ts = sorted(k for k in st if k != "bytes")
+        if len(ts) > 1:
+            k1, k2 = r["kernel"][ts[0]], r["kernel"][ts[-1]]
+            parts.append(f"{ts[-1]}T/{ts[0]}T speed-up bound (read bandwidth ratio) "
+                         f"{st[ts[-1]]['read'] / st[ts[0]]['read']:.2f}x, measured "
+                         f"{k1 / k2:.2f}x")
+        print(f"    {r['name']}: {per_bond:.0f} bytes per bond streamed; " +
+              ";\n      ".join(parts))
 
 
 def report(results, warm, layer):
@@ -412,6 +449,7 @@ def report(results, warm, layer):
                      f"{r['members']}{'' if full else ', MISMATCH'}); all bonds alive after the "
                      f"steps: {'yes' if r['alive'] else 'NO'}")
         print(f"  {r['name']}: " + ";\n          ".join(parts))
+    report_bandwidth(results)
     missing = [t for t in THREADS if t not in available_threads()]
     if missing:
         print(f"  (numba allows {available_threads()[-1]} thread(s) here: "

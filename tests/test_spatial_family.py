@@ -279,3 +279,40 @@ def test_errors():
                 family_search(np.vstack([pts, [outside]]), 0.1, period=[1.0, 1.0], method=method)
     with pytest.raises(ValueError, match="period"):
         family_search(pts, 0.1, period=[1.0, 0.0])
+
+
+def lines_cloud(rng, dim):
+    """Points on lines along the last axis (every column of the cell list a line, so
+    the extents of its points have no width) with rows of the lines jittered or
+    not, scaled and shifted: the clouds where the gap between columns is tight."""
+    m = rng.integers(3, 9)
+    grid = np.stack(np.meshgrid(*[np.arange(m)] * (dim - 1), indexing="ij"), -1)
+    feet = grid.reshape(-1, dim - 1).astype(float)
+    if rng.random() < 0.5:
+        feet += rng.uniform(-0.3, 0.3, feet.shape) * (rng.random(feet.shape) < 0.5)
+    per_line = rng.integers(5, 30)
+    heights = rng.choice([0.0, 1.0]) * rng.random((len(feet), per_line)) * m
+    heights += np.arange(per_line) * (m / per_line)
+    pts = np.column_stack([np.repeat(feet, per_line, axis=0), heights.reshape(-1)])
+    return pts[rng.permutation(len(pts))]
+
+
+@pytest.mark.parametrize("seed", range(12))
+@pytest.mark.parametrize("dim", [2, 3])
+def test_cells_on_lines_match_brute(seed, dim):
+    """Property: random clouds of lines (lattices and jittered lattices included),
+    random horizons (integer ones: ties), open (scaled and shifted) or periodic
+    (scaled): method='cells' gives the brute-force families."""
+    rng = np.random.default_rng(seed + 100 * dim)
+    pts = lines_cloud(rng, dim)
+    span = pts.max(axis=0) - pts.min(axis=0) + 1.0
+    horizon = float(rng.choice([1.0, 2.0, rng.uniform(0.3, 0.5 * span.min())]))
+    scale, shift = 2.0 ** rng.integers(-20, 20) * rng.uniform(0.5, 1), rng.uniform(-1e3, 1e3, dim)
+    if rng.random() < 0.5:                         # periodic: the cloud wrapped into its cell
+        period = np.ceil(pts.max(axis=0)) + rng.integers(0, 3, dim)
+        pts, horizon, period = np.mod(pts, period) * scale, horizon * scale, period * scale
+    else:
+        pts, horizon, period = pts * scale + shift, horizon * scale, None
+    ref = R.brute_family(pts, horizon, period)
+    fam = family_search(pts, horizon, period=period, method="cells")
+    assert_family(fam, len(pts), ref, f"seed {seed}")

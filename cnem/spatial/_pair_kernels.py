@@ -6,7 +6,9 @@ third inside each column. The points of a column are visited in that order;
 for every neighbouring column that follows it in the sorted order (and for
 the column itself, points after the visited one), a window of heights
 ``(z - reach, z + reach)`` slides up the neighbour as ``z`` grows, with
-``reach`` set by the gap between the two columns. Each candidate in the
+``reach`` set by the gap between the extents of the two columns' points (on
+a lattice, whose columns are lines, the window holds the members only: half
+the candidates of a gap between the columns' cells). Each candidate in the
 window is tested once; a member ``q`` of ``s`` goes to the row of ``s`` and
 ``s`` to the row of ``q``.
 
@@ -71,12 +73,24 @@ def _axis_columns(c, r, nc, size, period, tol, col, shift, gap):
     return m
 
 
+@numba.njit(cache=True, inline="always")
+def _box_gap(lo_c, hi_c, lo_k, hi_k, shift, tol):
+    """Gap along one axis between the extents ``[lo_c, hi_c]`` of a column and
+    ``[lo_k, hi_k]`` of another shifted by ``shift`` (0 when NaN: the period is
+    spanned), less ``tol``, at least 0."""
+    if np.isnan(shift):
+        return 0.0
+    return max(lo_k + shift - hi_c - tol, lo_c - (hi_k + shift) - tol, 0.0)
+
+
 @numba.njit(cache=True)
-def _neighbours(c, start, nc, size, period, h2, tol, cols, sx, sy, reach):
+def _neighbours(c, start, box, nc, size, period, h2, tol, cols, sx, sy, reach):
     """Columns that may hold partners of column ``c`` and follow it in sorted order.
 
     Fills ``cols``, their shifts ``sx``, ``sy`` and height ``reach``; the own
-    column comes first. Returns their number.
+    column comes first. The reach is set by the gap between the extents of
+    the two columns' points (``box``), so that on a lattice, whose columns are
+    lines, only the members' heights are scanned. Returns their number.
     """
     h = np.sqrt(h2)
     r0 = int(np.ceil(h / size[0]))
@@ -91,13 +105,31 @@ def _neighbours(c, start, nc, size, period, h2, tol, cols, sx, sy, reach):
     for a in range(na):
         for b in range(nb):
             k = ca[a] * nc[1] + cb[b]
-            g = ga[a] * ga[a] + gb[b] * gb[b]
             if k == c:
                 sx[0], sy[0] = sa[a], sb[b]     # NaN when the period is spanned
-            elif k > c and g < h2 and start[k + 1] > start[k]:
-                cols[m], sx[m], sy[m], reach[m] = k, sa[a], sb[b], np.sqrt(h2 - g)
-                m += 1
+            elif k > c and ga[a] * ga[a] + gb[b] * gb[b] < h2 and start[k + 1] > start[k]:
+                g0 = _box_gap(box[c, 0], box[c, 1], box[k, 0], box[k, 1], sa[a], tol)
+                g1 = _box_gap(box[c, 2], box[c, 3], box[k, 2], box[k, 3], sb[b], tol)
+                g = g0 * g0 + g1 * g1
+                if g < h2:
+                    cols[m], sx[m], sy[m], reach[m] = k, sa[a], sb[b], np.sqrt(h2 - g)
+                    m += 1
     return m
+
+
+@numba.njit(cache=True, parallel=True)
+def _column_boxes(spts, start):
+    """(ncol, 4) extents ``xmin, xmax, ymin, ymax`` of the points of each column
+    (``inf, -inf`` for an empty column)."""
+    ncol = start.shape[0] - 1
+    box = np.empty((ncol, 4))
+    for c in numba.prange(ncol):
+        x0, x1, y0, y1 = np.inf, -np.inf, np.inf, -np.inf
+        for s in range(start[c], start[c + 1]):
+            x0, x1 = min(x0, spts[s, 0]), max(x1, spts[s, 0])
+            y0, y1 = min(y0, spts[s, 1]), max(y1, spts[s, 1])
+        box[c, 0], box[c, 1], box[c, 2], box[c, 3] = x0, x1, y0, y1
+    return box
 
 
 @numba.njit(cache=True, inline="always")
@@ -112,7 +144,7 @@ def _height(spts, base, m, v, period):
 
 
 @numba.njit(cache=True)
-def _column_pass(col, spts, h2, tol, start, perm, nc, size, period, wrap_z, write, rows, lo,
+def _column_pass(col, spts, h2, tol, start, box, perm, nc, size, period, wrap_z, write, rows, lo,
                  out, cols, sx, sy, reach, wlo, whi):
     """Count (``write`` False) or write the pairs of the points of column ``col``.
 
@@ -120,7 +152,7 @@ def _column_pass(col, spts, h2, tol, start, perm, nc, size, period, wrap_z, writ
     writing uses ``rows`` as cursors into ``out``. ``tol`` bounds the rounding
     of coordinates (gaps are shrunk and windows widened by it).
     """
-    m = _neighbours(col, start, nc, size, period, h2, tol, cols, sx, sy, reach)
+    m = _neighbours(col, start, box, nc, size, period, h2, tol, cols, sx, sy, reach)
     periodic_z = np.isfinite(period[2]) and not wrap_z
     for k in range(m):
         wlo[k] = 0
@@ -216,7 +248,7 @@ def _record(d2, h2, write, rows, lo, out, q, own, perm, mine):
 
 
 @numba.njit(cache=True, parallel=True)
-def _scan_all(spts, h2, tol, start, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
+def _scan_all(spts, h2, tol, start, box, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
               write, rows, out):
     """One counting (``write`` False) or filling pass, a chunk of columns per thread."""
     nch = lo.shape[0]
@@ -229,7 +261,7 @@ def _scan_all(spts, h2, tol, start, perm, nc, size, period, wrap_z, chunk_cols, 
         wlo, whi = np.empty(most, dtype=np.int64), np.empty(most, dtype=np.int64)
         window = rows[woff[c]:woff[c + 1]]
         for col in range(chunk_cols[c], chunk_cols[c + 1]):
-            _column_pass(col, spts, h2, tol, start, perm, nc, size, period, wrap_z, write,
+            _column_pass(col, spts, h2, tol, start, box, perm, nc, size, period, wrap_z, write,
                          window, lo[c], out, cols, sx, sy, reach, wlo, whi)
 
 
@@ -297,6 +329,7 @@ def uniform_family(pts, h, origin, size, nc, period, index_dtype_sample, nch):
     for s in numba.prange(n):
         for k in range(3):
             spts[s, k] = pts[perm[s], k]
+    box = _column_boxes(spts, start)
     h2 = h * h
     tol = 1e-9 * h + 1e-12 * (np.abs(pts).max() + h)
     wrap_z = np.isfinite(period[2]) and 2.0 * h * (1.0 + 1e-9) >= period[2]
@@ -307,10 +340,10 @@ def uniform_family(pts, h, origin, size, nc, period, index_dtype_sample, nch):
         woff[c + 1] = woff[c] + hi[c] - lo[c]
     rows = np.zeros(woff[nch], dtype=np.int64)
     dummy = np.empty(0, dtype=index_dtype_sample.dtype)
-    _scan_all(spts, h2, tol, start, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
+    _scan_all(spts, h2, tol, start, box, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
               False, rows, dummy)
     offsets, out = _cursors(rows, woff, lo, hi, perm, index_dtype_sample)
-    _scan_all(spts, h2, tol, start, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
+    _scan_all(spts, h2, tol, start, box, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
               True, rows, out)
     return offsets, out
 
