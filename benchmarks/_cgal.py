@@ -76,8 +76,8 @@ def run(exe, nodes, points, repeat, tmp):
     Returns
     -------
     dict
-        ``build`` (Delaunay seconds), ``runs`` (seconds per timed run: Hilbert sort +
-        coordinates + CSR), ``outside``, ``rss`` (peak bytes), ``phi`` (the last run's
+        ``build`` (Delaunay seconds), ``runs`` (wall seconds per timed run: Hilbert sort +
+        coordinates + CSR), ``cpu_runs`` (the runs' CPU seconds), ``outside``, ``rss`` (peak bytes), ``phi`` (the last run's
         ``scipy.sparse.csr_matrix``, shape (q, n)); ``error`` when the driver failed.
     """
     import scipy.sparse as sp
@@ -102,4 +102,5 @@ def run(exe, nodes, points, repeat, tmp):
                  prefix + ".indptr"):
         os.remove(path)
     return dict(build=out["build"][0], n_vertices=int(out["vertices"][0]), runs=out["runs"],
+                cpu_runs=out["cpu_runs"],
                 outside=int(out["outside"][0]), rss=out["peak_kb"][0] * 1024, phi=phi)

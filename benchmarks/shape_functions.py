@@ -56,6 +56,23 @@ repetitions (of the Delaunay build and of the query, each) stop early once their
 cumulative time passes ``--baseline-budget`` seconds (default 60; at least one run); the
 table's ``rep`` column gives the runs done.
 
+**CGAL** (the compiled anchor, square domain only) -- when g++ and CGAL's headers are found
+(Debian: ``apt-get install libcgal-dev``; a benchmark-time tool, not a cnem dependency), the
+driver ``benchmarks/cgal_sibson.cpp`` is compiled once into a cache folder
+(``~/.cache/cnem-benchmarks``, see ``_cgal.py``) and run as its own process on the cnem
+model's nodes and the same query points (raw float64 files).  It builds a
+``Delaunay_triangulation_2`` (timed apart, not counted), then ``--repeat`` times, single
+threaded: ``CGAL::hilbert_sort`` of the query indices (counted), ``locate`` from the
+previous query's face and ``natural_neighbor_coordinates_2`` there (Sibson coordinates,
+normalised), and the CSR matrix in the input order of the queries (counted: cnem returns
+one); rate = query points / median time.  The last run's matrix is read back and compared
+with cnem's one-thread values: max ``|cnem - CGAL|`` is printed and checked against 1e-12.
+Otherwise the column says why it was skipped.  The cracked plate has no CGAL column: CGAL's
+unconstrained Delaunay triangulation ignores the crack, so its values are not cnem's there.
+``1T/CGAL`` is cnem's one-thread rate over CGAL's (target, issue 22: >= 1 at 100k and 1M
+nodes); the same ratio by CPU time per run (``time.process_time`` / ``std::clock``, less
+sensitive to other processes on a shared machine) is printed under the target.
+
 Peak memory is the child's high-water resident set size, ``VmHWM`` from
 ``/proc/self/status`` (``ru_maxrss`` is not used: across ``exec`` the kernel carries the
 parent's peak over into a spawned child).  In the cnem children the high-water mark is reset
@@ -70,9 +87,10 @@ Checks (printed): on the smallest model of each domain, the rows of Phi sum to 1
 no negative value; the one- and two-thread results are identical (fingerprint); every
 query point lies in a scipy simplex and the barycentric weights reproduce the points.
 
-The anchors from the issue (CGAL's ``natural_neighbor_coordinates_2``, C++, unconstrained,
-measured on this machine with 1M random queries; a plain numba Watson kernel) are printed
-next to our square-domain rates.  Target (issue): >= 2 M points/s with two threads on 100k
+The load average is printed before and after the run and at the start of each size: the
+machine is shared, so compare the rates measured within one run.  Without a CGAL column the
+CGAL rates recorded in an earlier issue are printed instead; the plain numba Watson kernel's
+recorded rates are printed next to our square-domain rates.  Target (issue): >= 2 M points/s with two threads on 100k
 nodes for 1M random (unsorted) query points, sorting included, Sibson values only.  Timings
 are printed, never asserted.
 
@@ -84,6 +102,7 @@ How to run
     python benchmarks/shape_functions.py --quick              # 5k nodes, 20k queries, cracked
     python benchmarks/shape_functions.py --sizes 10000 100000 --queries 200000
     python benchmarks/shape_functions.py --domains square --repeat 5
+    python benchmarks/shape_functions.py --no-cgal                # without the CGAL column
 """
 import argparse
 import gc
@@ -180,12 +199,13 @@ def _cnem_child(task):
     model.shape_functions(pts[:SETUP_POINTS], kind="sibson")
     setup = time.perf_counter() - t0
 
-    runs, phi = [], None
+    runs, cpu_runs, phi = [], [], None
     for _ in range(repeat):
         phi = None
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         phi = model.shape_functions(pts, kind="sibson")
         runs.append(time.perf_counter() - t0)
+        cpu_runs.append(time.process_time() - c0)
     rss = peak_rss_bytes()
     if task.get("save_phi"):                 # for the comparison with CGAL's values
         import scipy.sparse
@@ -203,7 +223,7 @@ def _cnem_child(task):
     cols = phi.indices.astype(np.float64)
     out = dict(n_nodes=len(model.nodes), n_tri=len(model.triangles), threads=threads,
                numba_threads=numba.get_num_threads(), warmup=warmup, discretize=t_disc,
-               setup=setup, runs=runs, grad_runs=grad_runs, rss=rss, rss_disc=rss_disc,
+               setup=setup, runs=runs, cpu_runs=cpu_runs, grad_runs=grad_runs, rss=rss, rss_disc=rss_disc,
                reset=reset,
                nnz=int(phi.nnz), vmin=float(data.min()),
                fingerprint=(int(phi.nnz), float(data.sum()), float((data * cols).sum()),
@@ -432,7 +452,8 @@ def report(results, args):
             c = r[key]
             if ok(c):
                 parts.append(f"{key}: median {median(c['runs']):.3f} s (runs "
-                             + ", ".join(f"{t:.3f}" for t in c["runs"]) +
+                             + ", ".join(f"{t:.3f}" for t in c["runs"]) + "; CPU "
+                             + ", ".join(f"{t:.3f}" for t in c["cpu_runs"]) +
                              f"), numba threads {c['numba_threads']}, {c['n_tri']} triangles, "
                              f"{c['nnz'] / r['queries']:.2f} natural neighbours per point, "
                              f"discretize {c['discretize']:.2f} s / peak "
@@ -451,7 +472,8 @@ def report(results, args):
         cg = r["cgal"]
         if ok(cg):
             parts.append(f"CGAL: Delaunay {cg['n_vertices']} vertices built in {cg['build']:.2f} s; "
-                         "runs " + ", ".join(f"{t:.3f}" for t in cg["runs"]) + " s; "
+                         "runs " + ", ".join(f"{t:.3f}" for t in cg["runs"]) + " s (CPU "
+                         + ", ".join(f"{t:.3f}" for t in cg["cpu_runs"]) + "); "
                          f"{cg['nnz'] / r['queries']:.2f} natural neighbours per point; peak "
                          f"{cg['rss'] / 2**20:.0f} MB (whole driver)")
         else:
@@ -511,6 +533,10 @@ def report(results, args):
             print(f"  {r['domain']:<8} {fmt_n(r['n']):>5}: " +
                   (f"{r1:.3f} vs {rc:.3f} M points/s, {r1 / rc:.2f}x {judged}"
                    if r1 else "cnem 1T not run"))
+            if r1:
+                c1, cc = median(r["1T"]["cpu_runs"]), median(r["cgal"]["cpu_runs"])
+                print(f"  {'':<8} {'':>5}  by CPU time per run (less sensitive to a busy "
+                      f"machine): cnem 1T {c1:.3f} s, CGAL {cc:.3f} s, {cc / c1:.2f}x")
     else:
         anchors(results, queries)
     watson(results, queries)
