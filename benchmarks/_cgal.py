@@ -77,8 +77,9 @@ def run(exe, nodes, points, repeat, tmp):
     -------
     dict
         ``build`` (Delaunay seconds), ``runs`` (wall seconds per timed run: Hilbert sort +
-        coordinates + CSR), ``cpu_runs`` (the runs' CPU seconds), ``outside``, ``rss`` (peak bytes), ``phi`` (the last run's
-        ``scipy.sparse.csr_matrix``, shape (q, n)); ``error`` when the driver failed.
+        coordinates + CSR), ``cpu_runs`` (the runs' CPU seconds), ``outside``, ``rss``
+        (peak bytes), ``phi`` (the last run's ``scipy.sparse.csr_matrix``, shape (q, n));
+        ``error`` when the driver failed.
     """
     import scipy.sparse as sp
 

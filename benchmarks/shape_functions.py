@@ -90,9 +90,9 @@ query point lies in a scipy simplex and the barycentric weights reproduce the po
 The load average is printed before and after the run and at the start of each size: the
 machine is shared, so compare the rates measured within one run.  Without a CGAL column the
 CGAL rates recorded in an earlier issue are printed instead; the plain numba Watson kernel's
-recorded rates are printed next to our square-domain rates.  Target (issue): >= 2 M points/s with two threads on 100k
-nodes for 1M random (unsorted) query points, sorting included, Sibson values only.  Timings
-are printed, never asserted.
+recorded rates are printed next to our square-domain rates.  Target (issue): >= 2 M points/s
+with two threads on 100k nodes for 1M random (unsorted) query points, sorting included,
+Sibson values only.  Timings are printed, never asserted.
 
 How to run
 ----------
@@ -223,7 +223,8 @@ def _cnem_child(task):
     cols = phi.indices.astype(np.float64)
     out = dict(n_nodes=len(model.nodes), n_tri=len(model.triangles), threads=threads,
                numba_threads=numba.get_num_threads(), warmup=warmup, discretize=t_disc,
-               setup=setup, runs=runs, cpu_runs=cpu_runs, grad_runs=grad_runs, rss=rss, rss_disc=rss_disc,
+               setup=setup, runs=runs, cpu_runs=cpu_runs, grad_runs=grad_runs, rss=rss,
+               rss_disc=rss_disc,
                reset=reset,
                nnz=int(phi.nnz), vmin=float(data.min()),
                fingerprint=(int(phi.nnz), float(data.sum()), float((data * cols).sum()),
@@ -471,7 +472,8 @@ def report(results, args):
             parts.append(f"scipy: {sc.get('error')}")
         cg = r["cgal"]
         if ok(cg):
-            parts.append(f"CGAL: Delaunay {cg['n_vertices']} vertices built in {cg['build']:.2f} s; "
+            parts.append(f"CGAL: Delaunay {cg['n_vertices']} vertices built in "
+                         f"{cg['build']:.2f} s; "
                          "runs " + ", ".join(f"{t:.3f}" for t in cg["runs"]) + " s (CPU "
                          + ", ".join(f"{t:.3f}" for t in cg["cpu_runs"]) + "); "
                          f"{cg['nnz'] / r['queries']:.2f} natural neighbours per point; peak "
