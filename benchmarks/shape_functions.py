@@ -56,6 +56,23 @@ repetitions (of the Delaunay build and of the query, each) stop early once their
 cumulative time passes ``--baseline-budget`` seconds (default 60; at least one run); the
 table's ``rep`` column gives the runs done.
 
+**CGAL** (the compiled anchor, square domain only) -- when g++ and CGAL's headers are found
+(Debian: ``apt-get install libcgal-dev``; a benchmark-time tool, not a cnem dependency), the
+driver ``benchmarks/cgal_sibson.cpp`` is compiled once into a cache folder
+(``~/.cache/cnem-benchmarks``, see ``_cgal.py``) and run as its own process on the cnem
+model's nodes and the same query points (raw float64 files).  It builds a
+``Delaunay_triangulation_2`` (timed apart, not counted), then ``--repeat`` times, single
+threaded: ``CGAL::hilbert_sort`` of the query indices (counted), ``locate`` from the
+previous query's face and ``natural_neighbor_coordinates_2`` there (Sibson coordinates,
+normalised), and the CSR matrix in the input order of the queries (counted: cnem returns
+one); rate = query points / median time.  The last run's matrix is read back and compared
+with cnem's one-thread values: max ``|cnem - CGAL|`` is printed and checked against 1e-12.
+Otherwise the column says why it was skipped.  The cracked plate has no CGAL column: CGAL's
+unconstrained Delaunay triangulation ignores the crack, so its values are not cnem's there.
+``1T/CGAL`` is cnem's one-thread rate over CGAL's (target, issue 22: >= 1 at 100k and 1M
+nodes); the same ratio by CPU time per run (``time.process_time`` / ``std::clock``, less
+sensitive to other processes on a shared machine) is printed under the target.
+
 Peak memory is the child's high-water resident set size, ``VmHWM`` from
 ``/proc/self/status`` (``ru_maxrss`` is not used: across ``exec`` the kernel carries the
 parent's peak over into a spawned child).  In the cnem children the high-water mark is reset
@@ -70,11 +87,12 @@ Checks (printed): on the smallest model of each domain, the rows of Phi sum to 1
 no negative value; the one- and two-thread results are identical (fingerprint); every
 query point lies in a scipy simplex and the barycentric weights reproduce the points.
 
-The anchors from the issue (CGAL's ``natural_neighbor_coordinates_2``, C++, unconstrained,
-measured on this machine with 1M random queries; a plain numba Watson kernel) are printed
-next to our square-domain rates.  Target (issue): >= 2 M points/s with two threads on 100k
-nodes for 1M random (unsorted) query points, sorting included, Sibson values only.  Timings
-are printed, never asserted.
+The load average is printed before and after the run and at the start of each size: the
+machine is shared, so compare the rates measured within one run.  Without a CGAL column the
+CGAL rates recorded in an earlier issue are printed instead; the plain numba Watson kernel's
+recorded rates are printed next to our square-domain rates.  Target (issue): >= 2 M points/s
+with two threads on 100k nodes for 1M random (unsorted) query points, sorting included,
+Sibson values only.  Timings are printed, never asserted.
 
 How to run
 ----------
@@ -84,6 +102,7 @@ How to run
     python benchmarks/shape_functions.py --quick              # 5k nodes, 20k queries, cracked
     python benchmarks/shape_functions.py --sizes 10000 100000 --queries 200000
     python benchmarks/shape_functions.py --domains square --repeat 5
+    python benchmarks/shape_functions.py --no-cgal                # without the CGAL column
 """
 import argparse
 import gc
@@ -97,6 +116,7 @@ from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
 
+import _cgal
 from _harness import fmt_n, median, peak_rss_bytes, reset_peak_rss, warm_both
 
 DOMAINS = {
@@ -115,6 +135,7 @@ TARGET_N = 100_000
 TARGET_QUERIES = 1_000_000
 TARGET_RATE = 2.0            # M points/s, two threads
 TARGET_THREADS = 2
+CGAL_TARGET_SIZES = (100_000, 1_000_000)   # cnem 1 thread >= CGAL 1 thread (issue 22)
 
 # (nodes, CGAL random order, CGAL Hilbert-sorted) in M points/s, 1M random queries (issue)
 CGAL_ANCHORS = [
@@ -178,13 +199,17 @@ def _cnem_child(task):
     model.shape_functions(pts[:SETUP_POINTS], kind="sibson")
     setup = time.perf_counter() - t0
 
-    runs, phi = [], None
+    runs, cpu_runs, phi = [], [], None
     for _ in range(repeat):
         phi = None
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         phi = model.shape_functions(pts, kind="sibson")
         runs.append(time.perf_counter() - t0)
+        cpu_runs.append(time.process_time() - c0)
     rss = peak_rss_bytes()
+    if task.get("save_phi"):                 # for the comparison with CGAL's values
+        import scipy.sparse
+        scipy.sparse.save_npz(task["save_phi"], phi, compressed=False)
     grad_runs = []
     if task.get("gradient"):                 # the same points with gradients (cavity points)
         for _ in range(repeat):
@@ -198,7 +223,8 @@ def _cnem_child(task):
     cols = phi.indices.astype(np.float64)
     out = dict(n_nodes=len(model.nodes), n_tri=len(model.triangles), threads=threads,
                numba_threads=numba.get_num_threads(), warmup=warmup, discretize=t_disc,
-               setup=setup, runs=runs, grad_runs=grad_runs, rss=rss, rss_disc=rss_disc,
+               setup=setup, runs=runs, cpu_runs=cpu_runs, grad_runs=grad_runs, rss=rss,
+               rss_disc=rss_disc,
                reset=reset,
                nnz=int(phi.nnz), vmin=float(data.min()),
                fingerprint=(int(phi.nnz), float(data.sum()), float((data * cols).sum()),
@@ -272,10 +298,27 @@ def ok(r):
     return r is not None and "error" not in r and "skipped" not in r
 
 
+def cgal_vs_cnem(exe, nodes_file, phi_file, queries, repeat, tmp):
+    """CGAL's Sibson coordinates on the cnem model's nodes and the same queries, timed by
+    the driver in its own process, and their max abs difference from cnem's values."""
+    import scipy.sparse
+
+    pts = query_points(queries)
+    out = _cgal.run(exe, np.load(nodes_file), pts, repeat, tmp)
+    if "error" in out:
+        return out
+    phi = out.pop("phi")
+    ours = scipy.sparse.load_npz(phi_file)
+    out["diff"] = float(abs(phi - ours).max())
+    out["sum_err"] = float(np.abs(np.asarray(phi.sum(axis=1)).ravel() - 1.0).max())
+    out["nnz"] = int(phi.nnz)
+    return out
+
+
 # --------------------------------------------------------------------------- driver
 
 
-def run(domains, sizes, queries, repeat, budget, tmp):
+def run(domains, sizes, queries, repeat, budget, tmp, cgal):
     results = []
     two = os.cpu_count() is not None and os.cpu_count() >= TARGET_THREADS
     for domain in domains:
@@ -283,10 +326,14 @@ def run(domains, sizes, queries, repeat, budget, tmp):
             nodes_file = os.path.join(tmp, f"nodes_{domain}_{n}.npy")
             print(f"  {domain} n = {fmt_n(n)}, {fmt_n(queries)} queries x{repeat}:",
                   end="", flush=True)
-            r = dict(domain=domain, n=n, queries=queries, repeat=repeat, smallest=i == 0)
+            phi_file = os.path.join(tmp, f"phi_{domain}_{n}.npz")
+            with_cgal = "exe" in cgal and domain == "square"
+            r = dict(domain=domain, n=n, queries=queries, repeat=repeat, smallest=i == 0,
+                     load=os.getloadavg())
             base = dict(domain=domain, n=n, queries=queries, repeat=repeat)
             print(" cnem 1T", end="", flush=True)
-            r["1T"] = in_child("cnem", dict(base, threads=1, save=nodes_file, check=i == 0))
+            r["1T"] = in_child("cnem", dict(base, threads=1, save=nodes_file, check=i == 0,
+                                            save_phi=phi_file if with_cgal else None))
             if two:
                 print(f" cnem {TARGET_THREADS}T", end="", flush=True)
                 r["2T"] = in_child("cnem", dict(base, threads=TARGET_THREADS, gradient=True))
@@ -296,10 +343,21 @@ def run(domains, sizes, queries, repeat, budget, tmp):
                 print(" scipy", end="", flush=True)
                 r["scipy"] = in_child("scipy", dict(nodes=nodes_file, queries=queries,
                                                     repeat=repeat, budget=budget))
-                os.remove(nodes_file)
             else:
                 r["scipy"] = dict(error="no nodes (the cnem 1T child failed)")
-            for key in ("1T", "2T", "scipy"):
+            if not with_cgal:
+                r["cgal"] = dict(skipped=cgal.get("skipped") or
+                                 "cracked plate: CGAL's unconstrained Delaunay triangulation "
+                                 "ignores the crack (its values are not cnem's there)")
+            elif os.path.exists(phi_file):
+                print(" CGAL", end="", flush=True)
+                r["cgal"] = cgal_vs_cnem(cgal["exe"], nodes_file, phi_file, queries, repeat, tmp)
+            else:
+                r["cgal"] = dict(error="no cnem values (the cnem 1T child failed)")
+            for path in (nodes_file, phi_file):
+                if os.path.exists(path):
+                    os.remove(path)
+            for key in ("1T", "2T", "scipy", "cgal"):
                 if "error" in r[key]:
                     print(f" ({key} FAILED)", end="", flush=True)
             print(" done", flush=True)
@@ -342,7 +400,7 @@ def report(results, args):
     print()
     head = (f"{'domain':<8} {'n':>5} {'nodes':>8} {'rep':>5} | {'discr s':>7} {'setup s':>7} | "
             f"{'1T':>7} {f'{TARGET_THREADS}T':>7} {'2T/1T':>6} | {'Delny s':>7} {'sc setup':>8} "
-            f"{'scipy':>7} | "
+            f"{'scipy':>7} | {'CGAL':>7} {'1T/CGAL':>7} | "
             f"{'2T/scipy':>8} | {'1T MB':>6} {'2T MB':>6} {'sc MB':>6}")
     print(head)
     print("-" * len(head))
@@ -350,6 +408,7 @@ def report(results, args):
         c1, c2, sc = r["1T"], r["2T"], r["scipy"]
         ref = c1 if ok(c1) else c2 if ok(c2) else None
         r1, r2, rs = rate(c1, queries), rate(c2, queries), rate(sc, queries)
+        rc = rate(r["cgal"], queries)
         n_nodes = ref["n_nodes"] if ref else (sc["n_nodes"] if ok(sc) else None)
         disc = median([c["discretize"] for c in (c1, c2) if ok(c)]) if ref else None
         setup = median([c["setup"] for c in (c1, c2) if ok(c)]) if ref else None
@@ -365,7 +424,8 @@ def report(results, args):
               f"{cell(r2 / r1 if r1 and r2 else None, '{:5.2f}x', 6)} | "
               f"{cell(median(sc['builds']) if ok(sc) else None, '{:7.2f}', 7)} "
               f"{cell(sc['setup'] if ok(sc) else None, '{:8.3f}', 8)} "
-              f"{cell(rs, '{:7.3f}', 7)} | "
+              f"{cell(rs, '{:7.3f}', 7)} | {cell(rc, '{:7.3f}', 7)} "
+              f"{cell(r1 / rc if r1 and rc else None, '{:6.2f}x', 7)} | "
               f"{cell(r2 / rs if r2 and rs else None, '{:7.2f}x', 8)} | "
               f"{mbc(c1)} {mbc(c2)} {cell(mb(sc), '{:6.0f}', 6)}")
     print()
@@ -379,6 +439,11 @@ def report(results, args):
           "excluded from its rate;")
     print("         scipy = find_simplex + transform barycentric weights rate (single-threaded); "
           f"2T/scipy = our {TARGET_THREADS}-thread rate / scipy's ('-' = not run)")
+    print("         CGAL = natural_neighbor_coordinates_2 (Sibson) on a Delaunay_triangulation_2 "
+          "of the same nodes, C++, 1 thread, queries")
+    print("                Hilbert-sorted (sort counted), previous face as the hint, CSR in "
+          "input order; Delaunay build apart; square only;")
+    print("         1T/CGAL = our 1-thread rate / CGAL's (measured in this run)")
 
     print()
     print("details:")
@@ -388,7 +453,8 @@ def report(results, args):
             c = r[key]
             if ok(c):
                 parts.append(f"{key}: median {median(c['runs']):.3f} s (runs "
-                             + ", ".join(f"{t:.3f}" for t in c["runs"]) +
+                             + ", ".join(f"{t:.3f}" for t in c["runs"]) + "; CPU "
+                             + ", ".join(f"{t:.3f}" for t in c["cpu_runs"]) +
                              f"), numba threads {c['numba_threads']}, {c['n_tri']} triangles, "
                              f"{c['nnz'] / r['queries']:.2f} natural neighbours per point, "
                              f"discretize {c['discretize']:.2f} s / peak "
@@ -404,6 +470,18 @@ def report(results, args):
                          + ", ".join(f"{t:.3f}" for t in sc["runs"]) + " s")
         else:
             parts.append(f"scipy: {sc.get('error')}")
+        cg = r["cgal"]
+        if ok(cg):
+            parts.append(f"CGAL: Delaunay {cg['n_vertices']} vertices built in "
+                         f"{cg['build']:.2f} s; "
+                         "runs " + ", ".join(f"{t:.3f}" for t in cg["runs"]) + " s (CPU "
+                         + ", ".join(f"{t:.3f}" for t in cg["cpu_runs"]) + "); "
+                         f"{cg['nnz'] / r['queries']:.2f} natural neighbours per point; peak "
+                         f"{cg['rss'] / 2**20:.0f} MB (whole driver)")
+        else:
+            parts.append(f"CGAL: {cg.get('skipped') or cg.get('error')}")
+        parts.append("load average at the start (1, 5, 15 min): "
+                     + " ".join(f"{x:.2f}" for x in r["load"]))
         print(f"  {r['domain']} {fmt_n(r['n'])}: " + ";\n    ".join(parts))
 
     print()
@@ -433,11 +511,42 @@ def report(results, args):
             good &= g
             line.append(f"scipy: {sc['outside']} points outside, barycentric reproduction "
                         f"{sc['rep_err']:.1e}")
+        cg = r["cgal"]
+        if ok(cg):
+            g = cg["outside"] == 0 and cg["diff"] <= CHECK_TOL
+            good &= g
+            line.append(f"CGAL: {cg['outside']} points outside, max |cnem - CGAL| = "
+                        f"{cg['diff']:.1e} (<= {CHECK_TOL:g}: {'yes' if g else 'NO'}), "
+                        f"CGAL max |row sum - 1| = {cg['sum_err']:.1e}")
         if not line:
             continue
         print(f"  {r['domain']} {fmt_n(r['n'])}: {'OK' if good else 'FAILED'}: "
               + ";\n    ".join(line))
 
+    measured = [r for r in results if ok(r["cgal"])]
+    if measured:
+        print()
+        print("target (issue): cnem at 1 thread >= CGAL at 1 thread (same run, same nodes and "
+              "queries) at 100k and 1M nodes:")
+        for r in measured:
+            r1, rc = rate(r["1T"], queries), rate(r["cgal"], queries)
+            judged = (f"-> {verdict(r1 >= rc)}" if r["n"] in CGAL_TARGET_SIZES
+                      else "(not a target size)") if r1 else ""
+            print(f"  {r['domain']:<8} {fmt_n(r['n']):>5}: " +
+                  (f"{r1:.3f} vs {rc:.3f} M points/s, {r1 / rc:.2f}x {judged}"
+                   if r1 else "cnem 1T not run"))
+            if r1:
+                c1, cc = median(r["1T"]["cpu_runs"]), median(r["cgal"]["cpu_runs"])
+                print(f"  {'':<8} {'':>5}  by CPU time per run (less sensitive to a busy "
+                      f"machine): cnem 1T {c1:.3f} s, CGAL {cc:.3f} s, {cc / c1:.2f}x")
+    else:
+        anchors(results, queries)
+    watson(results, queries)
+    targets(results, queries)
+
+
+def anchors(results, queries):
+    """The CGAL rates recorded in the earlier issue, printed when CGAL was not run here."""
     print()
     here = "" if queries == TARGET_QUERIES else f", measured here with {fmt_n(queries)} queries"
     print(f"anchors from the issue (this machine, 1M random queries; C++/numba, unconstrained: "
@@ -458,6 +567,13 @@ def report(results, args):
               f"{cell(r1, '{:7.3f}', 7)} {cell(r2, '{:7.3f}', 7)} | "
               f"{cell(r2 / a_rnd if r2 and a_rnd else None, '{:10.2f}x', 11)} "
               f"{cell(r2 / a_srt if r2 and a_srt else None, '{:10.2f}x', 11)}{note}")
+    print("  CGAL columns: rnd = random query order, srt = Hilbert-sorted queries each starting "
+          "from the previous face; M points/s")
+
+
+def watson(results, queries):
+    """The plain numba Watson kernel's recorded rates beside ours."""
+    sq = {r["n"]: r for r in results if r["domain"] == "square"}
     wn, w_rnd, w_srt = WATSON_ANCHOR
     r = sq.get(wn)
     r2 = rate(r["2T"], queries) if r else None
@@ -465,9 +581,10 @@ def report(results, args):
           f"{w_rnd:g} random, {w_srt:g} sorted; ours {TARGET_THREADS}T at {fmt_n(wn)}: "
           + (f"{r2:.3f} ({r2 / w_rnd:.2f}x random, {r2 / w_srt:.2f}x sorted)" if r2
              else "(not run)"))
-    print("  CGAL columns: rnd = random query order, srt = Hilbert-sorted queries each starting "
-          "from the previous face; M points/s")
 
+
+def targets(results, queries):
+    """The earlier issue's two-thread and gradient targets."""
     print()
     print("target (issue): >= 2 M points/s with two threads on 100k nodes for 1M random "
           "(unsorted) query points, sorting included, Sibson values only:")
@@ -511,6 +628,8 @@ def main(argv=None):
     parser.add_argument("--baseline-budget", type=float, default=60.0, metavar="S",
                         help="stop repeating a scipy timing once its runs total S seconds "
                              "(default 60; at least one run)")
+    parser.add_argument("--no-cgal", action="store_true",
+                        help="skip the CGAL column even when g++ and CGAL's headers are found")
     args = parser.parse_args(argv)
 
     if args.sizes:
@@ -529,9 +648,20 @@ def main(argv=None):
           f"{[fmt_n(n) for n in sizes]}, {fmt_n(queries)} queries, repeat {repeat}; "
           f"python {sys.version.split()[0]}, numpy {np.__version__}, scipy {scipy.__version__}, "
           f"{os.cpu_count()} CPUs")
+    cgal = _cgal.build() if "square" in domains and not args.no_cgal else \
+        dict(skipped="CGAL column not requested (--no-cgal or no square domain)")
+    if "exe" in cgal:
+        print(f"CGAL {cgal['cgal']} driver: {cgal['exe']} ("
+              + (f"compiled in {cgal['compile_s']:.1f} s" if cgal["compile_s"] else "cached")
+              + ")")
+    else:
+        print(cgal["skipped"])
+    print("load average before (1, 5, 15 min):", " ".join(f"{x:.2f}" for x in os.getloadavg()),
+          f"on {os.cpu_count()} CPUs (a shared machine: compare rates within one run)")
     with tempfile.TemporaryDirectory() as tmp:
-        results = run(domains, sizes, queries, repeat, args.baseline_budget, tmp)
+        results = run(domains, sizes, queries, repeat, args.baseline_budget, tmp, cgal)
     report(results, args)
+    print("\nload average after (1, 5, 15 min):", " ".join(f"{x:.2f}" for x in os.getloadavg()))
     return results
 
 

@@ -1,0 +1,107 @@
+"""Optional CGAL anchor for the shape-function benchmark: build and run ``cgal_sibson.cpp``.
+
+CGAL is a benchmark-time tool only, never a dependency of cnem: where g++ or CGAL's headers
+(Debian: ``apt-get install libcgal-dev``) are missing, `build` says why and the benchmark
+skips the CGAL column.  The executable is compiled once per source / compiler / flags into a
+cache folder (``$XDG_CACHE_HOME/cnem-benchmarks`` or ``~/.cache/cnem-benchmarks``) and
+reused; nothing is written into the repository.
+"""
+import hashlib
+import os
+import shutil
+import subprocess
+import time
+
+import numpy as np
+
+SOURCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "cgal_sibson.cpp")
+FLAGS = ["-O3", "-march=native", "-DNDEBUG", "-DCGAL_NDEBUG", "-std=c++17"]
+LIBS = ["-lgmp", "-lmpfr"]
+INSTALL_HINT = "apt-get install libcgal-dev"
+
+
+def cache_dir():
+    """The folder the driver is compiled into (created on demand)."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "cnem-benchmarks")
+
+
+def build(cxx=None):
+    """Compile the driver (or reuse the cached build).
+
+    Returns
+    -------
+    dict
+        ``exe`` (path), ``compile_s`` (0.0 when cached), ``cgal`` (CGAL's version string) on
+        success; ``skipped`` (why, with the fix) when g++ or CGAL's headers are missing.
+    """
+    cxx = cxx or os.environ.get("CXX") or "g++"
+    if shutil.which(cxx) is None:
+        return dict(skipped=f"no C++ compiler ({cxx!r} not on PATH): CGAL column skipped")
+    version = subprocess.run([cxx, "--version"], capture_output=True, text=True).stdout
+    with open(SOURCE, "rb") as f:
+        key = hashlib.sha256(f.read() + " ".join(FLAGS + LIBS + [version]).encode()).hexdigest()
+    exe = os.path.join(cache_dir(), f"cgal_sibson_{key[:16]}")
+    cgal = cgal_version(cxx)
+    if cgal is None:
+        return dict(skipped=f"CGAL headers not found by {cxx} ({INSTALL_HINT}): "
+                            "CGAL column skipped")
+    if os.path.exists(exe):
+        return dict(exe=exe, compile_s=0.0, cgal=cgal)
+    os.makedirs(cache_dir(), exist_ok=True)
+    tmp = f"{exe}.tmp{os.getpid()}"
+    t0 = time.perf_counter()
+    done = subprocess.run([cxx, *FLAGS, SOURCE, "-o", tmp, *LIBS], capture_output=True,
+                          text=True)
+    if done.returncode != 0:
+        return dict(skipped="compiling the CGAL driver failed: CGAL column skipped\n"
+                            + done.stderr[-2000:])
+    os.replace(tmp, exe)
+    return dict(exe=exe, compile_s=time.perf_counter() - t0, cgal=cgal)
+
+
+def cgal_version(cxx):
+    """``CGAL_VERSION_STR`` as the compiler sees it, or None when the headers are missing."""
+    probe = '#include <CGAL/version.h>\nCGAL_VERSION_STR\n'
+    done = subprocess.run([cxx, "-x", "c++", "-E", "-P", "-"], input=probe,
+                          capture_output=True, text=True)
+    if done.returncode != 0:
+        return None
+    return done.stdout.strip().splitlines()[-1].strip().strip('"')
+
+
+def run(exe, nodes, points, repeat, tmp):
+    """Run the driver on ``nodes`` (n, 2) and ``points`` (q, 2) in a fresh process.
+
+    Returns
+    -------
+    dict
+        ``build`` (Delaunay seconds), ``runs`` (wall seconds per timed run: Hilbert sort +
+        coordinates + CSR), ``cpu_runs`` (the runs' CPU seconds), ``outside``, ``rss``
+        (peak bytes), ``phi`` (the last run's ``scipy.sparse.csr_matrix``, shape (q, n));
+        ``error`` when the driver failed.
+    """
+    import scipy.sparse as sp
+
+    nodes_bin, points_bin = os.path.join(tmp, "cgal_nodes.bin"), os.path.join(tmp, "cgal_q.bin")
+    prefix = os.path.join(tmp, "cgal_phi")
+    np.ascontiguousarray(nodes, dtype="<f8").tofile(nodes_bin)
+    np.ascontiguousarray(points, dtype="<f8").tofile(points_bin)
+    done = subprocess.run([exe, nodes_bin, points_bin, str(repeat), prefix],
+                          capture_output=True, text=True)
+    if done.returncode != 0:
+        return dict(error=f"CGAL driver exit {done.returncode}: {done.stderr[-500:]}")
+    out = {}
+    for line in done.stdout.splitlines():
+        key, *vals = line.split()
+        out[key] = [float(v) for v in vals]
+    phi = sp.csr_matrix((np.fromfile(prefix + ".data", dtype="<f8"),
+                         np.fromfile(prefix + ".indices", dtype="<i4"),
+                         np.fromfile(prefix + ".indptr", dtype="<i8")),
+                        shape=(len(points), len(nodes)))
+    for path in (nodes_bin, points_bin, prefix + ".data", prefix + ".indices",
+                 prefix + ".indptr"):
+        os.remove(path)
+    return dict(build=out["build"][0], n_vertices=int(out["vertices"][0]), runs=out["runs"],
+                cpu_runs=out["cpu_runs"],
+                outside=int(out["outside"][0]), rss=out["peak_kb"][0] * 1024, phi=phi)
