@@ -59,18 +59,32 @@ within a horizon of the tip PD is not the K field.
 Above h = 0.1 the holes break first and no PD crack runs from a notch (the table
 says so, NaN rows); at h = 0.0625 (45k nodes) both cracks start at the notches.
 ADR load steps are then too slow (1300 - 2200 iterations per settle at 11k nodes
-already, 70 - 100 s each at a load average of 6.5), the event-by-event linear
-solves of ``--solver sequential`` (`cnem.pd.sequential`, about 2 s a solve at 45k
-nodes) grew the PD cracks in 19 minutes (30 load factors, 0.50 to 0.66) by about
-2 mm from each notch, with the ridge threshold 0.35 (``--threshold``: a clean PD
-crack's face points lose about 40 % of their bonds, so no point reaches 0.5 near
-the tips). Measured then (C-NEM on the same 45k nodes, 6 increments): first kink
-C-NEM 16.8 / 16.8 degrees, PD 28.3 / 25.0 (left / right); Hausdorff distance
-0.38 / 0.19 mm over the first 2.1 / 1.7 mm; neither path had reached a hole. PD
-starts at factor 0.50 (first bond), C-NEM's critical factor is 0.51; the PD
-crack needs 0.64 to run. A full PD path to the holes is not reached in 20
-minutes. The picture (``pd_cnem_paths.png``) draws both paths over the geometry
-on the PD damage field, one panel per spacing.
+already, 70 - 100 s each at a load average of 6.5); the event-by-event linear
+solves of ``--solver sequential`` (`cnem.pd.sequential`, 0.7 - 2 s a solve at 45k
+nodes) run the whole loading, with the ridge threshold 0.35 (``--threshold``: a
+clean PD crack's face points lose about 40 % of their bonds, so no point reaches
+0.5 near the tips)::
+
+    cnem demo growth-pd-vs-cnem --h 0.0625 --solver sequential --threshold 0.35
+
+(C-NEM 73 - 162 s, PD 1066 - 1951 s, by the machine's load; 40 load factors, 16834
+bonds broken, ended by the load drop). Measured: both PD cracks start at the
+notches (first bond at factor 0.49, growth from 0.50; C-NEM's critical factor
+0.513) and kink more than C-NEM's, first kink PD 28.3 / 25.0 degrees against
+C-NEM 16.8 / 16.8 (left / right); over the first 2.1 / 2.4 mm the paths are 0.35
+/ 0.16 mm apart (Hausdorff). The PD notch cracks grow stably against a rising
+load (about 2 mm long at factor 0.67) and then stop; at factor 0.76 two cracks start
+at the holes' edges facing the plate's centre and run at that load: 10.2 mm
+from the hole at (17, 3) to (5.0, 4.3) and 2.3 mm from the hole at (3, 7); the
+load drops and the run ends. Neither PD notch crack reaches a hole or the
+boundary; the C-NEM cracks (1 mm increments, LEFM: no strength, no nucleation)
+pass between the holes and meet each other after 11.4 mm. So at this horizon
+the two methods agree on where the notch cracks start and roughly on their
+first direction, not on the failure: PD's strength (the hole breaks at a stress
+~ E s_c that grows like delta^-1/2) still lets the holes nucleate before a
+notch crack gets there. The picture (``pd_cnem_paths.png``) draws the paths
+over the geometry on the PD damage field, one panel per spacing, with the PD
+cracks that did not grow from a notch (`cnem.geometry.ridge.ridge_bands`).
 """
 
 from __future__ import annotations
