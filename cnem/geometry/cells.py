@@ -34,6 +34,7 @@ from .. import config
 from .._predicates import Frame
 from ..errors import GeometryError
 from ._kernels import FAST, fast_cells
+from .halfplane import HalfPlaneCells
 from .topology import circumcenters, constraint_edges, triangle_neighbors, vertex_triangles
 
 __all__ = ["voronoi_cells"]
@@ -311,6 +312,14 @@ def _shared_centres(cc, nb, nodes):
     return np.ascontiguousarray(cc[first[label]])
 
 
+def _half_or_exact(half, exact, i, r):
+    """The cell of node ``i`` in region ``r`` by half-planes, else by shapely."""
+    fan = exact.fan(i, r)
+    start = float(np.linalg.norm(exact.nodes[exact.tri[fan].ravel()] - exact.nodes[i], axis=1).max())
+    poly = half.cell(i, r, start)
+    return exact.cell(i, r) if poly is None else poly
+
+
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
                   progress: bool | None = None, neighbors: np.ndarray | None = None,
                   only: ArrayLike | None = None, frame: Frame | None = None
@@ -358,7 +367,8 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     slow = which[status != FAST]
     pairs = sorted({(int(i), int(r)) for i in slow
                     for r in region[star[offsets[i]:offsets[i + 1]]]})
-    slow_polys = [exact.cell(i, r) for i, r in tqdm(
+    half = HalfPlaneCells(nodes, triangles, region, nb) if pairs else None
+    slow_polys = [_half_or_exact(half, exact, i, r) for i, r in tqdm(
         pairs, desc="clipping cells", disable=None if progress is None else not progress,
         leave=False)]
     cell_node = np.concatenate([fast, np.array([p[0] for p in pairs], dtype=np.int64)])
