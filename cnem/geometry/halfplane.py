@@ -82,11 +82,11 @@ class HalfPlaneCells:
         x = self.nodes[i]
         wedge = np.zeros((0, 4))
         if self.next[i] >= 0:
-            wedge = np.array([np.r_[self.nodes[self.prev[i]], x], np.r_[x, self.nodes[self.next[i]]]])
+            wedge = np.concatenate([self.nodes[self.prev[i]], x, x, self.nodes[self.next[i]]]).reshape(2, 4)
         size = start
         for _ in range(64):
-            box = np.clip(np.r_[x - size, x + size], np.r_[self.extent[:2], self.extent[:2]],
-                          np.r_[self.extent[2:], self.extent[2:]])
+            box = np.concatenate([np.maximum(x - size, self.extent[:2]),
+                                  np.minimum(x + size, self.extent[2:])])
             reach = size * np.sqrt(2.0)
             e = np.asarray(self.edge_tree.query_ball_point(x, reach + self.edge_half), dtype=np.int64)
             e = e[(self.edge_region[e] == r) & (self.edges[e] != i).all(axis=1)]
