@@ -47,3 +47,20 @@ def test_cut_bonds_of_a_crack_through_lattice_points_are_invariant(name, scale, 
     body = Body(moved, (H * scale) ** 2, 3.1 * H * scale, cracks=[CRACK * scale + np.asarray(shift)])
     assert whole == ref_whole
     assert whole - bonds(body) == cut
+
+
+@pytest.mark.parametrize("scale, shift", [(1.0, (1e8, 1e8)), (1.0, (5e5, 5e6)), (1e-6, (0.0, 0.0)),
+                                          (1e6, (0.0, 0.0))])
+def test_body_from_a_cracked_cloud_is_invariant(scale, shift):
+    """`Body.from_cloud` splits the crack-face points and nudges each copy towards its
+    face for the crossing test: the same bonds, in the same order, far from the origin
+    and in other units (the nudge, 1e-6 h, is below the round-off of coordinates at 1e8)."""
+    def body(s, t):
+        dom = cnem.geometry.rectangle(s, s, origin=t,
+                                      cracks=[np.array([[0.0, 0.5], [0.5, 0.5]]) * s + t])
+        return Body.from_cloud(cnem.nodes.regular(dom, s / 16), 3.0)
+    ref = body(1.0, np.zeros(2))
+    moved = body(scale, np.asarray(shift))
+    np.testing.assert_allclose((moved.points - np.asarray(shift)) / scale, ref.points, atol=1e-9)
+    np.testing.assert_array_equal(moved.family.offsets, ref.family.offsets)
+    np.testing.assert_array_equal(moved.family.indices, ref.family.indices)
