@@ -5,13 +5,17 @@ visible from ``x`` (the segment between them crosses no boundary, interface or
 crack; touching at the node is allowed) and no node visible from ``x`` is
 nearer. A node on an interface owns one cell per region.
 
-Two paths compute the cells:
+Three paths compute the cells:
 
 * the *fast path* (numba, `._kernels.fast_cells`): a node whose circumcentres
   are all visible from it and whose dual polygon is star-shaped around it owns
   exactly the polygon of its circumcentres (closed by the node and the
   midpoints of its two constraint edges when it sits on a straight boundary or
   a convex corner);
+* the *half-plane path* (`.halfplane`), for a node the fast path refuses whose
+  neighbourhood is convex (no reflex corner, tip or interface node within twice
+  its cell's radius: a thin strip, circumcentres behind a straight boundary): a
+  box cut by its wedge, the constraint chords and the bisectors, in numba;
 * the *exact path* (shapely, snap-rounded overlays), for every other node and
   region (reflex corners, crack tips, interfaces, circumcentres behind a
   constraint): the cell is the part of a bounding box that node ``i`` sees
