@@ -5,13 +5,17 @@ visible from ``x`` (the segment between them crosses no boundary, interface or
 crack; touching at the node is allowed) and no node visible from ``x`` is
 nearer. A node on an interface owns one cell per region.
 
-Two paths compute the cells:
+Three paths compute the cells:
 
 * the *fast path* (numba, `._kernels.fast_cells`): a node whose circumcentres
   are all visible from it and whose dual polygon is star-shaped around it owns
   exactly the polygon of its circumcentres (closed by the node and the
   midpoints of its two constraint edges when it sits on a straight boundary or
   a convex corner);
+* the *half-plane path* (`.halfplane`), for a node the fast path refuses whose
+  neighbourhood is convex (no reflex corner, tip or interface node within twice
+  its cell's radius: a thin strip, circumcentres behind a straight boundary): a
+  box cut by its wedge, the constraint chords and the bisectors, in numba;
 * the *exact path* (shapely, snap-rounded overlays), for every other node and
   region (reflex corners, crack tips, interfaces, circumcentres behind a
   constraint): the cell is the part of a bounding box that node ``i`` sees
@@ -34,6 +38,7 @@ from .. import config
 from .._predicates import Frame
 from ..errors import GeometryError
 from ._kernels import FAST, fast_cells
+from .halfplane import HalfPlaneCells
 from .topology import circumcenters, constraint_edges, triangle_neighbors, vertex_triangles
 
 __all__ = ["voronoi_cells"]
@@ -316,6 +321,14 @@ def _shared_centres(cc, nb, nodes, resolution=0.0):
     return np.ascontiguousarray(cc[first[label]])
 
 
+def _half_or_exact(half, exact, i, r):
+    """The cell of node ``i`` in region ``r`` by half-planes, else by shapely."""
+    fan = exact.fan(i, r)
+    start = float(np.linalg.norm(exact.nodes[exact.tri[fan].ravel()] - exact.nodes[i], axis=1).max())
+    poly = half.cell(i, r, start)
+    return exact.cell(i, r) if poly is None else poly
+
+
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
                   progress: bool | None = None, neighbors: np.ndarray | None = None,
                   only: ArrayLike | None = None, frame: Frame | None = None
@@ -365,7 +378,8 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     slow = which[status != FAST]
     pairs = sorted({(int(i), int(r)) for i in slow
                     for r in region[star[offsets[i]:offsets[i + 1]]]})
-    slow_polys = [exact.cell(i, r) for i, r in tqdm(
+    half = HalfPlaneCells(nodes, triangles, region, nb) if pairs else None
+    slow_polys = [_half_or_exact(half, exact, i, r) for i, r in tqdm(
         pairs, desc="clipping cells", disable=None if progress is None else not progress,
         leave=False)]
     cell_node = np.concatenate([fast, np.array([p[0] for p in pairs], dtype=np.int64)])

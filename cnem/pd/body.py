@@ -20,12 +20,13 @@ if TYPE_CHECKING:
 __all__ = ["Body", "checked_input", "crack_segments"]
 
 
-def _past_the_mouths(crack, tips, reach):
+def _past_the_mouths(crack, tips, reach, tol):
     """A crack polyline with each end on the boundary (an edge crack's mouth) pushed
-    ``reach`` further out, so that bonds passing through the mouth are cut too."""
+    ``reach`` further out, so that bonds passing through the mouth are cut too; an end
+    within ``tol`` (the domain's tolerance) of a tip is a tip."""
     crack = np.array(crack, dtype=float)
     for end, before in ((-1, -2), (0, 1)):
-        if not (np.hypot(*(tips - crack[end]).T) < 1e-12).any() if len(tips) else True:
+        if not (np.hypot(*(tips - crack[end]).T) <= tol).any() if len(tips) else True:
             d = crack[end] - crack[before]
             crack[end] = crack[end] + reach * d / np.hypot(*d)
     return crack
@@ -152,13 +153,17 @@ class Body:
         area = np.bincount(model.cells.node, weights=model.cells.area, minlength=len(model.nodes))
         h = np.sqrt(model.domain.area / len(np.unique(model.node_of_point)))
         copies = np.bincount(model.node_of_point)[model.node_of_point] > 1
-        # a crack-face copy is nudged towards its own face for the crossing test only
+        # a crack-face copy is nudged towards its own face for the crossing test only,
+        # in the model's local frame (at 1e8 a nudge of 1e-6 h would round away)
+        frame = model.frame
         shift = model.node_sides() - model.nodes
         norm = np.maximum(np.hypot(*shift.T), 1e-300)[:, None]
-        nudged = model.nodes + np.where(copies[:, None], 1e-6 * h * shift / norm, 0.0)
+        nudged = frame.to_local(model.nodes) + np.where(copies[:, None],
+                                                        1e-6 * (h / frame.scale) * shift / norm, 0.0)
         horizon = horizon_factor * h
         body = cls(model.nodes, area * thickness, horizon, thickness=thickness,
-                   cracks=[_past_the_mouths(c, model.domain.tips, horizon)
+                   cracks=[frame.to_local(_past_the_mouths(c, model.domain.tips, horizon,
+                                                           model.domain.tolerance))
                            for c in model.domain.cracks], crossing_points=nudged)
         body.model = model
         return body

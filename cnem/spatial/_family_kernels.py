@@ -272,8 +272,16 @@ def exact_filter(pts, rows, cols, horizon, period):
     return keep
 
 
+@numba.njit(cache=True)
+def _side(ax, ay, bx, by, px, py, tol):
+    """`_orient` of ``p`` against the line ``a -> b``, 0 when ``p`` lies within ``tol``
+    of it (the coordinates' round-off: a point put on a crack stays on it in any units)."""
+    o = _orient(ax, ay, bx, by, px, py)
+    return 0.0 if abs(o) <= tol * np.hypot(bx - ax, by - ay) else o
+
+
 @numba.njit(cache=True, parallel=True)
-def crossing_mask(pts, offsets, indices, seg, far, cand_off, cand_idx):
+def crossing_mask(pts, offsets, indices, seg, far, cand_off, cand_idx, tol):
     """Mask of bonds that cross none of their point's candidate segments.
 
     ``seg`` is ``(s, 4)``: ``ax, ay, bx, by``; ``far`` is ``(s, 2, 2)``: for
@@ -282,7 +290,8 @@ def crossing_mask(pts, offsets, indices, seg, far, cand_off, cand_idx):
     a segment when their interiors cross, or when it passes through an inner
     vertex of a polyline whose two segments leave on opposite sides of the
     bond; a bond through a crack tip or along a segment only touches it.
-    Candidates of point ``i`` are ``cand_idx[cand_off[i]:cand_off[i + 1]]``.
+    Candidates of point ``i`` are ``cand_idx[cand_off[i]:cand_off[i + 1]]``. A point
+    within ``tol`` of a line is on it.
     """
     n = offsets.shape[0] - 1
     keep = np.ones(indices.shape[0], dtype=np.bool_)
@@ -294,12 +303,12 @@ def crossing_mask(pts, offsets, indices, seg, far, cand_off, cand_idx):
             for c in range(cand_off[i], cand_off[i + 1]):
                 s = cand_idx[c]
                 ax, ay, bx, by = seg[s, 0], seg[s, 1], seg[s, 2], seg[s, 3]
-                o1 = _orient(ax, ay, bx, by, xi, yi)
-                o2 = _orient(ax, ay, bx, by, xj, yj)
+                o1 = _side(ax, ay, bx, by, xi, yi, tol)
+                o2 = _side(ax, ay, bx, by, xj, yj, tol)
                 if o1 * o2 >= 0.0:
                     continue
-                o3 = _orient(xi, yi, xj, yj, ax, ay)
-                o4 = _orient(xi, yi, xj, yj, bx, by)
+                o3 = _side(xi, yi, xj, yj, ax, ay, tol)
+                o4 = _side(xi, yi, xj, yj, bx, by, tol)
                 if o3 * o4 < 0.0:
                     keep[k] = False
                     break
@@ -310,7 +319,7 @@ def crossing_mask(pts, offsets, indices, seg, far, cand_off, cand_idx):
                     o_end, o_other = (o3, o4) if end == 0 else (o4, o3)
                     fx, fy = far[s, end, 0], far[s, end, 1]
                     if o_end == 0.0 and o_other != 0.0 and not np.isnan(fx):
-                        if o_other * _orient(xi, yi, xj, yj, fx, fy) < 0.0:
+                        if o_other * _side(xi, yi, xj, yj, fx, fy, tol) < 0.0:
                             keep[k] = False
                 if not keep[k]:
                     break

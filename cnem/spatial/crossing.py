@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .. import config
 from ..errors import SpatialError
 from . import _family_kernels as K
 from .family import Family
@@ -33,7 +34,10 @@ def remove_crossing(family: Family, points: ArrayLike, segments: ArrayLike) -> F
     inner vertex of a polyline (two segments sharing an end) whose segments
     leave on opposite sides of it. A bond that only touches (an end on a
     segment, passing through a crack tip, running along a segment) is kept: a
-    point on a crack line, or a crack tip, does not cut bonds.
+    point on a crack line, or a crack tip, does not cut bonds. A point within
+    `cnem.config.ROUNDOFF_ULPS` round-offs of the coordinates (``eps`` times their
+    largest magnitude) from a line counts as on it, so points put on a crack stay
+    on it in other units or far from the origin.
 
     Parameters
     ----------
@@ -75,7 +79,9 @@ def remove_crossing(family: Family, points: ArrayLike, segments: ArrayLike) -> F
     rows = np.repeat(np.arange(len(pts)), family.counts)
     np.maximum.at(reach, rows, np.linalg.norm(pts[idx] - pts[rows], axis=1))
     cand_off, cand_idx = tree.query_ball(pts, reach)
-    keep = K.crossing_mask(pts, family.offsets, idx, seg, far, cand_off, cand_idx)
+    # within the coordinates' round-off of a line is on it (any units, any origin)
+    tol = config.ROUNDOFF_ULPS * np.finfo(float).eps * max(np.abs(pts).max(), np.abs(seg).max())
+    keep = K.crossing_mask(pts, family.offsets, idx, seg, far, cand_off, cand_idx, tol)
     counts = np.bincount(rows[keep], minlength=len(pts))
     offsets = np.zeros(len(pts) + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
