@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 import cnem.pd as pd
 from cnem.errors import InputError, SolveError
@@ -75,7 +76,13 @@ def test_a_notched_strip_breaks_straight_across_as_with_ADR():
     assert run.stopped == "load_drop"
     path = ridge_path(prob.body.points, run.damage, (0.2, mid), threshold=0.3)
     inner = path[(path[:, 0] > 0.2 + 0.15) & (path[:, 0] < 1.0 - 0.15)]
-    assert len(inner) >= 2 and np.abs(inner[:, 1] - mid).max() < 1e-9
+    # the damage is symmetric about the notch line (the bonds through the notch's tip are
+    # all kept), so the ridge runs in the band's middle, up to its tie-breaking between
+    # the two rows (as in the ADR test)
+    p = prob.body.points
+    dist, mirror = cKDTree(p).query(np.column_stack([p[:, 0], 2 * mid - p[:, 1]]))
+    assert dist.max() < 1e-12 and np.abs(run.damage - run.damage[mirror]).max() < 1e-12
+    assert len(inner) >= 2 and np.abs(inner[:, 1] - mid).max() < 0.01 * 0.05
     assert path[-1, 0] > 1.0 - 0.1
     adr_prob, _ = strip_problem(material)
     step = 0.1

@@ -14,6 +14,8 @@ the exact clipping path instead.
 import numba
 import numpy as np
 
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
+
 #: Status codes of `clip_cell`.
 CLIPPED, GROW, REFUSED = 0, 1, 2
 

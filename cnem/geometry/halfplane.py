@@ -32,7 +32,8 @@ class HalfPlaneCells:
         Neighbours with region changes cut (-1).
     """
 
-    def __init__(self, nodes, triangles, region, nb):
+    def __init__(self, nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray,
+                 nb: np.ndarray) -> None:
         n = len(nodes)
         self.nodes = nodes
         lo, hi = nodes.min(axis=0), nodes.max(axis=0)
@@ -62,10 +63,15 @@ class HalfPlaneCells:
         # interface nodes, several fans
         self.safe = (out_deg == 0) & (in_deg == 0)
         self.safe[b[convex]] = True
+        # the two copies of a crack-face node: their faces are coincident constraint
+        # edges of one region, which the clipping does not tell apart (the cells beside a
+        # crack go to the exact path)
+        self.node_tree = cKDTree(nodes)
+        twins = self.node_tree.query_pairs(max(self.tol, 0.0), output_type="ndarray")
+        self.safe[twins.ravel()] = False
         self.ends = np.flatnonzero(~self.safe)
         self.end_tree = cKDTree(nodes[self.ends]) if len(self.ends) else None
         self.wedge[~self.safe] = 0.0
-        self.node_tree = cKDTree(nodes)
         self.edge_tree = cKDTree(0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]]))
         self.edge_half = 0.5 * float(np.linalg.norm(nodes[edges[:, 0]] - nodes[edges[:, 1]],
                                                     axis=1).max(initial=0.0))
