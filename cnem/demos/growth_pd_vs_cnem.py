@@ -218,19 +218,16 @@ def _other_cracks(body, run, notch_paths, threshold, reached):
     """The PD cracks that did not grow from a notch: the bands of damage >= ``threshold``
     (`ridge_bands`) with no point within a horizon of a notch path and a ridge longer than
     a horizon, each from its end nearest a hole or the outer boundary along its ridge
-    (`ridge_path`). One dict each,
-    largest first: ``path`` (k, 2), ``length``, ``start`` (what it starts at) and
-    ``factor``, the first load factor at which a point of the band reached the threshold
-    (``reached``: that factor per point, see `_Report`)."""
+    (`ridge_path`). One dict each, largest first: ``path`` (k, 2), ``length``,
+    ``start`` (what it starts at) and ``factor``, the first load factor at which a
+    point of the band reached the threshold (``reached``: that factor per point, see
+    `_Report`)."""
     if not (run.damage >= threshold).any():
         return []
     labels = ridge_bands(body.points, run.damage, threshold=threshold)
     notches = shapely.MultiLineString([p if len(p) > 1 else np.vstack([p, p])
                                        for p in notch_paths])
-    holes = [shapely.Point(c).buffer(plate.R, 256).exterior for c in plate.HOLES]
-    outer = shapely.box(0.0, 0.0, plate.L, plate.B).exterior
-    edges = {f"hole ({c[0]:g}, {c[1]:g})": hole for c, hole in zip(plate.HOLES, holes)}
-    edges["boundary"] = outer
+    edges = _plate_edges()
     cracks = []
     for k in range(labels.max() + 1):
         band = labels == k
@@ -275,12 +272,20 @@ def _kink_deg(path, direction, chord):
                                        direction @ end)))
 
 
+def _plate_edges():
+    """The holes' edges (named by their centres) and the outer boundary, as lines."""
+    edges = {f"hole ({c[0]:g}, {c[1]:g})": shapely.Point(c).buffer(plate.R, 256).exterior
+             for c in plate.HOLES}
+    edges["boundary"] = shapely.box(0.0, 0.0, plate.L, plate.B).exterior
+    return edges
+
+
 def _arrival(path, other, reach):
     """Crack growth (arc length from the initial tip) at which ``path`` first comes
     within ``reach`` of a hole, the outer boundary or ``other``, and what it meets."""
-    holes = [shapely.Point(c).buffer(plate.R, 256).exterior for c in plate.HOLES]
-    outer = shapely.box(0.0, 0.0, plate.L, plate.B).exterior
-    targets = {"hole": shapely.MultiLineString(holes), "boundary": outer}
+    edges = _plate_edges()
+    targets = {"hole": shapely.union_all([e for n, e in edges.items() if n != "boundary"]),
+               "boundary": edges["boundary"]}
     if _length(other) > 0:
         targets["other crack"] = shapely.LineString(other)
     s = np.r_[0.0, np.cumsum(np.hypot(*np.diff(path, axis=0).T))]
