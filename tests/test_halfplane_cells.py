@@ -12,6 +12,7 @@ from scipy.spatial import cKDTree
 import cases
 import cnem
 from cnem.geometry import cells
+from cnem.geometry._clip_kernels import CLIPPED, GROW, clip_cell
 from cnem.geometry.halfplane import HalfPlaneCells
 from cnem.geometry.model import triangulate
 from cnem.geometry.topology import circumcenters, vertex_triangles
@@ -32,19 +33,15 @@ def test_half_plane_cells_equal_the_exact_cells(name):
     exact = cells._ExactCells(local, tri, region, neighbors[0], off, star,
                               circumcenters(local, tri), dom.frame)
     half = HalfPlaneCells(local, tri, region, neighbors[0])
-    accepted = refused = 0
-    for i in range(len(local)):
-        for r in np.unique(region[star[off[i]:off[i + 1]]]):
-            fan = exact.fan(i, r)
-            start = float(np.linalg.norm(local[tri[fan].ravel()] - local[i], axis=1).max())
-            poly = half.cell(i, r, start)
-            if poly is None:
-                refused += 1
-                continue
-            accepted += 1
-            a, b = shapely.Polygon(poly), shapely.Polygon(exact.cell(i, r))
-            assert a.is_valid and a.exterior.is_ccw
-            assert a.symmetric_difference(b).area < 1e-10 * b.area, (i, r)
+    node, reg, start = cells._slow_pairs(np.arange(len(local)), local, tri, region, off, star)
+    done, counts, verts = half.cells(node, reg, start)
+    first = np.concatenate([[0], np.cumsum(counts)])
+    for k, c in enumerate(done):
+        a = shapely.Polygon(verts[first[k]:first[k + 1]])
+        b = shapely.Polygon(exact.cell(int(node[c]), int(reg[c])))
+        assert a.is_valid and a.exterior.is_ccw
+        assert a.symmetric_difference(b).area < 1e-10 * b.area, (node[c], reg[c])
+    accepted, refused = len(done), len(node) - len(done)
     assert accepted > len(local) / 2
     if name != "square_irregular" and name != "random_points":
         assert refused > 0               # corners or tips nearby: some are refused
@@ -81,3 +78,70 @@ def test_cells_of_an_irregular_thin_strip_need_no_shapely(h):
     inside = shapely.contains_xy(np.array(polys, dtype=object)[near[clear, 0]],
                                  sample[clear, 0], sample[clear, 1])
     assert inside.all() and clear.sum() > 1900
+
+
+def _per_cell(half, i, r, start):
+    """The half-plane cell of node ``i`` in region ``r`` one at a time, as before the
+    batching (issue 19): three k-d trees (nodes, constraint-edge midpoints, constraint
+    ends) queried per cell, candidates in index order, the box doubled on `GROW`."""
+    nodes, edges = half.nodes, half.edges
+    edge_tree = cKDTree(0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]]))
+    ends = np.flatnonzero(~half.safe)
+    x = nodes[i]
+    wedge = np.zeros((0, 4))
+    if half.next[i] >= 0:
+        wedge = np.concatenate([nodes[half.prev[i]], x, x, nodes[half.next[i]]]).reshape(2, 4)
+    size = start
+    for _ in range(64):
+        box = np.concatenate([np.maximum(x - size, half.extent[:2]), np.minimum(x + size, half.extent[2:])])
+        reach = size * np.sqrt(2.0)
+        e = np.asarray(edge_tree.query_ball_point(x, reach + half.edge_half, return_sorted=True), dtype=np.int64)
+        e = e[(half.edge_region[e] == r) & (edges[e] != i).all(axis=1)]
+        j = np.asarray(half.node_tree.query_ball_point(x, reach, return_sorted=True), dtype=np.int64)
+        j = j[half.member[j, r] & (j != i)]
+        j = j[np.argsort(np.hypot(*(nodes[j] - x).T), kind="stable")]
+        near_ends = nodes[ends[np.hypot(*(nodes[ends] - x).T) <= reach]].reshape(-1, 2)
+        status, poly = clip_cell(x, box, half.extent, wedge, nodes[edges[e]].reshape(-1, 4),
+                                 np.ascontiguousarray(nodes[j]), half.wedge[j],
+                                 np.ascontiguousarray(near_ends), half.tol)
+        if status == CLIPPED:
+            return poly
+        if status != GROW or ((box[:2] <= half.extent[:2]).all() and (box[2:] >= half.extent[2:]).all()):
+            return None
+        size *= 2.0
+    return None
+
+
+def _strip(h):
+    dom = cnem.geometry.rectangle(1.0, 1e-6)
+    return dom, cnem.nodes.irregular(dom, h, seed=0)
+
+
+@pytest.mark.parametrize("moved", [(1.0, 0.0), (1.0, 1e6), (1e-6, 0.0)], ids=["origin", "offset1e6", "scale1e-6"])
+@pytest.mark.parametrize("name", ["square_irregular", "plate_hole_irregular", "kinked_crack_irregular",
+                                  "three_rectangles_irregular", "graded_inclined_crack", "strip"])
+def test_batched_cells_equal_the_per_cell_path(name, moved):
+    """All half-plane cells at once (one tree query, one kernel, the growing boxes
+    retried together) are the cells of the per-cell path: the same (node, region)
+    pairs taken, the same vertices to 1e-15 of the extent (in practice bit for bit),
+    at the origin, moved by 1e6 and in units 1e-6 times smaller."""
+    dom, cloud = _strip(1e-3) if name == "strip" else cases.case(name)
+    nodes, _, tri, region, _, _, neighbors = triangulate(cloud, {})
+    scale, offset = moved
+    local = dom.frame.to_local(nodes) * scale + offset
+    off, star = vertex_triangles(tri, len(local))
+    half = HalfPlaneCells(local, tri, region, neighbors[0])
+    node, reg, start = cells._slow_pairs(np.arange(len(local)), local, tri, region, off, star)
+    done, counts, verts = half.cells(node, reg, start)
+    first = np.concatenate([[0], np.cumsum(counts)])
+    got = {int(c): verts[first[k]:first[k + 1]] for k, c in enumerate(done)}
+    size = float(np.hypot(*np.ptp(local, axis=0)))
+    taken = 0
+    for c in range(len(node)):
+        want = _per_cell(half, node[c], reg[c], start[c])
+        assert (want is None) == (c not in got), (node[c], reg[c])
+        if want is not None:
+            taken += 1
+            assert got[c].shape == want.shape
+            np.testing.assert_allclose(got[c], want, rtol=0.0, atol=1e-15 * size)
+    assert taken > len(node) / 5           # most cells of every case, a third of the graded one

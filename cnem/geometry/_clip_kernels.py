@@ -15,6 +15,7 @@ import numba
 import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
+from .._parallel import parallel_kernel
 
 #: Status codes of `clip_cell`.
 CLIPPED, GROW, REFUSED = 0, 1, 2
@@ -184,3 +185,144 @@ def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol):
             or (x[1] + reach > box[3] and box[3] < extent[3])):
         return GROW, poly[:0]
     return CLIPPED, poly[:n].copy()
+
+
+@numba.njit(cache=True)
+def _within(nodes, j, x, reach):
+    """Whether node ``j`` lies within ``reach`` of ``x`` (squared, as a k-d tree tests)."""
+    dx, dy = nodes[j, 0] - x[0], nodes[j, 1] - x[1]
+    return dx * dx + dy * dy <= reach * reach
+
+
+@parallel_kernel("cell_node")
+def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedge, member, safe,
+               edges, edge_region, edge_half, out_ptr, out_idx, near_ptr, near_idx, tol):
+    """`clip_cell` of many (node, region) cells, each in its own box, from one candidate
+    list per cell.
+
+    The box of cell ``s`` has half-size ``size[s]`` and circumradius ``reach =
+    sqrt(2) size[s]``; its chords are the constraint edges of its region whose
+    midpoints lie within ``reach + edge_half``, its neighbours the region's nodes within
+    ``reach`` (nearest first, ties by index), its constraint ends the nodes that are not
+    ``safe`` within ``reach``.
+
+    Parameters
+    ----------
+    nodes : (n, 2) float64
+    cell_node, cell_region : (w,) int64
+        The cells: a ``safe`` node and one of its regions.
+    size : (w,) float64
+        Half-size of each cell's box (clipped to ``extent``).
+    extent : (4,) float64
+        The nodes' bounding box.
+    prev, nxt : (n,) int64
+        A boundary node's constraint neighbours before and after it (region on the
+        left), -1 for an interior node.
+    node_wedge : (n, 4) float64
+        A convex boundary node's incoming and outgoing edge directions, zeros for
+        every other node (`clip_cell`'s ``near_wedge``).
+    member : (n, m) bool
+        Whether node ``j`` is a vertex of a triangle of region ``r``.
+    safe : (n,) bool
+        Nodes with no constraint edge or on a convex boundary (the others are
+        constraint ends: reflex corners, tips, interface nodes, crack-face copies).
+    edges : (e, 2) int64
+        Constraint edges ``u -> v`` (their region on the left).
+    edge_region : (e,) int64
+    edge_half : float
+        Half the longest constraint edge.
+    out_ptr, out_idx : (n + 1,), (e,) int64
+        CSR of the constraint edges leaving each node.
+    near_ptr, near_idx : (w + 1,), (k,) int64
+        CSR of each cell's candidate nodes, in any order: at least every node within
+        ``reach + 2 edge_half`` (so every start of a chord).
+    tol : float
+        Absolute length under which points are on a line.
+
+    Returns
+    -------
+    status : (w,) int8
+        `CLIPPED`, `GROW` (retry with a larger box) or `REFUSED` (the exact path;
+        also a cell that would grow beyond a box covering ``extent``).
+    counts : (w,) int64
+        Vertices of each clipped cell (0 otherwise).
+    starts : (w + 1,) int64
+        Where each cell's vertices start in ``out``.
+    out : (k, 2) float64
+        The counter-clockwise cells, cell ``s`` at ``out[starts[s]:starts[s] + counts[s]]``.
+    """
+    w = cell_node.shape[0]
+    status = np.full(w, REFUSED, dtype=np.int8)
+    counts = np.zeros(w, dtype=np.int64)
+    starts = np.zeros(w + 1, dtype=np.int64)
+    for s in range(w):                   # at most one vertex per chord and node, as in
+        cand = near_idx[near_ptr[s]:near_ptr[s + 1]]          # `clip_cell`'s buffers
+        m = 0
+        for j in cand:
+            m += 1 + out_ptr[j + 1] - out_ptr[j]
+        starts[s + 1] = starts[s] + 2 * (6 + m) + 8
+    out = np.empty((starts[w], 2))
+    for s in numba.prange(w):
+        i, r = cell_node[s], cell_region[s]
+        x = nodes[i]
+        reach = size[s] * np.sqrt(2.0)
+        box = np.empty(4)
+        box[0] = max(x[0] - size[s], extent[0])
+        box[1] = max(x[1] - size[s], extent[1])
+        box[2] = min(x[0] + size[s], extent[2])
+        box[3] = min(x[1] + size[s], extent[3])
+        wedge = np.empty((2 if nxt[i] >= 0 else 0, 4))
+        if nxt[i] >= 0:
+            a, b = prev[i], nxt[i]
+            wedge[0, 0], wedge[0, 1], wedge[0, 2], wedge[0, 3] = nodes[a, 0], nodes[a, 1], x[0], x[1]
+            wedge[1, 0], wedge[1, 1], wedge[1, 2], wedge[1, 3] = x[0], x[1], nodes[b, 0], nodes[b, 1]
+        cand = np.sort(near_idx[near_ptr[s]:near_ptr[s + 1]])
+        far = reach + edge_half
+        seg = np.empty(starts[s + 1] - starts[s], dtype=np.int64)
+        keep = np.empty(cand.shape[0], dtype=np.int64)
+        ends = np.empty((cand.shape[0], 2))
+        m = p = q = 0
+        for j in cand:
+            for k in range(out_ptr[j], out_ptr[j + 1]):
+                e = out_idx[k]
+                u, v = edges[e, 0], edges[e, 1]
+                mx, my = 0.5 * (nodes[u, 0] + nodes[v, 0]), 0.5 * (nodes[u, 1] + nodes[v, 1])
+                if (edge_region[e] == r and u != i and v != i
+                        and (mx - x[0]) ** 2 + (my - x[1]) ** 2 <= far * far):
+                    seg[m] = e
+                    m += 1
+            if _within(nodes, j, x, reach):
+                if member[j, r] and j != i:
+                    keep[p] = j
+                    p += 1
+                if not safe[j]:
+                    ends[q, 0], ends[q, 1] = nodes[j, 0], nodes[j, 1]
+                    q += 1
+        seg = np.sort(seg[:m])
+        chords = np.empty((m, 4))
+        for k in range(m):
+            u, v = edges[seg[k], 0], edges[seg[k], 1]
+            chords[k, 0], chords[k, 1], chords[k, 2], chords[k, 3] = (nodes[u, 0], nodes[u, 1],
+                                                                      nodes[v, 0], nodes[v, 1])
+        dist = np.empty(p)
+        for k in range(p):
+            dist[k] = np.hypot(nodes[keep[k], 0] - x[0], nodes[keep[k], 1] - x[1])
+        order = np.argsort(dist, kind="mergesort")
+        near = np.empty((p, 2))
+        near_wedge = np.empty((p, 4))
+        for k in range(p):
+            j = keep[order[k]]
+            near[k, 0], near[k, 1] = nodes[j, 0], nodes[j, 1]
+            for c in range(4):
+                near_wedge[k, c] = node_wedge[j, c]
+        st, poly = clip_cell(x, box, extent, wedge, chords, near, near_wedge, ends[:q], tol)
+        if (st == GROW and box[0] <= extent[0] and box[1] <= extent[1] and box[2] >= extent[2]
+                and box[3] >= extent[3]):
+            st = REFUSED
+        status[s] = st
+        if st == CLIPPED:
+            counts[s] = poly.shape[0]
+            for k in range(poly.shape[0]):
+                out[starts[s] + k, 0] = poly[k, 0]
+                out[starts[s] + k, 1] = poly[k, 1]
+    return status, counts, starts, out

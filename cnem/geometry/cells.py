@@ -321,12 +321,24 @@ def _shared_centres(cc, nb, nodes, resolution=0.0):
     return np.ascontiguousarray(cc[first[label]])
 
 
-def _half_or_exact(half, exact, i, r):
-    """The cell of node ``i`` in region ``r`` by half-planes, else by shapely."""
-    fan = exact.fan(i, r)
-    start = float(np.linalg.norm(exact.nodes[exact.tri[fan].ravel()] - exact.nodes[i], axis=1).max())
-    poly = half.cell(i, r, start)
-    return exact.cell(i, r) if poly is None else poly
+def _slow_pairs(slow, nodes, triangles, region, offsets, star):
+    """The (node, region) pairs of the nodes ``slow``, sorted, with the distance from
+    each node to the farthest vertex of its triangles in that region.
+
+    Returns
+    -------
+    node, reg : (m,) int64 ndarray
+    reach : (m,) float64 ndarray
+    """
+    count = offsets[slow + 1] - offsets[slow]
+    owner = np.repeat(slow, count)
+    ts = star[np.repeat(offsets[slow] - np.cumsum(count) + count, count) + np.arange(count.sum())]
+    far = np.linalg.norm(nodes[triangles[ts]] - nodes[owner][:, None], axis=2).max(axis=1, initial=0.0)
+    regions = int(region.max(initial=0)) + 1
+    keys, inverse = np.unique(owner * regions + region[ts], return_inverse=True)
+    reach = np.zeros(len(keys))
+    np.maximum.at(reach, inverse, far)
+    return keys // regions, keys % regions, reach
 
 
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
@@ -374,19 +386,23 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
                                           max_deg, which)
     is_fast = np.flatnonzero(status == FAST)     # positions in `which`
     fast = which[is_fast]
-    exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, frame)
-    slow = which[status != FAST]
-    pairs = sorted({(int(i), int(r)) for i in slow
-                    for r in region[star[offsets[i]:offsets[i + 1]]]})
-    half = HalfPlaneCells(nodes, triangles, region, nb) if pairs else None
-    slow_polys = [_half_or_exact(half, exact, i, r) for i, r in tqdm(
-        pairs, desc="clipping cells", disable=None if progress is None else not progress,
+    slow_node, slow_region, reach = _slow_pairs(which[status != FAST], nodes, triangles,
+                                                region, offsets, star)
+    done = np.zeros(0, dtype=np.int64)
+    half_counts, half_verts = done, np.zeros((0, 2))
+    if len(slow_node):
+        half = HalfPlaneCells(nodes, triangles, region, nb)
+        done, half_counts, half_verts = half.cells(slow_node, slow_region, reach)
+    rest = np.setdiff1d(np.arange(len(slow_node)), done)
+    exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, frame) if len(rest) else None
+    exact_polys = [exact.cell(int(slow_node[k]), int(slow_region[k])) for k in tqdm(
+        rest, desc="clipping cells", disable=None if progress is None else not progress,
         leave=False)]
-    cell_node = np.concatenate([fast, np.array([p[0] for p in pairs], dtype=np.int64)])
-    cell_region = np.concatenate([region[rtri[is_fast]], np.array([p[1] for p in pairs], dtype=np.int64)])
-    counts = np.concatenate([poff[is_fast + 1] - poff[is_fast],
-                             np.array([len(p) for p in slow_polys], dtype=np.int64)])
-    verts = np.concatenate([poly] + slow_polys) if slow_polys else poly
+    cell_node = np.concatenate([fast, slow_node[done], slow_node[rest]])
+    cell_region = np.concatenate([region[rtri[is_fast]], slow_region[done], slow_region[rest]])
+    counts = np.concatenate([poff[is_fast + 1] - poff[is_fast], half_counts,
+                             np.array([len(p) for p in exact_polys], dtype=np.int64)])
+    verts = np.concatenate([poly, half_verts] + exact_polys)
     order = np.lexsort((cell_region, cell_node))
     cell_offsets = np.zeros(len(counts) + 1, dtype=np.int64)
     np.cumsum(counts, out=cell_offsets[1:])

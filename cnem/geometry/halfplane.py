@@ -3,17 +3,22 @@
 Between the fast path (a cell made of circumcentres) and the exact shapely
 clipping: a node whose circumcentres lie behind a constraint but whose
 neighbourhood is convex (a thin strip, a coarse boundary with nodes
-crowded inside) gets its cell by clipping a box with half-planes, in about a
-microsecond instead of milliseconds.
+crowded inside) gets its cell by clipping a box with half-planes, a few
+microseconds instead of milliseconds. All such cells are done at once: one
+k-d tree query gathers every cell's candidate nodes (and through them its
+constraint edges), one kernel (`._clip_kernels.clip_cells`) clips them all, and
+the cells whose box was too small are retried together in boxes twice as large.
 """
 
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import config
-from ._clip_kernels import CLIPPED, GROW, clip_cell
+from ._clip_kernels import CLIPPED, GROW, clip_cells
 from .topology import constraint_edges
 
 __all__ = ["HalfPlaneCells"]
@@ -69,48 +74,71 @@ class HalfPlaneCells:
         self.node_tree = cKDTree(nodes)
         twins = self.node_tree.query_pairs(max(self.tol, 0.0), output_type="ndarray")
         self.safe[twins.ravel()] = False
-        self.ends = np.flatnonzero(~self.safe)
-        self.end_tree = cKDTree(nodes[self.ends]) if len(self.ends) else None
         self.wedge[~self.safe] = 0.0
-        self.edge_tree = cKDTree(0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]]))
+        self.out_idx = np.argsort(edges[:, 0], kind="stable")
+        self.out_ptr = np.zeros(n + 1, dtype=np.int64)
+        np.cumsum(out_deg, out=self.out_ptr[1:])
         self.edge_half = 0.5 * float(np.linalg.norm(nodes[edges[:, 0]] - nodes[edges[:, 1]],
                                                     axis=1).max(initial=0.0))
 
-    def cell(self, i: int, r: int, start: float) -> np.ndarray | None:
-        """The cell of node ``i`` in region ``r`` (counter-clockwise ``(k, 2)``), or None
-        when it needs the exact path.
+    def cells(self, node: np.ndarray, region: np.ndarray, start: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The cells of nodes ``node`` in regions ``region``, those the half-plane path
+        can take (the others need the exact path).
 
-        ``start`` is the half-size of the first box tried (e.g. the distance to the
-        farthest neighbour); it doubles, at most until the box covers the nodes.
+        Parameters
+        ----------
+        node, region : (w,) int64 ndarray
+            The (node, region) pairs.
+        start : (w,) float64 ndarray
+            Half-size of the first box tried for each (e.g. the distance to the
+            farthest neighbour); a cell that may reach beyond its box is retried in
+            a box twice as large, at most until the box covers the nodes.
+
+        Returns
+        -------
+        done : (c,) int64 ndarray
+            Positions in ``node`` of the cells clipped, in no particular order.
+        counts : (c,) int64 ndarray
+            Their vertex counts.
+        vertices : (counts.sum(), 2) ndarray
+            Their counter-clockwise vertices, one cell after another in the order of
+            ``done``.
         """
-        if not self.safe[i]:
-            return None
-        x = self.nodes[i]
-        wedge = np.zeros((0, 4))
-        if self.next[i] >= 0:
-            wedge = np.concatenate([self.nodes[self.prev[i]], x, x, self.nodes[self.next[i]]]).reshape(2, 4)
-        size = start
+        node = np.asarray(node, dtype=np.int64)
+        region = np.asarray(region, dtype=np.int64)
+        size = np.array(start, dtype=np.float64)
+        todo = np.flatnonzero(self.safe[node])
+        done, counts, vertices = [], [], []
+        # a box doubles up to the nodes' extent: 64 doublings span any float ratio of
+        # start to extent that can occur, and a box covering the extent ends a cell
         for _ in range(64):
-            box = np.concatenate([np.maximum(x - size, self.extent[:2]),
-                                  np.minimum(x + size, self.extent[2:])])
-            reach = size * np.sqrt(2.0)
-            e = np.asarray(self.edge_tree.query_ball_point(x, reach + self.edge_half), dtype=np.int64)
-            e = e[(self.edge_region[e] == r) & (self.edges[e] != i).all(axis=1)]
-            j = np.asarray(self.node_tree.query_ball_point(x, reach), dtype=np.int64)
-            j = j[self.member[j, r] & (j != i)]
-            j = j[np.argsort(np.hypot(*(self.nodes[j] - x).T), kind="stable")]
-            ends = np.zeros((0, 2))
-            if self.end_tree is not None:
-                ends = self.nodes[self.ends[self.end_tree.query_ball_point(x, reach)]]
-            status, poly = clip_cell(x, box, self.extent, wedge,
-                                     self.nodes[self.edges[e]].reshape(-1, 4),
-                                     np.ascontiguousarray(self.nodes[j]), self.wedge[j],
-                                     np.ascontiguousarray(ends.reshape(-1, 2)), self.tol)
-            if status == CLIPPED:
-                return poly
-            if status != GROW:
-                return None
-            if (box[:2] <= self.extent[:2]).all() and (box[2:] >= self.extent[2:]).all():
-                return None
-            size *= 2.0
-        return None
+            if todo.size == 0:
+                break
+            reach = size[todo] * np.sqrt(2.0)
+            near_ptr, near_idx = _balls(self.node_tree, self.nodes[node[todo]],
+                                        reach + 2.0 * self.edge_half + self.tol)
+            status, count, first, out = clip_cells(
+                self.nodes, node[todo], region[todo], size[todo], self.extent, self.prev,
+                self.next, self.wedge, self.member, self.safe, self.edges, self.edge_region,
+                self.edge_half, self.out_ptr, self.out_idx, near_ptr, near_idx, self.tol)
+            ok = np.flatnonzero(status == CLIPPED)
+            done.append(todo[ok])
+            counts.append(count[ok])
+            vertices.append(out[np.repeat(first[ok] - np.cumsum(count[ok]) + count[ok], count[ok])
+                                + np.arange(count[ok].sum())])
+            todo = todo[status == GROW]
+            size[todo] *= 2.0
+        if not done:
+            return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 2))
+        return np.concatenate(done), np.concatenate(counts), np.concatenate(vertices)
+
+
+def _balls(tree: cKDTree, x: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """CSR ``(ptr, idx)`` of the tree's points within ``radius[k]`` of ``x[k]`` (in the
+    tree's order), all queries at once."""
+    hits = tree.query_ball_point(x, radius, return_sorted=False)
+    ptr = np.zeros(len(x) + 1, dtype=np.int64)
+    np.cumsum(np.fromiter(map(len, hits), dtype=np.int64, count=len(hits)), out=ptr[1:])
+    idx = np.fromiter(itertools.chain.from_iterable(hits), dtype=np.int64, count=ptr[-1])
+    return ptr, idx
