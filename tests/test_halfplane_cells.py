@@ -86,6 +86,7 @@ def _per_cell(half, i, r, start):
     ends) queried per cell, candidates in index order, the box doubled on `GROW`."""
     nodes, edges = half.nodes, half.edges
     edge_tree = cKDTree(0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]]))
+    node_tree = cKDTree(nodes)
     ends = np.flatnonzero(~half.safe)
     x = nodes[i]
     wedge = np.zeros((0, 4))
@@ -97,15 +98,16 @@ def _per_cell(half, i, r, start):
         reach = size * np.sqrt(2.0)
         e = np.asarray(edge_tree.query_ball_point(x, reach + half.edge_half, return_sorted=True), dtype=np.int64)
         e = e[(half.edge_region[e] == r) & (edges[e] != i).all(axis=1)]
-        j = np.asarray(half.node_tree.query_ball_point(x, reach, return_sorted=True), dtype=np.int64)
+        j = np.asarray(node_tree.query_ball_point(x, reach, return_sorted=True), dtype=np.int64)
         j = j[half.member[j, r] & (j != i)]
         j = j[np.argsort(np.hypot(*(nodes[j] - x).T), kind="stable")]
         near_ends = nodes[ends[np.hypot(*(nodes[ends] - x).T) <= reach]].reshape(-1, 2)
-        status, poly = clip_cell(x, box, half.extent, wedge, nodes[edges[e]].reshape(-1, 4),
-                                 np.ascontiguousarray(nodes[j]), half.wedge[j],
-                                 np.ascontiguousarray(near_ends), half.tol)
+        scratch = [np.empty((2 * (4 + len(wedge) + len(e) + len(j)) + 8, c)) for c in (2, 2, 3)]
+        status, k = clip_cell(x, box, half.extent, wedge, nodes[edges[e]].reshape(-1, 4),
+                              np.ascontiguousarray(nodes[j]), half.wedge[j],
+                              np.ascontiguousarray(near_ends), half.tol, *scratch)
         if status == CLIPPED:
-            return poly
+            return scratch[0][:k]
         if status != GROW or ((box[:2] <= half.extent[:2]).all() and (box[2:] >= half.extent[2:]).all()):
             return None
         size *= 2.0

@@ -17,6 +17,9 @@ import numpy as np
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from .._parallel import parallel_kernel
 
+#: Lists longer than this are sorted by numba's sort, shorter ones by insertion.
+_SHORT = 32
+
 #: Status codes of `clip_cell`.
 CLIPPED, GROW, REFUSED = 0, 1, 2
 
@@ -59,7 +62,7 @@ def _side(poly, n, ux, uy, vx, vy):
 
 
 @numba.njit(cache=True)
-def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol):
+def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol, poly, work, seen):
     """The half-plane cell of one node (see the module docstring).
 
     Parameters
@@ -85,18 +88,17 @@ def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol):
         tips, interface nodes) near the box.
     tol : float
         Absolute length under which points are on a line.
+    poly, work, seen : (2 (4 + w + e + p) + 8, 2), (same, 2), (same, 3) float64
+        Scratch; the cell is written to ``poly[:k]``.
 
     Returns
     -------
     status : int
         `CLIPPED`, `GROW` (the cell may reach beyond the box: retry a larger one)
         or `REFUSED` (leave the node to the exact path).
-    poly : (k, 2) float64
-        The counter-clockwise cell when `CLIPPED`.
+    k : int
+        Vertices of the counter-clockwise cell ``poly[:k]`` when `CLIPPED`, else 0.
     """
-    cap = 4 + wedge.shape[0] + edges.shape[0] + near.shape[0]
-    poly = np.empty((2 * cap + 8, 2))
-    work = np.empty((2 * cap + 8, 2))
     poly[0, 0], poly[0, 1] = box[0], box[1]
     poly[1, 0], poly[1, 1] = box[2], box[1]
     poly[2, 0], poly[2, 1] = box[2], box[3]
@@ -131,20 +133,25 @@ def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol):
             if tmax <= tol or tmin >= length - tol:
                 continue                           # the segment lies beside the part
             if tmin < -tol or tmax > length + tol:
-                return REFUSED, poly[:0]           # it ends inside the visible part
+                return REFUSED, 0                  # it ends inside the visible part
             di = (dx * (x[1] - uy) - dy * (x[0] - ux)) / length
             if abs(di) <= tol:
-                return REFUSED, poly[:0]
+                return REFUSED, 0
             sign = 1.0 if di > 0 else -1.0         # keep the node's side
             n = _clip(poly, n, ux, uy, sign * dy, -sign * dx, 0.0, work)
             changed = True
         if not changed:
             break
-    seen = poly[:n].copy()
+    ns = n                                         # the visible part, its sides' lengths
+    for k in range(n):
+        seen[k, 0], seen[k, 1] = poly[k, 0], poly[k, 1]
+    for a in range(n):
+        b = (a + 1) % n
+        seen[a, 2] = np.hypot(seen[b, 0] - seen[a, 0], seen[b, 1] - seen[a, 1])
     cx, cy = 0.0, 0.0
     for k in range(n):
-        cx += seen[k, 0] / n
-        cy += seen[k, 1] / n
+        cx += seen[k, 0] / ns
+        cy += seen[k, 1] / ns
     radius = 0.0
     for k in range(n):
         radius = max(radius, np.hypot(poly[k, 0] - x[0], poly[k, 1] - x[1]))
@@ -156,10 +163,10 @@ def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol):
         if dj <= tol:
             continue
         lo = np.inf                                # is q in the visible part?
-        for a in range(seen.shape[0]):
-            b = (a + 1) % seen.shape[0]
+        for a in range(ns):
+            b = (a + 1) % ns
             ex, ey = seen[b, 0] - seen[a, 0], seen[b, 1] - seen[a, 1]
-            length = np.hypot(ex, ey)
+            length = seen[a, 2]
             if length > 0.0:
                 lo = min(lo, (ex * (qy - seen[a, 1]) - ey * (qx - seen[a, 0])) / length)
         if lo < -tol:
@@ -172,19 +179,19 @@ def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol):
         mx, my = 0.5 * (qx + x[0]), 0.5 * (qy + x[1])
         n = _clip(poly, n, mx, my, nx, ny, 0.0, work)
         if n < 3:
-            return REFUSED, poly[:0]
+            return REFUSED, 0
         radius = 0.0
         for k in range(n):
             radius = max(radius, np.hypot(poly[k, 0] - x[0], poly[k, 1] - x[1]))
     for k in range(ends.shape[0]):
         if np.hypot(ends[k, 0] - x[0], ends[k, 1] - x[1]) <= 2.0 * radius + tol:
-            return REFUSED, poly[:0]
+            return REFUSED, 0
     reach = 2.0 * radius + tol
     if ((x[0] - reach < box[0] and box[0] > extent[0]) or (x[1] - reach < box[1] and box[1] > extent[1])
             or (x[0] + reach > box[2] and box[2] < extent[2])
             or (x[1] + reach > box[3] and box[3] < extent[3])):
-        return GROW, poly[:0]
-    return CLIPPED, poly[:n].copy()
+        return GROW, 0
+    return CLIPPED, n
 
 
 @numba.njit(cache=True)
@@ -196,7 +203,7 @@ def _within(nodes, j, x, reach):
 
 @parallel_kernel("cell_node")
 def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedge, member, safe,
-               edges, edge_region, edge_half, out_ptr, out_idx, near_ptr, near_idx, tol):
+               edges, edge_region, edge_half, edge_ptr, edge_idx, near_ptr, near_idx, tol, chunks):
     """`clip_cell` of many (node, region) cells, each in its own box, from one candidate
     list per cell.
 
@@ -231,13 +238,17 @@ def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedg
     edge_region : (e,) int64
     edge_half : float
         Half the longest constraint edge.
-    out_ptr, out_idx : (n + 1,), (e,) int64
-        CSR of the constraint edges leaving each node.
+    edge_ptr, edge_idx : (n + 1,), (2 e,) int64
+        CSR of the constraint edges at each node (leaving or entering it).
     near_ptr, near_idx : (w + 1,), (k,) int64
         CSR of each cell's candidate nodes, in any order: at least every node within
-        ``reach + 2 edge_half`` (so every start of a chord).
+        ``reach + edge_half``, so an end of every constraint edge that meets the box
+        (the edges further away that the midpoint test lets through cannot meet the
+        box, and a chord that does not meet the cell changes nothing).
     tol : float
         Absolute length under which points are on a line.
+    chunks : int
+        Work chunks the cells are cut into (`cnem._parallel.work_chunks`).
 
     Returns
     -------
@@ -255,74 +266,127 @@ def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedg
     status = np.full(w, REFUSED, dtype=np.int8)
     counts = np.zeros(w, dtype=np.int64)
     starts = np.zeros(w + 1, dtype=np.int64)
-    for s in range(w):                   # at most one vertex per chord and node, as in
-        cand = near_idx[near_ptr[s]:near_ptr[s + 1]]          # `clip_cell`'s buffers
-        m = 0
-        for j in cand:
-            m += 1 + out_ptr[j + 1] - out_ptr[j]
+    for s in range(w):                   # as `clip_cell`'s scratch: one vertex per chord
+        m = 0                            # and node at most
+        for j in near_idx[near_ptr[s]:near_ptr[s + 1]]:
+            m += 1 + edge_ptr[j + 1] - edge_ptr[j]
         starts[s + 1] = starts[s] + 2 * (6 + m) + 8
     out = np.empty((starts[w], 2))
-    for s in numba.prange(w):
-        i, r = cell_node[s], cell_region[s]
-        x = nodes[i]
-        reach = size[s] * np.sqrt(2.0)
+    nch = max(1, min(chunks, w))
+    for ch in numba.prange(nch):
+        first, last = ch * w // nch, (ch + 1) * w // nch
+        big = most = 0
+        for s in range(first, last):
+            big = max(big, starts[s + 1] - starts[s])
+            most = max(most, near_ptr[s + 1] - near_ptr[s])
         box = np.empty(4)
-        box[0] = max(x[0] - size[s], extent[0])
-        box[1] = max(x[1] - size[s], extent[1])
-        box[2] = min(x[0] + size[s], extent[2])
-        box[3] = min(x[1] + size[s], extent[3])
-        wedge = np.empty((2 if nxt[i] >= 0 else 0, 4))
-        if nxt[i] >= 0:
-            a, b = prev[i], nxt[i]
-            wedge[0, 0], wedge[0, 1], wedge[0, 2], wedge[0, 3] = nodes[a, 0], nodes[a, 1], x[0], x[1]
-            wedge[1, 0], wedge[1, 1], wedge[1, 2], wedge[1, 3] = x[0], x[1], nodes[b, 0], nodes[b, 1]
-        cand = np.sort(near_idx[near_ptr[s]:near_ptr[s + 1]])
-        far = reach + edge_half
-        seg = np.empty(starts[s + 1] - starts[s], dtype=np.int64)
-        keep = np.empty(cand.shape[0], dtype=np.int64)
-        ends = np.empty((cand.shape[0], 2))
-        m = p = q = 0
-        for j in cand:
-            for k in range(out_ptr[j], out_ptr[j + 1]):
-                e = out_idx[k]
-                u, v = edges[e, 0], edges[e, 1]
-                mx, my = 0.5 * (nodes[u, 0] + nodes[v, 0]), 0.5 * (nodes[u, 1] + nodes[v, 1])
-                if (edge_region[e] == r and u != i and v != i
-                        and (mx - x[0]) ** 2 + (my - x[1]) ** 2 <= far * far):
-                    seg[m] = e
-                    m += 1
-            if _within(nodes, j, x, reach):
-                if member[j, r] and j != i:
-                    keep[p] = j
-                    p += 1
-                if not safe[j]:
-                    ends[q, 0], ends[q, 1] = nodes[j, 0], nodes[j, 1]
-                    q += 1
-        seg = np.sort(seg[:m])
-        chords = np.empty((m, 4))
-        for k in range(m):
-            u, v = edges[seg[k], 0], edges[seg[k], 1]
-            chords[k, 0], chords[k, 1], chords[k, 2], chords[k, 3] = (nodes[u, 0], nodes[u, 1],
-                                                                      nodes[v, 0], nodes[v, 1])
-        dist = np.empty(p)
-        for k in range(p):
-            dist[k] = np.hypot(nodes[keep[k], 0] - x[0], nodes[keep[k], 1] - x[1])
-        order = np.argsort(dist, kind="mergesort")
-        near = np.empty((p, 2))
-        near_wedge = np.empty((p, 4))
-        for k in range(p):
-            j = keep[order[k]]
-            near[k, 0], near[k, 1] = nodes[j, 0], nodes[j, 1]
-            for c in range(4):
-                near_wedge[k, c] = node_wedge[j, c]
-        st, poly = clip_cell(x, box, extent, wedge, chords, near, near_wedge, ends[:q], tol)
-        if (st == GROW and box[0] <= extent[0] and box[1] <= extent[1] and box[2] >= extent[2]
-                and box[3] >= extent[3]):
-            st = REFUSED
-        status[s] = st
-        if st == CLIPPED:
-            counts[s] = poly.shape[0]
-            for k in range(poly.shape[0]):
+        wedge = np.empty((2, 4))
+        keep = np.empty(most, dtype=np.int64)
+        dist = np.empty(most)
+        ends = np.empty((most, 2))
+        near = np.empty((most, 2))
+        near_wedge = np.empty((most, 4))
+        seg = np.empty(big, dtype=np.int64)
+        chords = np.empty((big, 4))
+        poly, work, seen = np.empty((big, 2)), np.empty((big, 2)), np.empty((big, 3))
+        for s in range(first, last):
+            status[s], counts[s] = _batch_cell(
+                s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedge, member, safe,
+                edges, edge_region, edge_half, edge_ptr, edge_idx, near_ptr, near_idx, tol, box,
+                wedge, keep, dist, ends, near, near_wedge, seg, chords, poly, work, seen)
+            for k in range(counts[s]):
                 out[starts[s] + k, 0] = poly[k, 0]
                 out[starts[s] + k, 1] = poly[k, 1]
     return status, counts, starts, out
+
+
+@numba.njit(cache=True)
+def _sort_ints(a, n):
+    """Sort ``a[:n]`` in place (by insertion: a cell's lists are short)."""
+    if n > _SHORT:
+        a[:n].sort()
+        return
+    for k in range(1, n):
+        v, t = a[k], k
+        while t > 0 and a[t - 1] > v:
+            a[t] = a[t - 1]
+            t -= 1
+        a[t] = v
+
+
+@numba.njit(cache=True)
+def _sort_near(keep, dist, p):
+    """Order ``keep[:p]`` and ``dist[:p]`` in place by distance, ties by node index."""
+    if p > _SHORT:
+        first = np.argsort(keep[:p])
+        k0, d0 = keep[:p][first], dist[:p][first]
+        then = np.argsort(d0, kind="mergesort")
+        keep[:p], dist[:p] = k0[then], d0[then]
+        return
+    for k in range(1, p):
+        j, d, t = keep[k], dist[k], k
+        while t > 0 and (dist[t - 1] > d or (dist[t - 1] == d and keep[t - 1] > j)):
+            keep[t], dist[t] = keep[t - 1], dist[t - 1]
+            t -= 1
+        keep[t], dist[t] = j, d
+
+
+@numba.njit(cache=True)
+def _batch_cell(s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedge, member, safe,
+                edges, edge_region, edge_half, edge_ptr, edge_idx, near_ptr, near_idx, tol, box,
+                wedge, keep, dist, ends, near, near_wedge, seg, chords, poly, work, seen):
+    """Cell ``s`` of `clip_cells` in the scratch arrays that follow ``tol``: its
+    ``(status, vertex count)``, the cell in ``poly``."""
+    i, r = cell_node[s], cell_region[s]
+    x = nodes[i]
+    reach = size[s] * np.sqrt(2.0)
+    box[0] = max(x[0] - size[s], extent[0])
+    box[1] = max(x[1] - size[s], extent[1])
+    box[2] = min(x[0] + size[s], extent[2])
+    box[3] = min(x[1] + size[s], extent[3])
+    sides = 0
+    if nxt[i] >= 0:
+        a, b = prev[i], nxt[i]
+        wedge[0, 0], wedge[0, 1], wedge[0, 2], wedge[0, 3] = nodes[a, 0], nodes[a, 1], x[0], x[1]
+        wedge[1, 0], wedge[1, 1], wedge[1, 2], wedge[1, 3] = x[0], x[1], nodes[b, 0], nodes[b, 1]
+        sides = 2
+    far = reach + edge_half
+    m = p = q = 0
+    for j in near_idx[near_ptr[s]:near_ptr[s + 1]]:
+        for k in range(edge_ptr[j], edge_ptr[j + 1]):
+            e = edge_idx[k]
+            u, v = edges[e, 0], edges[e, 1]
+            mx, my = 0.5 * (nodes[u, 0] + nodes[v, 0]), 0.5 * (nodes[u, 1] + nodes[v, 1])
+            if (edge_region[e] == r and u != i and v != i
+                    and (mx - x[0]) ** 2 + (my - x[1]) ** 2 <= far * far):
+                seg[m] = e
+                m += 1
+        if _within(nodes, j, x, reach):
+            if member[j, r] and j != i:
+                keep[p] = j
+                dist[p] = np.hypot(nodes[j, 0] - x[0], nodes[j, 1] - x[1])
+                p += 1
+            if not safe[j]:
+                ends[q, 0], ends[q, 1] = nodes[j, 0], nodes[j, 1]
+                q += 1
+    _sort_ints(seg, m)
+    c = 0
+    for k in range(m):
+        if k > 0 and seg[k] == seg[k - 1]:
+            continue                             # found from both its ends
+        u, v = edges[seg[k], 0], edges[seg[k], 1]
+        chords[c, 0], chords[c, 1], chords[c, 2], chords[c, 3] = (nodes[u, 0], nodes[u, 1],
+                                                                  nodes[v, 0], nodes[v, 1])
+        c += 1
+    _sort_near(keep, dist, p)
+    for k in range(p):
+        j = keep[k]
+        near[k, 0], near[k, 1] = nodes[j, 0], nodes[j, 1]
+        for t in range(4):
+            near_wedge[k, t] = node_wedge[j, t]
+    st, n = clip_cell(x, box, extent, wedge[:sides], chords[:c], near[:p], near_wedge[:p], ends[:q],
+                      tol, poly, work, seen)
+    if (st == GROW and box[0] <= extent[0] and box[1] <= extent[1] and box[2] >= extent[2]
+            and box[3] >= extent[3]):
+        st = REFUSED
+    return st, n

@@ -333,12 +333,15 @@ def _slow_pairs(slow, nodes, triangles, region, offsets, star):
     count = offsets[slow + 1] - offsets[slow]
     owner = np.repeat(slow, count)
     ts = star[np.repeat(offsets[slow] - np.cumsum(count) + count, count) + np.arange(count.sum())]
-    far = np.linalg.norm(nodes[triangles[ts]] - nodes[owner][:, None], axis=2).max(axis=1, initial=0.0)
+    d = nodes[triangles[ts]] - nodes[owner][:, None]
+    far = np.sqrt(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1]).max(axis=1, initial=0.0)
     regions = int(region.max(initial=0)) + 1
-    keys, inverse = np.unique(owner * regions + region[ts], return_inverse=True)
-    reach = np.zeros(len(keys))
-    np.maximum.at(reach, inverse, far)
-    return keys // regions, keys % regions, reach
+    key = owner * regions + region[ts]
+    order = np.argsort(key, kind="stable")          # nearly sorted already: fast
+    key, far = key[order], far[order]
+    first = np.flatnonzero(np.diff(key, prepend=-1))
+    reach = np.maximum.reduceat(far, first) if len(first) else far
+    return key[first] // regions, key[first] % regions, reach
 
 
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,

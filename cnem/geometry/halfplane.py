@@ -5,19 +5,19 @@ clipping: a node whose circumcentres lie behind a constraint but whose
 neighbourhood is convex (a thin strip, a coarse boundary with nodes
 crowded inside) gets its cell by clipping a box with half-planes, a few
 microseconds instead of milliseconds. All such cells are done at once: one
-k-d tree query gathers every cell's candidate nodes (and through them its
+R-tree query gathers every cell's candidate nodes (and through them its
 constraint edges), one kernel (`._clip_kernels.clip_cells`) clips them all, and
 the cells whose box was too small are retried together in boxes twice as large.
 """
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import config
+from .._parallel import work_chunks
+from ..spatial import RTree
 from ._clip_kernels import CLIPPED, GROW, clip_cells
 from .topology import constraint_edges
 
@@ -71,13 +71,13 @@ class HalfPlaneCells:
         # the two copies of a crack-face node: their faces are coincident constraint
         # edges of one region, which the clipping does not tell apart (the cells beside a
         # crack go to the exact path)
-        self.node_tree = cKDTree(nodes)
-        twins = self.node_tree.query_pairs(max(self.tol, 0.0), output_type="ndarray")
+        twins = cKDTree(nodes).query_pairs(max(self.tol, 0.0), output_type="ndarray")
         self.safe[twins.ravel()] = False
         self.wedge[~self.safe] = 0.0
-        self.out_idx = np.argsort(edges[:, 0], kind="stable")
-        self.out_ptr = np.zeros(n + 1, dtype=np.int64)
-        np.cumsum(out_deg, out=self.out_ptr[1:])
+        self.node_rtree = RTree.from_points(nodes)
+        self.edge_idx = np.argsort(edges.ravel(), kind="stable") // 2
+        self.edge_ptr = np.zeros(n + 1, dtype=np.int64)
+        np.cumsum(out_deg + in_deg, out=self.edge_ptr[1:])
         self.edge_half = 0.5 * float(np.linalg.norm(nodes[edges[:, 0]] - nodes[edges[:, 1]],
                                                     axis=1).max(initial=0.0))
 
@@ -116,12 +116,12 @@ class HalfPlaneCells:
             if todo.size == 0:
                 break
             reach = size[todo] * np.sqrt(2.0)
-            near_ptr, near_idx = _balls(self.node_tree, self.nodes[node[todo]],
-                                        reach + 2.0 * self.edge_half + self.tol)
+            near_ptr, near_idx = self.node_rtree.query_ball(self.nodes[node[todo]],
+                                                            reach + self.edge_half + self.tol)
             status, count, first, out = clip_cells(
                 self.nodes, node[todo], region[todo], size[todo], self.extent, self.prev,
                 self.next, self.wedge, self.member, self.safe, self.edges, self.edge_region,
-                self.edge_half, self.out_ptr, self.out_idx, near_ptr, near_idx, self.tol)
+                self.edge_half, self.edge_ptr, self.edge_idx, near_ptr, near_idx, self.tol, work_chunks())
             ok = np.flatnonzero(status == CLIPPED)
             done.append(todo[ok])
             counts.append(count[ok])
@@ -133,12 +133,3 @@ class HalfPlaneCells:
             return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 2))
         return np.concatenate(done), np.concatenate(counts), np.concatenate(vertices)
 
-
-def _balls(tree: cKDTree, x: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """CSR ``(ptr, idx)`` of the tree's points within ``radius[k]`` of ``x[k]`` (in the
-    tree's order), all queries at once."""
-    hits = tree.query_ball_point(x, radius, return_sorted=False)
-    ptr = np.zeros(len(x) + 1, dtype=np.int64)
-    np.cumsum(np.fromiter(map(len, hits), dtype=np.int64, count=len(hits)), out=ptr[1:])
-    idx = np.fromiter(itertools.chain.from_iterable(hits), dtype=np.int64, count=ptr[-1])
-    return ptr, idx
