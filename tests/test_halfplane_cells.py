@@ -11,6 +11,7 @@ from scipy.spatial import cKDTree
 
 import cases
 import cnem
+from cnem._parallel import always_parallel
 from cnem.geometry import cells
 from cnem.geometry._clip_kernels import CLIPPED, GROW, clip_cell
 from cnem.geometry.halfplane import HalfPlaneCells
@@ -147,3 +148,20 @@ def test_batched_cells_equal_the_per_cell_path(name, moved):
             assert got[c].shape == want.shape
             np.testing.assert_allclose(got[c], want, rtol=0.0, atol=1e-15 * size)
     assert taken > len(node) / 5           # most cells of every case, a third of the graded one
+
+
+def test_the_parallel_copy_clips_the_same_cells():
+    """The batch kernel's parallel copy (`cnem._parallel`, chosen above
+    `cnem.config.PARALLEL_MIN` cells) gives the serial copy's cells bit for bit."""
+    dom, cloud = _strip(1e-3)
+    nodes, _, tri, region, _, _, neighbors = triangulate(cloud, {})
+    local = dom.frame.to_local(nodes)
+    off, star = vertex_triangles(tri, len(local))
+    half = HalfPlaneCells(local, tri, region, neighbors[0])
+    pairs = cells._slow_pairs(np.arange(len(local)), local, tri, region, off, star)
+    serial = half.cells(*pairs)
+    with always_parallel():
+        parallel = half.cells(*pairs)
+    assert len(serial[0]) == len(local)
+    for a, b in zip(serial, parallel):
+        np.testing.assert_array_equal(a, b)
