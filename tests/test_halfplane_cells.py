@@ -14,6 +14,7 @@ import cnem
 from cnem._parallel import always_parallel
 from cnem.geometry import cells
 from cnem.geometry._clip_kernels import CLIPPED, GROW, clip_cell
+from cnem.geometry._kernels import fan_regions
 from cnem.geometry.halfplane import HalfPlaneCells
 from cnem.geometry.model import triangulate
 from cnem.geometry.topology import circumcenters, vertex_triangles
@@ -34,7 +35,7 @@ def test_half_plane_cells_equal_the_exact_cells(name):
     exact = cells._ExactCells(local, tri, region, neighbors[0], off, star,
                               circumcenters(local, tri), dom.frame)
     half = HalfPlaneCells(local, tri, region, neighbors[0])
-    node, reg, start = cells._slow_pairs(np.arange(len(local)), local, tri, region, off, star)
+    node, reg, start = fan_regions(local, tri, region, off, star, np.arange(len(local)))
     done, counts, verts = half.cells(node, reg, start)
     first = np.concatenate([[0], np.cumsum(counts)])
     for k, c in enumerate(done):
@@ -134,7 +135,7 @@ def test_batched_cells_equal_the_per_cell_path(name, moved):
     local = dom.frame.to_local(nodes) * scale + offset
     off, star = vertex_triangles(tri, len(local))
     half = HalfPlaneCells(local, tri, region, neighbors[0])
-    node, reg, start = cells._slow_pairs(np.arange(len(local)), local, tri, region, off, star)
+    node, reg, start = fan_regions(local, tri, region, off, star, np.arange(len(local)))
     done, counts, verts = half.cells(node, reg, start)
     first = np.concatenate([[0], np.cumsum(counts)])
     got = {int(c): verts[first[k]:first[k + 1]] for k, c in enumerate(done)}
@@ -158,7 +159,7 @@ def test_the_parallel_copy_clips_the_same_cells():
     local = dom.frame.to_local(nodes)
     off, star = vertex_triangles(tri, len(local))
     half = HalfPlaneCells(local, tri, region, neighbors[0])
-    pairs = cells._slow_pairs(np.arange(len(local)), local, tri, region, off, star)
+    pairs = fan_regions(local, tri, region, off, star, np.arange(len(local)))
     serial = half.cells(*pairs)
     with always_parallel():
         parallel = half.cells(*pairs)

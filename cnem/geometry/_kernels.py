@@ -291,3 +291,51 @@ def polygon_moments(offsets, vertices):
         centroid[c, 0] = cx / (3.0 * a) + x0
         centroid[c, 1] = cy / (3.0 * a) + y0
     return area, centroid
+
+
+@numba.njit(cache=True)
+def fan_regions(pts, tri, region, offsets, star, nodes):
+    """The regions around each of ``nodes`` (the cells the fast path left), with the
+    distance from the node to the farthest vertex of its triangles in that region.
+
+    Parameters
+    ----------
+    pts : (n, 2) float64
+    tri : (t, 3) int64
+    region : (t,) int64
+    offsets, star : CSR of the triangles around each node.
+    nodes : (w,) int64
+        Sorted.
+
+    Returns
+    -------
+    node, reg : (m,) int64
+        The (node, region) pairs, sorted by node then region.
+    far : (m,) float64
+    """
+    total = 0
+    for i in nodes:
+        total += offsets[i + 1] - offsets[i]
+    node = np.empty(total, dtype=np.int64)
+    reg = np.empty(total, dtype=np.int64)
+    far = np.empty(total)
+    m = 0
+    for i in nodes:
+        first = m
+        for k in range(offsets[i], offsets[i + 1]):
+            t, r = star[k], region[star[k]]
+            d = 0.0
+            for c in range(3):
+                dx, dy = pts[tri[t, c], 0] - pts[i, 0], pts[tri[t, c], 1] - pts[i, 1]
+                d = max(d, np.sqrt(dx * dx + dy * dy))
+            at = first
+            while at < m and reg[at] < r:            # the node's regions, kept sorted
+                at += 1
+            if at < m and reg[at] == r:
+                far[at] = max(far[at], d)
+                continue
+            for q in range(m, at, -1):
+                reg[q], far[q] = reg[q - 1], far[q - 1]
+            node[m], reg[at], far[at] = i, r, d
+            m += 1
+    return node[:m], reg[:m], far[:m]

@@ -37,7 +37,7 @@ from tqdm.auto import tqdm
 from .. import config
 from .._predicates import Frame
 from ..errors import GeometryError
-from ._kernels import FAST, fast_cells
+from ._kernels import FAST, fan_regions, fast_cells
 from .halfplane import HalfPlaneCells
 from .topology import circumcenters, constraint_edges, triangle_neighbors, vertex_triangles
 
@@ -321,29 +321,6 @@ def _shared_centres(cc, nb, nodes, resolution=0.0):
     return np.ascontiguousarray(cc[first[label]])
 
 
-def _slow_pairs(slow, nodes, triangles, region, offsets, star):
-    """The (node, region) pairs of the nodes ``slow``, sorted, with the distance from
-    each node to the farthest vertex of its triangles in that region.
-
-    Returns
-    -------
-    node, reg : (m,) int64 ndarray
-    reach : (m,) float64 ndarray
-    """
-    count = offsets[slow + 1] - offsets[slow]
-    owner = np.repeat(slow, count)
-    ts = star[np.repeat(offsets[slow] - np.cumsum(count) + count, count) + np.arange(count.sum())]
-    d = nodes[triangles[ts]] - nodes[owner][:, None]
-    far = np.sqrt(d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1]).max(axis=1, initial=0.0)
-    regions = int(region.max(initial=0)) + 1
-    key = owner * regions + region[ts]
-    order = np.argsort(key, kind="stable")          # nearly sorted already: fast
-    key, far = key[order], far[order]
-    first = np.flatnonzero(np.diff(key, prepend=-1))
-    reach = np.maximum.reduceat(far, first) if len(first) else far
-    return key[first] // regions, key[first] % regions, reach
-
-
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
                   progress: bool | None = None, neighbors: np.ndarray | None = None,
                   only: ArrayLike | None = None, frame: Frame | None = None
@@ -389,8 +366,8 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
                                           max_deg, which)
     is_fast = np.flatnonzero(status == FAST)     # positions in `which`
     fast = which[is_fast]
-    slow_node, slow_region, reach = _slow_pairs(which[status != FAST], nodes, triangles,
-                                                region, offsets, star)
+    slow_node, slow_region, reach = fan_regions(nodes, triangles, region, offsets, star,
+                                                which[status != FAST])
     done = np.zeros(0, dtype=np.int64)
     half_counts, half_verts = done, np.zeros((0, 2))
     if len(slow_node):
