@@ -110,8 +110,8 @@ class HalfPlaneCells:
         size = np.array(start, dtype=np.float64)
         todo = np.flatnonzero(self.safe[node])
         done, counts, vertices = [], [], []
-        # a box doubles up to the nodes' extent: 64 doublings span any float ratio of
-        # start to extent that can occur, and a box covering the extent ends a cell
+        # at most 64 doublings (boxes up to 1.8e19 times the first): a cell still growing
+        # then, like one whose box covers the extent, is left to the exact path
         for _ in range(64):
             if todo.size == 0:
                 break
