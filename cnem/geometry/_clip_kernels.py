@@ -203,15 +203,19 @@ def _within(nodes, j, x, reach):
 
 @parallel_kernel("cell_node")
 def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedge, member, safe,
-               edges, edge_region, edge_half, edge_ptr, edge_idx, near_ptr, near_idx, tol, chunks):
-    """`clip_cell` of many (node, region) cells, each in its own box, from one candidate
-    list per cell.
+               edges, edge_region, edge_half, edge_ptr, edge_idx, group, near_ptr, near_idx, tol,
+               chunks):
+    """`clip_cell` of many (node, region) cells, each in its own box, from candidate lists
+    shared by groups of nearby cells.
 
     The box of cell ``s`` has half-size ``size[s]`` and circumradius ``reach =
     sqrt(2) size[s]``; its chords are the constraint edges of its region whose
     midpoints lie within ``reach + edge_half``, its neighbours the region's nodes within
     ``reach`` (nearest first, ties by index), its constraint ends the nodes that are not
-    ``safe`` within ``reach``.
+    ``safe`` within ``reach``. They are found among the candidates within ``reach +
+    edge_half + tol``: an end of every constraint edge that meets the box (the edges
+    further away that the midpoint test lets through cannot meet the box, and a chord
+    that does not meet the cell changes nothing).
 
     Parameters
     ----------
@@ -240,11 +244,11 @@ def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedg
         Half the longest constraint edge.
     edge_ptr, edge_idx : (n + 1,), (2 e,) int64
         CSR of the constraint edges at each node (leaving or entering it).
-    near_ptr, near_idx : (w + 1,), (k,) int64
-        CSR of each cell's candidate nodes, in any order: at least every node within
-        ``reach + edge_half``, so an end of every constraint edge that meets the box
-        (the edges further away that the midpoint test lets through cannot meet the
-        box, and a chord that does not meet the cell changes nothing).
+    group : (w,) int64
+        The candidate list of each cell.
+    near_ptr, near_idx : (g + 1,), (k,) int64
+        CSR of the candidate lists, in any order: each holds at least every node
+        within ``reach + edge_half + tol`` of each cell of its group.
     tol : float
         Absolute length under which points are on a line.
     chunks : int
@@ -266,10 +270,14 @@ def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedg
     status = np.full(w, REFUSED, dtype=np.int8)
     counts = np.zeros(w, dtype=np.int64)
     starts = np.zeros(w + 1, dtype=np.int64)
+    found = np.zeros(w, dtype=np.int64)
     for s in range(w):                   # as `clip_cell`'s scratch: one vertex per chord
         m = 0                            # and node at most
-        for j in near_idx[near_ptr[s]:near_ptr[s + 1]]:
-            m += 1 + edge_ptr[j + 1] - edge_ptr[j]
+        x = nodes[cell_node[s]]
+        for j in near_idx[near_ptr[group[s]]:near_ptr[group[s] + 1]]:
+            if _within(nodes, j, x, size[s] * np.sqrt(2.0) + edge_half + tol):
+                m += 1 + edge_ptr[j + 1] - edge_ptr[j]
+                found[s] += 1
         starts[s + 1] = starts[s] + 2 * (6 + m) + 8
     out = np.empty((starts[w], 2))
     nch = max(1, min(chunks, w))
@@ -278,7 +286,7 @@ def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedg
         big = most = 0
         for s in range(first, last):
             big = max(big, starts[s + 1] - starts[s])
-            most = max(most, near_ptr[s + 1] - near_ptr[s])
+            most = max(most, found[s])
         box = np.empty(4)
         wedge = np.empty((2, 4))
         keep = np.empty(most, dtype=np.int64)
@@ -292,8 +300,8 @@ def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedg
         for s in range(first, last):
             status[s], counts[s] = _batch_cell(
                 s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedge, member, safe,
-                edges, edge_region, edge_half, edge_ptr, edge_idx, near_ptr, near_idx, tol, box,
-                wedge, keep, dist, ends, near, near_wedge, seg, chords, poly, work, seen)
+                edges, edge_region, edge_half, edge_ptr, edge_idx, group, near_ptr, near_idx, tol,
+                box, wedge, keep, dist, ends, near, near_wedge, seg, chords, poly, work, seen)
             for k in range(counts[s]):
                 out[starts[s] + k, 0] = poly[k, 0]
                 out[starts[s] + k, 1] = poly[k, 1]
@@ -333,8 +341,8 @@ def _sort_near(keep, dist, p):
 
 @numba.njit(cache=True)
 def _batch_cell(s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedge, member, safe,
-                edges, edge_region, edge_half, edge_ptr, edge_idx, near_ptr, near_idx, tol, box,
-                wedge, keep, dist, ends, near, near_wedge, seg, chords, poly, work, seen):
+                edges, edge_region, edge_half, edge_ptr, edge_idx, group, near_ptr, near_idx, tol,
+                box, wedge, keep, dist, ends, near, near_wedge, seg, chords, poly, work, seen):
     """Cell ``s`` of `clip_cells` in the scratch arrays that follow ``tol``: its
     ``(status, vertex count)``, the cell in ``poly``."""
     i, r = cell_node[s], cell_region[s]
@@ -352,7 +360,9 @@ def _batch_cell(s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_
         sides = 2
     far = reach + edge_half
     m = p = q = 0
-    for j in near_idx[near_ptr[s]:near_ptr[s + 1]]:
+    for j in near_idx[near_ptr[group[s]]:near_ptr[group[s] + 1]]:
+        if not _within(nodes, j, x, reach + edge_half + tol):
+            continue
         for k in range(edge_ptr[j], edge_ptr[j + 1]):
             e = edge_idx[k]
             u, v = edges[e, 0], edges[e, 1]

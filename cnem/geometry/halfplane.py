@@ -5,8 +5,8 @@ clipping: a node whose circumcentres lie behind a constraint but whose
 neighbourhood is convex (a thin strip, a coarse boundary with nodes
 crowded inside) gets its cell by clipping a box with half-planes, a few
 microseconds instead of milliseconds. All such cells are done at once: one
-R-tree query gathers every cell's candidate nodes (and through them its
-constraint edges), one kernel (`._clip_kernels.clip_cells`) clips them all, and
+R-tree query per leaf of the tree gathers the candidate nodes of the leaf's cells (and
+through them their constraint edges), one kernel (`._clip_kernels.clip_cells`) clips them all, and
 the cells whose box was too small are retried together in boxes twice as large.
 """
 
@@ -75,6 +75,8 @@ class HalfPlaneCells:
         self.safe[twins.ravel()] = False
         self.wedge[~self.safe] = 0.0
         self.node_rtree = RTree.from_points(nodes)
+        self.leaf = np.empty(n, dtype=np.int64)    # the tree's leaf of each node
+        self.leaf[self.node_rtree.order] = np.arange(n) // self.node_rtree.fanout
         self.edge_idx = np.argsort(edges.ravel(), kind="stable") // 2
         self.edge_ptr = np.zeros(n + 1, dtype=np.int64)
         np.cumsum(out_deg + in_deg, out=self.edge_ptr[1:])
@@ -115,13 +117,12 @@ class HalfPlaneCells:
         for _ in range(64):
             if todo.size == 0:
                 break
-            reach = size[todo] * np.sqrt(2.0)
-            near_ptr, near_idx = self.node_rtree.query_ball(self.nodes[node[todo]],
-                                                            reach + self.edge_half + self.tol)
+            group, near_ptr, near_idx = self._candidates(node[todo], size[todo])
             status, count, first, out = clip_cells(
                 self.nodes, node[todo], region[todo], size[todo], self.extent, self.prev,
                 self.next, self.wedge, self.member, self.safe, self.edges, self.edge_region,
-                self.edge_half, self.edge_ptr, self.edge_idx, near_ptr, near_idx, self.tol, work_chunks())
+                self.edge_half, self.edge_ptr, self.edge_idx, group, near_ptr, near_idx, self.tol,
+                work_chunks())
             ok = np.flatnonzero(status == CLIPPED)
             done.append(todo[ok])
             counts.append(count[ok])
@@ -133,3 +134,27 @@ class HalfPlaneCells:
             return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 2))
         return np.concatenate(done), np.concatenate(counts), np.concatenate(vertices)
 
+    def _candidates(self, node: np.ndarray, size: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Candidate lists for the cells of ``node`` with boxes of half-size ``size``: one
+        list per leaf of the nodes' R-tree, every node of the box holding the discs of
+        radius ``sqrt(2) size + edge_half + tol`` around that leaf's nodes (one query per
+        leaf, not per cell).
+
+        Returns
+        -------
+        group : (w,) int64 ndarray
+            Each cell's list.
+        ptr, idx : (g + 1,), (k,) int64 ndarray
+            CSR of the lists.
+        """
+        x = self.nodes[node]
+        radius = size * np.sqrt(2.0) + self.edge_half + self.tol
+        pad = radius[:, None] * (1.0 + 1e-12) + 8.0 * np.spacing(np.abs(x))   # rounding of x -+ r
+        leaves, group = np.unique(self.leaf[node], return_inverse=True)
+        lo = np.full((len(leaves), 2), np.inf)
+        hi = np.full((len(leaves), 2), -np.inf)
+        np.minimum.at(lo, group, x - pad)
+        np.maximum.at(hi, group, x + pad)
+        ptr, idx = self.node_rtree.query(lo, hi)
+        return group, ptr, idx
