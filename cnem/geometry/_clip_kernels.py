@@ -62,6 +62,16 @@ def _side(poly, n, ux, uy, vx, vy):
 
 
 @numba.njit(cache=True)
+def _radius(poly, n, x):
+    """Largest distance from ``x`` to a vertex of ``poly[:n]`` (one square root)."""
+    r2 = 0.0
+    for k in range(n):
+        dx, dy = poly[k, 0] - x[0], poly[k, 1] - x[1]
+        r2 = max(r2, dx * dx + dy * dy)
+    return np.sqrt(r2)
+
+
+@numba.njit(cache=True)
 def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol, poly, work, seen):
     """The half-plane cell of one node (see the module docstring).
 
@@ -152,9 +162,7 @@ def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol, poly, w
     for k in range(n):
         cx += seen[k, 0] / ns
         cy += seen[k, 1] / ns
-    radius = 0.0
-    for k in range(n):
-        radius = max(radius, np.hypot(poly[k, 0] - x[0], poly[k, 1] - x[1]))
+    radius = _radius(poly, n, x)
     for j in range(near.shape[0]):
         qx, qy = near[j, 0], near[j, 1]
         dj = np.hypot(qx - x[0], qy - x[1])
@@ -180,9 +188,7 @@ def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol, poly, w
         n = _clip(poly, n, mx, my, nx, ny, 0.0, work)
         if n < 3:
             return REFUSED, 0
-        radius = 0.0
-        for k in range(n):
-            radius = max(radius, np.hypot(poly[k, 0] - x[0], poly[k, 1] - x[1]))
+        radius = _radius(poly, n, x)
     for k in range(ends.shape[0]):
         if np.hypot(ends[k, 0] - x[0], ends[k, 1] - x[1]) <= 2.0 * radius + tol:
             return REFUSED, 0
