@@ -98,7 +98,8 @@ def _per_cell(half, i, r, start):
     for _ in range(64):
         box = np.concatenate([np.maximum(x - size, half.extent[:2]), np.minimum(x + size, half.extent[2:])])
         reach = size * np.sqrt(2.0)
-        e = np.asarray(edge_tree.query_ball_point(x, reach + half.edge_half, return_sorted=True), dtype=np.int64)
+        e = np.asarray(edge_tree.query_ball_point(x, reach + half.edge_half, return_sorted=True),
+                       dtype=np.int64)
         e = e[(half.edge_region[e] == r) & (edges[e] != i).all(axis=1)]
         j = np.asarray(node_tree.query_ball_point(x, reach, return_sorted=True), dtype=np.int64)
         j = j[half.member[j, r] & (j != i)]
@@ -121,11 +122,12 @@ def _strip(h):
     return dom, cnem.nodes.irregular(dom, h, seed=0)
 
 
-@pytest.mark.parametrize("moved", [(1.0, 0.0), (1.0, 1e6), (1e-6, 0.0)], ids=["origin", "offset1e6", "scale1e-6"])
+@pytest.mark.parametrize("moved", [(1.0, 0.0), (1.0, 1e6), (1e-6, 0.0)],
+                         ids=["origin", "offset1e6", "scale1e-6"])
 @pytest.mark.parametrize("name", ["square_irregular", "plate_hole_irregular", "kinked_crack_irregular",
                                   "three_rectangles_irregular", "graded_inclined_crack", "strip"])
 def test_batched_cells_equal_the_per_cell_path(name, moved):
-    """All half-plane cells at once (one tree query, one kernel, the growing boxes
+    """All half-plane cells at once (one tree query per leaf, one kernel, the growing boxes
     retried together) are the cells of the per-cell path: the same (node, region)
     pairs taken, the same vertices to 1e-15 of the extent (in practice bit for bit),
     at the origin, moved by 1e6 and in units 1e-6 times smaller."""
