@@ -372,6 +372,8 @@ def _batch_cell(s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_
         for k in range(edge_ptr[j], edge_ptr[j + 1]):
             e = edge_idx[k]
             u, v = edges[e, 0], edges[e, 1]
+            if v == j and _within(nodes, u, x, reach + edge_half + tol):
+                continue                         # a candidate too: found from there
             mx, my = 0.5 * (nodes[u, 0] + nodes[v, 0]), 0.5 * (nodes[u, 1] + nodes[v, 1])
             if (edge_region[e] == r and u != i and v != i
                     and (mx - x[0]) ** 2 + (my - x[1]) ** 2 <= far * far):
@@ -386,21 +388,17 @@ def _batch_cell(s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_
                 ends[q, 0], ends[q, 1] = nodes[j, 0], nodes[j, 1]
                 q += 1
     _sort_ints(seg, m)
-    c = 0
     for k in range(m):
-        if k > 0 and seg[k] == seg[k - 1]:
-            continue                             # found from both its ends
         u, v = edges[seg[k], 0], edges[seg[k], 1]
-        chords[c, 0], chords[c, 1], chords[c, 2], chords[c, 3] = (nodes[u, 0], nodes[u, 1],
+        chords[k, 0], chords[k, 1], chords[k, 2], chords[k, 3] = (nodes[u, 0], nodes[u, 1],
                                                                   nodes[v, 0], nodes[v, 1])
-        c += 1
     _sort_near(keep, dist, p)
     for k in range(p):
         j = keep[k]
         near[k, 0], near[k, 1] = nodes[j, 0], nodes[j, 1]
         for t in range(4):
             near_wedge[k, t] = node_wedge[j, t]
-    st, n = clip_cell(x, box, extent, wedge[:sides], chords[:c], near[:p], near_wedge[:p], ends[:q],
+    st, n = clip_cell(x, box, extent, wedge[:sides], chords[:m], near[:p], near_wedge[:p], ends[:q],
                       tol, poly, work, seen)
     if (st == GROW and box[0] <= extent[0] and box[1] <= extent[1] and box[2] >= extent[2]
             and box[3] >= extent[3]):
