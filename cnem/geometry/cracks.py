@@ -13,6 +13,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..errors import GeometryError
 from .pslg import BOUNDARY, CRACK
+from ._mesh_kernels import edge_triangles
 from .topology import vertex_triangles
 
 __all__ = ["split_cracks"]
@@ -74,32 +75,23 @@ def split_cracks(points: np.ndarray, triangles: np.ndarray, segments: np.ndarray
         crack_nb.setdefault(int(b), set()).add(int(a))
     offsets, star = vertex_triangles(triangles, n0)
     new_tri = triangles.copy()
-    node_of_point = list(range(n0))
+    copies = []
     for v in split:
         fan = star[offsets[v]:offsets[v + 1]].tolist()
         for group in _fan_groups(v, fan, triangles, crack_nb[int(v)])[1:]:
-            copy = len(node_of_point)
-            node_of_point.append(int(v))
+            copy = n0 + len(copies)
+            copies.append(int(v))
             g = np.asarray(group)
             new_tri[g] = np.where(triangles[g] == v, copy, new_tri[g])
-    node_of_point = np.asarray(node_of_point, dtype=np.int64)
-    # renumber segments through the triangles that carry them
-    a = triangles[:, [1, 2, 0]].ravel()
-    b = triangles[:, [2, 0, 1]].ravel()
-    na = new_tri[:, [1, 2, 0]].ravel()
-    nb_ = new_tri[:, [2, 0, 1]].ravel()
-    key = np.minimum(a, b) * n0 + np.maximum(a, b)
-    order = np.argsort(key, kind="stable")
-    skey = np.minimum(segments[:, 0], segments[:, 1]) * n0 + np.maximum(segments[:, 0], segments[:, 1])
-    lo = np.searchsorted(key[order], skey, side="left")
-    hi = np.searchsorted(key[order], skey, side="right")
-    seg_new, kind_new = [], []
-    for s in range(len(segments)):
-        for slot in order[lo[s]:hi[s]]:
-            seg_new.append(sorted((int(na[slot]), int(nb_[slot]))))
-            kind_new.append(kind[s])
-    seg_new = np.asarray(seg_new, dtype=np.int64)
-    kind_new = np.asarray(kind_new, dtype=np.int8)
+    node_of_point = np.concatenate([np.arange(n0), np.asarray(copies, dtype=np.int64)])
+    # renumber segments through the triangles that carry them (each one's edge
+    # opposite vertex k is slot 3 t + k)
+    ptr, slot = edge_triangles(np.ascontiguousarray(triangles, dtype=np.int64), offsets, star,
+                               np.ascontiguousarray(segments, dtype=np.int64))
+    t, k = slot // 3, slot % 3
+    seg_new = np.sort(np.column_stack([new_tri[t, (k + 1) % 3], new_tri[t, (k + 2) % 3]]),
+                      axis=1).astype(np.int64)
+    kind_new = np.repeat(kind, np.diff(ptr)).astype(np.int8)
     _, first = np.unique(seg_new, axis=0, return_index=True)
     first = np.sort(first)
     opened = np.count_nonzero(kind_new[first] == CRACK)
