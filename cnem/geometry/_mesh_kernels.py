@@ -41,7 +41,7 @@ def orient_and_centroids(points, tri):
     return centroid
 
 
-@numba.njit(cache=True)
+@parallel_kernel("tri")
 def canonical_order(tri, n):
     """The triangles each from its smallest node on (counter-clockwise kept), sorted
     by their nodes (first, second, third): a stable counting sort by the first node,
@@ -62,14 +62,15 @@ def canonical_order(tri, n):
     """
     t = tri.shape[0]
     rot = np.empty((t, 3), dtype=np.int64)
-    start = np.zeros(n + 1, dtype=np.int64)
-    for s in range(t):
+    for s in numba.prange(t):
         first = 0
         for k in range(1, 3):
             if tri[s, k] < tri[s, first]:
                 first = k
         for k in range(3):
             rot[s, k] = tri[s, (first + k) % 3]
+    start = np.zeros(n + 1, dtype=np.int64)
+    for s in range(t):
         start[rot[s, 0] + 1] += 1
     for v in range(n):
         start[v + 1] += start[v]
@@ -78,7 +79,7 @@ def canonical_order(tri, n):
     for s in range(t):
         order[fill[rot[s, 0]]] = s
         fill[rot[s, 0]] += 1
-    for v in range(n):
+    for v in numba.prange(n):
         for p in range(start[v] + 1, start[v + 1]):
             s = order[p]
             q = p
@@ -88,7 +89,7 @@ def canonical_order(tri, n):
                 q -= 1
             order[q] = s
     out = np.empty((t, 3), dtype=np.int64)
-    for p in range(t):
+    for p in numba.prange(t):
         for k in range(3):
             out[p, k] = rot[order[p], k]
     return out, order
@@ -187,20 +188,24 @@ def close_neighbours(cc, nb, tol):
         In the order of the lower triangle, then of its edge.
     """
     t = nb.shape[0]
+    close = np.zeros((t, 3), dtype=np.bool_)
     count = 0
     for s in range(t):
         for k in range(3):
             u = nb[s, k]
-            if u > s and np.hypot(cc[s, 0] - cc[u, 0], cc[s, 1] - cc[u, 1]) <= tol:
-                count += 1
+            if u > s:
+                dx, dy = cc[s, 0] - cc[u, 0], cc[s, 1] - cc[u, 1]
+                # hypot >= max(|dx|, |dy|): the cheap test first
+                if abs(dx) <= tol and abs(dy) <= tol and np.hypot(dx, dy) <= tol:
+                    close[s, k] = True
+                    count += 1
     low = np.empty(count, dtype=np.int64)
     high = np.empty(count, dtype=np.int64)
     q = 0
     for s in range(t):
         for k in range(3):
-            u = nb[s, k]
-            if u > s and np.hypot(cc[s, 0] - cc[u, 0], cc[s, 1] - cc[u, 1]) <= tol:
-                low[q], high[q] = s, u
+            if close[s, k]:
+                low[q], high[q] = s, nb[s, k]
                 q += 1
     return low, high
 

@@ -8,8 +8,6 @@ the crack and the crack faces become boundaries of the triangulation.
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from ..errors import GeometryError
 from .pslg import BOUNDARY, CRACK
@@ -27,17 +25,26 @@ def _fan_groups(v, fan, triangles, crack_neighbors):
     """
     by_other = {}
     for k, t in enumerate(fan):
-        for w in triangles[t]:
+        for w in triangles[t].tolist():
             if w != v:
-                by_other.setdefault(int(w), []).append(k)
-    links = np.array([ks for w, ks in by_other.items()
-                      if len(ks) == 2 and w not in crack_neighbors], dtype=np.int64).reshape(-1, 2)
-    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])),
-                       shape=(len(fan), len(fan)))
-    _, label = connected_components(graph, directed=False)
-    fan = np.asarray(fan)
-    groups = [fan[label == g].tolist() for g in range(label.max() + 1)]
-    return sorted(groups, key=min)
+                by_other.setdefault(w, []).append(k)
+    root = list(range(len(fan)))         # union-find over the fan: root[k] <= k
+
+    def find(k):
+        for _ in range(len(fan)):
+            if root[k] == k:
+                break
+            k = root[k]
+        return k
+
+    for w, ks in by_other.items():
+        if len(ks) == 2 and w not in crack_neighbors:
+            a, b = find(ks[0]), find(ks[1])
+            root[max(a, b)] = min(a, b)
+    groups = {}
+    for k, t in enumerate(fan):
+        groups.setdefault(find(k), []).append(t)
+    return sorted(groups.values(), key=min)
 
 
 def split_cracks(points: np.ndarray, triangles: np.ndarray, segments: np.ndarray, kind: np.ndarray
