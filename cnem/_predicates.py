@@ -58,9 +58,14 @@ class Frame(NamedTuple):
         return np.ascontiguousarray((np.asarray(points, dtype=np.float64) - self.origin)
                                     / self.scale)
 
-    def to_global(self, points: ArrayLike) -> np.ndarray:
-        """``(p, 2)`` local points back in global coordinates."""
-        return np.asarray(points, dtype=np.float64) * self.scale + self.origin
+    def to_global(self, points: ArrayLike, *, out: np.ndarray | None = None) -> np.ndarray:
+        """``(p, 2)`` local points back in global coordinates (a new array, or ``out``:
+        ``points`` itself, say, to save a copy of a large array)."""
+        if out is None:
+            return np.asarray(points, dtype=np.float64) * self.scale + self.origin
+        np.multiply(points, self.scale, out=out)
+        out += self.origin
+        return out
 
 
 def local_frame(bounds: ArrayLike) -> Frame:

@@ -139,7 +139,8 @@ def _open_fan(i, tri, nb, offsets, star, out):
 def _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly):
     """Write the fast-path cell of node ``i`` into ``poly``; count, or -1 if not fast.
 
-    ``fan``, ``path`` and ``poly`` are scratch arrays of length ``max_deg + 2``.
+    ``fan`` and ``path`` are scratch arrays of lengths ``max_deg`` and ``max_deg + 2``;
+    ``poly`` has room for a vertex per triangle around ``i`` and three more.
     """
     xi, yi = pts[i, 0], pts[i, 1]
     nfan = _ordered_fan(i, tri, nb, offsets, star, fan)
@@ -225,19 +226,22 @@ def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg, which):
     -------
     status : (w,) int8
         ``FAST`` or ``SLOW``, per entry of ``which``.
-    poly_offsets : (w + 1,) int64
-    poly : (k, 2) float64
-        Vertices of the fast cells, CCW; empty rows for slow nodes.
+    room : (w + 1,) int64
+    poly : (room[w], 2) float64
+        The cell of ``which[s]``, CCW, is ``poly[room[s]:room[s] + count[s]]`` (a node's
+        room holds a vertex per triangle of its star and three more).
+    count : (w,) int64
+        0 for slow nodes.
     region_tri : (w,) int64
         One triangle of each fast node (for its region).
     """
     w = which.shape[0]
     # a cell has at most one vertex per triangle of its node plus three: each node
-    # writes into its own room of a scratch array, compacted afterwards
+    # writes into its own room of one array (placed by the caller, `place_rows`)
     room = np.zeros(w + 1, dtype=np.int64)
     for s in range(w):
         room[s + 1] = room[s] + offsets[which[s] + 1] - offsets[which[s]] + 3
-    scratch = np.empty((room[w], 2), dtype=np.float64)
+    poly = np.empty((room[w], 2), dtype=np.float64)
     status = np.full(w, SLOW, dtype=np.int8)
     counts = np.zeros(w, dtype=np.int64)
     region_tri = np.full(w, -1, dtype=np.int64)
@@ -245,26 +249,25 @@ def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg, which):
     for ch in numba.prange(nch):
         fan = np.empty(max_deg, dtype=np.int64)
         path = np.empty((max_deg + 2, 2))
-        poly = np.empty((max_deg + 3, 2))
         for s in range(ch * w // nch, (ch + 1) * w // nch):
             i = which[s]
-            c = _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly)
+            c = _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path,
+                              poly[room[s]:room[s + 1]])
             if c > 0:
                 status[s] = FAST
                 counts[s] = c
                 region_tri[s] = star[offsets[i]]
-                for k in range(c):               # not a slice assignment: see `_offsets`
-                    scratch[room[s] + k, 0] = poly[k, 0]   # of cnem.assembly._sparse_kernels
-                    scratch[room[s] + k, 1] = poly[k, 1]
-    poly_offsets = np.zeros(w + 1, dtype=np.int64)
-    for s in range(w):
-        poly_offsets[s + 1] = poly_offsets[s] + counts[s]
-    out = np.empty((poly_offsets[w], 2), dtype=np.float64)
-    for s in numba.prange(w):
-        for k in range(counts[s]):
-            out[poly_offsets[s] + k, 0] = scratch[room[s] + k, 0]
-            out[poly_offsets[s] + k, 1] = scratch[room[s] + k, 1]
-    return status, poly_offsets, out, region_tri
+    return status, room, poly, counts, region_tri
+
+
+@parallel_kernel("dst_start")
+def place_rows(src, src_start, dst, dst_start, length):
+    """Copy blocks of rows: ``dst[dst_start[b]:][:length[b]] = src[src_start[b]:][:length[b]]``
+    for every block ``b`` (``src``, ``dst``: (k, 2) float64, written in place)."""
+    for b in numba.prange(dst_start.shape[0]):
+        for k in range(length[b]):
+            dst[dst_start[b] + k, 0] = src[src_start[b] + k, 0]
+            dst[dst_start[b] + k, 1] = src[src_start[b] + k, 1]
 
 
 @parallel_kernel("vertices")

@@ -37,7 +37,7 @@ from tqdm.auto import tqdm
 from .. import config
 from .._predicates import Frame
 from ..errors import GeometryError
-from ._kernels import FAST, fast_cells
+from ._kernels import FAST, fast_cells, place_rows
 from ._mesh_kernels import close_neighbours
 from .halfplane import HalfPlaneCells
 from .topology import circumcenters, constraint_edges, triangle_neighbors, vertex_triangles
@@ -368,10 +368,9 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     resolution = 0.0 if frame is None else frame.resolution
     max_deg = int(np.diff(offsets).max())
     which = np.arange(n, dtype=np.int64) if only is None else np.unique(np.asarray(only, dtype=np.int64))
-    status, poff, poly, rtri = fast_cells(nodes, triangles, nb, offsets, star,
-                                          _shared_centres(cc, nb, nodes, resolution),
-                                          config.MERGE_TOL,
-                                          max_deg, which)
+    status, room, poly, count, rtri = fast_cells(
+        nodes, triangles, nb, offsets, star, _shared_centres(cc, nb, nodes, resolution),
+        config.MERGE_TOL, max_deg, which)
     slow_at = np.flatnonzero(status != FAST)     # positions in `which`
     pairs = sorted({(int(i), int(r)) for i in which[slow_at]
                     for r in region[star[offsets[i]:offsets[i + 1]]]})
@@ -384,13 +383,14 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
             pairs, desc="clipping cells", disable=None if progress is None else not progress,
             leave=False)]
     fast_region = region[rtri[status == FAST]]
-    return _in_place_of_slow(which, slow_at, fast_region, poff, poly, pairs, slow_polys)
+    return _in_place_of_slow(which, slow_at, fast_region, (room, poly, count), pairs, slow_polys)
 
 
-def _in_place_of_slow(which, slow_at, fast_region, poff, poly, pairs, slow_polys):
+def _in_place_of_slow(which, slow_at, fast_region, fast, pairs, slow_polys):
     """The cells sorted by node, then region: the fast cells (one per entry of ``which``,
-    none at the positions ``slow_at``) with the slow ones (``pairs``, sorted, and their
-    polygons ``slow_polys``) put where their nodes are.
+    none at the positions ``slow_at``; ``fast`` = ``(room, poly, count)`` of `fast_cells`)
+    with the slow ones (``pairs``, sorted, and their polygons ``slow_polys``) put where
+    their nodes are.
 
     Returns
     -------
@@ -409,15 +409,15 @@ def _in_place_of_slow(which, slow_at, fast_region, poff, poly, pairs, slow_polys
     cell_region = np.empty(first[-1], dtype=np.int64)
     cell_region[fast_cell] = fast_region
     cell_region[slow_cell] = np.array([p[1] for p in pairs], dtype=np.int64)
+    room, poly, count = fast
     counts = np.empty(first[-1], dtype=np.int64)
-    counts[fast_cell] = np.delete(np.diff(poff), slow_at)
+    counts[fast_cell] = np.delete(count, slow_at)
     counts[slow_cell] = np.array([len(p) for p in slow_polys], dtype=np.int64)
     offsets = np.zeros(first[-1] + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
-    pieces, last, done = [], 0, 0
-    for s, k in zip(slow_at, per_slow):       # a slow position has no fast vertices
-        pieces += [poly[last:poff[s]]] + slow_polys[done:done + k]
-        last, done = poff[s], done + k
-    pieces.append(poly[last:])
-    vertices = np.concatenate(pieces) if len(pieces) > 1 else poly
+    vertices = np.empty((offsets[-1], 2))
+    place_rows(poly, np.delete(room[:-1], slow_at), vertices, offsets[fast_cell],
+               counts[fast_cell])
+    for c, p in zip(np.flatnonzero(slow_cell), slow_polys):
+        vertices[offsets[c]:offsets[c + 1]] = p
     return np.repeat(which, per_pos), cell_region, offsets, vertices
