@@ -35,7 +35,7 @@ from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
 from .. import config
-from .._predicates import Frame
+from .._predicates import Frame, bounding_box
 from ..errors import GeometryError
 from ._kernels import FAST, fast_cells, place_rows
 from ._mesh_kernels import close_neighbours
@@ -160,7 +160,7 @@ class _ExactCells:
 
     def __init__(self, nodes, triangles, region, nb, offsets, star, cc, frame, node_tree=None):
         self.nodes, self.tri, self.region, self.frame = nodes, triangles, region, frame
-        self.extent = (nodes.min(axis=0), nodes.max(axis=0))   # every cell lies inside
+        self.extent = bounding_box(nodes)     # every cell lies inside
         self.grid = config.GRID_TOL * float(np.hypot(*(self.extent[1] - self.extent[0])))
         self.offsets, self.star, self.cc = offsets, star, cc
         edges, owner = constraint_edges(triangles, nb)
@@ -309,7 +309,8 @@ def _shared_centres(cc, nb, nodes, resolution=0.0):
     it would keep different ones (a gap between them) or a vertex twice (which
     of the quad's diagonals the triangulation took decides it, and a fan sub-cell of
     no area beside the pair changed the stabilised stiffness by 5 %)."""
-    tol = max(config.MERGE_TOL * float(np.hypot(*np.ptp(nodes, axis=0))),
+    lo, hi = bounding_box(nodes)
+    tol = max(config.MERGE_TOL * float(np.hypot(*(hi - lo))),
               config.ROUNDOFF_ULPS * resolution)
     t, u = close_neighbours(cc, nb, tol)
     if len(t) == 0:

@@ -13,6 +13,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .. import config
+from .._predicates import bounding_box
 from ._clip_kernels import CLIPPED, GROW, clip_cell
 from .topology import constraint_edges
 
@@ -38,7 +39,7 @@ class HalfPlaneCells:
                  nb: np.ndarray, *, node_tree: cKDTree | None = None) -> None:
         n = len(nodes)
         self.nodes = nodes
-        lo, hi = nodes.min(axis=0), nodes.max(axis=0)
+        lo, hi = bounding_box(nodes)
         self.extent = np.array([lo[0], lo[1], hi[0], hi[1]])
         self.tol = config.MERGE_TOL * float(np.hypot(*(hi - lo)))
         edges, owner = constraint_edges(triangles, nb)
