@@ -65,7 +65,7 @@ def constrained_delaunay(cloud: NodeCloud) -> tuple[np.ndarray, np.ndarray]:
     # went, and those change with the triangles it removes afterwards (in holes: the same
     # body moved elsewhere may triangulate a cocircular hole otherwise), and so would the
     # crack faces' node copies and every cell's first vertex
-    tri, order = canonical_order(np.ascontiguousarray(tri[inside]), len(points))
+    tri, order = canonical_order(tri[inside], len(points))
     region = region[inside][order]
     used = np.zeros(len(points), dtype=bool)
     used[tri.ravel()] = True
