@@ -215,16 +215,21 @@ def _ratios(r):
             _median(runs, "cpu") / _median(runs, "triangle_cpu"))
 
 
+def _table_head(head, *title):
+    """Print a blank line, the title lines, a blank line, the column heads and a rule."""
+    print()
+    print("\n".join(title))
+    print()
+    print(head)
+    print("-" * len(head))
+
+
 def _report_triangle(results):
     head = (f"{'geometry':>8} {'n':>5} {'points':>8} {'rep':>3} | {'triangle':>8} {'cpu':>6} | "
             f"{'triang':>6} {'split':>6} {'cells':>6} {'total':>6} {'cpu':>6} | "
             f"{'ratio':>5} {'cpu ratio':>9} | {'MB':>5}")
-    print()
-    print("cnem.discretize vs bare triangle.triangulate(points, segments, 'pQ') in the same "
-          "process (median times in s)")
-    print()
-    print(head)
-    print("-" * len(head))
+    _table_head(head, "cnem.discretize vs bare triangle.triangulate(points, segments, 'pQ') in "
+                      "the same process (median times in s)")
     for r in results:
         cn = r["cnem"]
         runs = cn["runs"]
@@ -248,16 +253,12 @@ def _report_voronoi(results):
     head = (f"{'n':>6} {'points':>9} {'rep':>3} | {'triang':>7} {'split':>7} {'cells':>7} "
             f"{'cnem':>7} | {'voronoi':>7} {'clip':>7} {'base':>7} | {'ratio':>5} | "
             f"{'cnem MB':>8} {'base MB':>8}")
-    print()
-    print("cnem.discretize vs scipy.spatial.Voronoi + shapely.clip_by_rect "
-          "(cracked unit square, median wall times in s)")
-    print("numba warmed up by one tiny discretize in each cnem child before timing "
-          "(compile time excluded)")
-    print("peak memory = high-water RSS of a fresh child per size and side "
-          "(interpreter + imports + cloud + timed runs)")
-    print()
-    print(head)
-    print("-" * len(head))
+    _table_head(head, "cnem.discretize vs scipy.spatial.Voronoi + shapely.clip_by_rect "
+                      "(cracked unit square, median wall times in s)",
+                "numba warmed up by one tiny discretize in each cnem child before timing "
+                "(compile time excluded)",
+                "peak memory = high-water RSS of a fresh child per size and side "
+                "(interpreter + imports + cloud + timed runs)")
     for r in rows:
         cn, bl = r["cnem"], r["baseline"]
         c_tot, b_tot = _median(cn["runs"], "total"), _median(bl["runs"], "total")

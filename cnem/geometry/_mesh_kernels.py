@@ -20,7 +20,7 @@ def orient_and_centroids(points, tri):
     Parameters
     ----------
     points : (n, 2) float64
-    tri : (t, 3) int64
+    tri : (t, 3) int32 or int64
         Modified: a clockwise triangle ``(a, b, c)`` becomes ``(a, c, b)``.
 
     Returns
@@ -49,7 +49,7 @@ def canonical_order(tri, n):
 
     Parameters
     ----------
-    tri : (t, 3) int64
+    tri : (t, 3) int32 or int64
     n : int
         Number of nodes (> every entry of ``tri``).
 

@@ -58,7 +58,7 @@ def constrained_delaunay(cloud: NodeCloud) -> tuple[np.ndarray, np.ndarray]:
     if len(verts) != len(points) or not np.array_equal(verts, points):
         extra = verts[len(points):]
         raise _steiner_error(points, cloud.segments, extra, cloud.domain.tolerance)
-    tri = out["triangles"].astype(np.int64)
+    tri = np.ascontiguousarray(out["triangles"])           # int32 from triangle, ours
     region = cloud.domain.region_of(orient_and_centroids(points, tri))
     inside = region >= 0
     # an order that depends on the triangles alone: `triangle` numbers them as its flips
