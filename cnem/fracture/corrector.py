@@ -22,8 +22,10 @@ path):
 The trial configuration is thrown away: its model is a local update of the
 accepted one and the accepted segments are grown from the accepted model again,
 so the models of the run are those of the explicit scheme's construction
-(`discretize` of the same cloud and cracks). The increments (a Paris-type
-``exponent`` included), load factors and cycles are those of the accepted tips.
+(`discretize` of the same cloud and cracks); the `cnem.SIFWarning` of a trial
+tip's discs is not passed on (the accepted tip's own K warns at the next
+increment). The increments (a Paris-type ``exponent`` included), load factors
+and cycles are those of the accepted tips.
 A tip whose trial segment meets the boundary, a hole or a crack, or whose trial
 tip is closed or finds no direction, takes the predictor's direction in that
 step, reported as event ``"predictor"``; a trial that cannot be built or solved
@@ -32,11 +34,12 @@ step, reported as event ``"predictor"``; a trial that cannot be built or solved
 
 from __future__ import annotations
 
+import warnings
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import CNEMError
+from ..errors import CNEMError, SIFWarning
 
 if TYPE_CHECKING:
     from typing import Any
@@ -91,7 +94,9 @@ def corrections(run: Any, state: dict, increments: np.ndarray, step: int,
             if i in fallback or not active:
                 fallback.setdefault(int(i), "its trial tip stopped growing")
                 continue
-            res, theta, _, at_bound = run.tip_kink(sol, run.cracks[c][end])
+            with warnings.catch_warnings():    # a trial tip's discs: not the user's tip
+                warnings.simplefilter("ignore", SIFWarning)
+                res, theta, _, at_bound = run.tip_kink(sol, run.cracks[c][end])
             if res[0] <= 0 or at_bound:
                 fallback[int(i)] = (f"the criterion finds no direction at its trial tip "
                                     f"(K = {res[0]:.4g}, {res[1]:.4g})")

@@ -53,14 +53,21 @@ def _ordered_fan(i, tri, nb, offsets, star, out):
 
 
 @numba.njit(cache=True)
-def _visible(i, cx, cy, pts, tri, nb, fan, nfan, max_steps):
-    """Whether the segment from node ``i`` to ``(cx, cy)`` crosses no constraint."""
+def _visible(i, cx, cy, pts, tri, nb, fan, nfan, first, max_steps):
+    """Whether the segment from node ``i`` to ``(cx, cy)`` crosses no constraint.
+
+    The sector of the fan holding the direction is looked for from ``fan[first]``
+    outwards (then its neighbours, alternately): a circumcentre lies in its own
+    triangle's sector or a neighbouring one. The sectors' cones meet only on their
+    common edges, where both give the same answer, so the order does not matter.
+    """
     xi, yi = pts[i, 0], pts[i, 1]
     t = -1
     a = -1
     b = -1
-    for m in range(nfan):
-        s = fan[m]
+    for q in range(nfan):
+        step = (q + 1) // 2
+        s = fan[(first + (step if q % 2 == 1 else -step)) % nfan]
         p = _local(tri, s, i)
         j, k = tri[s, (p + 1) % 3], tri[s, (p + 2) % 3]
         oj = _orient(xi, yi, pts[j, 0], pts[j, 1], cx, cy)
@@ -132,7 +139,8 @@ def _open_fan(i, tri, nb, offsets, star, out):
 def _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly):
     """Write the fast-path cell of node ``i`` into ``poly``; count, or -1 if not fast.
 
-    ``fan``, ``path`` and ``poly`` are scratch arrays of length ``max_deg + 2``.
+    ``fan`` and ``path`` are scratch arrays of lengths ``max_deg`` and ``max_deg + 2``;
+    ``poly`` has room for a vertex per triangle around ``i`` and three more.
     """
     xi, yi = pts[i, 0], pts[i, 1]
     nfan = _ordered_fan(i, tri, nb, offsets, star, fan)
@@ -151,12 +159,13 @@ def _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly
         npath = 1
     for m in range(nfan):
         t = fan[m]
-        p = _local(tri, t, i)
-        j, k = tri[t, (p + 1) % 3], tri[t, (p + 2) % 3]
-        ux, uy = pts[j, 0] - xi, pts[j, 1] - yi
-        vx, vy = pts[k, 0] - xi, pts[k, 1] - yi
-        angle += np.arctan2(ux * vy - uy * vx, ux * vx + uy * vy)
-        if not _visible(i, cc[t, 0], cc[t, 1], pts, tri, nb, fan, nfan, 64):
+        if not closed:                  # the angle of an open fan (a closed one has 2 pi)
+            p = _local(tri, t, i)
+            j, k = tri[t, (p + 1) % 3], tri[t, (p + 2) % 3]
+            ux, uy = pts[j, 0] - xi, pts[j, 1] - yi
+            vx, vy = pts[k, 0] - xi, pts[k, 1] - yi
+            angle += np.arctan2(ux * vy - uy * vx, ux * vx + uy * vy)
+        if not _visible(i, cc[t, 0], cc[t, 1], pts, tri, nb, fan, nfan, m, 64):
             return -1
         path[npath, 0] = cc[t, 0]
         path[npath, 1] = cc[t, 1]
@@ -217,42 +226,48 @@ def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg, which):
     -------
     status : (w,) int8
         ``FAST`` or ``SLOW``, per entry of ``which``.
-    poly_offsets : (w + 1,) int64
-    poly : (k, 2) float64
-        Vertices of the fast cells, CCW; empty rows for slow nodes.
+    room : (w + 1,) int64
+    poly : (room[w], 2) float64
+        The cell of ``which[s]``, CCW, is ``poly[room[s]:room[s] + count[s]]`` (a node's
+        room holds a vertex per triangle of its star and three more).
+    count : (w,) int64
+        0 for slow nodes.
     region_tri : (w,) int64
         One triangle of each fast node (for its region).
     """
     w = which.shape[0]
+    # a cell has at most one vertex per triangle of its node plus three: each node
+    # writes into its own room of one array (placed by the caller, `place_rows`)
+    room = np.zeros(w + 1, dtype=np.int64)
+    for s in range(w):
+        room[s + 1] = room[s] + offsets[which[s] + 1] - offsets[which[s]] + 3
+    poly = np.empty((room[w], 2), dtype=np.float64)
     status = np.full(w, SLOW, dtype=np.int8)
     counts = np.zeros(w, dtype=np.int64)
     region_tri = np.full(w, -1, dtype=np.int64)
-    for s in numba.prange(w):
-        i = which[s]
+    nch = (w + 255) // 256               # chunks of about 256 nodes share work buffers
+    for ch in numba.prange(nch):
         fan = np.empty(max_deg, dtype=np.int64)
         path = np.empty((max_deg + 2, 2))
-        poly = np.empty((max_deg + 3, 2))
-        c = _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly)
-        if c > 0:
-            status[s] = FAST
-            counts[s] = c
-            region_tri[s] = star[offsets[i]]
-    poly_offsets = np.zeros(w + 1, dtype=np.int64)
-    for s in range(w):
-        poly_offsets[s + 1] = poly_offsets[s] + counts[s]
-    out = np.empty((poly_offsets[w], 2), dtype=np.float64)
-    for s in numba.prange(w):
-        if status[s] != FAST:
-            continue
-        i = which[s]
-        fan = np.empty(max_deg, dtype=np.int64)
-        path = np.empty((max_deg + 2, 2))
-        poly = np.empty((max_deg + 3, 2))
-        c = _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly)
-        for k in range(c):               # not a slice assignment: see `_offsets` of
-            out[poly_offsets[s] + k, 0] = poly[k, 0]     # cnem.assembly._sparse_kernels
-            out[poly_offsets[s] + k, 1] = poly[k, 1]
-    return status, poly_offsets, out, region_tri
+        for s in range(ch * w // nch, (ch + 1) * w // nch):
+            i = which[s]
+            c = _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path,
+                              poly[room[s]:room[s + 1]])
+            if c > 0:
+                status[s] = FAST
+                counts[s] = c
+                region_tri[s] = star[offsets[i]]
+    return status, room, poly, counts, region_tri
+
+
+@parallel_kernel("dst_start")
+def place_rows(src, src_start, dst, dst_start, length):
+    """Copy blocks of rows: ``dst[dst_start[b]:][:length[b]] = src[src_start[b]:][:length[b]]``
+    for every block ``b`` (``src``, ``dst``: (k, 2) float64, written in place)."""
+    for b in numba.prange(dst_start.shape[0]):
+        for k in range(length[b]):
+            dst[dst_start[b] + k, 0] = src[src_start[b] + k, 0]
+            dst[dst_start[b] + k, 1] = src[src_start[b] + k, 1]
 
 
 @parallel_kernel("vertices")

@@ -35,9 +35,10 @@ from scipy.spatial import cKDTree
 from tqdm.auto import tqdm
 
 from .. import config
-from .._predicates import Frame
+from .._predicates import Frame, bounding_box
 from ..errors import GeometryError
-from ._kernels import FAST, fan_regions, fast_cells
+from ._kernels import FAST, fan_regions, fast_cells, place_rows
+from ._mesh_kernels import close_neighbours
 from .halfplane import HalfPlaneCells
 from .topology import circumcenters, constraint_edges, triangle_neighbors, vertex_triangles
 
@@ -154,11 +155,12 @@ def _splice_hole(ring, hole):
 
 
 class _ExactCells:
-    """State shared by the exact (clipping) path."""
+    """State shared by the exact (clipping) path (``node_tree``: a ``cKDTree`` of
+    ``nodes`` if already built)."""
 
-    def __init__(self, nodes, triangles, region, nb, offsets, star, cc, frame):
+    def __init__(self, nodes, triangles, region, nb, offsets, star, cc, frame, node_tree=None):
         self.nodes, self.tri, self.region, self.frame = nodes, triangles, region, frame
-        self.extent = (nodes.min(axis=0), nodes.max(axis=0))   # every cell lies inside
+        self.extent = bounding_box(nodes)     # every cell lies inside
         self.grid = config.GRID_TOL * float(np.hypot(*(self.extent[1] - self.extent[0])))
         self.offsets, self.star, self.cc = offsets, star, cc
         edges, owner = constraint_edges(triangles, nb)
@@ -166,7 +168,7 @@ class _ExactCells:
         mid = 0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]])
         self.edge_tree = cKDTree(mid)
         self.edge_half = 0.5 * np.linalg.norm(nodes[edges[:, 0]] - nodes[edges[:, 1]], axis=1).max()
-        self.node_tree = cKDTree(nodes)
+        self.node_tree = cKDTree(nodes) if node_tree is None else node_tree
         on_edge = np.column_stack([edges.ravel(), np.repeat(self.edge_region, 2)])
         self.constrained = set(map(tuple, on_edge.tolist()))
         self.circ_r = np.linalg.norm(cc - nodes[triangles[:, 0]], axis=1)
@@ -307,14 +309,13 @@ def _shared_centres(cc, nb, nodes, resolution=0.0):
     it would keep different ones (a gap between them) or a vertex twice (which
     of the quad's diagonals the triangulation took decides it, and a fan sub-cell of
     no area beside the pair changed the stabilised stiffness by 5 %)."""
-    t, k = np.nonzero(nb > np.arange(len(nb))[:, None])
-    u = nb[t, k]
-    tol = max(config.MERGE_TOL * float(np.hypot(*np.ptp(nodes, axis=0))),
+    lo, hi = bounding_box(nodes)
+    tol = max(config.MERGE_TOL * float(np.hypot(*(hi - lo))),
               config.ROUNDOFF_ULPS * resolution)
-    close = np.hypot(*(cc[t] - cc[u]).T) <= tol
-    if not close.any():
+    t, u = close_neighbours(cc, nb, tol)
+    if len(t) == 0:
         return cc
-    graph = coo_matrix((np.ones(close.sum()), (t[close], u[close])), shape=(len(cc), len(cc)))
+    graph = coo_matrix((np.ones(len(t)), (t, u)), shape=(len(cc), len(cc)))
     _, label = connected_components(graph, directed=False)
     first = np.full(label.max() + 1, len(cc))
     np.minimum.at(first, label, np.arange(len(cc)))
@@ -360,35 +361,68 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     resolution = 0.0 if frame is None else frame.resolution
     max_deg = int(np.diff(offsets).max())
     which = np.arange(n, dtype=np.int64) if only is None else np.unique(np.asarray(only, dtype=np.int64))
-    status, poff, poly, rtri = fast_cells(nodes, triangles, nb, offsets, star,
-                                          _shared_centres(cc, nb, nodes, resolution),
-                                          config.MERGE_TOL,
-                                          max_deg, which)
-    is_fast = np.flatnonzero(status == FAST)     # positions in `which`
-    fast = which[is_fast]
+    status, room, poly, count, rtri = fast_cells(
+        nodes, triangles, nb, offsets, star, _shared_centres(cc, nb, nodes, resolution),
+        config.MERGE_TOL, max_deg, which)
+    slow_at = np.flatnonzero(status != FAST)     # positions in `which`
     slow_node, slow_region, reach = fan_regions(nodes, triangles, region, offsets, star,
-                                                which[status != FAST])
-    done = np.zeros(0, dtype=np.int64)
-    half_counts, half_verts = done, np.zeros((0, 2))
+                                                which[slow_at])
+    slow_start = np.zeros(len(slow_node), dtype=np.int64)
+    slow_count = np.zeros(len(slow_node), dtype=np.int64)
+    slow_verts = np.zeros((0, 2))
     if len(slow_node):
-        half = HalfPlaneCells(nodes, triangles, region, nb)
-        done, half_counts, half_verts = half.cells(slow_node, slow_region, reach)
-    rest = np.setdiff1d(np.arange(len(slow_node)), done)
-    exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, frame) if len(rest) else None
-    exact_polys = [exact.cell(int(slow_node[k]), int(slow_region[k])) for k in tqdm(
-        rest, desc="clipping cells", disable=None if progress is None else not progress,
-        leave=False)]
-    cell_node = np.concatenate([fast, slow_node[done], slow_node[rest]])
-    cell_region = np.concatenate([region[rtri[is_fast]], slow_region[done], slow_region[rest]])
-    counts = np.concatenate([poff[is_fast + 1] - poff[is_fast], half_counts,
-                             np.array([len(p) for p in exact_polys], dtype=np.int64)])
-    verts = np.concatenate([poly, half_verts] + exact_polys)
-    order = np.lexsort((cell_region, cell_node))
-    cell_offsets = np.zeros(len(counts) + 1, dtype=np.int64)
-    np.cumsum(counts, out=cell_offsets[1:])
-    starts = cell_offsets[:-1][order]
-    new_counts = counts[order]
-    new_offsets = np.zeros(len(counts) + 1, dtype=np.int64)
-    np.cumsum(new_counts, out=new_offsets[1:])
-    gather = np.repeat(starts - new_offsets[:-1], new_counts) + np.arange(new_offsets[-1])
-    return cell_node[order], cell_region[order], new_offsets, verts[gather]
+        node_tree = cKDTree(nodes)
+        half = HalfPlaneCells(nodes, triangles, region, nb, node_tree=node_tree)
+        done, half_count, half_verts = half.cells(slow_node, slow_region, reach)
+        rest = np.setdiff1d(np.arange(len(slow_node)), done)
+        exact_polys = []
+        if len(rest):
+            exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, frame, node_tree)
+            exact_polys = [exact.cell(int(slow_node[k]), int(slow_region[k])) for k in tqdm(
+                rest, desc="clipping cells", disable=None if progress is None else not progress,
+                leave=False)]
+        slow_count[done] = half_count
+        slow_count[rest] = [len(p) for p in exact_polys]
+        blocks = slow_count[np.concatenate([done, rest])]
+        slow_start[np.concatenate([done, rest])] = np.cumsum(blocks) - blocks
+        slow_verts = np.concatenate([half_verts] + exact_polys)
+    fast_region = region[rtri[status == FAST]]
+    return _in_place_of_slow(which, slow_at, fast_region, (room, poly, count),
+                             (slow_node, slow_region, slow_start, slow_count, slow_verts))
+
+
+def _in_place_of_slow(which, slow_at, fast_region, fast, slow):
+    """The cells sorted by node, then region: the fast cells (one per entry of ``which``,
+    none at the positions ``slow_at``; ``fast`` = ``(room, poly, count)`` of `fast_cells`)
+    with the slow ones put where their nodes are (``slow`` = ``(node, region, start,
+    count, vertices)``: the (node, region) pairs, sorted, and their polygons
+    ``vertices[start[k]:][:count[k]]``).
+
+    Returns
+    -------
+    node, region, offsets, vertices
+        As `voronoi_cells`.
+    """
+    slow_node, slow_region, slow_start, slow_count, slow_verts = slow
+    per_slow = np.unique(slow_node, return_counts=True)[1]     # every slow node has a pair
+    per_pos = np.ones(len(which), dtype=np.int64)
+    per_pos[slow_at] = per_slow
+    first = np.zeros(len(which) + 1, dtype=np.int64)
+    np.cumsum(per_pos, out=first[1:])
+    fast_cell = np.delete(first[:-1], slow_at)
+    slow_cell = np.ones(first[-1], dtype=bool)
+    slow_cell[fast_cell] = False
+    cell_region = np.empty(first[-1], dtype=np.int64)
+    cell_region[fast_cell] = fast_region
+    cell_region[slow_cell] = slow_region
+    room, poly, count = fast
+    counts = np.empty(first[-1], dtype=np.int64)
+    counts[fast_cell] = np.delete(count, slow_at)
+    counts[slow_cell] = slow_count
+    offsets = np.zeros(first[-1] + 1, dtype=np.int64)
+    np.cumsum(counts, out=offsets[1:])
+    vertices = np.empty((offsets[-1], 2))
+    place_rows(poly, np.delete(room[:-1], slow_at), vertices, offsets[fast_cell],
+               counts[fast_cell])
+    place_rows(slow_verts, slow_start, vertices, offsets[:-1][slow_cell], slow_count)
+    return np.repeat(which, per_pos), cell_region, offsets, vertices

@@ -8,11 +8,10 @@ the crack and the crack faces become boundaries of the triangulation.
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 from ..errors import GeometryError
 from .pslg import BOUNDARY, CRACK
+from ._mesh_kernels import edge_triangles
 from .topology import vertex_triangles
 
 __all__ = ["split_cracks"]
@@ -26,17 +25,26 @@ def _fan_groups(v, fan, triangles, crack_neighbors):
     """
     by_other = {}
     for k, t in enumerate(fan):
-        for w in triangles[t]:
+        for w in triangles[t].tolist():
             if w != v:
-                by_other.setdefault(int(w), []).append(k)
-    links = np.array([ks for w, ks in by_other.items()
-                      if len(ks) == 2 and w not in crack_neighbors], dtype=np.int64).reshape(-1, 2)
-    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])),
-                       shape=(len(fan), len(fan)))
-    _, label = connected_components(graph, directed=False)
-    fan = np.asarray(fan)
-    groups = [fan[label == g].tolist() for g in range(label.max() + 1)]
-    return sorted(groups, key=min)
+                by_other.setdefault(w, []).append(k)
+    root = list(range(len(fan)))         # union-find over the fan: root[k] <= k
+
+    def find(k):
+        for _ in range(len(fan)):
+            if root[k] == k:
+                break
+            k = root[k]
+        return k
+
+    for w, ks in by_other.items():
+        if len(ks) == 2 and w not in crack_neighbors:
+            a, b = find(ks[0]), find(ks[1])
+            root[max(a, b)] = min(a, b)
+    groups = {}
+    for k, t in enumerate(fan):
+        groups.setdefault(find(k), []).append(t)
+    return sorted(groups.values(), key=min)
 
 
 def split_cracks(points: np.ndarray, triangles: np.ndarray, segments: np.ndarray, kind: np.ndarray
@@ -74,32 +82,23 @@ def split_cracks(points: np.ndarray, triangles: np.ndarray, segments: np.ndarray
         crack_nb.setdefault(int(b), set()).add(int(a))
     offsets, star = vertex_triangles(triangles, n0)
     new_tri = triangles.copy()
-    node_of_point = list(range(n0))
+    copies = []
     for v in split:
         fan = star[offsets[v]:offsets[v + 1]].tolist()
         for group in _fan_groups(v, fan, triangles, crack_nb[int(v)])[1:]:
-            copy = len(node_of_point)
-            node_of_point.append(int(v))
+            copy = n0 + len(copies)
+            copies.append(int(v))
             g = np.asarray(group)
             new_tri[g] = np.where(triangles[g] == v, copy, new_tri[g])
-    node_of_point = np.asarray(node_of_point, dtype=np.int64)
-    # renumber segments through the triangles that carry them
-    a = triangles[:, [1, 2, 0]].ravel()
-    b = triangles[:, [2, 0, 1]].ravel()
-    na = new_tri[:, [1, 2, 0]].ravel()
-    nb_ = new_tri[:, [2, 0, 1]].ravel()
-    key = np.minimum(a, b) * n0 + np.maximum(a, b)
-    order = np.argsort(key, kind="stable")
-    skey = np.minimum(segments[:, 0], segments[:, 1]) * n0 + np.maximum(segments[:, 0], segments[:, 1])
-    lo = np.searchsorted(key[order], skey, side="left")
-    hi = np.searchsorted(key[order], skey, side="right")
-    seg_new, kind_new = [], []
-    for s in range(len(segments)):
-        for slot in order[lo[s]:hi[s]]:
-            seg_new.append(sorted((int(na[slot]), int(nb_[slot]))))
-            kind_new.append(kind[s])
-    seg_new = np.asarray(seg_new, dtype=np.int64)
-    kind_new = np.asarray(kind_new, dtype=np.int8)
+    node_of_point = np.concatenate([np.arange(n0), np.asarray(copies, dtype=np.int64)])
+    # renumber segments through the triangles that carry them (each one's edge
+    # opposite vertex k is slot 3 t + k)
+    ptr, slot = edge_triangles(np.ascontiguousarray(triangles, dtype=np.int64), offsets, star,
+                               np.ascontiguousarray(segments, dtype=np.int64))
+    t, k = slot // 3, slot % 3
+    seg_new = np.sort(np.column_stack([new_tri[t, (k + 1) % 3], new_tri[t, (k + 2) % 3]]),
+                      axis=1).astype(np.int64)
+    kind_new = np.repeat(kind, np.diff(ptr)).astype(np.int8)
     _, first = np.unique(seg_new, axis=0, return_index=True)
     first = np.sort(first)
     opened = np.count_nonzero(kind_new[first] == CRACK)

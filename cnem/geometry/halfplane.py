@@ -17,6 +17,7 @@ from scipy.spatial import cKDTree
 
 from .. import config
 from .._parallel import work_chunks
+from .._predicates import bounding_box
 from ..spatial import RTree
 from ._clip_kernels import CLIPPED, GROW, clip_cells
 from .topology import constraint_edges
@@ -35,13 +36,15 @@ class HalfPlaneCells:
     region : (t,) int64 ndarray
     nb : (t, 3) int64 ndarray
         Neighbours with region changes cut (-1).
+    node_tree : scipy.spatial.cKDTree, optional
+        Of ``nodes``, if already built.
     """
 
     def __init__(self, nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray,
-                 nb: np.ndarray) -> None:
+                 nb: np.ndarray, *, node_tree: cKDTree | None = None) -> None:
         n = len(nodes)
         self.nodes = nodes
-        lo, hi = nodes.min(axis=0), nodes.max(axis=0)
+        lo, hi = bounding_box(nodes)
         self.extent = np.array([lo[0], lo[1], hi[0], hi[1]])
         self.tol = config.MERGE_TOL * float(np.hypot(*(hi - lo)))
         edges, owner = constraint_edges(triangles, nb)
@@ -71,7 +74,8 @@ class HalfPlaneCells:
         # the two copies of a crack-face node: their faces are coincident constraint
         # edges of one region, which the clipping does not tell apart (the cells beside a
         # crack go to the exact path)
-        twins = cKDTree(nodes).query_pairs(max(self.tol, 0.0), output_type="ndarray")
+        node_tree = cKDTree(nodes) if node_tree is None else node_tree
+        twins = node_tree.query_pairs(max(self.tol, 0.0), output_type="ndarray")
         self.safe[twins.ravel()] = False
         self.wedge[~self.safe] = 0.0
         self.node_rtree = RTree.from_points(nodes)

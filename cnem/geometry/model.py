@@ -263,7 +263,7 @@ def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:
     local = frame.to_local(nodes)
     node, cell_region, offsets, vertices = voronoi_cells(local, tri, region, progress=progress,
                                                          neighbors=neighbors[0], frame=frame)
-    vertices = frame.to_global(vertices)
+    vertices = frame.to_global(vertices, out=vertices)     # voronoi_cells' own array
     timings["cells"] = time.perf_counter() - t2
     log.info("discretize: %d nodes, %s", len(nodes),
              ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))

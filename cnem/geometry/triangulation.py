@@ -8,29 +8,13 @@ import numpy as np
 import triangle
 
 from ..errors import GeometryError
+from ._mesh_kernels import canonical_order, orient_and_centroids
 from .pslg import segment_projection
 
 if TYPE_CHECKING:
     from .cloud import NodeCloud
 
 __all__ = ["constrained_delaunay"]
-
-
-def _orient(points, tri):
-    a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
-    return (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
-
-
-def _canonical(tri, region):
-    """The triangles in an order that depends on them alone: each from its smallest
-    node on (counter-clockwise kept), sorted by their nodes. `triangle` numbers them
-    as its flips went, and those change with the triangles it removes afterwards (in
-    holes: the same body moved elsewhere may triangulate a cocircular hole otherwise),
-    and so would the crack faces' node copies and every cell's first vertex."""
-    first = np.argmin(tri, axis=1)[:, None]
-    tri = np.take_along_axis(tri, (first + np.arange(3)) % 3, axis=1)
-    order = np.lexsort((tri[:, 2], tri[:, 1], tri[:, 0]))
-    return tri[order], region[order]
 
 
 def _steiner_error(points, segments, extra, tol):
@@ -74,12 +58,15 @@ def constrained_delaunay(cloud: NodeCloud) -> tuple[np.ndarray, np.ndarray]:
     if len(verts) != len(points) or not np.array_equal(verts, points):
         extra = verts[len(points):]
         raise _steiner_error(points, cloud.segments, extra, cloud.domain.tolerance)
-    tri = out["triangles"].astype(np.int64)
-    flip = _orient(points, tri) < 0
-    tri[flip] = tri[flip][:, [0, 2, 1]]
-    centroid = points[tri].mean(axis=1)
-    region = cloud.domain.region_of(centroid)
-    tri, region = _canonical(tri[region >= 0], region[region >= 0])
+    tri = np.ascontiguousarray(out["triangles"])           # int32 from triangle, ours
+    region = cloud.domain.region_of(orient_and_centroids(points, tri))
+    inside = region >= 0
+    # an order that depends on the triangles alone: `triangle` numbers them as its flips
+    # went, and those change with the triangles it removes afterwards (in holes: the same
+    # body moved elsewhere may triangulate a cocircular hole otherwise), and so would the
+    # crack faces' node copies and every cell's first vertex
+    tri, order = canonical_order(tri[inside], len(points))
+    region = region[inside][order]
     used = np.zeros(len(points), dtype=bool)
     used[tri.ravel()] = True
     if not used.all():

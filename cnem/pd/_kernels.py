@@ -6,11 +6,18 @@ import numpy as np
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
 
 
-@numba.njit(cache=True, fastmath=True)
+@numba.njit(cache=True, fastmath=True, error_model="numpy")
 def _pmb_point(i, u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit, out):
     """The PMB force density of point ``i`` into ``out[i]`` (see `pmb_forces`); returns
-    the number of its bonds broken."""
+    the number of its bonds broken.
+
+    One square root and one division per bond: ``s / |y| = (|y| - L) / (L |y|)``, and
+    the break test ``|y| / L - 1 > limit`` as ``|y|^2 > (L (1 + limit))^2`` (every bond
+    breaks when ``limit < -1``: a stretch is at least -1).
+    """
     d = u.shape[1]
+    grow = 1.0 + limit
+    every = grow < 0.0
     broken = 0
     f0 = 0.0
     f1 = 0.0
@@ -24,13 +31,15 @@ def _pmb_point(i, u, xi, length, offsets, bond_j, stiffness, volumes, alive, lim
         y2 = 0.0
         if d == 3:
             y2 = xi[b, 2] + u[j, 2] - u[i, 2]
-        ly = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-        s = ly / length[b] - 1.0
-        if s > limit:
+        yy = y0 * y0 + y1 * y1 + y2 * y2
+        L = length[b]
+        reach = L * grow
+        if every or yy > reach * reach:
             alive[b] = 0
             broken += 1
             continue
-        g = stiffness[b] * s * volumes[j] / ly
+        ly = np.sqrt(yy)
+        g = stiffness[b] * volumes[j] * (ly - L) / (L * ly)
         f0 += g * y0
         f1 += g * y1
         f2 += g * y2
@@ -41,7 +50,7 @@ def _pmb_point(i, u, xi, length, offsets, bond_j, stiffness, volumes, alive, lim
     return broken
 
 
-@numba.njit(cache=True, parallel=True, fastmath=True)
+@numba.njit(cache=True, parallel=True, fastmath=True, error_model="numpy")
 def pmb_forces(u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit, out):
     """Bond-based PMB force density at every point, breaking bonds beyond ``limit``.
 
@@ -58,7 +67,7 @@ def pmb_forces(u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit,
     return broken.sum()
 
 
-@numba.njit(cache=True, parallel=True, fastmath=True)
+@numba.njit(cache=True, parallel=True, fastmath=True, error_model="numpy")
 def pmb_forces_rows(rows, u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit,
                     out):
     """`pmb_forces` at the points ``rows`` only (``out`` written at those rows)."""
