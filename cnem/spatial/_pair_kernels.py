@@ -145,72 +145,73 @@ def _height(spts, base, m, v, period):
 
 @numba.njit(cache=True)
 def _column_pass(col, spts, h2, tol, start, box, perm, nc, size, period, wrap_z, write, rows, lo,
-                 out, cols, sx, sy, reach, wlo, whi):
+                 out, cols, sx, sy, reach):
     """Count (``write`` False) or write the pairs of the points of column ``col``.
 
     Counting adds 1 to ``rows[x - lo]`` for both points of every pair;
     writing uses ``rows`` as cursors into ``out``. ``tol`` bounds the rounding
     of coordinates (gaps are shrunk and windows widened by it).
+
+    The neighbour columns are the outer loop and the points of ``col`` the
+    inner one: a window slides up one neighbour column at a time, so its
+    length repeats (on a lattice it is the same for every point) and the rows
+    written stay few. Each neighbour column appears once, so every row
+    receives its entries in the same order as with the points outermost.
     """
     m = _neighbours(col, start, box, nc, size, period, h2, tol, cols, sx, sy, reach)
     periodic_z = np.isfinite(period[2]) and not wrap_z
+    first, stop = start[col], start[col + 1]
     for k in range(m):
-        wlo[k] = 0
-        whi[k] = 0
-    for s in range(start[col], start[col + 1]):
-        x0, x1, x2 = spts[s, 0], spts[s, 1], spts[s, 2]
-        own = perm[s]
-        mine = rows[s - lo]
-        for k in range(m):
-            base = start[cols[k]]
-            size_k = start[cols[k] + 1] - base
-            exact = wrap_z or np.isnan(sx[k]) or np.isnan(sy[k])
-            # in the own column (k = 0) only the points after s: each pair is
-            # found from its first point
-            after = s + 1 if k == 0 else base
-            if wrap_z:
-                mine = _run(max(base, after), base + size_k, 0.0, True, s, spts, h2, sx[k],
-                            sy[k], period, write, rows, lo, out, perm, mine)
-                continue
+        base = start[cols[k]]
+        size_k = start[cols[k] + 1] - base
+        exact = wrap_z or np.isnan(sx[k]) or np.isnan(sy[k])
+        sa, sb = sx[k], sy[k]
+        if wrap_z:
+            for s in range(first, stop):
+                # in the own column (k = 0) only the points after s: each pair
+                # is found from its first point
+                qa = s + 1 if k == 0 else base
+                rows[s - lo] = _run(qa, base + size_k, 0.0, True, s, spts, h2, sa, sb, period,
+                                    write, rows, lo, out, perm, rows[s - lo])
+            continue
+        offset, end = (size_k, 3 * size_k) if periodic_z else (0, size_k)
+        va, vb = 0, 0
+        for s in range(first, stop):
+            x0, x1, x2 = spts[s, 0], spts[s, 1], spts[s, 2]
             zlo, zhi = x2 - reach[k] - tol, x2 + reach[k] + tol
+            after = s + 1 if k == 0 else base
             if periodic_z:
                 # the window slides over three copies of the column (shifted
                 # by -L, 0, +L) laid end to end; offset: where the unshifted starts
-                offset, end = size_k, 3 * size_k
-                va = wlo[k]
                 while va < end and _height(spts, base, size_k, va, period[2]) <= zlo:
                     va += 1
-                vb = max(whi[k], va)
+                vb = max(vb, va)
                 while vb < end and _height(spts, base, size_k, vb, period[2]) < zhi:
                     vb += 1
             else:
-                offset, end = 0, size_k
-                va = wlo[k]
                 while va < end and spts[base + va, 2] <= zlo:
                     va += 1
-                vb = max(whi[k], va)
+                vb = max(vb, va)
                 while vb < end and spts[base + vb, 2] < zhi:
                     vb += 1
-            wlo[k], whi[k] = va, vb
+            mine = rows[s - lo]
             if va < offset or vb > offset + size_k:
                 for copy in range(3):      # the window wraps around the period
                     qa = base + max(va - copy * size_k, 0)
                     qb = base + min(vb - copy * size_k, size_k)
                     mine = _run(max(qa, after), qb, (copy - 1) * period[2], exact, s, spts,
-                                h2, sx[k], sy[k], period, write, rows, lo, out, perm, mine)
-                continue
-            qa, qb = max(base + va - offset, after), base + vb - offset
-            if exact:
-                mine = _run(qa, qb, 0.0, True, s, spts, h2, sx[k], sy[k], period, write, rows,
-                            lo, out, perm, mine)
-                continue
-            sa, sb = sx[k], sy[k]
-            # the common case, one straight run; written out here: through _run
-            # (inlined by numba) this loop measured 1.4x slower
-            for q in range(qa, qb):
-                d2 = _shifted_dist2(spts, q, x0, x1, x2, sa, sb, 0.0)
-                mine = _record(d2, h2, write, rows, lo, out, q, own, perm, mine)
-        rows[s - lo] = mine
+                                h2, sa, sb, period, write, rows, lo, out, perm, mine)
+            elif exact:
+                mine = _run(max(base + va - offset, after), base + vb - offset, 0.0, True, s,
+                            spts, h2, sa, sb, period, write, rows, lo, out, perm, mine)
+            else:
+                # the common case, one straight run; written out here: through _run
+                # (inlined by numba) this loop measured 1.4x slower
+                own = perm[s]
+                for q in range(max(base + va - offset, after), base + vb - offset):
+                    d2 = _shifted_dist2(spts, q, x0, x1, x2, sa, sb, 0.0)
+                    mine = _record(d2, h2, write, rows, lo, out, q, own, perm, mine)
+            rows[s - lo] = mine
 
 
 @numba.njit(cache=True, inline="always")
@@ -258,11 +259,10 @@ def _scan_all(spts, h2, tol, start, box, perm, nc, size, period, wrap_z, chunk_c
     for c in numba.prange(nch):
         cols = np.empty(most, dtype=np.int64)
         sx, sy, reach = np.empty(most), np.empty(most), np.empty(most)
-        wlo, whi = np.empty(most, dtype=np.int64), np.empty(most, dtype=np.int64)
         window = rows[woff[c]:woff[c + 1]]
         for col in range(chunk_cols[c], chunk_cols[c + 1]):
             _column_pass(col, spts, h2, tol, start, box, perm, nc, size, period, wrap_z, write,
-                         window, lo[c], out, cols, sx, sy, reach, wlo, whi)
+                         window, lo[c], out, cols, sx, sy, reach)
 
 
 @numba.njit(cache=True)
