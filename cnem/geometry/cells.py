@@ -173,6 +173,11 @@ class _ExactCells:
         self.nodes, self.tri, self.region, self.frame = nodes, triangles, region, frame
         self.extent = (nodes.min(axis=0), nodes.max(axis=0))   # every cell lies inside
         self.grid = config.GRID_TOL * float(np.hypot(*(self.extent[1] - self.extent[0])))
+        # vertices nearer than this are one: ten grid steps, and the coordinates' round-off
+        # far from the origin (`_shared_centres` merges the fast path's centres alike): a
+        # cluster of vertices a few ulps apart in the caller's coordinates folds there
+        resolution = 0.0 if frame is None else frame.resolution
+        self.merge = max(10 * self.grid, config.ROUNDOFF_ULPS * resolution)
         self.offsets, self.star, self.cc = offsets, star, cc
         edges, owner = constraint_edges(triangles, nb)
         self.edges, self.edge_region = edges, region[owner]
@@ -301,12 +306,12 @@ class _ExactCells:
         if total - parts[0].area > 1e-9 * total:
             raise self._unresolved(i, r, "is not connected")
         poly = shapely.geometry.polygon.orient(parts[0], 1.0)
-        ring = _drop_repeats(np.asarray(poly.exterior.coords)[:-1], 10 * self.grid)
+        ring = _drop_repeats(np.asarray(poly.exterior.coords)[:-1], self.merge)
         for hole in poly.interiors:
             ring = _splice_hole(ring, np.asarray(hole.coords)[:-1])
             if ring is None:
                 raise self._unresolved(i, r, "has a hole")
-        return _drop_spikes(ring, 10 * self.grid)
+        return _drop_spikes(ring, self.merge)
 
     def _where(self, i):
         """Node ``i`` in the caller's coordinates, formatted."""
