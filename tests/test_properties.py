@@ -191,7 +191,16 @@ FOLDED_CELL = (([star([1.0, 1.0, 1.0, 1.0, 1.0, 0.875])], [], 0.12109375, 0),
                turned(0.0, 1e6, 2.0, 1e-6))
 
 
+#: A regular hexagon with an inclusion and a crack moved by 1e6 sizes: cells kept
+#: clusters of vertices closer than the coordinates' round-off, which folded once
+#: mapped back (shapely: "Self-intersection"); an example always run.
+ROUNDOFF_CLUSTER = (problem(star(np.ones(6)), "inclusion", 0.15625, 0.0, "kinked", 0.0, 0.0,
+                            h=0.140625, seed=0),
+                    turned(0.0, 1e6, 0.0, 1.0))
+
+
 @example(*FOLDED_CELL)
+@example(*ROUNDOFF_CLUSTER)
 @given(problems(), similarities())
 def test_cells_are_valid_polygons(problem, similarity):
     case = Mapped(problem, similarity)
