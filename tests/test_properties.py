@@ -37,15 +37,13 @@ def turned(angle, far=0.0, direction=0.0, scale=1.0):
     return rot, far * np.array([np.cos(direction), np.sin(direction)]), scale
 
 
-@st.composite
-def problems(draw):
-    """``(regions, cracks, h, seed)`` of a random valid domain about the origin (diameter ~2)."""
-    k = draw(st.integers(6, 9))
-    jitter = draw(st.lists(st.floats(-0.25, 0.25), min_size=k, max_size=k))
-    shell = star(draw(st.lists(st.floats(0.8, 1.0), min_size=k, max_size=k)), jitter)
-    inner = draw(st.sampled_from(["none", "hole", "inclusion"]))
-    r_in = draw(st.floats(0.15, 0.22))
-    ring = np.linspace(0.0, 2 * np.pi, 10, endpoint=False) + draw(st.floats(0.0, 1.0))
+def problem(shell, inner="none", r_in=0.2, phase=0.0, crack="none", theta=0.0, turn=0.0,
+            h=0.1, seed=0):
+    """``(regions, cracks, h, seed)``: outline ``shell``, optionally (``inner``: "hole" or
+    "inclusion") a 10-gon of radius ``r_in`` turned by ``phase``, optionally (``crack``:
+    "straight" or "kinked") a crack from ``0.32 (cos theta, sin theta)`` along the circle's
+    tangent, 0.24 long, its second half turned by ``turn``."""
+    ring = np.linspace(0.0, 2 * np.pi, 10, endpoint=False) + phase
     inner_ring = np.column_stack([r_in * np.cos(ring), r_in * np.sin(ring)])
     if inner == "none":
         regions = [shell]
@@ -53,11 +51,8 @@ def problems(draw):
         regions = [(shell, [inner_ring])]
     else:
         regions = [(shell, [inner_ring]), inner_ring]
-    crack = draw(st.sampled_from(["none", "straight", "kinked"]))
     cracks = []
     if crack != "none":
-        theta = draw(st.floats(0.0, 2 * np.pi))
-        turn = draw(st.floats(-0.5, 0.5)) if crack == "kinked" else 0.0
         start = 0.32 * np.array([np.cos(theta), np.sin(theta)])
         along = np.array([-np.sin(theta), np.cos(theta)])
         middle = start + 0.12 * along
@@ -65,8 +60,22 @@ def problems(draw):
                          np.sin(turn) * along[0] + np.cos(turn) * along[1]])
         end = middle + 0.12 * bend
         cracks = [np.array([start, end]) if crack == "straight" else np.array([start, middle, end])]
+    return regions, cracks, h, seed
+
+
+@st.composite
+def problems(draw):
+    """``(regions, cracks, h, seed)`` of a random valid domain about the origin (diameter ~2)."""
+    k = draw(st.integers(6, 9))
+    jitter = draw(st.lists(st.floats(-0.25, 0.25), min_size=k, max_size=k))
+    shell = star(draw(st.lists(st.floats(0.8, 1.0), min_size=k, max_size=k)), jitter)
+    inner = draw(st.sampled_from(["none", "hole", "inclusion"]))
+    r_in, phase = draw(st.floats(0.15, 0.22)), draw(st.floats(0.0, 1.0))
+    crack = draw(st.sampled_from(["none", "straight", "kinked"]))
+    theta = draw(st.floats(0.0, 2 * np.pi)) if crack != "none" else 0.0
+    turn = draw(st.floats(-0.5, 0.5)) if crack == "kinked" else 0.0
     h = draw(st.floats(0.1, 0.15))      # at most the inner ring's radius: nodes inside it
-    return regions, cracks, h, draw(st.integers(0, 2 ** 16))
+    return problem(shell, inner, r_in, phase, crack, theta, turn, h, draw(st.integers(0, 2 ** 16)))
 
 
 @st.composite
@@ -144,6 +153,22 @@ def _cell_areas(model, node=None):
     return {(int(n), int(r)): a for n, r, a in zip(owner, c.region, c.area)}
 
 
+#: Two domains where the union of the shadows that a boundary node's constraint edges cast
+#: (rays from the node through the ends of adjacent edges, one shared ray apiece) lost
+#: a whole shadow in GEOS 3.14 without a snapping grid, so the node's cell kept a piece
+#: behind a boundary edge and was refused as "not connected" (hypothesis, thorough
+#: profile, shrunk): a hexagon scaled by 1e-6, and a heptagon with a hole and a crack
+#: (whose cloud at the origin already failed) moved by 1e6 sizes and scaled by 1e-6.
+SCALED_HEXAGON = (problem(star([0.80078125, 0.875, 1.0, 0.80078125, 0.8046875, 0.8],
+                               [0.0, 0.0, -0.25, 0.25, -0.25, -0.228515625]), h=0.1, seed=6),
+                  turned(0.0, 0.0, 0.0, 1e-6))
+MOVED_HOLE_AND_CRACK = (problem(star([1.0, 1.0, 1.0, 1.0, 1.0, 0.875, 0.9375]), "hole",
+                                0.1875, 0.0, "straight", 0.0, h=0.1, seed=3),
+                        turned(0.0, 1e6, 0.0, 1e-6))
+
+
+@example(*SCALED_HEXAGON)
+@example(*MOVED_HOLE_AND_CRACK)
 @given(problems(), similarities())
 def test_cells_partition_the_domain_at_any_origin_and_scale(problem, similarity):
     case = Mapped(problem, similarity)
@@ -166,7 +191,16 @@ FOLDED_CELL = (([star([1.0, 1.0, 1.0, 1.0, 1.0, 0.875])], [], 0.12109375, 0),
                turned(0.0, 1e6, 2.0, 1e-6))
 
 
+#: A regular hexagon with an inclusion and a crack moved by 1e6 sizes: cells kept
+#: clusters of vertices closer than the coordinates' round-off, which folded once
+#: mapped back (shapely: "Self-intersection"); an example always run.
+ROUNDOFF_CLUSTER = (problem(star(np.ones(6)), "inclusion", 0.15625, 0.0, "kinked", 0.0, 0.0,
+                            h=0.140625, seed=0),
+                    turned(0.0, 1e6, 0.0, 1.0))
+
+
 @example(*FOLDED_CELL)
+@example(*ROUNDOFF_CLUSTER)
 @given(problems(), similarities())
 def test_cells_are_valid_polygons(problem, similarity):
     case = Mapped(problem, similarity)

@@ -104,17 +104,45 @@ def test_rings_apart_accepted():
     assert dom.area == pytest.approx(1 - 0.5 * 0.4 * (0.3 - 1e-3))
 
 
-def test_boundary_finer_than_the_cloud_is_named():
-    """A 5000-vertex circle at h = 0.2 (vertices 1.3e-3 apart): the message says the
-    boundary is finer than the nodes and what to do, at the node's true position
-    (on the circle; it was printed shifted by the cloud's minimum corner)."""
+def _fine_circle():
+    """A 5000-vertex circle about (3, -2) (vertices 1.3e-3 apart) and its cloud at h = 0.2."""
     t = np.linspace(0, 2 * np.pi, 5000, endpoint=False)
     centre = np.array([3.0, -2.0])
     dom = cnem.Domain(centre + np.column_stack([np.cos(t), np.sin(t)]))
-    with pytest.raises(GeometryError, match="boundary there is much finer than the node "
-                                            "cloud.*coarsen the outline") as err:
-        cnem.discretize(cnem.nodes.regular(dom, 0.2), progress=False)
-    x, y = map(float, re.search(r"at \(([^,]+), ([^)]+)\)", str(err.value)).groups())
+    return dom, centre, cnem.nodes.regular(dom, 0.2)
+
+
+def test_boundary_finer_than_the_cloud_gets_cells_that_partition_it():
+    """The 5000-vertex circle at h = 0.2 (nearest interior node 0.17 from the boundary):
+    valid cells that partition the disc. It was refused as a boundary finer than the
+    cloud, but the cause was GEOS's union of the shadows a boundary node's edges cast,
+    which dropped one of them (now snap-rounded, `cnem.geometry.cells._union`)."""
+    dom, _, cloud = _fine_circle()
+    polys = R.cell_polygons(cnem.discretize(cloud, progress=False))
+    assert shapely.is_valid(polys).all()
+    disc = dom.regions[0]
+    assert sum(p.area for p in polys) == pytest.approx(disc.area, rel=1e-12)
+    assert shapely.symmetric_difference(shapely.union_all(polys), disc).area <= 1e-12 * disc.area
+
+
+def test_boundary_finer_than_the_cloud_is_named():
+    """A cell the cloud cannot resolve at a node of that circle: the message says the
+    boundary is finer than the nodes and what to do, at the node's true position (on
+    the circle; it was printed shifted by the cloud's minimum corner)."""
+    from cnem.geometry import cells
+    from cnem.geometry.model import triangulate
+    from cnem.geometry.topology import circumcenters, vertex_triangles
+    dom, centre, cloud = _fine_circle()
+    nodes, _, tri, region, _, _, neighbors = triangulate(cloud, {})
+    local = dom.frame.to_local(nodes)
+    off, star = vertex_triangles(tri, len(local))
+    exact = cells._ExactCells(local, tri, region, neighbors[0], off, star,
+                              circumcenters(local, tri), dom.frame)
+    err = exact._unresolved(int(exact.edges[0, 0]), 0, "is not connected")
+    assert isinstance(err, GeometryError)
+    assert re.search("boundary there is much finer than the node cloud.*coarsen the outline",
+                     str(err))
+    x, y = map(float, re.search(r"at \(([^,]+), ([^)]+)\)", str(err)).groups())
     assert np.hypot(x - centre[0], y - centre[1]) == pytest.approx(1.0, abs=1e-5)
 
 

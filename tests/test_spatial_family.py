@@ -316,3 +316,25 @@ def test_cells_on_lines_match_brute(seed, dim):
     ref = R.brute_family(pts, horizon, period)
     fam = family_search(pts, horizon, period=period, method="cells")
     assert_family(fam, len(pts), ref, f"seed {seed}")
+
+
+@pytest.mark.parametrize("rel", [-1e-8, -1e-10, -1e-15, 0.0, 1e-15, 1e-10, 1e-8])
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("periodic", [False, True], ids=["open", "periodic"])
+def test_cells_near_ties_on_a_lattice(rel, dim, periodic):
+    """Lattice distances sqrt(1..10) times a spacing that is not a power of two, the
+    horizon within a relative 1e-15 .. 1e-8 of one of them (on either side), the
+    lattice far from the origin: the members method='cells' takes without a distance
+    test (lines whose extents leave the squared distance well below the horizon's)
+    and those it tests give exactly the brute-force families."""
+    m, spacing = 9, 0.1 * (1 + 1 / 3)
+    axes = [np.arange(m) * spacing] * dim
+    pts = np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, dim)
+    period = np.full(dim, m * spacing) if periodic else None
+    if not periodic:
+        pts = pts + 1e4
+    for k2 in (2, 5, 8, 9):
+        horizon = np.sqrt(k2) * spacing * (1.0 + rel)
+        ref = R.brute_family(pts, horizon, period)
+        fam = family_search(pts, horizon, period=period, method="cells")
+        assert_family(fam, len(pts), ref, f"|v|^2 = {k2}")

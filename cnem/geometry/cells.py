@@ -61,8 +61,21 @@ def _halfplane_box(box, p, q):
     return shapely.Polygon(out) if len(out) >= 3 else None
 
 
-def _shadows(origin, edges_xy, reach):
-    """Union of the shadows cast by segments seen from ``origin``, up to ``reach``.
+def _union(polygons, grid):
+    """The union of ``polygons`` snap-rounded to ``grid``.
+
+    Without a grid GEOS (3.14) can drop a whole polygon from the union of fans
+    that share their edges only nearly (rays from one node through the ends of
+    adjacent segments, computed from different angles): the shadow of a
+    boundary edge went missing and the cell kept a piece behind that edge (a
+    cell "not connected"). Snap rounding nodes the near-coincident edges.
+    """
+    return _polygonal(shapely.union_all(polygons, grid_size=grid))
+
+
+def _shadows(origin, edges_xy, reach, grid):
+    """Union of the shadows cast by segments seen from ``origin``, up to ``reach``,
+    snap-rounded to ``grid``.
 
     The shadow of segment ``a-b`` is bounded by the segment, the two rays from
     ``origin`` through its ends and an arc of radius ``2 * reach`` drawn as
@@ -86,7 +99,7 @@ def _shadows(origin, edges_xy, reach):
     ang = start[:, None] + sweep[:, None] * t[None, :]
     arc = origin + radius[:, None, None] * np.stack([np.cos(ang), np.sin(ang)], axis=2)
     ring = np.concatenate([a[:, None], b[:, None], arc, a[:, None]], axis=1)
-    return shapely.union_all(shapely.polygons(ring))
+    return _union(shapely.polygons(ring), grid)
 
 
 def _overlay(op, a, b, grid):
@@ -162,6 +175,11 @@ class _ExactCells:
         self.nodes, self.tri, self.region, self.frame = nodes, triangles, region, frame
         self.extent = bounding_box(nodes)     # every cell lies inside
         self.grid = config.GRID_TOL * float(np.hypot(*(self.extent[1] - self.extent[0])))
+        # vertices nearer than this are one: ten grid steps, and the coordinates' round-off
+        # far from the origin (`_shared_centres` merges the fast path's centres alike): a
+        # cluster of vertices a few ulps apart in the caller's coordinates folds there
+        resolution = 0.0 if frame is None else frame.resolution
+        self.merge = max(10 * self.grid, config.ROUNDOFF_ULPS * resolution)
         self.offsets, self.star, self.cc = offsets, star, cc
         edges, owner = constraint_edges(triangles, nb)
         self.edges, self.edge_region = edges, region[owner]
@@ -182,20 +200,46 @@ class _ExactCells:
         return bool((self.region[self.star[self.offsets[j]:self.offsets[j + 1]]] == r).any())
 
     def wedge(self, i, r, reach):
-        """Directions from node ``i`` into region ``r`` (None: all directions)."""
+        """Directions from node ``i`` into region ``r`` (None: all directions).
+
+        The triangles of the fan, chained counter-clockwise (a triangle's second
+        vertex is the previous one's third), make sectors; a sector's polygon is the
+        node, then the points ``2 reach`` away towards each triangle's first edge and
+        the bisector of its angle, and towards the last edge (consecutive points at
+        most 90 degrees apart: the chords stay beyond ``reach``). One polygon per
+        sector, not a union of one per triangle: those share their edges only nearly,
+        and their snap-rounded union can pinch at the node. A sector closed around the
+        node (a crack tip: the two faces' copies of the next node coincide) sees all
+        directions; several sectors (a region touching itself at the node) are united.
+        """
         if (i, r) not in self.constrained:
             return None
         x = self.nodes[i]
-        quads = []
-        for t in self.fan(i, r):
-            k = int(np.flatnonzero(self.tri[t] == i)[0])
-            u = self.nodes[self.tri[t, (k + 1) % 3]] - x
-            v = self.nodes[self.tri[t, (k + 2) % 3]] - x
-            u, v = u / np.linalg.norm(u), v / np.linalg.norm(v)
-            w = u + v
-            w /= np.linalg.norm(w)
-            quads.append([x, x + 2 * reach * u, x + 2 * reach * w, x + 2 * reach * v, x])
-        return shapely.union_all(shapely.polygons(np.asarray(quads)))
+        fan = self.fan(i, r)
+        k = np.argmax(self.tri[fan] == i, axis=1)
+        first, last = self.tri[fan, (k + 1) % 3], self.tri[fan, (k + 2) % 3]
+        u = self.nodes[first] - x
+        v = self.nodes[last] - x
+        u /= np.linalg.norm(u, axis=1)[:, None]
+        v /= np.linalg.norm(v, axis=1)[:, None]
+        w = u + v
+        w /= np.linalg.norm(w, axis=1)[:, None]
+        angle = np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], (u * v).sum(axis=1))
+        after = {int(a): t for t, a in enumerate(first)}
+        starts = np.flatnonzero(~np.isin(first, last))
+        sectors = []
+        for t in starts:
+            chain = [int(t)]
+            while len(chain) < len(fan) and int(last[chain[-1]]) in after:
+                chain.append(after[int(last[chain[-1]])])
+            if angle[chain].sum() >= 2 * np.pi * (1 - 1e-9):
+                return None
+            ends = np.column_stack([u[chain], w[chain]]).reshape(-1, 2)
+            ring = np.vstack([[x], x + 2 * reach * ends, [x + 2 * reach * v[chain[-1]]], [x]])
+            sectors.append(shapely.Polygon(ring))
+        if not sectors:
+            return None                      # the fan closes on itself: every direction
+        return sectors[0] if len(sectors) == 1 else _union(sectors, self.grid)
 
     def visible_part(self, i, r, geom, reach):
         """The part of ``geom`` that node ``i`` sees within region ``r``."""
@@ -212,7 +256,7 @@ class _ExactCells:
             return geom
         xy = self.nodes[self.edges[cand]]
         hit = shapely.intersects(shapely.linestrings(xy), hull)
-        shadow = _shadows(self.nodes[i], xy[hit], 4 * reach)
+        shadow = _shadows(self.nodes[i], xy[hit], 4 * reach, self.grid)
         return geom if shadow is None else _overlay(shapely.difference, geom, shadow, self.grid)
 
     def cell(self, i, r):
@@ -264,12 +308,12 @@ class _ExactCells:
         if total - parts[0].area > 1e-9 * total:
             raise self._unresolved(i, r, "is not connected")
         poly = shapely.geometry.polygon.orient(parts[0], 1.0)
-        ring = _drop_repeats(np.asarray(poly.exterior.coords)[:-1], 10 * self.grid)
+        ring = _drop_repeats(np.asarray(poly.exterior.coords)[:-1], self.merge)
         for hole in poly.interiors:
             ring = _splice_hole(ring, np.asarray(hole.coords)[:-1])
             if ring is None:
                 raise self._unresolved(i, r, "has a hole")
-        return _drop_spikes(ring, 10 * self.grid)
+        return _drop_spikes(ring, self.merge)
 
     def _where(self, i):
         """Node ``i`` in the caller's coordinates, formatted."""

@@ -83,14 +83,26 @@ def _box_gap(lo_c, hi_c, lo_k, hi_k, shift, tol):
     return max(lo_k + shift - hi_c - tol, lo_c - (hi_k + shift) - tol, 0.0)
 
 
+@numba.njit(cache=True, inline="always")
+def _box_far(lo_c, hi_c, lo_k, hi_k, shift, tol):
+    """Largest distance along one axis between a point of ``[lo_c, hi_c]`` and one
+    of ``[lo_k, hi_k]`` shifted by ``shift``, plus ``tol``."""
+    return max(hi_k + shift - lo_c, hi_c - (lo_k + shift)) + tol
+
+
 @numba.njit(cache=True)
-def _neighbours(c, start, box, nc, size, period, h2, tol, cols, sx, sy, reach):
+def _neighbours(c, start, box, nc, size, period, h2, tol, cols, sx, sy, reach, sure):
     """Columns that may hold partners of column ``c`` and follow it in sorted order.
 
-    Fills ``cols``, their shifts ``sx``, ``sy`` and height ``reach``; the own
-    column comes first. The reach is set by the gap between the extents of
-    the two columns' points (``box``), so that on a lattice, whose columns are
-    lines, only the members' heights are scanned. Returns their number.
+    Fills ``cols``, their shifts ``sx``, ``sy``, height ``reach`` and ``sure``;
+    the own column comes first. The reach is set by the gap between the
+    extents of the two columns' points (``box``), so that on a lattice, whose
+    columns are lines, only the members' heights are scanned. Within the
+    height ``sure`` (-1: none) of a point every candidate is a member whatever
+    its place in the column's extent: the largest distance across the two
+    extents and the coordinates' rounding (``tol``) leave the squared distance
+    below ``h2`` by a relative 1e-9, and the columns' gap keeps it above 0.
+    Returns their number.
     """
     h = np.sqrt(h2)
     r0 = int(np.ceil(h / size[0]))
@@ -100,7 +112,7 @@ def _neighbours(c, start, box, nc, size, period, h2, tol, cols, sx, sy, reach):
     cb, sb, gb = np.empty(w, np.int64), np.empty(w), np.empty(w)
     na = _axis_columns(c // nc[1], r0, nc[0], size[0], period[0], tol, ca, sa, ga)
     nb = _axis_columns(c % nc[1], r1, nc[1], size[1], period[1], tol, cb, sb, gb)
-    cols[0], sx[0], sy[0], reach[0] = c, 0.0, 0.0, np.sqrt(h2)
+    cols[0], sx[0], sy[0], reach[0], sure[0] = c, 0.0, 0.0, np.sqrt(h2), -1.0
     m = 1
     for a in range(na):
         for b in range(nb):
@@ -113,6 +125,13 @@ def _neighbours(c, start, box, nc, size, period, h2, tol, cols, sx, sy, reach):
                 g = g0 * g0 + g1 * g1
                 if g < h2:
                     cols[m], sx[m], sy[m], reach[m] = k, sa[a], sb[b], np.sqrt(h2 - g)
+                    sure[m] = -1.0
+                    if g > 0.0 and not (np.isnan(sa[a]) or np.isnan(sb[b])):
+                        f0 = _box_far(box[c, 0], box[c, 1], box[k, 0], box[k, 1], sa[a], tol)
+                        f1 = _box_far(box[c, 2], box[c, 3], box[k, 2], box[k, 3], sb[b], tol)
+                        r2 = h2 * (1.0 - 1e-9) - (f0 * f0 + f1 * f1)
+                        if r2 > 0.0:
+                            sure[m] = np.sqrt(r2) - 2.0 * tol
                     m += 1
     return m
 
@@ -143,74 +162,100 @@ def _height(spts, base, m, v, period):
     return spts[base + v - 2 * m, 2] + period
 
 
+@numba.njit(cache=True, inline="always")
+def _at(spts, base, m, v, period, periodic):
+    """Height of point ``v`` of a column of ``m`` points (of its three shifted
+    copies on a periodic third axis, see `_height`)."""
+    return _height(spts, base, m, v, period) if periodic else spts[base + v, 2]
+
+
 @numba.njit(cache=True)
 def _column_pass(col, spts, h2, tol, start, box, perm, nc, size, period, wrap_z, write, rows, lo,
-                 out, cols, sx, sy, reach, wlo, whi):
+                 dif, out, cols, sx, sy, reach, sure):
     """Count (``write`` False) or write the pairs of the points of column ``col``.
 
-    Counting adds 1 to ``rows[x - lo]`` for both points of every pair;
-    writing uses ``rows`` as cursors into ``out``. ``tol`` bounds the rounding
-    of coordinates (gaps are shrunk and windows widened by it).
+    Counting adds 1 to ``rows[x - lo]`` for both points of every pair (for a
+    run of sure members ``a <= x < b`` of a point: 1 to ``dif[a - lo]``, -1 to
+    ``dif[b - lo]``, summed later); writing uses ``rows`` as cursors into
+    ``out``. ``tol`` bounds the rounding of coordinates (gaps are shrunk and
+    windows widened by it).
+
+    The neighbour columns are the outer loop and the points of ``col`` the
+    inner one: a window slides up one neighbour column at a time, so its
+    length repeats (on a lattice it is the same for every point) and the rows
+    written stay few. Each neighbour column appears once, so every row
+    receives its entries in the same order as with the points outermost.
     """
-    m = _neighbours(col, start, box, nc, size, period, h2, tol, cols, sx, sy, reach)
+    m = _neighbours(col, start, box, nc, size, period, h2, tol, cols, sx, sy, reach, sure)
     periodic_z = np.isfinite(period[2]) and not wrap_z
+    first, stop = start[col], start[col + 1]
+    pz = period[2]
     for k in range(m):
-        wlo[k] = 0
-        whi[k] = 0
-    for s in range(start[col], start[col + 1]):
-        x0, x1, x2 = spts[s, 0], spts[s, 1], spts[s, 2]
-        own = perm[s]
-        mine = rows[s - lo]
-        for k in range(m):
-            base = start[cols[k]]
-            size_k = start[cols[k] + 1] - base
-            exact = wrap_z or np.isnan(sx[k]) or np.isnan(sy[k])
-            # in the own column (k = 0) only the points after s: each pair is
-            # found from its first point
-            after = s + 1 if k == 0 else base
-            if wrap_z:
-                mine = _run(max(base, after), base + size_k, 0.0, True, s, spts, h2, sx[k],
-                            sy[k], period, write, rows, lo, out, perm, mine)
-                continue
+        base = start[cols[k]]
+        size_k = start[cols[k] + 1] - base
+        exact = wrap_z or np.isnan(sx[k]) or np.isnan(sy[k])
+        sa, sb, rz = sx[k], sy[k], sure[k]
+        if wrap_z:
+            for s in range(first, stop):
+                # in the own column (k = 0) only the points after s: each pair
+                # is found from its first point
+                qa = s + 1 if k == 0 else base
+                rows[s - lo] = _run(qa, base + size_k, 0.0, True, s, spts, h2, sa, sb, period,
+                                    write, rows, lo, out, perm, rows[s - lo])
+            continue
+        offset, end = (size_k, 3 * size_k) if periodic_z else (0, size_k)
+        va, vb, ua, ub = 0, 0, 0, 0
+        for s in range(first, stop):
+            x0, x1, x2 = spts[s, 0], spts[s, 1], spts[s, 2]
             zlo, zhi = x2 - reach[k] - tol, x2 + reach[k] + tol
-            if periodic_z:
-                # the window slides over three copies of the column (shifted
-                # by -L, 0, +L) laid end to end; offset: where the unshifted starts
-                offset, end = size_k, 3 * size_k
-                va = wlo[k]
-                while va < end and _height(spts, base, size_k, va, period[2]) <= zlo:
-                    va += 1
-                vb = max(whi[k], va)
-                while vb < end and _height(spts, base, size_k, vb, period[2]) < zhi:
-                    vb += 1
-            else:
-                offset, end = 0, size_k
-                va = wlo[k]
-                while va < end and spts[base + va, 2] <= zlo:
-                    va += 1
-                vb = max(whi[k], va)
-                while vb < end and spts[base + vb, 2] < zhi:
-                    vb += 1
-            wlo[k], whi[k] = va, vb
+            after = s + 1 if k == 0 else base
+            # the window slides over the column (periodic: over its three copies
+            # shifted by -L, 0, +L laid end to end; offset: where the unshifted starts)
+            while va < end and _at(spts, base, size_k, va, pz, periodic_z) <= zlo:
+                va += 1
+            vb = max(vb, va)
+            while vb < end and _at(spts, base, size_k, vb, pz, periodic_z) < zhi:
+                vb += 1
+            mine = rows[s - lo]
             if va < offset or vb > offset + size_k:
                 for copy in range(3):      # the window wraps around the period
                     qa = base + max(va - copy * size_k, 0)
                     qb = base + min(vb - copy * size_k, size_k)
-                    mine = _run(max(qa, after), qb, (copy - 1) * period[2], exact, s, spts,
-                                h2, sx[k], sy[k], period, write, rows, lo, out, perm, mine)
+                    mine = _run(max(qa, after), qb, (copy - 1) * pz, exact, s, spts,
+                                h2, sa, sb, period, write, rows, lo, out, perm, mine)
+                rows[s - lo] = mine
                 continue
             qa, qb = max(base + va - offset, after), base + vb - offset
             if exact:
-                mine = _run(qa, qb, 0.0, True, s, spts, h2, sx[k], sy[k], period, write, rows,
-                            lo, out, perm, mine)
+                rows[s - lo] = _run(qa, qb, 0.0, True, s, spts, h2, sa, sb, period, write, rows,
+                                    lo, out, perm, mine)
                 continue
-            sa, sb = sx[k], sy[k]
-            # the common case, one straight run; written out here: through _run
-            # (inlined by numba) this loop measured 1.4x slower
-            for q in range(qa, qb):
+            qu, qv = qb, qb                # the sure members [qu, qv), not tested
+            if rz > 0.0:
+                while ua < end and _at(spts, base, size_k, ua, pz, periodic_z) <= x2 - rz:
+                    ua += 1
+                ub = max(ub, ua)
+                while ub < end and _at(spts, base, size_k, ub, pz, periodic_z) < x2 + rz:
+                    ub += 1
+                qu = min(max(base + ua - offset, qa), qb)
+                qv = min(max(base + ub - offset, qu), qb)
+            own = perm[s]
+            # the straight runs written out here: through _run (inlined by
+            # numba) this loop measured 1.4x slower
+            for q in range(qa, qu):
                 d2 = _shifted_dist2(spts, q, x0, x1, x2, sa, sb, 0.0)
                 mine = _record(d2, h2, write, rows, lo, out, q, own, perm, mine)
-        rows[s - lo] = mine
+            if write:
+                for q in range(qu, qv):
+                    mine = _member(rows, lo, out, q, own, perm, mine)
+            elif qv > qu:
+                mine += qv - qu
+                dif[qu - lo] += 1
+                dif[qv - lo] -= 1
+            for q in range(qv, qb):
+                d2 = _shifted_dist2(spts, q, x0, x1, x2, sa, sb, 0.0)
+                mine = _record(d2, h2, write, rows, lo, out, q, own, perm, mine)
+            rows[s - lo] = mine
 
 
 @numba.njit(cache=True, inline="always")
@@ -239,30 +284,45 @@ def _record(d2, h2, write, rows, lo, out, q, own, perm, mine):
         rows[q - lo] += hit
         return mine + hit
     if d2 < h2 and d2 > 0.0:
-        i = rows[q - lo]
-        out[i] = own
-        rows[q - lo] = i + 1
-        out[mine] = perm[q]
-        return mine + 1
+        return _member(rows, lo, out, q, own, perm, mine)
     return mine
+
+
+@numba.njit(cache=True, inline="always")
+def _member(rows, lo, out, q, own, perm, mine):
+    """Write the pair of member ``q`` and the point ``own``: ``own`` at the cursor of
+    the row of ``q``, ``q`` at ``mine``. Returns the new ``mine``."""
+    i = rows[q - lo]
+    out[i] = own
+    rows[q - lo] = i + 1
+    out[mine] = perm[q]
+    return mine + 1
 
 
 @numba.njit(cache=True, parallel=True)
 def _scan_all(spts, h2, tol, start, box, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
-              write, rows, out):
-    """One counting (``write`` False) or filling pass, a chunk of columns per thread."""
+              write, rows, dif, out):
+    """One counting (``write`` False) or filling pass, a chunk of columns per thread.
+
+    ``dif`` holds ``woff[c + 1] - woff[c] + 1`` run ends per chunk ``c`` (from
+    ``woff[c] + c``), added to ``rows`` at the end of a counting pass."""
     nch = lo.shape[0]
     h = np.sqrt(h2)
     most = (2 * int(np.ceil(h / size[0])) + 1) * (2 * int(np.ceil(h / size[1])) + 1)
     most = min(most, nc[0] * nc[1]) + 1
     for c in numba.prange(nch):
         cols = np.empty(most, dtype=np.int64)
-        sx, sy, reach = np.empty(most), np.empty(most), np.empty(most)
-        wlo, whi = np.empty(most, dtype=np.int64), np.empty(most, dtype=np.int64)
+        sx, sy, reach, sure = np.empty(most), np.empty(most), np.empty(most), np.empty(most)
         window = rows[woff[c]:woff[c + 1]]
+        runs = dif[woff[c] + c:woff[c + 1] + c + 1]
         for col in range(chunk_cols[c], chunk_cols[c + 1]):
             _column_pass(col, spts, h2, tol, start, box, perm, nc, size, period, wrap_z, write,
-                         window, lo[c], out, cols, sx, sy, reach, wlo, whi)
+                         window, lo[c], runs, out, cols, sx, sy, reach, sure)
+        if not write:
+            t = 0
+            for x in range(window.shape[0]):
+                t += runs[x]
+                window[x] += t
 
 
 @numba.njit(cache=True)
@@ -339,12 +399,13 @@ def uniform_family(pts, h, origin, size, nc, period, index_dtype_sample, nch):
     for c in range(nch):
         woff[c + 1] = woff[c] + hi[c] - lo[c]
     rows = np.zeros(woff[nch], dtype=np.int64)
+    dif = np.zeros(woff[nch] + nch, dtype=np.int64)
     dummy = np.empty(0, dtype=index_dtype_sample.dtype)
     _scan_all(spts, h2, tol, start, box, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
-              False, rows, dummy)
+              False, rows, dif, dummy)
     offsets, out = _cursors(rows, woff, lo, hi, perm, index_dtype_sample)
     _scan_all(spts, h2, tol, start, box, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
-              True, rows, out)
+              True, rows, dif, out)
     return offsets, out
 
 
