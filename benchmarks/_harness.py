@@ -284,11 +284,12 @@ class MachineLoad:
                 f"before and after, steal <= {BUSY_STEAL:.0%}")
 
     def short(self):
-        """One line for a table row or a size: load before -> after, others, steal."""
+        """One line for a table row or a size: 1-min load before -> after, the other
+        processes as cores busy on average, the steal."""
         steal, others = self.steal(), self.others_cpu_s()
         wall = max(self.after.wall - self.before.wall, 1e-9)
-        load = ("not available" if self.before.load is None else
-                f"{self.before.load[0]:.2f} -> {self.after.load[0]:.2f}")
+        loads = (self.before.load, self.after.load)
+        load = "not available" if None in loads else f"{loads[0][0]:.2f} -> {loads[1][0]:.2f}"
         return (f"load {load}, others "
                 + ("not available" if others is None else f"{others / wall:.2f} cores")
                 + ", steal " + ("not available" if steal is None else f"{steal:.1%}"))
