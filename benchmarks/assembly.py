@@ -76,7 +76,8 @@ import time
 
 import numpy as np
 
-from _harness import fmt_n, mem_available_bytes, median, peak_rss_bytes, reset_peak_rss, warm_both
+from _harness import (MachineLoad, fmt_n, load_text, mem_available_bytes, median, peak_rss_bytes,
+                      reset_peak_rss, warm_both)
 
 E, NU, PLANE = 1.0, 0.3, "strain"
 TRACTION = (1.0, 0.0)
@@ -503,13 +504,15 @@ def main(argv=None):
 
     import scipy
     import skfem
+    machine = MachineLoad()
     print(f"benchmarks/assembly.py: sizes {[fmt_n(n) for n in sizes]}, repeat {repeat}, "
           f"C-NEM cloud {args.cloud}, stabilization {args.stabilization:g}; "
           f"python {sys.version.split()[0]}, numpy {np.__version__}, scipy {scipy.__version__}, "
-          f"scikit-fem {skfem.__version__}, {os.cpu_count()} CPUs")
+          f"scikit-fem {skfem.__version__}; load average {load_text(machine.before.load)}")
     warm = warm_up()
     results = run(sizes, repeat, args.skip_fem_above, not args.no_memory_check)
     report(results, warm)
+    print("\n" + machine.stop().report())
     return results
 
 

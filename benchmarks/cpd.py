@@ -45,14 +45,13 @@ How to run
     python benchmarks/cpd.py --cases 1k 10k --repeat 5
 """
 import argparse
-import os
 import sys
 import time
 
 import numpy as np
 import scipy.sparse as sp
 
-from _harness import fmt_n, median, warm_median
+from _harness import MachineLoad, fmt_n, load_text, median, warm_median
 
 HORIZON_FACTOR = 3.015
 CASES = {"400": 20, "1k": 32, "10k": 100, "40k": 200}
@@ -207,8 +206,9 @@ def main(argv=None):
     parser.add_argument("--no-newton", action="store_true", help="skip the Newton iteration")
     args = parser.parse_args(argv)
     cases = args.cases or (QUICK_CASES if args.quick else DEFAULT_CASES)
+    machine = MachineLoad()
     print(f"benchmarks/cpd.py: cases {cases}; python {sys.version.split()[0]}, numpy "
-          f"{np.__version__}; load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
+          f"{np.__version__}; load average {load_text(machine.before.load)}")
     import cnem.pd as pd
     t0 = time.perf_counter()
     points, h = lattice(12)
@@ -220,6 +220,7 @@ def main(argv=None):
     rows = [run_case(f"{fmt_n(CASES[c] ** 2)}", CASES[c], args.repeat, not args.no_newton)
             for c in cases]
     report(rows)
+    print("\n" + machine.stop().report())
 
 
 if __name__ == "__main__":

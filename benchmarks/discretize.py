@@ -67,7 +67,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from _harness import fmt_n, load_text, peak_rss_bytes, warm_both
+from _harness import MachineLoad, fmt_n, load_text, peak_rss_bytes, warm_both
 
 CRACK = [[[0.0, 0.5], [0.5, 0.5]]]
 GEOMETRIES = {"square": None, "cracked": CRACK}
@@ -339,11 +339,13 @@ def main(argv=None):
         sizes = [5_000]
     else:
         sizes = [100_000, 1_000_000]
+    machine = MachineLoad()
     print(f"benchmarks/discretize.py: geometries {args.geometries}, sizes {sizes}, python "
-          f"{sys.version.split()[0]}, {os.cpu_count()} CPUs; load average {load_text()}")
+          f"{sys.version.split()[0]}, {os.cpu_count()} CPUs; load average "
+          f"{load_text(machine.before.load)}")
     results = run(args.geometries, sizes, args.repeat)
     report(results)
-    print(f"\nload average at the end: {load_text()}")
+    print("\n" + machine.stop().report())
     return results
 
 

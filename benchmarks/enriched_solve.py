@@ -29,7 +29,7 @@ import scipy.sparse.linalg as spla
 
 from cnem.assembly import linsolve
 
-from _harness import peak_rss_bytes
+from _harness import MachineLoad, load_text, peak_rss_bytes
 
 
 def build(nodes, radius):
@@ -47,6 +47,8 @@ def main():
     parser.add_argument("--direct", action="store_true", help="time the direct solve too")
     args = parser.parse_args()
     logging.basicConfig(level=logging.INFO, format="  %(message)s")
+    machine = MachineLoad()
+    print(f"benchmarks/enriched_solve.py: load average {load_text(machine.before.load)}")
     for nodes in args.nodes:
         start = time.perf_counter()
         A, b, nodal, modes = build(nodes, args.radius)
@@ -63,6 +65,7 @@ def main():
             print(f"  direct {time.perf_counter() - start:.1f} s, residual "
                   f"{np.linalg.norm(A @ x - b) / np.linalg.norm(b):.1e}", flush=True)
         print(f"  peak RSS {peak_rss_bytes() / 1e9:.2f} GB", flush=True)
+    print("\n" + machine.stop().report())
 
 
 if __name__ == "__main__":

@@ -103,7 +103,8 @@ from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
 
-from _harness import fmt_n, median, mem_available_bytes, peak_rss_bytes, warm_both
+from _harness import (MachineLoad, fmt_n, load_text, median, mem_available_bytes, peak_rss_bytes,
+                      warm_both)
 
 HORIZON = 3.0001
 DEFAULT_SIZES = [27_000, 125_000, 343_000, 1_000_000]
@@ -811,17 +812,18 @@ def main(argv=None):
     else:
         mem_limit = 0.8 * avail if avail else float("inf")
 
+    machine = MachineLoad()
     print(f"benchmarks/family_search.py: lattice sizes {[fmt_n(n) for n in sizes]}, "
           f"graded {fmt_n(graded_n) if not args.no_graded else 'off'}, periodic "
           f"{[fmt_n(n) for n in periodic_sizes] if not args.no_periodic else 'off'}; "
           f"python {sys.version.split()[0]}, numpy {np.__version__}, {os.cpu_count()} CPUs, "
           f"MemAvailable {avail / 2**30 if avail else float('nan'):.1f} GB, "
-          f"memory limit {mem_limit / 2**30:.1f} GB, load average {os.getloadavg()[0]:.2f}")
+          f"memory limit {mem_limit / 2**30:.1f} GB, load average {load_text(machine.before.load)}")
     with tempfile.TemporaryDirectory() as tmp:
         lattice_results = run_lattice(sizes, args, mem_limit, tmp)
     graded = None if args.no_graded else run_graded(graded_n, args, mem_limit)
     periodic = None if args.no_periodic else run_periodic(periodic_sizes, args, mem_limit)
-    print(f"load average after the measurements: {os.getloadavg()[0]:.2f}")
+    print("\n" + machine.stop().report())
 
     report_lattice(lattice_results)
     if graded:

@@ -24,6 +24,8 @@ import sys
 import tempfile
 import time
 
+from _harness import MachineLoad, load_text
+
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 
@@ -62,21 +64,25 @@ def main(argv=None):
     root = args.root.resolve()
     print(f"checkout {root}, numba threads {os.environ.get('NUMBA_NUM_THREADS', 'default')}")
     labels = ["import cnem", "cnem --help"] + ([] if args.quick else ["main demo"])
-    print(f"{'run':<24} {'wall s':>8} {'CPU s':>8} {'load before':>12} {'after':>6}  notice")
+    machine = MachineLoad()
+    print(f"load average before {load_text(machine.before.load)}")
+    print(f"{'run':<24} {'wall s':>8} {'CPU s':>8}  {'notice':<28} machine during the run")
     with tempfile.TemporaryDirectory() as tmp:
         cache = pathlib.Path(tmp) / "numba-cache"
         cache.mkdir()
         for state in ("empty cache", "warm cache"):
             for label in labels:
-                load = os.getloadavg()[0]
+                during = MachineLoad()
                 res = _run(commands(root)[label], cache, tmp, root)
                 name = f"{label}, {state}"
                 if res is None:
                     print(f"{name:<24} {'fails':>8}")
                     continue
                 wall, cpu, notice = res
-                print(f"{name:<24} {wall:8.2f} {cpu:8.2f} {load:12.2f} {os.getloadavg()[0]:6.2f}"
-                      f"  {f'compiling announced x{notice}' if notice else '-'}", flush=True)
+                notice = f"compiling announced x{notice}" if notice else "-"
+                print(f"{name:<24} {wall:8.2f} {cpu:8.2f}  {notice:<28} {during.stop().short()}",
+                      flush=True)
+    print("\n" + machine.stop().report())
 
 
 if __name__ == "__main__":

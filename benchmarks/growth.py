@@ -18,8 +18,8 @@ Every increment is done both ways on the same cloud, in one run:
 ``solve`` is the solution's ``timings["solve"]`` (condensation + the sparse solver,
 direct up to ~20k nodes, AMG-CG above), the same in both paths. The table shows the
 medians over the increments, the ratio increment / solve (target of issue 18: at most
-1.5 for the local increment) and the speed-up full / local, with the load average
-(``os.getloadavg``) before and after: the machine is shared, so absolute times move
+1.5 for the local increment) and the speed-up full / local, with the machine's load
+before and after (``_harness.MachineLoad``): the machine is shared, so absolute times move
 with it; the ratios are from one run. Timings are printed, never asserted.
 
 How to run
@@ -31,12 +31,11 @@ How to run
     python benchmarks/growth.py --sizes 20000 --steps 5
 """
 import argparse
-import os
 import time
 
 import numpy as np
 
-from _harness import fmt_n, median
+from _harness import MachineLoad, fmt_n, load_text, median
 
 W, H, A0 = 1.0, 2.0, 0.3
 
@@ -129,10 +128,11 @@ def main():
     sizes, steps = ([3_000], 2) if args.quick else (args.sizes, args.steps)
     import cnem
     cnem.discretize(cnem.nodes.irregular(domain(np.array([[0.0, 1.0], [0.3, 1.0]])), 0.1))
-    print("load average before (1, 5, 15 min):", " ".join(f"{x:.2f}" for x in os.getloadavg()))
+    machine = MachineLoad()
+    print(f"load average before {load_text(machine.before.load)}")
     for n in sizes:
         report(n, run_size(n, steps))
-    print("\nload average after (1, 5, 15 min):", " ".join(f"{x:.2f}" for x in os.getloadavg()))
+    print("\n" + machine.stop().report())
 
 
 if __name__ == "__main__":

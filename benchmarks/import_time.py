@@ -17,7 +17,7 @@ import subprocess
 import sys
 import time
 
-from _harness import median
+from _harness import MachineLoad, load_text, median
 
 STATEMENTS = {
     "python (nothing)": "pass",
@@ -56,7 +56,8 @@ def main(argv=None):
     check = "import cnem, pathlib; print(pathlib.Path(cnem.__file__).parents[1])"
     found = subprocess.run([sys.executable, "-c", check], cwd=args.source.resolve(), text=True,
                            capture_output=True, check=True).stdout.strip()
-    print(f"load average before: {os.getloadavg()[0]:.2f}; cnem from {found}")
+    machine = MachineLoad()
+    print(f"load average before {load_text(machine.before.load)}; cnem from {found}")
     base = None
     print(f"{'statement':<22} {'median s':>9} {'minus python':>13}")
     for label, statement in STATEMENTS.items():
@@ -66,7 +67,7 @@ def main(argv=None):
             continue
         base = t if base is None else base
         print(f"{label:<22} {t:9.3f} {t - base:13.3f}")
-    print(f"load average after: {os.getloadavg()[0]:.2f}")
+    print("\n" + machine.stop().report())
 
 
 if __name__ == "__main__":

@@ -37,6 +37,8 @@ import cnem
 from cnem.fracture import sif
 from cnem.spatial import family_search
 
+from _harness import MachineLoad, load_text
+
 OFFSETS = (0.0, 1e6, 1e8)
 SCALES = (1e-6, 1.0, 1e6)
 UTM = (5e6, 100.0)                  # offset, scale: a body 100 m across in UTM metres
@@ -117,6 +119,8 @@ def main(argv=None):
     parser.add_argument("--quick", action="store_true", help="CI smoke size (h = 0.06)")
     args = parser.parse_args(argv)
     h = 0.06 if args.quick else args.h
+    machine = MachineLoad()
+    print(f"benchmarks/invariance.py: load average {load_text(machine.before.load)}")
     ref_dom = _domain(1.0, 0.0)
     points = cnem.nodes.irregular(ref_dom, h, seed=1).points
     rng = np.random.default_rng(7)
@@ -135,6 +139,7 @@ def main(argv=None):
         except cnem.CNEMError as exc:
             row = f"{type(exc).__name__}: {str(exc)[:90]}"
         print(f"{o:8.0e} {s:8.0e} {row}")
+    print("\n" + machine.stop().report())
 
 
 if __name__ == "__main__":

@@ -67,7 +67,7 @@ import time
 import numpy as np
 
 import _bandwidth as stream
-from _harness import mem_available_bytes, median, peak_rss_bytes
+from _harness import MachineLoad, load_text, mem_available_bytes, median, peak_rss_bytes
 
 HORIZON_FACTOR = 3.015
 CASES = {"2d-40k": (2, 200), "2d-1M": (2, 1000), "3d-1M": (3, 100)}
@@ -222,8 +222,9 @@ def main(argv=None):
         print("benchmarks/pd_mpi.py: mpiexec not found; pip install 'cnem[mpi]'")
         return None
     cases = args.cases or (QUICK_CASES if args.quick else DEFAULT_CASES)
-    print(f"benchmarks/pd_mpi.py: cases {cases}; {os.cpu_count()} CPUs, load average "
-          f"{os.getloadavg()[0]:.2f} (other processes slow every configuration)")
+    machine = MachineLoad()
+    print(f"benchmarks/pd_mpi.py: cases {cases}; load average {load_text(machine.before.load)} "
+          "(other processes slow every configuration)")
     results, streams = {}, {}
     for case in cases:
         d, k = CASES[case]
@@ -237,23 +238,25 @@ def main(argv=None):
                     print(f"  {case} {mode} {ranks} rank(s) skipped: needs ~{need / 2**30:.1f} GB, "
                           f"{avail / 2**30:.1f} GB available")
                     continue
+                during = MachineLoad()
                 r = launch(case, mode, ranks)
                 print(f"  round {round_ + 1}: {case} {mode} {ranks} rank(s): "
                       + ("failed" if r is None else f"{r['step']:.4f} s/step") +
-                      f" (load {os.getloadavg()[0]:.2f})", flush=True)
+                      f" ({during.stop().short()})", flush=True)
                 if r is not None:
                     rounds.setdefault((mode, ranks), []).append(r)
+            during = MachineLoad()
             for procs in streams[case]:
                 streams[case][procs].append(stream.concurrent_read(MEMBERS[d] * k ** d, d, procs))
             print(f"  round {round_ + 1}: {case} read bandwidth, 1 process "
                   f"{streams[case][1][-1]:.1f} GB/s, 2 at once {streams[case][2][-1]:.1f} GB/s "
-                  f"(load {os.getloadavg()[0]:.2f})", flush=True)
+                  f"({during.stop().short()})", flush=True)
         # the run of median step time of each configuration
         results[case] = {key: sorted(rs, key=lambda r: r["step"])[(len(rs) - 1) // 2]
                          for key, rs in rounds.items()}
-    print(f"load average after: {os.getloadavg()[0]:.2f}")
     report(results)
     report_bandwidth(results, streams)
+    print("\n" + machine.stop().report())
     return results
 
 

@@ -69,14 +69,14 @@ How to run
 """
 import argparse
 import gc
-import os
 import sys
 import time
 
 import numpy as np
 
 import _bandwidth as stream
-from _harness import median, mem_available_bytes, peak_rss_bytes, reset_peak_rss, warm_median
+from _harness import (MachineLoad, load_text, median, mem_available_bytes, peak_rss_bytes,
+                      reset_peak_rss, warm_median)
 
 HORIZON_FACTOR = 3.015                  # horizon / h (delta = 3h)
 DISPLACEMENT = 1e-4                     # |u| ~ DISPLACEMENT * h
@@ -496,10 +496,11 @@ def main(argv=None):
 
     import numba
     guard = Guard(float("inf") if args.mem_limit_gb is None else args.mem_limit_gb * 2 ** 30)
+    machine = MachineLoad()
     print(f"benchmarks/pd_step.py: cases {cases}; python {sys.version.split()[0]}, numpy "
           f"{np.__version__}, numba {numba.__version__} ({numba.config.NUMBA_NUM_THREADS} "
-          f"threads max), {os.cpu_count()} CPUs; memory guard: {guard.describe()}; load "
-          f"average {os.getloadavg()[0]:.2f} (other processes on the machine slow the "
+          f"threads max); memory guard: {guard.describe()}; load "
+          f"average {load_text(machine.before.load)} (other processes on the machine slow the "
           "multi-threaded kernel)")
     problem_class = make_problem_class()
     print("  warm-up", flush=True)
@@ -509,6 +510,7 @@ def main(argv=None):
         results.append(run_case(name, args, guard, problem_class))
         gc.collect()
     report(results, warm, numba.threading_layer())
+    print("\n" + machine.stop().report())
     return results
 
 

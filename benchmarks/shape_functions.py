@@ -87,12 +87,13 @@ Checks (printed): on the smallest model of each domain, the rows of Phi sum to 1
 no negative value; the one- and two-thread results are identical (fingerprint); every
 query point lies in a scipy simplex and the barycentric weights reproduce the points.
 
-The load average is printed before and after the run and at the start of each size: the
-machine is shared, so compare the rates measured within one run.  Without a CGAL column the
-CGAL rates recorded in an earlier issue are printed instead; the plain numba Watson kernel's
-recorded rates are printed next to our square-domain rates.  Target (issue): >= 2 M points/s
-with two threads on 100k nodes for 1M random (unsorted) query points, sorting included,
-Sibson values only.  Timings are printed, never asserted.
+The machine's load (``_harness.MachineLoad``: load average, other processes' CPU time, CPU
+steal) is printed before and after the run and over each size: the machine is shared, so
+compare the rates measured within one run. Without a CGAL column the CGAL rates recorded in
+an earlier issue are printed instead; the plain numba Watson kernel's recorded rates are
+printed next to our square-domain rates. Target (issue): >= 2 M points/s with two threads
+on 100k nodes for 1M random (unsorted) query points, sorting included, Sibson values only.
+Timings are printed, never asserted.
 
 How to run
 ----------
@@ -117,7 +118,8 @@ from concurrent.futures.process import BrokenProcessPool
 import numpy as np
 
 import _cgal
-from _harness import fmt_n, median, peak_rss_bytes, reset_peak_rss, warm_both
+from _harness import (MachineLoad, fmt_n, load_text, median, peak_rss_bytes, reset_peak_rss,
+                      warm_both)
 
 DOMAINS = {
     "square": dict(),
@@ -328,8 +330,8 @@ def run(domains, sizes, queries, repeat, budget, tmp, cgal):
                   end="", flush=True)
             phi_file = os.path.join(tmp, f"phi_{domain}_{n}.npz")
             with_cgal = "exe" in cgal and domain == "square"
-            r = dict(domain=domain, n=n, queries=queries, repeat=repeat, smallest=i == 0,
-                     load=os.getloadavg())
+            during = MachineLoad()
+            r = dict(domain=domain, n=n, queries=queries, repeat=repeat, smallest=i == 0)
             base = dict(domain=domain, n=n, queries=queries, repeat=repeat)
             print(" cnem 1T", end="", flush=True)
             r["1T"] = in_child("cnem", dict(base, threads=1, save=nodes_file, check=i == 0,
@@ -361,6 +363,7 @@ def run(domains, sizes, queries, repeat, budget, tmp, cgal):
                 if "error" in r[key]:
                     print(f" ({key} FAILED)", end="", flush=True)
             print(" done", flush=True)
+            r["load"] = during.stop().short()
             results.append(r)
     return results
 
@@ -480,8 +483,7 @@ def report(results, args):
                          f"{cg['rss'] / 2**20:.0f} MB (whole driver)")
         else:
             parts.append(f"CGAL: {cg.get('skipped') or cg.get('error')}")
-        parts.append("load average at the start (1, 5, 15 min): "
-                     + " ".join(f"{x:.2f}" for x in r["load"]))
+        parts.append("machine during the size: " + r["load"])
         print(f"  {r['domain']} {fmt_n(r['n'])}: " + ";\n    ".join(parts))
 
     print()
@@ -656,12 +658,13 @@ def main(argv=None):
               + ")")
     else:
         print(cgal["skipped"])
-    print("load average before (1, 5, 15 min):", " ".join(f"{x:.2f}" for x in os.getloadavg()),
-          f"on {os.cpu_count()} CPUs (a shared machine: compare rates within one run)")
+    machine = MachineLoad()
+    print(f"load average before {load_text(machine.before.load)} (a shared machine: compare "
+          "rates within one run)")
     with tempfile.TemporaryDirectory() as tmp:
         results = run(domains, sizes, queries, repeat, args.baseline_budget, tmp, cgal)
     report(results, args)
-    print("\nload average after (1, 5, 15 min):", " ".join(f"{x:.2f}" for x in os.getloadavg()))
+    print("\n" + machine.stop().report())
     return results
 
 
