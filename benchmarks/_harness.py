@@ -229,8 +229,9 @@ class MachineLoad:
     Examples
     --------
     >>> machine = MachineLoad()
-    >>> text = machine.stop().report()
-    >>> "load average before" in text and "verdict" in text
+    >>> text = machine.stop().report()          # the benchmark runs in between
+    >>> text.splitlines()[-1].split(":")[0].strip() in ("machine busy", "machine quiet",
+    ...                                                 "verdict not available")
     True
     """
 
