@@ -117,6 +117,7 @@ CPU_FIELDS = ("user", "nice", "system", "idle", "iowait", "irq", "softirq", "ste
 CPU_BUSY = ("user", "nice", "system", "irq", "softirq")
 #: Thresholds of `MachineLoad`'s verdict: 1-min load above this many per core, steal share.
 BUSY_LOAD_PER_CORE = 0.5
+BUSY_OTHERS_CORES = 0.25
 BUSY_STEAL = 0.05
 
 
@@ -209,11 +210,12 @@ class MachineLoad:
       average; it counts the kernel's interrupt work and tick rounding (~1 tick per CPU);
     - the CPU steal: the share of all CPU time (the 8 fields of `CPU_FIELDS`) that the
       hypervisor gave to other virtual machines;
-    - a verdict: "machine busy" when the 1-min load average before or after is above
-      `BUSY_LOAD_PER_CORE` x cores, or the steal above `BUSY_STEAL` (5 %); "machine
-      quiet" otherwise.  The load after includes the benchmark itself, so a multi-threaded
-      run of a minute or more can be "busy" by its own doing: the other-processes line
-      tells which it was.
+    - a verdict: "machine busy" when the 1-min load average before is above
+      `BUSY_LOAD_PER_CORE` x cores, other processes kept more than `BUSY_OTHERS_CORES`
+      cores busy on average during the run, or the steal was above `BUSY_STEAL` (5 %);
+      "machine quiet" otherwise.  The load after is printed but not judged: it counts
+      the benchmark's own threads, so a multi-threaded run of a minute would be "busy"
+      by its own doing.
 
     Off Linux, what cannot be measured reads "not available".
 
@@ -266,9 +268,14 @@ class MachineLoad:
     def busy_reasons(self):
         """Why the machine counts as busy (see the class docstring); [] if quiet."""
         limit = BUSY_LOAD_PER_CORE * self.cores
-        reasons = [f"1-min load {when} {s.load[0]:.2f} > {limit:.2f}"
-                   for when, s in (("before", self.before), ("after", self.after))
-                   if s.load is not None and s.load[0] > limit]
+        load = self.before.load
+        reasons = [f"1-min load before {load[0]:.2f} > {limit:.2f}"] \
+            if load is not None and load[0] > limit else []
+        others = self.others_cpu_s()
+        if others is not None:
+            cores = others / max(self.after.wall - self.before.wall, 1e-9)
+            if cores > BUSY_OTHERS_CORES:
+                reasons.append(f"other processes {cores:.2f} cores > {BUSY_OTHERS_CORES}")
         steal = self.steal()
         if steal is not None and steal > BUSY_STEAL:
             reasons.append(f"steal {steal:.1%} > {BUSY_STEAL:.0%}")
@@ -281,8 +288,9 @@ class MachineLoad:
         reasons = self.busy_reasons()
         if reasons:
             return "machine busy: " + ", ".join(reasons)
-        return (f"machine quiet: 1-min load <= {BUSY_LOAD_PER_CORE} x {self.cores} cores "
-                f"before and after, steal <= {BUSY_STEAL:.0%}")
+        return (f"machine quiet: 1-min load before <= {BUSY_LOAD_PER_CORE} x {self.cores} "
+                f"cores, other processes <= {BUSY_OTHERS_CORES} cores, steal <= "
+                f"{BUSY_STEAL:.0%}")
 
     def short(self):
         """One line for a table row or a size: 1-min load before -> after, the other

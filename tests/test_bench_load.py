@@ -59,24 +59,36 @@ def test_steal_and_other_processes_between_two_looks():
     m.stop()
     assert m.steal() == 100 / 2000
     assert m.others_cpu_s() == (1800 - 1000) / 100
-    assert m.busy_reasons() == []
-    assert m.verdict().startswith("machine quiet")
+    # 8 CPU s of others over 10 s: 0.80 cores > 0.25; steal 5 % is not above 5 %
+    assert m.busy_reasons() == ["other processes 0.80 cores > 0.25"]
     text = m.report()
     assert "8.0 CPU s = 0.80 cores on average" in text and "5.0% of all CPU time" in text
 
 
-def test_busy_by_load_or_by_steal():
-    # load after 1.5 > 0.5 x 2 cores; steal 200 of 1000 ticks = 20 % > 5 %
-    m = _harness.MachineLoad(samples(BEFORE, after((1.5, 0.3, 0.2), 1500, 300, 5200, 230,
-                                                   (300, 40, 7, 3))),
+def test_busy_by_load_before_by_others_or_by_steal():
+    # load before 1.5 > 0.5 x 2 cores; others: 1800 busy - 0 own ticks = 18 s over 10 s
+    # = 1.80 cores; steal 200 of 1000 ticks = 20 % > 5 %
+    busy_before = BEFORE._replace(load=(1.5, 0.3, 0.2))
+    m = _harness.MachineLoad(samples(busy_before, after((0.2, 0.3, 0.2), 2500, 500, 5200, 230,
+                                                        (300, 40, 7, 3))),
                              cores=2, ticks_per_s=100).stop()
-    assert m.steal() == 0.2
-    reasons = m.busy_reasons()
-    assert len(reasons) == 2 and "after 1.50 > 1.00" in reasons[0] and "steal" in reasons[1]
+    assert m.steal() == 200 / 2200
+    assert m.busy_reasons() == ["1-min load before 1.50 > 1.00",
+                                "other processes 1.80 cores > 0.25", "steal 9.1% > 5%"]
     assert m.verdict().startswith("machine busy")
-    # the same load on 4 cores is below the threshold 2.0: only the steal remains
-    m4 = _harness.MachineLoad(samples(BEFORE, m.after), cores=4, ticks_per_s=100).stop()
+    # the same load on 4 cores is below the threshold 2.0; a high load after is not judged
+    m4 = _harness.MachineLoad(samples(busy_before, m.after._replace(load=(9.0, 9.0, 9.0))),
+                              cores=4, ticks_per_s=100).stop()
     assert [r for r in m4.busy_reasons() if "load" in r] == []
+
+
+def test_quiet_machine():
+    # others: 1000 busy ticks - 1000 own = 0; no steal; load before 0.3 <= 1.0
+    m = _harness.MachineLoad(samples(BEFORE, after((1.9, 0.3, 0.2), 1800, 400, 5100, 30,
+                                                   (1200, 100, 47, 3))),
+                             cores=2, ticks_per_s=100).stop()
+    assert m.others_cpu_s() == 0.0 and m.steal() == 0.0
+    assert m.busy_reasons() == [] and m.verdict().startswith("machine quiet")
 
 
 def test_own_time_above_the_machines_busy_time_is_clamped_to_zero():
