@@ -309,7 +309,7 @@ def check_points(name: str, value: object, *, dims: tuple = (2, 3),
     if arr.ndim != 2 or arr.shape[1] not in dims:
         raise error(f"{name}: expected an {' or '.join(f'(n, {d})' for d in dims)} array of "
                     f"coordinates, received shape {arr.shape}; pass one row per point")
-    top = float(np.abs(arr).max(initial=0.0))
+    top = max(-float(arr.min(initial=0.0)), float(arr.max(initial=0.0)))   # max |x|, no temporary
     if top >= config.COORDINATE_LIMIT:
         raise error(f"{name}: expected coordinates below {config.COORDINATE_LIMIT:g} in "
                     f"magnitude (their squared distances must not overflow float64), received "

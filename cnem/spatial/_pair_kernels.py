@@ -37,11 +37,38 @@ from ._family_kernels import _dist2, _shifted_dist2, bin_points
 
 
 @numba.njit(cache=True, parallel=True)
-def _sort_heights(pts, perm, start):
-    """Sort every column of ``perm`` by the third coordinate, in place."""
-    for c in numba.prange(start.shape[0] - 1):
-        seg = perm[start[c]:start[c + 1]]
-        seg[:] = seg[np.argsort(pts[seg, 2], kind="mergesort")]
+def _sort_columns(pts, perm, start):
+    """Sort every column of ``perm`` by the third coordinate, in place (stable; a
+    column already in order, as a structured grid's often is, is left as it is),
+    and gather the sorted points and the extents of each column.
+
+    Returns
+    -------
+    spts : (n, 3) float64, ``pts[perm]``
+    box : (ncol, 4) float64, extents ``xmin, xmax, ymin, ymax`` of the points of
+        each column (``inf, -inf`` for an empty column)
+    """
+    ncol = start.shape[0] - 1
+    spts = np.empty_like(pts)
+    box = np.empty((ncol, 4))
+    for c in numba.prange(ncol):
+        a, b = start[c], start[c + 1]
+        ordered = True
+        for s in range(a + 1, b):
+            if pts[perm[s], 2] < pts[perm[s - 1], 2]:
+                ordered = False
+                break
+        if not ordered:
+            seg = perm[a:b]
+            seg[:] = seg[np.argsort(pts[seg, 2], kind="mergesort")]
+        x0, x1, y0, y1 = np.inf, -np.inf, np.inf, -np.inf
+        for s in range(a, b):
+            i = perm[s]
+            x, y = pts[i, 0], pts[i, 1]
+            spts[s, 0], spts[s, 1], spts[s, 2] = x, y, pts[i, 2]
+            x0, x1, y0, y1 = min(x0, x), max(x1, x), min(y0, y), max(y1, y)
+        box[c, 0], box[c, 1], box[c, 2], box[c, 3] = x0, x1, y0, y1
+    return spts, box
 
 
 @numba.njit(cache=True)
@@ -134,21 +161,6 @@ def _neighbours(c, start, box, nc, size, period, h2, tol, cols, sx, sy, reach, s
                             sure[m] = np.sqrt(r2) - 2.0 * tol
                     m += 1
     return m
-
-
-@numba.njit(cache=True, parallel=True)
-def _column_boxes(spts, start):
-    """(ncol, 4) extents ``xmin, xmax, ymin, ymax`` of the points of each column
-    (``inf, -inf`` for an empty column)."""
-    ncol = start.shape[0] - 1
-    box = np.empty((ncol, 4))
-    for c in numba.prange(ncol):
-        x0, x1, y0, y1 = np.inf, -np.inf, np.inf, -np.inf
-        for s in range(start[c], start[c + 1]):
-            x0, x1 = min(x0, spts[s, 0]), max(x1, spts[s, 0])
-            y0, y1 = min(y0, spts[s, 1]), max(y1, spts[s, 1])
-        box[c, 0], box[c, 1], box[c, 2], box[c, 3] = x0, x1, y0, y1
-    return box
 
 
 @numba.njit(cache=True, inline="always")
@@ -382,16 +394,10 @@ def uniform_family(pts, h, origin, size, nc, period, index_dtype_sample, nch):
     offsets : (n + 1,) int64
     indices : (offsets[-1],) index_dtype_sample.dtype
     """
-    n = pts.shape[0]
     perm, start = bin_points(pts, origin, size, nc, period)     # nc[2] = 1: columns
-    _sort_heights(pts, perm, start)
-    spts = np.empty_like(pts)
-    for s in numba.prange(n):
-        for k in range(3):
-            spts[s, k] = pts[perm[s], k]
-    box = _column_boxes(spts, start)
+    spts, box = _sort_columns(pts, perm, start)
     h2 = h * h
-    tol = 1e-9 * h + 1e-12 * (np.abs(pts).max() + h)
+    tol = 1e-9 * h + 1e-12 * (max(-pts.min(), pts.max()) + h)     # max |x|, no temporary
     wrap_z = np.isfinite(period[2]) and 2.0 * h * (1.0 + 1e-9) >= period[2]
     nch = max(1, min(nch, nc[0] * nc[1]))
     chunk_cols, lo, hi = _chunks(start, nc, size, h, period, nch)

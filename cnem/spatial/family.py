@@ -221,8 +221,10 @@ def family_search(points: ArrayLike, horizon: float | ArrayLike, *,
                              f"(or raise cnem.config.BRUTE_LIMIT)")
         offsets, indices = K.brute_family(xs, hs, ps)
     elif method == "cells":
-        pts3 = np.zeros((n, 3))
-        pts3[:, :d] = xs
+        pts3 = xs                          # the scaled copy: the kernels only read it
+        if d == 2:
+            pts3 = np.zeros((n, 3))
+            pts3[:, :d] = xs
         per3 = np.full(3, np.inf)
         per3[:d] = ps
         offsets, indices = _cells(pts3, hs, per3, d)
