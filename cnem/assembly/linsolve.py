@@ -20,6 +20,7 @@ import scipy.sparse.linalg as spla
 
 from .. import config
 from ..errors import InputError, SolveError, check_choice
+from .multigrid import hierarchy, parallel_operator
 
 if TYPE_CHECKING:
     from typing import Callable, Literal
@@ -299,20 +300,16 @@ def _schwarz_cg(A, b, nodal, modes, tol):
     rel : float
     its : int
     """
-    import pyamg
     A = A.tocsr()
     inner, outer = np.flatnonzero(nodal), np.flatnonzero(~nodal)
-    ml = pyamg.smoothed_aggregation_solver(A[inner][:, inner].tocsr(),
-                                           B=None if modes is None else modes[inner],
-                                           symmetry="symmetric")
-    amg = ml.aspreconditioner()
+    amg = hierarchy(A[inner][:, inner], None if modes is None else modes[inner])
     lu = spla.splu(A[outer][:, outer].tocsc(), permc_spec="MMD_AT_PLUS_A",
                    diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
 
     def apply(r):
         r = np.asarray(r, dtype=float).reshape(-1)
         z = np.empty(len(r))
-        z[inner] = amg @ r[inner]
+        z[inner] = amg.matvec(r[inner])
         z[outer] = lu.solve(r[outer])
         return z
 
@@ -328,7 +325,8 @@ def _cg(A, b, M, tol, label):
     def count(_):
         its[0] += 1
 
-    x, _ = spla.cg(A, b, rtol=tol, atol=0.0, maxiter=config.CG_MAXITER, M=M, callback=count)
+    x, _ = spla.cg(parallel_operator(A), b, rtol=tol, atol=0.0, maxiter=config.CG_MAXITER, M=M,
+                   callback=count)
     norm = np.linalg.norm(b)
     rel = np.linalg.norm(b - A @ x) / norm if norm > 0 else 0.0
     log.info("pyamg (%s) + CG: %d iterations, relative residual %.2e", label, its[0], rel)
@@ -337,7 +335,7 @@ def _cg(A, b, M, tol, label):
 
 def _amg_cg(A, b, P, modes, tol, smooth_with_A=False):
     """CG on ``A x = b`` preconditioned by a smoothed-aggregation V-cycle built on ``P``
-    (its finest level smoothed with ``A`` if ``smooth_with_A``).
+    (its finest level smoothed with ``A`` if ``smooth_with_A``), `cnem.assembly.multigrid`.
 
     Returns
     -------
@@ -347,13 +345,9 @@ def _amg_cg(A, b, P, modes, tol, smooth_with_A=False):
     its : int
         Iterations.
     """
-    import pyamg
     same = P is A
     A = A.tocsr()
-    ml = pyamg.smoothed_aggregation_solver(A if same else P.tocsr(), B=modes,
-                                           symmetry="symmetric")
-    if smooth_with_A and not same:
-        ml.levels[0].A = A                  # the smoothers take the level's matrix per call
+    cycle = hierarchy(A if same else P, modes, top=A if smooth_with_A and not same else None)
     label = "hierarchy on " + ("the matrix" if same else "the preconditioner matrix" +
                                (", smoothing with the matrix" if smooth_with_A else ""))
-    return _cg(A, b, ml.aspreconditioner(), tol, label)
+    return _cg(A, b, cycle, tol, label)
