@@ -32,7 +32,8 @@ nothing), so nothing cached by one run serves the next:
   ``asm(linear_elasticity(...), basis)``;
 * ``solve`` (both sides, the very same function): ``skfem.condense`` of the clamped dofs, the
   rigid-body modes of the free dofs, and ``cnem.assembly.linsolve.solve_spd`` (direct up to
-  2.5M non-zeros, pyamg smoothed aggregation + CG above, tol 1e-10; on the C-NEM side the
+  2.5M non-zeros, smoothed aggregation + CG above: pyamg's set-up, cnem's parallel V-cycle,
+  ``cnem.assembly.multigrid``; tol 1e-10; on the C-NEM side the
   hierarchy is built on the P1 stiffness of the same nodes on the model's triangles,
   ``Elasticity.solver_options``, whose assembly is timed in the stage).  This is what
   ``Elasticity.solve`` does after K and the load, minus its rigid-motion check
@@ -40,8 +41,9 @@ nothing), so nothing cached by one run serves the next:
 * ``total``: the sum of a run's stages (load vectors and dof selection are not timed).
 
 Both sides first run once on a tiny problem, C-NEM twice (serial and parallel copies of
-its kernels, ``_harness.warm_both``; numba JIT compile and first-call costs excluded from
-the timings).  Peak memory is the process's high-water resident set size
+its kernels, ``_harness.warm_both``), with the iterative solver forced
+(``cnem.config.DIRECT_NNZ = 0``) so that its kernels compile too: numba JIT compile and
+first-call costs are excluded from the timings.  Peak memory is the process's high-water resident set size
 (``VmHWM``), reset (``echo 5 > /proc/self/clear_refs``) before every stage: the peak of a
 side is the largest of its stages', i.e. the whole process (interpreter, imports, the node
 cloud or mesh, whatever is live) while that side runs; the details give every stage's.
@@ -56,8 +58,9 @@ it does not fit (``--no-memory-check`` disables it).
 Checks (printed): no rigid motion left free, K symmetric, and the mean x-displacement of the
 nodes on x = 1 on both sides (they should agree to about the discretisation error).
 
-Targets (issue): C-NEM (B~ + K) within 3x of scikit-fem (basis + K) at 100k nodes; the 1M
-C-NEM total under 120 s with peak memory under 8 GB.  Printed, never asserted.
+Targets: C-NEM (B~ + K) within 3x of scikit-fem (basis + K) at 100k nodes (issue 2); the
+1M C-NEM total at most 60 s with peak memory at most 6 GB (issue 22).  Printed, never
+asserted.
 
 How to run
 ----------
@@ -87,7 +90,7 @@ DEFAULT_SIZES = [10_000, 100_000, 1_000_000]
 QUICK_SIZES = [2_000, 10_000]
 
 TARGET_RATIO_AT, TARGET_RATIO = 100_000, 3.0
-TARGET_1M, TARGET_1M_SECONDS, TARGET_1M_GB = 1_000_000, 120.0, 8.0
+TARGET_1M, TARGET_1M_SECONDS, TARGET_1M_GB = 1_000_000, 60.0, 6.0
 
 # memory guard (see memory_need): bytes per node and base RSS when no size has been run yet
 # on a side; safety margin; growth exponent of the sparse direct solver's memory; memory of
@@ -249,12 +252,19 @@ PIPELINES = {"cnem": cnem_pipeline, "skfem": skfem_pipeline}
 
 
 def warm_up():
-    """Both sides once on a tiny problem (numba compile, first calls); seconds per side."""
-    times = {}
-    for side in PIPELINES:
-        t0 = time.perf_counter()
-        warm_both(lambda: measure(side, WARMUP_SIDE ** 2, 1))
-        times[side] = time.perf_counter() - t0
+    """Both sides once on a tiny problem, the iterative solver forced (numba compile, first
+    calls); seconds per side."""
+    from cnem import config
+
+    times, direct_nnz = {}, config.DIRECT_NNZ
+    config.DIRECT_NNZ = 0
+    try:
+        for side in PIPELINES:
+            t0 = time.perf_counter()
+            warm_both(lambda: measure(side, WARMUP_SIDE ** 2, 1))
+            times[side] = time.perf_counter() - t0
+    finally:
+        config.DIRECT_NNZ = direct_nnz
     return times
 
 
@@ -456,10 +466,10 @@ def report(results, warm):
     cn = by_n[TARGET_1M]["cnem"] if TARGET_1M in by_n else None
     if ok(cn):
         t, mem = total_time(cn), gb(cn)
-        print(f"  {fmt_n(TARGET_1M)} C-NEM total under {TARGET_1M_SECONDS:g} s: {t:.1f} s -> "
-              f"{verdict(t < TARGET_1M_SECONDS)}")
-        print(f"  {fmt_n(TARGET_1M)} C-NEM peak memory under {TARGET_1M_GB:g} GB: {mem:.2f} GB "
-              f"-> {verdict(mem < TARGET_1M_GB)}")
+        print(f"  {fmt_n(TARGET_1M)} C-NEM total at most {TARGET_1M_SECONDS:g} s: {t:.1f} s -> "
+              f"{verdict(t <= TARGET_1M_SECONDS)}")
+        print(f"  {fmt_n(TARGET_1M)} C-NEM peak memory at most {TARGET_1M_GB:g} GB: {mem:.2f} GB "
+              f"-> {verdict(mem <= TARGET_1M_GB)}")
     else:
         why = (cn.get("skipped") or cn.get("error")) if cn else "not run"
         print(f"  {fmt_n(TARGET_1M)} C-NEM total under {TARGET_1M_SECONDS:g} s and peak memory "
