@@ -168,12 +168,14 @@ def _splice_hole(ring, hole):
 
 
 class _ExactCells:
-    """State shared by the exact (clipping) path (``node_tree``: a ``cKDTree`` of
-    ``nodes`` if already built)."""
+    """State shared by the exact (clipping) path (``extent``: the nodes' bounding box,
+    ``constraints``: `constraint_edges` of ``triangles`` and ``nb``, if already known)."""
 
-    def __init__(self, nodes, triangles, region, nb, offsets, star, cc, frame, node_tree=None):
+    def __init__(self, nodes, triangles, region, nb, offsets, star, cc, frame, extent=None,
+                 constraints=None):
         self.nodes, self.tri, self.region, self.frame = nodes, triangles, region, frame
-        self.extent = bounding_box(nodes)     # every cell lies inside
+        # every cell lies inside the nodes' box
+        self.extent = bounding_box(nodes) if extent is None else extent
         self.grid = config.GRID_TOL * float(np.hypot(*(self.extent[1] - self.extent[0])))
         # vertices nearer than this are one: ten grid steps, and the coordinates' round-off
         # far from the origin (`_shared_centres` merges the fast path's centres alike): a
@@ -181,12 +183,12 @@ class _ExactCells:
         resolution = 0.0 if frame is None else frame.resolution
         self.merge = max(10 * self.grid, config.ROUNDOFF_ULPS * resolution)
         self.offsets, self.star, self.cc = offsets, star, cc
-        edges, owner = constraint_edges(triangles, nb)
+        edges, owner = constraint_edges(triangles, nb) if constraints is None else constraints
         self.edges, self.edge_region = edges, region[owner]
         mid = 0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]])
         self.edge_tree = cKDTree(mid)
         self.edge_half = 0.5 * np.linalg.norm(nodes[edges[:, 0]] - nodes[edges[:, 1]], axis=1).max()
-        self.node_tree = cKDTree(nodes) if node_tree is None else node_tree
+        self.node_tree = cKDTree(nodes)
         on_edge = np.column_stack([edges.ravel(), np.repeat(self.edge_region, 2)])
         self.constrained = set(map(tuple, on_edge.tolist()))
         self.circ_r = np.linalg.norm(cc - nodes[triangles[:, 0]], axis=1)
@@ -343,7 +345,7 @@ class _ExactCells:
                              "node: refine it there")
 
 
-def _shared_centres(cc, nb, nodes, resolution=0.0):
+def _shared_centres(cc, nb, extent, resolution=0.0):
     """The circumcentres with those of neighbouring triangles closer than
     ``MERGE_TOL`` times the nodes' extent, or than ``ROUNDOFF_ULPS`` times the
     coordinates' round-off ``resolution``, made one (the lowest triangle's): the two
@@ -353,7 +355,7 @@ def _shared_centres(cc, nb, nodes, resolution=0.0):
     it would keep different ones (a gap between them) or a vertex twice (which
     of the quad's diagonals the triangulation took decides it, and a fan sub-cell of
     no area beside the pair changed the stabilised stiffness by 5 %)."""
-    lo, hi = bounding_box(nodes)
+    lo, hi = extent
     tol = max(config.MERGE_TOL * float(np.hypot(*(hi - lo))),
               config.ROUNDOFF_ULPS * resolution)
     t, u = close_neighbours(cc, nb, tol)
@@ -405,8 +407,9 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     resolution = 0.0 if frame is None else frame.resolution
     max_deg = int(np.diff(offsets).max())
     which = np.arange(n, dtype=np.int64) if only is None else np.unique(np.asarray(only, dtype=np.int64))
+    extent = bounding_box(nodes)
     status, room, poly, count, rtri = fast_cells(
-        nodes, triangles, nb, offsets, star, _shared_centres(cc, nb, nodes, resolution),
+        nodes, triangles, nb, offsets, star, _shared_centres(cc, nb, extent, resolution),
         config.MERGE_TOL, max_deg, which)
     slow_at = np.flatnonzero(status != FAST)     # positions in `which`
     slow_node, slow_region, reach = fan_regions(nodes, triangles, region, offsets, star,
@@ -415,13 +418,15 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     slow_count = np.zeros(len(slow_node), dtype=np.int64)
     slow_verts = np.zeros((0, 2))
     if len(slow_node):
-        node_tree = cKDTree(nodes)
-        half = HalfPlaneCells(nodes, triangles, region, nb, node_tree=node_tree)
+        constraints = constraint_edges(triangles, nb)
+        half = HalfPlaneCells(nodes, triangles, region, nb, extent=extent,
+                              constraints=constraints)
         done, half_count, half_verts = half.cells(slow_node, slow_region, reach)
         rest = np.setdiff1d(np.arange(len(slow_node)), done)
         exact_polys = []
         if len(rest):
-            exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, frame, node_tree)
+            exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, frame, extent,
+                                constraints)
             exact_polys = [exact.cell(int(slow_node[k]), int(slow_region[k])) for k in tqdm(
                 rest, desc="clipping cells", disable=None if progress is None else not progress,
                 leave=False)]
