@@ -37,12 +37,17 @@ from tqdm.auto import tqdm
 from .. import config
 from .._predicates import Frame, bounding_box
 from ..errors import GeometryError
+from ..spatial import RTree
 from ._kernels import FAST, fan_regions, fast_cells, place_rows
 from ._mesh_kernels import close_neighbours
 from .halfplane import HalfPlaneCells
 from .topology import circumcenters, constraint_edges, triangle_neighbors, vertex_triangles
 
 __all__ = ["voronoi_cells"]
+
+#: Relative margin by which the exact path's node distances must clear a search radius
+#: for a tree over some of the nodes to stand in for a k-d tree of all (`_ExactCells.near`).
+_BAND = 1e-9
 
 
 def _halfplane_box(box, p, q):
@@ -188,10 +193,63 @@ class _ExactCells:
         mid = 0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]])
         self.edge_tree = cKDTree(mid)
         self.edge_half = 0.5 * np.linalg.norm(nodes[edges[:, 0]] - nodes[edges[:, 1]], axis=1).max()
-        self.node_tree = cKDTree(nodes)
         on_edge = np.column_stack([edges.ravel(), np.repeat(self.edge_region, 2)])
         self.constrained = set(map(tuple, on_edge.tolist()))
-        self.circ_r = np.linalg.norm(cc - nodes[triangles[:, 0]], axis=1)
+        self.boxes = {}          # (node, region) -> its cell's box and reach (`box`)
+        self.near_tree = None    # over the nodes near the cells `expected` (`expect`)
+        self.expected = set()
+        self.node_tree = None    # a cKDTree of all the nodes, built if needed (`near`)
+
+    def box(self, i, r):
+        """The box ``(xmin, ymin, xmax, ymax)`` the cell of node ``i`` in region ``r`` is
+        clipped from (its triangles' circumcircles, within the extent) and its reach (the
+        distance from the node to the box's farthest corner)."""
+        if (i, r) not in self.boxes:
+            x = self.nodes[i]
+            fan = self.fan(i, r)
+            circ_r = np.linalg.norm(self.cc[fan] - self.nodes[self.tri[fan, 0]], axis=1)
+            lo = (self.cc[fan] - circ_r[:, None]).min(axis=0)
+            hi = (self.cc[fan] + circ_r[:, None]).max(axis=0)
+            lo = np.clip(np.minimum(lo, x), self.extent[0], self.extent[1])
+            hi = np.clip(np.maximum(hi, x), self.extent[0], self.extent[1])
+            corners = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
+            reach = float(np.max(np.linalg.norm(corners - x, axis=1)))
+            self.boxes[i, r] = (lo[0], lo[1], hi[0], hi[1]), reach
+        return self.boxes[i, r]
+
+    def expect(self, node, region):
+        """Prepare the cells of the (node, region) pairs: their boxes, and an R-tree over
+        the nodes within twice their reach (`near`), not over all the nodes."""
+        self.expected = set(zip(np.asarray(node).tolist(), np.asarray(region).tolist()))
+        reach = np.array([self.box(int(i), int(r))[1] for i, r in zip(node, region)])
+        x = self.nodes[node]
+        pad = (2.0 * reach * (1.0 + 4 * _BAND))[:, None] + 8.0 * np.spacing(np.abs(x))
+        self.near_tree = RTree.from_points_in(self.nodes, x - pad, x + pad, self.extent)
+
+    def near(self, i, r, radius, tiny):
+        """The nodes within ``radius`` of node ``i`` and their distances, in the order a
+        k-d tree of all the nodes gives them, as far as it matters: sorted by distance,
+        their order is unique but among those within ``tiny`` (the cell skips them all).
+
+        From `near_tree` (`expect`) when every distance lies clear of ``radius`` (by a
+        relative ``_BAND``: the test ``d <= radius`` cannot round otherwise) and those
+        beyond ``tiny`` are distinct; else from a k-d tree of all the nodes.
+        """
+        x = self.nodes[i]
+        if (i, r) in self.expected:
+            tree, subset = self.near_tree
+            _, idx = tree.query_ball(x[None], radius * (1.0 + 2 * _BAND))
+            near = subset[idx]
+            dist = np.linalg.norm(self.nodes[near] - x, axis=1)
+            inside = dist <= radius * (1.0 - _BAND)
+            far = dist[inside & (dist > tiny)]
+            if not (~inside & (dist <= radius * (1.0 + _BAND))).any() and \
+                    len(np.unique(far)) == len(far):
+                return near[inside], dist[inside]
+        if self.node_tree is None:
+            self.node_tree = cKDTree(self.nodes)
+        near = np.asarray(self.node_tree.query_ball_point(x, radius), dtype=np.int64)
+        return near, np.linalg.norm(self.nodes[near] - x, axis=1)
 
     def fan(self, i, r):
         ts = self.star[self.offsets[i]:self.offsets[i + 1]]
@@ -263,20 +321,12 @@ class _ExactCells:
 
     def cell(self, i, r):
         x = self.nodes[i]
-        fan = self.fan(i, r)
-        lo = (self.cc[fan] - self.circ_r[fan, None]).min(axis=0)
-        hi = (self.cc[fan] + self.circ_r[fan, None]).max(axis=0)
-        lo = np.clip(np.minimum(lo, x), self.extent[0], self.extent[1])
-        hi = np.clip(np.maximum(hi, x), self.extent[0], self.extent[1])
-        box = (lo[0], lo[1], hi[0], hi[1])
-        reach = float(np.max(np.linalg.norm(np.array([[lo[0], lo[1]], [hi[0], lo[1]],
-                                                       [hi[0], hi[1]], [lo[0], hi[1]]]) - x, axis=1)))
+        box, reach = self.box(i, r)
         cell = self.visible_part(i, r, shapely.set_precision(shapely.box(*box), self.grid), reach)
-        near = np.asarray(self.node_tree.query_ball_point(x, 2 * reach), dtype=np.int64)
-        dist = np.linalg.norm(self.nodes[near] - x, axis=1)
+        tiny = config.MERGE_TOL * reach
+        near, dist = self.near(i, r, 2 * reach, tiny)
         order = np.argsort(dist)
         near, dist = near[order], dist[order]
-        tiny = config.MERGE_TOL * reach
         corners = shapely.get_coordinates(cell)
         radius = np.linalg.norm(corners - x, axis=1).max(initial=0.0)
         for j, dj in zip(near, dist):
@@ -370,8 +420,8 @@ def _shared_centres(cc, nb, extent, resolution=0.0):
 
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
                   progress: bool | None = None, neighbors: np.ndarray | None = None,
-                  only: ArrayLike | None = None, frame: Frame | None = None
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                  only: ArrayLike | None = None, frame: Frame | None = None,
+                  star: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Constrained Voronoi cells of a (crack-split) constrained Delaunay triangulation.
 
     Parameters
@@ -391,6 +441,8 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     frame : cnem._predicates.Frame, optional
         The local frame ``nodes`` are given in (`cnem._predicates.local_frame`): the
         points and lengths named in errors are mapped back to the caller's coordinates.
+    star : (offsets, indices), optional
+        `vertex_triangles` of the triangles, if already known.
 
     Returns
     -------
@@ -402,7 +454,9 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     """
     n = len(nodes)
     nb = triangle_neighbors(triangles, region) if neighbors is None else neighbors
-    offsets, star = vertex_triangles(triangles, n)
+    if star is None or len(star[0]) != n + 1:
+        star = vertex_triangles(triangles, n)
+    offsets, star = star
     cc = circumcenters(nodes, triangles)
     resolution = 0.0 if frame is None else frame.resolution
     max_deg = int(np.diff(offsets).max())
@@ -427,6 +481,7 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
         if len(rest):
             exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, frame, extent,
                                 constraints)
+            exact.expect(slow_node[rest], slow_region[rest])
             exact_polys = [exact.cell(int(slow_node[k]), int(slow_region[k])) for k in tqdm(
                 rest, desc="clipping cells", disable=None if progress is None else not progress,
                 leave=False)]
@@ -458,7 +513,9 @@ def _in_place_of_slow(which, slow_at, fast_region, fast, slow):
     per_pos[slow_at] = per_slow
     first = np.zeros(len(which) + 1, dtype=np.int64)
     np.cumsum(per_pos, out=first[1:])
-    fast_cell = np.delete(first[:-1], slow_at)
+    fast_at = np.ones(len(which), dtype=bool)
+    fast_at[slow_at] = False
+    fast_cell = first[:-1][fast_at]
     slow_cell = np.ones(first[-1], dtype=bool)
     slow_cell[fast_cell] = False
     cell_region = np.empty(first[-1], dtype=np.int64)
@@ -466,12 +523,12 @@ def _in_place_of_slow(which, slow_at, fast_region, fast, slow):
     cell_region[slow_cell] = slow_region
     room, poly, count = fast
     counts = np.empty(first[-1], dtype=np.int64)
-    counts[fast_cell] = np.delete(count, slow_at)
+    counts[fast_cell] = count[fast_at]
     counts[slow_cell] = slow_count
     offsets = np.zeros(first[-1] + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
     vertices = np.empty((offsets[-1], 2))
-    place_rows(poly, np.delete(room[:-1], slow_at), vertices, offsets[fast_cell],
+    place_rows(poly, room[:-1][fast_at], vertices, offsets[fast_cell],
                counts[fast_cell])
     place_rows(slow_verts, slow_start, vertices, offsets[:-1][slow_cell], slow_count)
     return np.repeat(which, per_pos), cell_region, offsets, vertices

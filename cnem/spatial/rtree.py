@@ -130,10 +130,10 @@ class RTree:
         subset : (m,) int64 ndarray
             Increasing.
         """
-        pts = as_points(points)
-        if pts.shape[1] != 2:
-            raise SpatialError(f"from_points_in: expected 2-D points, received dimension "
-                               f"{pts.shape[1]}; use RTree.from_points")
+        pts = np.ascontiguousarray(points, dtype=np.float64)  # those in the tree are checked
+        if pts.ndim != 2 or pts.shape[1] != 2:
+            raise SpatialError(f"from_points_in: expected (n, 2) points, received shape "
+                               f"{pts.shape}; use RTree.from_points in 3-D")
         g = max(1, int(np.sqrt(len(pts)) / 2))
         width = extent[1] - extent[0]
         inv = np.divide(g, width, out=np.zeros(2), where=width > 0)
