@@ -421,7 +421,8 @@ def _shared_centres(cc, nb, extent, resolution=0.0):
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
                   progress: bool | None = None, neighbors: np.ndarray | None = None,
                   only: ArrayLike | None = None, frame: Frame | None = None,
-                  star: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                  star: tuple[np.ndarray, np.ndarray] | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Constrained Voronoi cells of a (crack-split) constrained Delaunay triangulation.
 
     Parameters

@@ -315,8 +315,10 @@ def grid_cover(points, lo, hi, origin, inv, g):
     """
     count = np.zeros((g + 1, g + 1), dtype=np.int64)
     for b in range(lo.shape[0]):
-        i0, i1 = _grid_cell(lo[b, 0], origin[0], inv[0], g), _grid_cell(hi[b, 0], origin[0], inv[0], g)
-        j0, j1 = _grid_cell(lo[b, 1], origin[1], inv[1], g), _grid_cell(hi[b, 1], origin[1], inv[1], g)
+        i0 = _grid_cell(lo[b, 0], origin[0], inv[0], g)
+        i1 = _grid_cell(hi[b, 0], origin[0], inv[0], g)
+        j0 = _grid_cell(lo[b, 1], origin[1], inv[1], g)
+        j1 = _grid_cell(hi[b, 1], origin[1], inv[1], g)
         count[i0, j0] += 1
         count[i1 + 1, j0] -= 1
         count[i0, j1 + 1] -= 1
