@@ -463,9 +463,14 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     max_deg = int(np.diff(offsets).max())
     which = np.arange(n, dtype=np.int64) if only is None else np.unique(np.asarray(only, dtype=np.int64))
     extent = bounding_box(nodes)
-    status, room, poly, count, rtri = fast_cells(
+    # a cell has at most one vertex per triangle of its node plus three: each node
+    # writes into its own room of one array (placed by `_in_place_of_slow`)
+    room = np.zeros(len(which) + 1, dtype=np.int64)
+    np.cumsum(offsets[which + 1] - offsets[which] + 3, out=room[1:])
+    poly = np.empty((room[-1], 2))
+    status, count, rtri = fast_cells(
         nodes, triangles, nb, offsets, star, _shared_centres(cc, nb, extent, resolution),
-        config.MERGE_TOL, max_deg, which)
+        config.MERGE_TOL, max_deg, which, room, poly)
     slow_at = np.flatnonzero(status != FAST)     # positions in `which`
     slow_node, slow_region, reach = fan_regions(nodes, triangles, region, offsets, star,
                                                 which[slow_at])
@@ -528,8 +533,16 @@ def _in_place_of_slow(which, slow_at, fast_region, fast, slow):
     counts[slow_cell] = slow_count
     offsets = np.zeros(first[-1] + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
-    vertices = np.empty((offsets[-1], 2))
-    place_rows(poly, room[:-1][fast_at], vertices, offsets[fast_cell],
-               counts[fast_cell])
+    src, dst = room[:-1][fast_at], offsets[fast_cell]
+    if offsets[-1] <= len(poly) and (dst <= src).all():
+        # the fast cells moved down inside `poly` (in order: no block overwrites one not
+        # yet read), then `poly` shortened, not copied to new memory (first touching its
+        # 100 MB at 1M nodes cost several times the copy)
+        place_rows.serial(poly, src, poly, dst, counts[fast_cell])
+        poly.resize((offsets[-1], 2), refcheck=False)   # no view of it: the array is ours
+        vertices = poly
+    else:
+        vertices = np.empty((offsets[-1], 2))
+        place_rows(poly, src, vertices, dst, counts[fast_cell])
     place_rows(slow_verts, slow_start, vertices, offsets[:-1][slow_cell], slow_count)
     return np.repeat(which, per_pos), cell_region, offsets, vertices
