@@ -4,10 +4,11 @@ Between the fast path (a cell made of circumcentres) and the exact shapely
 clipping: a node whose circumcentres lie behind a constraint but whose
 neighbourhood is convex (a thin strip, a coarse boundary with nodes
 crowded inside) gets its cell by clipping a box with half-planes, a few
-microseconds instead of milliseconds. All such cells are done at once: one
-R-tree query per leaf of the tree gathers the candidate nodes of the leaf's cells (and
-through them their constraint edges), one kernel (`._clip_kernels.clip_cells`) clips them all, and
-the cells whose box was too small are retried together in boxes twice as large.
+microseconds instead of milliseconds. All such cells are done at once: an R-tree
+over the nodes near them only (`cnem.spatial.RTree.from_points_in`), one query per leaf
+of it gathers the candidate nodes of the leaf's cells (and through them their
+constraint edges), one kernel (`._clip_kernels.clip_cells`) clips them all, and the
+cells whose box was too small are retried together in boxes twice as large.
 """
 
 from __future__ import annotations
