@@ -170,3 +170,38 @@ def test_cells_far_from_constraints_are_voronoi_cells(built):
         scale = radius[i]
         assert got.symmetric_difference(expected).area <= 1e-12 * scale**2, f"node {i}"
         assert shapely.hausdorff_distance(got, expected) <= 1e-12 * scale, f"node {i}"
+
+
+# --------------------------------------------------------------- exact path's search
+def test_the_exact_path_finds_the_k_d_tree_s_nodes_in_its_order(name):
+    """The exact path looks its cells' neighbours up in a tree over the nodes near them
+    (`_ExactCells.expect`), or in a k-d tree of all nodes when that one's order could
+    matter: the same nodes as that k-d tree, and sorted by distance the same order
+    beyond the merge tolerance (among those nearer the cell skips them all)."""
+    from scipy.spatial import cKDTree
+
+    from cnem.geometry import cells
+    from cnem.geometry._kernels import fan_regions
+    from cnem.geometry.model import triangulate
+    from cnem.geometry.topology import circumcenters
+
+    dom, cloud = cases.case(name)
+    nodes, _, tri, region, _, _, neighbors = triangulate(cloud, {})
+    local = dom.frame.to_local(nodes)
+    off, star = neighbors[2]
+    exact = cells._ExactCells(local, tri, region, neighbors[0], off, star,
+                              circumcenters(local, tri), dom.frame)
+    node, reg, _ = fan_regions(local, tri, region, off, star, np.arange(0, len(local), 7))
+    exact.expect(node, reg)
+    full = cKDTree(local)
+    for i, r in zip(node.tolist(), reg.tolist()):
+        _, reach = exact.box(i, r)
+        tiny = cells.config.MERGE_TOL * reach
+        got, dist = exact.near(i, r, 2 * reach, tiny)
+        want = np.asarray(full.query_ball_point(local[i], 2 * reach), dtype=np.int64)
+        assert np.array_equal(np.sort(got), np.sort(want))
+        np.testing.assert_array_equal(dist, np.linalg.norm(local[got] - local[i], axis=1))
+        w_dist = np.linalg.norm(local[want] - local[i], axis=1)
+        a, b = got[np.argsort(dist)], want[np.argsort(w_dist)]
+        beyond = np.sort(dist) > tiny
+        assert np.array_equal(a[beyond], b[beyond])

@@ -137,6 +137,32 @@ def test_contains_and_region_of():
     assert dom2.region_of([[0.5, 0.5]]).tolist() == [1]
 
 
+@pytest.mark.parametrize("regions", [
+    [UNIT],
+    [UNIT, [[1, 0], [2, 0], [2, 1], [1, 1]]],
+    [[[1e6, 1e6], [1e6 + 1e-6, 1e6], [1e6 + 1e-6, 1e6 + 3e-6], [1e6, 1e6 + 3e-6]]],
+    [[[0, 0], [1, 0], [1, 1], [0.5, 1], [0, 1]]],            # a rectangle with a vertex mid-edge
+    [[[0, 0], [1, 0], [1, 1], [0, 0.5]]],                     # not a rectangle
+])
+def test_region_of_a_rectangle_is_shapely_s_closed_polygon_test(regions):
+    """Rectangular regions are tested by coordinate comparisons: the same answers as
+    shapely's ``intersects_xy`` of the closed polygons, inside, outside and exactly on
+    the sides and corners, the lowest region winning on an interface."""
+    dom = cnem.Domain(regions)
+    x0, y0, x1, y1 = dom.bounds
+    rng = np.random.default_rng(0)
+    pts = np.array([x0, y0]) + np.array([x1 - x0, y1 - y0]) * rng.uniform(-0.1, 1.1, (20000, 2))
+    corners = np.array([[x, y] for p in dom.regions for x, y in p.exterior.coords])
+    pts[:100, 0] = x0
+    pts[100:200, 1] = y1
+    pts[200:300, 0] = corners[rng.integers(len(corners), size=100), 0]
+    pts[300:300 + len(corners)] = corners
+    want = np.full(len(pts), -1)
+    for i in reversed(range(len(dom.regions))):
+        want[shapely.intersects_xy(dom.regions[i], pts[:, 0], pts[:, 1])] = i
+    np.testing.assert_array_equal(dom.region_of(pts), want)
+
+
 def test_region_of_with_holes_and_rings():
     dom = geometry.annulus([1.0, 1.5, 2.0], spacing=0.05)
     theta = 0.3

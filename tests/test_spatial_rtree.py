@@ -565,3 +565,38 @@ def test_far_from_the_origin_in_bounded_time(offset, extent, n):
                           timeout=240)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "True"
+
+
+@pytest.mark.parametrize("kind", ["uniform", "clustered", "far", "line"])
+def test_a_tree_over_the_points_near_boxes_finds_every_point_in_them(kind):
+    """`RTree.from_points_in` keeps only the points in the coarse grid cells the boxes
+    meet, but a query by any box holding one of them finds exactly the points inside
+    it (brute force), on the boxes' sides too; far from the boxes it holds few points."""
+    rng = np.random.default_rng(3)
+    n = 20000
+    pts = rng.random((n, 2))
+    if kind == "clustered":
+        pts[: n // 2] = 0.5 + 1e-4 * rng.standard_normal((n // 2, 2))
+    elif kind == "far":
+        pts = 1e6 + 1e-3 * pts
+    elif kind == "line":
+        pts[:, 1] = 0.25
+    lo0, hi0 = pts.min(axis=0), pts.max(axis=0)
+    span = hi0 - lo0
+    centre = pts[rng.integers(n, size=40)]
+    half = span * rng.uniform(0.0, 0.05, (40, 1))
+    lo, hi = centre - half, centre + half
+    lo[0], hi[0] = pts[1], pts[1]                        # a box of one point
+    lo[1], hi[1] = lo0, lo0 + 0.3 * span                 # a corner of the extent
+    tree, subset = RTree.from_points_in(pts, lo, hi, (lo0, hi0))
+    assert (np.diff(subset) > 0).all()
+    grow = 0.01 * span
+    for qlo, qhi in ((lo, hi), (lo - grow, hi + grow)):
+        ptr, idx = tree.query(qlo, qhi)
+        for b in range(len(lo)):
+            want = np.flatnonzero(((pts >= lo[b]) & (pts <= hi[b])).all(axis=1))
+            got = subset[idx[ptr[b]:ptr[b + 1]]]
+            inside = ((pts[got] >= lo[b]) & (pts[got] <= hi[b])).all(axis=1)
+            assert np.array_equal(np.sort(got[inside]), want)
+    if kind == "uniform":
+        assert len(subset) < n / 2

@@ -203,7 +203,7 @@ def _fast_polygon(i, pts, tri, nb, offsets, star, cc, merge_tol, fan, path, poly
 
 
 @parallel_kernel("which")
-def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg, which):
+def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg, which, room, poly):
     """Cells of the nodes ``which`` that need no clipping.
 
     Parameters
@@ -221,27 +221,24 @@ def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg, which):
         Largest vertex degree.
     which : (w,) int64
         The nodes whose cells are wanted.
+    room : (w + 1,) int64
+        Where each node's room starts in ``poly``: a vertex per triangle of its star
+        and three more.
+    poly : (room[w], 2) float64
+        Written: the cell of ``which[s]``, CCW, is ``poly[room[s]:room[s] + count[s]]``
+        (allocated by the caller: NumPy's large arrays get huge pages, numba's do not,
+        and first touching 4 KiB pages cost more than the writes).
 
     Returns
     -------
     status : (w,) int8
         ``FAST`` or ``SLOW``, per entry of ``which``.
-    room : (w + 1,) int64
-    poly : (room[w], 2) float64
-        The cell of ``which[s]``, CCW, is ``poly[room[s]:room[s] + count[s]]`` (a node's
-        room holds a vertex per triangle of its star and three more).
     count : (w,) int64
         0 for slow nodes.
     region_tri : (w,) int64
         One triangle of each fast node (for its region).
     """
     w = which.shape[0]
-    # a cell has at most one vertex per triangle of its node plus three: each node
-    # writes into its own room of one array (placed by the caller, `place_rows`)
-    room = np.zeros(w + 1, dtype=np.int64)
-    for s in range(w):
-        room[s + 1] = room[s] + offsets[which[s] + 1] - offsets[which[s]] + 3
-    poly = np.empty((room[w], 2), dtype=np.float64)
     status = np.full(w, SLOW, dtype=np.int8)
     counts = np.zeros(w, dtype=np.int64)
     region_tri = np.full(w, -1, dtype=np.int64)
@@ -257,7 +254,7 @@ def fast_cells(pts, tri, nb, offsets, star, cc, merge_tol, max_deg, which):
                 status[s] = FAST
                 counts[s] = c
                 region_tri[s] = star[offsets[i]]
-    return status, room, poly, counts, region_tri
+    return status, counts, region_tri
 
 
 @parallel_kernel("dst_start")

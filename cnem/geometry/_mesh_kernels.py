@@ -255,3 +255,14 @@ def edge_triangles(tri, offsets, star, edges):
                 slot[q] = 3 * star[p] + k
                 q += 1
     return ptr, slot
+
+
+@numba.njit(cache=True)
+def region_members(tri, region, n, m):
+    """``(n, m)`` bool: whether node ``j`` is a vertex of a triangle of region ``r``
+    (``region`` in ``[0, m)``)."""
+    member = np.zeros((n, m), dtype=np.bool_)
+    for s in range(tri.shape[0]):
+        for k in range(3):
+            member[tri[s, k], region[s]] = True
+    return member

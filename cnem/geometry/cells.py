@@ -37,12 +37,17 @@ from tqdm.auto import tqdm
 from .. import config
 from .._predicates import Frame, bounding_box
 from ..errors import GeometryError
+from ..spatial import RTree
 from ._kernels import FAST, fan_regions, fast_cells, place_rows
 from ._mesh_kernels import close_neighbours
 from .halfplane import HalfPlaneCells
 from .topology import circumcenters, constraint_edges, triangle_neighbors, vertex_triangles
 
 __all__ = ["voronoi_cells"]
+
+#: Relative margin by which the exact path's node distances must clear a search radius
+#: for a tree over some of the nodes to stand in for a k-d tree of all (`_ExactCells.near`).
+_BAND = 1e-9
 
 
 def _halfplane_box(box, p, q):
@@ -168,12 +173,14 @@ def _splice_hole(ring, hole):
 
 
 class _ExactCells:
-    """State shared by the exact (clipping) path (``node_tree``: a ``cKDTree`` of
-    ``nodes`` if already built)."""
+    """State shared by the exact (clipping) path (``extent``: the nodes' bounding box,
+    ``constraints``: `constraint_edges` of ``triangles`` and ``nb``, if already known)."""
 
-    def __init__(self, nodes, triangles, region, nb, offsets, star, cc, frame, node_tree=None):
+    def __init__(self, nodes, triangles, region, nb, offsets, star, cc, frame, extent=None,
+                 constraints=None):
         self.nodes, self.tri, self.region, self.frame = nodes, triangles, region, frame
-        self.extent = bounding_box(nodes)     # every cell lies inside
+        # every cell lies inside the nodes' box
+        self.extent = bounding_box(nodes) if extent is None else extent
         self.grid = config.GRID_TOL * float(np.hypot(*(self.extent[1] - self.extent[0])))
         # vertices nearer than this are one: ten grid steps, and the coordinates' round-off
         # far from the origin (`_shared_centres` merges the fast path's centres alike): a
@@ -181,15 +188,68 @@ class _ExactCells:
         resolution = 0.0 if frame is None else frame.resolution
         self.merge = max(10 * self.grid, config.ROUNDOFF_ULPS * resolution)
         self.offsets, self.star, self.cc = offsets, star, cc
-        edges, owner = constraint_edges(triangles, nb)
+        edges, owner = constraint_edges(triangles, nb) if constraints is None else constraints
         self.edges, self.edge_region = edges, region[owner]
         mid = 0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]])
         self.edge_tree = cKDTree(mid)
         self.edge_half = 0.5 * np.linalg.norm(nodes[edges[:, 0]] - nodes[edges[:, 1]], axis=1).max()
-        self.node_tree = cKDTree(nodes) if node_tree is None else node_tree
         on_edge = np.column_stack([edges.ravel(), np.repeat(self.edge_region, 2)])
         self.constrained = set(map(tuple, on_edge.tolist()))
-        self.circ_r = np.linalg.norm(cc - nodes[triangles[:, 0]], axis=1)
+        self.boxes = {}          # (node, region) -> its cell's box and reach (`box`)
+        self.near_tree = None    # over the nodes near the cells `expected` (`expect`)
+        self.expected = set()
+        self.node_tree = None    # a cKDTree of all the nodes, built if needed (`near`)
+
+    def box(self, i, r):
+        """The box ``(xmin, ymin, xmax, ymax)`` the cell of node ``i`` in region ``r`` is
+        clipped from (its triangles' circumcircles, within the extent) and its reach (the
+        distance from the node to the box's farthest corner)."""
+        if (i, r) not in self.boxes:
+            x = self.nodes[i]
+            fan = self.fan(i, r)
+            circ_r = np.linalg.norm(self.cc[fan] - self.nodes[self.tri[fan, 0]], axis=1)
+            lo = (self.cc[fan] - circ_r[:, None]).min(axis=0)
+            hi = (self.cc[fan] + circ_r[:, None]).max(axis=0)
+            lo = np.clip(np.minimum(lo, x), self.extent[0], self.extent[1])
+            hi = np.clip(np.maximum(hi, x), self.extent[0], self.extent[1])
+            corners = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
+            reach = float(np.max(np.linalg.norm(corners - x, axis=1)))
+            self.boxes[i, r] = (lo[0], lo[1], hi[0], hi[1]), reach
+        return self.boxes[i, r]
+
+    def expect(self, node, region):
+        """Prepare the cells of the (node, region) pairs: their boxes, and an R-tree over
+        the nodes within twice their reach (`near`), not over all the nodes."""
+        self.expected = set(zip(np.asarray(node).tolist(), np.asarray(region).tolist()))
+        reach = np.array([self.box(int(i), int(r))[1] for i, r in zip(node, region)])
+        x = self.nodes[node]
+        pad = (2.0 * reach * (1.0 + 4 * _BAND))[:, None] + 8.0 * np.spacing(np.abs(x))
+        self.near_tree = RTree.from_points_in(self.nodes, x - pad, x + pad, self.extent)
+
+    def near(self, i, r, radius, tiny):
+        """The nodes within ``radius`` of node ``i`` and their distances, in the order a
+        k-d tree of all the nodes gives them, as far as it matters: sorted by distance,
+        their order is unique but among those within ``tiny`` (the cell skips them all).
+
+        From `near_tree` (`expect`) when every distance lies clear of ``radius`` (by a
+        relative ``_BAND``: the test ``d <= radius`` cannot round otherwise) and those
+        beyond ``tiny`` are distinct; else from a k-d tree of all the nodes.
+        """
+        x = self.nodes[i]
+        if (i, r) in self.expected:
+            tree, subset = self.near_tree
+            _, idx = tree.query_ball(x[None], radius * (1.0 + 2 * _BAND))
+            near = subset[idx]
+            dist = np.linalg.norm(self.nodes[near] - x, axis=1)
+            inside = dist <= radius * (1.0 - _BAND)
+            far = dist[inside & (dist > tiny)]
+            if not (~inside & (dist <= radius * (1.0 + _BAND))).any() and \
+                    len(np.unique(far)) == len(far):
+                return near[inside], dist[inside]
+        if self.node_tree is None:
+            self.node_tree = cKDTree(self.nodes)
+        near = np.asarray(self.node_tree.query_ball_point(x, radius), dtype=np.int64)
+        return near, np.linalg.norm(self.nodes[near] - x, axis=1)
 
     def fan(self, i, r):
         ts = self.star[self.offsets[i]:self.offsets[i + 1]]
@@ -261,20 +321,12 @@ class _ExactCells:
 
     def cell(self, i, r):
         x = self.nodes[i]
-        fan = self.fan(i, r)
-        lo = (self.cc[fan] - self.circ_r[fan, None]).min(axis=0)
-        hi = (self.cc[fan] + self.circ_r[fan, None]).max(axis=0)
-        lo = np.clip(np.minimum(lo, x), self.extent[0], self.extent[1])
-        hi = np.clip(np.maximum(hi, x), self.extent[0], self.extent[1])
-        box = (lo[0], lo[1], hi[0], hi[1])
-        reach = float(np.max(np.linalg.norm(np.array([[lo[0], lo[1]], [hi[0], lo[1]],
-                                                       [hi[0], hi[1]], [lo[0], hi[1]]]) - x, axis=1)))
+        box, reach = self.box(i, r)
         cell = self.visible_part(i, r, shapely.set_precision(shapely.box(*box), self.grid), reach)
-        near = np.asarray(self.node_tree.query_ball_point(x, 2 * reach), dtype=np.int64)
-        dist = np.linalg.norm(self.nodes[near] - x, axis=1)
+        tiny = config.MERGE_TOL * reach
+        near, dist = self.near(i, r, 2 * reach, tiny)
         order = np.argsort(dist)
         near, dist = near[order], dist[order]
-        tiny = config.MERGE_TOL * reach
         corners = shapely.get_coordinates(cell)
         radius = np.linalg.norm(corners - x, axis=1).max(initial=0.0)
         for j, dj in zip(near, dist):
@@ -343,7 +395,7 @@ class _ExactCells:
                              "node: refine it there")
 
 
-def _shared_centres(cc, nb, nodes, resolution=0.0):
+def _shared_centres(cc, nb, extent, resolution=0.0):
     """The circumcentres with those of neighbouring triangles closer than
     ``MERGE_TOL`` times the nodes' extent, or than ``ROUNDOFF_ULPS`` times the
     coordinates' round-off ``resolution``, made one (the lowest triangle's): the two
@@ -353,7 +405,7 @@ def _shared_centres(cc, nb, nodes, resolution=0.0):
     it would keep different ones (a gap between them) or a vertex twice (which
     of the quad's diagonals the triangulation took decides it, and a fan sub-cell of
     no area beside the pair changed the stabilised stiffness by 5 %)."""
-    lo, hi = bounding_box(nodes)
+    lo, hi = extent
     tol = max(config.MERGE_TOL * float(np.hypot(*(hi - lo))),
               config.ROUNDOFF_ULPS * resolution)
     t, u = close_neighbours(cc, nb, tol)
@@ -368,7 +420,8 @@ def _shared_centres(cc, nb, nodes, resolution=0.0):
 
 def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, *,
                   progress: bool | None = None, neighbors: np.ndarray | None = None,
-                  only: ArrayLike | None = None, frame: Frame | None = None
+                  only: ArrayLike | None = None, frame: Frame | None = None,
+                  star: tuple[np.ndarray, np.ndarray] | None = None
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Constrained Voronoi cells of a (crack-split) constrained Delaunay triangulation.
 
@@ -389,6 +442,8 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     frame : cnem._predicates.Frame, optional
         The local frame ``nodes`` are given in (`cnem._predicates.local_frame`): the
         points and lengths named in errors are mapped back to the caller's coordinates.
+    star : (offsets, indices), optional
+        `vertex_triangles` of the triangles, if already known.
 
     Returns
     -------
@@ -400,14 +455,22 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     """
     n = len(nodes)
     nb = triangle_neighbors(triangles, region) if neighbors is None else neighbors
-    offsets, star = vertex_triangles(triangles, n)
+    if star is None or len(star[0]) != n + 1:
+        star = vertex_triangles(triangles, n)
+    offsets, star = star
     cc = circumcenters(nodes, triangles)
     resolution = 0.0 if frame is None else frame.resolution
     max_deg = int(np.diff(offsets).max())
     which = np.arange(n, dtype=np.int64) if only is None else np.unique(np.asarray(only, dtype=np.int64))
-    status, room, poly, count, rtri = fast_cells(
-        nodes, triangles, nb, offsets, star, _shared_centres(cc, nb, nodes, resolution),
-        config.MERGE_TOL, max_deg, which)
+    extent = bounding_box(nodes)
+    # a cell has at most one vertex per triangle of its node plus three: each node
+    # writes into its own room of one array (placed by `_in_place_of_slow`)
+    room = np.zeros(len(which) + 1, dtype=np.int64)
+    np.cumsum(offsets[which + 1] - offsets[which] + 3, out=room[1:])
+    poly = np.empty((room[-1], 2))
+    status, count, rtri = fast_cells(
+        nodes, triangles, nb, offsets, star, _shared_centres(cc, nb, extent, resolution),
+        config.MERGE_TOL, max_deg, which, room, poly)
     slow_at = np.flatnonzero(status != FAST)     # positions in `which`
     slow_node, slow_region, reach = fan_regions(nodes, triangles, region, offsets, star,
                                                 which[slow_at])
@@ -415,13 +478,16 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     slow_count = np.zeros(len(slow_node), dtype=np.int64)
     slow_verts = np.zeros((0, 2))
     if len(slow_node):
-        node_tree = cKDTree(nodes)
-        half = HalfPlaneCells(nodes, triangles, region, nb, node_tree=node_tree)
+        constraints = constraint_edges(triangles, nb)
+        half = HalfPlaneCells(nodes, triangles, region, nb, extent=extent,
+                              constraints=constraints)
         done, half_count, half_verts = half.cells(slow_node, slow_region, reach)
         rest = np.setdiff1d(np.arange(len(slow_node)), done)
         exact_polys = []
         if len(rest):
-            exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, frame, node_tree)
+            exact = _ExactCells(nodes, triangles, region, nb, offsets, star, cc, frame, extent,
+                                constraints)
+            exact.expect(slow_node[rest], slow_region[rest])
             exact_polys = [exact.cell(int(slow_node[k]), int(slow_region[k])) for k in tqdm(
                 rest, desc="clipping cells", disable=None if progress is None else not progress,
                 leave=False)]
@@ -453,7 +519,9 @@ def _in_place_of_slow(which, slow_at, fast_region, fast, slow):
     per_pos[slow_at] = per_slow
     first = np.zeros(len(which) + 1, dtype=np.int64)
     np.cumsum(per_pos, out=first[1:])
-    fast_cell = np.delete(first[:-1], slow_at)
+    fast_at = np.ones(len(which), dtype=bool)
+    fast_at[slow_at] = False
+    fast_cell = first[:-1][fast_at]
     slow_cell = np.ones(first[-1], dtype=bool)
     slow_cell[fast_cell] = False
     cell_region = np.empty(first[-1], dtype=np.int64)
@@ -461,12 +529,20 @@ def _in_place_of_slow(which, slow_at, fast_region, fast, slow):
     cell_region[slow_cell] = slow_region
     room, poly, count = fast
     counts = np.empty(first[-1], dtype=np.int64)
-    counts[fast_cell] = np.delete(count, slow_at)
+    counts[fast_cell] = count[fast_at]
     counts[slow_cell] = slow_count
     offsets = np.zeros(first[-1] + 1, dtype=np.int64)
     np.cumsum(counts, out=offsets[1:])
-    vertices = np.empty((offsets[-1], 2))
-    place_rows(poly, np.delete(room[:-1], slow_at), vertices, offsets[fast_cell],
-               counts[fast_cell])
+    src, dst = room[:-1][fast_at], offsets[fast_cell]
+    if offsets[-1] <= len(poly) and (dst <= src).all():
+        # the fast cells moved down inside `poly` (in order: no block overwrites one not
+        # yet read), then `poly` shortened, not copied to new memory (first touching its
+        # 100 MB at 1M nodes cost several times the copy)
+        place_rows.serial(poly, src, poly, dst, counts[fast_cell])
+        poly.resize((offsets[-1], 2), refcheck=False)   # no view of it: the array is ours
+        vertices = poly
+    else:
+        vertices = np.empty((offsets[-1], 2))
+        place_rows(poly, src, vertices, dst, counts[fast_cell])
     place_rows(slow_verts, slow_start, vertices, offsets[:-1][slow_cell], slow_count)
     return np.repeat(which, per_pos), cell_region, offsets, vertices

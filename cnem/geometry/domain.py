@@ -99,6 +99,19 @@ def _as_polygon(obj, index, tol):
     return orient(poly, 1.0)
 
 
+def _axis_box(polygon):
+    """``(xmin, ymin, xmax, ymax)`` if ``polygon`` is an axis-aligned rectangle (no hole,
+    every edge along a side of its bounding box), else None."""
+    if len(polygon.interiors):
+        return None
+    x0, y0, x1, y1 = polygon.bounds
+    ring = np.asarray(polygon.exterior.coords)
+    a, b = ring[:-1], ring[1:]
+    vertical = (a[:, 0] == b[:, 0]) & ((a[:, 0] == x0) | (a[:, 0] == x1))
+    horizontal = (a[:, 1] == b[:, 1]) & ((a[:, 1] == y0) | (a[:, 1] == y1))
+    return (x0, y0, x1, y1) if (vertical | horizontal).all() else None
+
+
 def _is_single_polygon(obj):
     """Whether ``obj`` is one polygon rather than a list of polygons."""
     if isinstance(obj, Polygon):
@@ -379,8 +392,13 @@ class Domain:
             raise GeometryError("points: coordinates must be finite, received NaN or inf")
         out = np.full(len(pts), -1, dtype=np.int64)
         for i in reversed(range(len(self._regions))):
-            shapely.prepare(self._regions[i])
-            inside = shapely.intersects_xy(self._regions[i], pts[:, 0], pts[:, 1])
+            box = _axis_box(self._regions[i])
+            if box is None:
+                shapely.prepare(self._regions[i])
+                inside = shapely.intersects_xy(self._regions[i], pts[:, 0], pts[:, 1])
+            else:        # the same closed set, by exact comparisons (tens of times faster)
+                inside = ((pts[:, 0] >= box[0]) & (pts[:, 0] <= box[2])
+                          & (pts[:, 1] >= box[1]) & (pts[:, 1] <= box[3]))
             out[inside] = i
         return out
 

@@ -4,22 +4,23 @@ Between the fast path (a cell made of circumcentres) and the exact shapely
 clipping: a node whose circumcentres lie behind a constraint but whose
 neighbourhood is convex (a thin strip, a coarse boundary with nodes
 crowded inside) gets its cell by clipping a box with half-planes, a few
-microseconds instead of milliseconds. All such cells are done at once: one
-R-tree query per leaf of the tree gathers the candidate nodes of the leaf's cells (and
-through them their constraint edges), one kernel (`._clip_kernels.clip_cells`) clips them all, and
-the cells whose box was too small are retried together in boxes twice as large.
+microseconds instead of milliseconds. All such cells are done at once: an R-tree
+over the nodes near them only (`cnem.spatial.RTree.from_points_in`), one query per leaf
+of it gathers the candidate nodes of the leaf's cells (and through them their
+constraint edges), one kernel (`._clip_kernels.clip_cells`) clips them all, and the
+cells whose box was too small are retried together in boxes twice as large.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from .. import config
 from .._parallel import work_chunks
 from .._predicates import bounding_box
 from ..spatial import RTree
 from ._clip_kernels import CLIPPED, GROW, clip_cells
+from ._mesh_kernels import region_members
 from .topology import constraint_edges
 
 __all__ = ["HalfPlaneCells"]
@@ -36,21 +37,26 @@ class HalfPlaneCells:
     region : (t,) int64 ndarray
     nb : (t, 3) int64 ndarray
         Neighbours with region changes cut (-1).
-    node_tree : scipy.spatial.cKDTree, optional
-        Of ``nodes``, if already built.
+    extent : two (2,) ndarray, optional
+        The nodes' bounding box (`cnem._predicates.bounding_box`), if already known.
+    constraints : two ndarray, optional
+        `constraint_edges` of ``triangles`` and ``nb``, if already known.
     """
 
     def __init__(self, nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray,
-                 nb: np.ndarray, *, node_tree: cKDTree | None = None) -> None:
+                 nb: np.ndarray, *, extent: tuple[np.ndarray, np.ndarray] | None = None,
+                 constraints: tuple[np.ndarray, np.ndarray] | None = None) -> None:
         n = len(nodes)
         self.nodes = nodes
-        lo, hi = bounding_box(nodes)
+        lo, hi = bounding_box(nodes) if extent is None else extent
+        self.box = (lo, hi)
         self.extent = np.array([lo[0], lo[1], hi[0], hi[1]])
         self.tol = config.MERGE_TOL * float(np.hypot(*(hi - lo)))
-        edges, owner = constraint_edges(triangles, nb)
+        edges, owner = constraint_edges(triangles, nb) if constraints is None else constraints
         self.edges, self.edge_region = edges, region[owner]
-        self.member = np.zeros((n, int(region.max()) + 1), dtype=bool)
-        self.member[triangles.ravel(), np.repeat(region, 3)] = True
+        self.member = region_members(np.ascontiguousarray(triangles, dtype=np.int64),
+                                     np.ascontiguousarray(region, dtype=np.int64), n,
+                                     int(region.max()) + 1)
         out_deg = np.bincount(edges[:, 0], minlength=n)
         in_deg = np.bincount(edges[:, 1], minlength=n)
         simple = (out_deg == 1) & (in_deg == 1)
@@ -68,19 +74,13 @@ class HalfPlaneCells:
         convex = (cross >= -1e-12 * size) & ((dot > 0) | (cross > 1e-12 * size))
         self.wedge[b] = np.column_stack([u, v])
         # constraint ends that are not convex boundary nodes: reflex corners, crack tips,
-        # interface nodes, several fans
+        # interface nodes, several fans; the two copies of a crack-face node (nodes
+        # within `tol` of another: their faces are coincident constraint edges of one
+        # region, which the clipping does not tell apart) are found near the cells
+        # asked for (`_near`)
         self.safe = (out_deg == 0) & (in_deg == 0)
         self.safe[b[convex]] = True
-        # the two copies of a crack-face node: their faces are coincident constraint
-        # edges of one region, which the clipping does not tell apart (the cells beside a
-        # crack go to the exact path)
-        node_tree = cKDTree(nodes) if node_tree is None else node_tree
-        twins = node_tree.query_pairs(max(self.tol, 0.0), output_type="ndarray")
-        self.safe[twins.ravel()] = False
         self.wedge[~self.safe] = 0.0
-        self.node_rtree = RTree.from_points(nodes)
-        self.leaf = np.empty(n, dtype=np.int64)    # the tree's leaf of each node
-        self.leaf[self.node_rtree.order] = np.arange(n) // self.node_rtree.fanout
         self.edge_idx = np.argsort(edges.ravel(), kind="stable") // 2
         self.edge_ptr = np.zeros(n + 1, dtype=np.int64)
         np.cumsum(out_deg + in_deg, out=self.edge_ptr[1:])
@@ -114,14 +114,17 @@ class HalfPlaneCells:
         node = np.asarray(node, dtype=np.int64)
         region = np.asarray(region, dtype=np.int64)
         size = np.array(start, dtype=np.float64)
-        todo = np.flatnonzero(self.safe[node])
+        todo = np.arange(len(node))
         done, counts, vertices = [], [], []
         # at most 64 doublings (boxes up to 1.8e19 times the first): a cell still growing
         # then, like one whose box covers the extent, is left to the exact path
         for _ in range(64):
+            if todo.size:
+                tree, subset = self._near(node[todo], size[todo])
+                todo = todo[self.safe[node[todo]]]
             if todo.size == 0:
                 break
-            group, near_ptr, near_idx = self._candidates(node[todo], size[todo])
+            group, near_ptr, near_idx = self._candidates(node[todo], size[todo], tree, subset)
             status, count, first, out = clip_cells(
                 self.nodes, node[todo], region[todo], size[todo], self.extent, self.prev,
                 self.next, self.wedge, self.member, self.safe, self.edges, self.edge_region,
@@ -138,12 +141,40 @@ class HalfPlaneCells:
             return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros((0, 2))
         return np.concatenate(done), np.concatenate(counts), np.concatenate(vertices)
 
-    def _candidates(self, node: np.ndarray, size: np.ndarray
+    def _reach(self, node: np.ndarray, size: np.ndarray) -> np.ndarray:
+        """Half-sizes ``(w, 2)`` of the boxes around the nodes that hold the discs of radius
+        ``sqrt(2) size + edge_half + tol`` (`clip_cells`' candidates), rounding of the
+        corners included."""
+        radius = size * np.sqrt(2.0) + self.edge_half + self.tol
+        return radius[:, None] * (1.0 + 1e-12) + 8.0 * np.spacing(np.abs(self.nodes[node]))
+
+    def _near(self, node: np.ndarray, size: np.ndarray) -> tuple[RTree, np.ndarray]:
+        """An R-tree over the nodes near the cells of ``node`` (boxes of half-size
+        ``size``): every node within ``2 tol`` of the boxes that hold their candidates'
+        discs is in it; those within ``tol`` of another node are marked not `safe` (the
+        other one is in the tree too).
+
+        Returns
+        -------
+        tree : RTree
+        subset : (m,) int64 ndarray
+            The nodes of the tree's entries.
+        """
+        x = self.nodes[node]
+        pad = self._reach(node, size) + 2.0 * self.tol
+        tree, subset = RTree.from_points_in(self.nodes, x - pad, x + pad, self.box)
+        ptr, _ = tree.query_ball(self.nodes[subset], max(self.tol, 0.0))
+        twins = subset[np.diff(ptr) > 1]           # a node finds itself
+        self.safe[twins] = False
+        self.wedge[twins] = 0.0
+        return tree, subset
+
+    def _candidates(self, node: np.ndarray, size: np.ndarray, tree: RTree, subset: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Candidate lists for the cells of ``node`` with boxes of half-size ``size``: one
-        list per leaf of the nodes' R-tree, every node of the box holding the discs of
-        radius ``sqrt(2) size + edge_half + tol`` around that leaf's nodes (one query per
-        leaf, not per cell).
+        list per leaf of ``tree`` (`_near`, whose nodes include ``node``), every node of
+        the box holding the discs of radius ``sqrt(2) size + edge_half + tol`` around that
+        leaf's cells (one query per leaf, not per cell).
 
         Returns
         -------
@@ -153,12 +184,13 @@ class HalfPlaneCells:
             CSR of the lists.
         """
         x = self.nodes[node]
-        radius = size * np.sqrt(2.0) + self.edge_half + self.tol
-        pad = radius[:, None] * (1.0 + 1e-12) + 8.0 * np.spacing(np.abs(x))   # rounding of x -+ r
-        leaves, group = np.unique(self.leaf[node], return_inverse=True)
+        pad = self._reach(node, size)
+        leaf = np.empty(len(subset), dtype=np.int64)
+        leaf[tree.order] = np.arange(len(subset)) // tree.fanout
+        leaves, group = np.unique(leaf[np.searchsorted(subset, node)], return_inverse=True)
         lo = np.full((len(leaves), 2), np.inf)
         hi = np.full((len(leaves), 2), -np.inf)
         np.minimum.at(lo, group, x - pad)
         np.maximum.at(hi, group, x + pad)
-        ptr, idx = self.node_rtree.query(lo, hi)
-        return group, ptr, idx
+        ptr, idx = tree.query(lo, hi)
+        return group, ptr, subset[idx]

@@ -19,7 +19,8 @@ from .cloud import NodeCloud
 from .cracks import split_cracks
 from ..shape import shape_functions
 from ..spatial.rtree import RTree
-from .topology import circumcenters, cut_between_regions, triangle_neighbors
+from .topology import (circumcenters, cut_between_regions, triangle_neighbors,
+                       vertex_triangles)
 
 from .triangulation import constrained_delaunay
 
@@ -262,7 +263,8 @@ def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:
     frame = cloud.domain.frame
     local = frame.to_local(nodes)
     node, cell_region, offsets, vertices = voronoi_cells(local, tri, region, progress=progress,
-                                                         neighbors=neighbors[0], frame=frame)
+                                                         neighbors=neighbors[0], frame=frame,
+                                                         star=neighbors[2])
     vertices = frame.to_global(vertices, out=vertices)     # voronoi_cells' own array
     timings["cells"] = time.perf_counter() - t2
     log.info("discretize: %d nodes, %s", len(nodes),
@@ -288,8 +290,10 @@ def triangulate(cloud, timings, caller="discretize"):
     -------
     nodes, node_of_point, triangles, triangle_region, segments, segment_kind
         As the `Model` attributes.
-    neighbors : tuple of two (t, 3) int64 ndarray
-        Within regions and across them (`Model.neighbors`).
+    neighbors : tuple
+        Two (t, 3) int64 ndarray, the neighbours within regions and across them
+        (`Model.neighbors`), then the vertex star they were found from
+        (`cnem.geometry.topology.vertex_triangles`).
     """
     if not isinstance(cloud, NodeCloud):
         raise GeometryError(f"{caller} expects a NodeCloud from cnem.nodes, received "
@@ -305,6 +309,8 @@ def triangulate(cloud, timings, caller="discretize"):
 
 
 def _neighbor_tables(triangles, region):
-    """`Model.neighbors` within regions and across them: ``(cut, every)``."""
-    every = triangle_neighbors(triangles)
-    return cut_between_regions(every, region), every
+    """`Model.neighbors` within regions and across them, and the vertex star they were
+    found from: ``(cut, every, (offsets, star))``."""
+    star = vertex_triangles(triangles, int(triangles.max()) + 1 if len(triangles) else 0)
+    every = triangle_neighbors(triangles, star=star)
+    return cut_between_regions(every, region), every, star

@@ -10,7 +10,8 @@ __all__ = ["triangle_neighbors", "cut_between_regions", "vertex_triangles", "cir
            "constraint_edges"]
 
 
-def triangle_neighbors(triangles: np.ndarray, region: np.ndarray | None = None) -> np.ndarray:
+def triangle_neighbors(triangles: np.ndarray, region: np.ndarray | None = None, *,
+                       star: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """Neighbour across each edge; edges between regions count as boundaries.
 
     Parameters
@@ -19,6 +20,8 @@ def triangle_neighbors(triangles: np.ndarray, region: np.ndarray | None = None) 
         A triangulation: each edge in at most two triangles.
     region : (t,) int ndarray, optional
         When given, neighbours in another region are reported as -1.
+    star : (offsets, indices), optional
+        `vertex_triangles` of ``triangles``, if already known.
 
     Returns
     -------
@@ -27,7 +30,7 @@ def triangle_neighbors(triangles: np.ndarray, region: np.ndarray | None = None) 
     """
     triangles = np.ascontiguousarray(triangles, dtype=np.int64)
     n = int(triangles.max()) + 1 if len(triangles) else 0
-    nb = edge_neighbors(triangles, *vertex_star(triangles, n))
+    nb = edge_neighbors(triangles, *(vertex_star(triangles, n) if star is None else star))
     return nb if region is None else cut_between_regions(nb, region)
 
 

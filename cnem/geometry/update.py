@@ -295,7 +295,7 @@ def update(model: Model, cloud: NodeCloud, *, progress: bool | None = None) -> M
     with one_thread():                  # a few cells
         node, cell_region, offsets, vertices = voronoi_cells(
             frame.to_local(nodes), tri, region, progress=progress, neighbors=neighbors[0],
-            only=np.flatnonzero(redo), frame=frame)
+            star=neighbors[2], only=np.flatnonzero(redo), frame=frame)
         fresh = Cells(node, cell_region, offsets, frame.to_global(vertices))
     new_of_old_node = np.full(len(model.nodes), -1, dtype=np.int64)
     new_of_old_node[old_node[old_node >= 0]] = np.flatnonzero(old_node >= 0)

@@ -280,3 +280,58 @@ def nearest(cen, half, first, cnt, nbox, depth, fanout, order, points, period, n
             best_idx[i] = bi
             best_d[i] = np.sqrt(bd)
     return best_idx, best_d
+
+
+@numba.njit(cache=True, inline="always")
+def _grid_cell(x, origin, inv, g):
+    """The coarse grid column of coordinate ``x`` (monotone in ``x``, clamped to
+    ``[0, g)``): a point inside a box lies in a column between its corners'."""
+    v = (x - origin) * inv
+    if not v > 0.0:              # also NaN
+        return 0
+    if v >= g - 1:
+        return g - 1
+    return int(v)
+
+
+@parallel_kernel("points")
+def grid_cover(points, lo, hi, origin, inv, g):
+    """Whether each point lies in a cell of a ``g x g`` grid that a box meets.
+
+    Parameters
+    ----------
+    points : (n, 2) float64
+    lo, hi : (b, 2) float64
+        The closed boxes.
+    origin, inv : (2,) float64
+        Grid cell ``(i, j)`` holds ``floor((x - origin) * inv)`` = ``(i, j)`` (clamped).
+    g : int
+
+    Returns
+    -------
+    (n,) bool
+        True at least for every point inside a box (the boxes are marked in a 2-D
+        difference array, one prefix sum per axis: ``O(b + g^2 + n)``).
+    """
+    count = np.zeros((g + 1, g + 1), dtype=np.int64)
+    for b in range(lo.shape[0]):
+        i0 = _grid_cell(lo[b, 0], origin[0], inv[0], g)
+        i1 = _grid_cell(hi[b, 0], origin[0], inv[0], g)
+        j0 = _grid_cell(lo[b, 1], origin[1], inv[1], g)
+        j1 = _grid_cell(hi[b, 1], origin[1], inv[1], g)
+        count[i0, j0] += 1
+        count[i1 + 1, j0] -= 1
+        count[i0, j1 + 1] -= 1
+        count[i1 + 1, j1 + 1] += 1
+    for i in range(1, g + 1):
+        for j in range(g + 1):
+            count[i, j] += count[i - 1, j]
+    for i in range(g + 1):
+        for j in range(1, g + 1):
+            count[i, j] += count[i, j - 1]
+    n = points.shape[0]
+    mask = np.empty(n, dtype=np.bool_)
+    for p in numba.prange(n):
+        mask[p] = count[_grid_cell(points[p, 0], origin[0], inv[0], g),
+                        _grid_cell(points[p, 1], origin[1], inv[1], g)] > 0
+    return mask

@@ -107,6 +107,40 @@ class RTree:
         tree._build(pts, np.zeros_like(pts), period)
         return tree
 
+    @classmethod
+    def from_points_in(cls, points: ArrayLike, lo: ArrayLike, hi: ArrayLike,
+                       extent: tuple[np.ndarray, np.ndarray]) -> tuple[RTree, np.ndarray]:
+        """A tree over the 2-D points that may lie in the closed boxes ``[lo, hi]``:
+        those in the cells of a coarse grid (about 4 points per cell) that the boxes
+        meet. A query by a box that holds one of ``[lo, hi]`` finds every point of
+        ``points`` in that one (the points left out lie in no box), at the cost of
+        the points near the boxes, not of all of them.
+
+        Parameters
+        ----------
+        points : (n, 2) array_like
+        lo, hi : (b, 2) array_like
+        extent : two (2,) ndarray
+            The points' bounding box (`cnem._predicates.bounding_box`).
+
+        Returns
+        -------
+        tree : RTree
+            Over ``points[subset]``: its entry ``k`` is point ``subset[k]``.
+        subset : (m,) int64 ndarray
+            Increasing.
+        """
+        pts = np.ascontiguousarray(points, dtype=np.float64)  # those in the tree are checked
+        if pts.ndim != 2 or pts.shape[1] != 2:
+            raise SpatialError(f"from_points_in: expected (n, 2) points, received shape "
+                               f"{pts.shape}; use RTree.from_points in 3-D")
+        g = max(1, int(np.sqrt(len(pts)) / 2))
+        width = extent[1] - extent[0]
+        inv = np.divide(g, width, out=np.zeros(2), where=width > 0)
+        subset = np.flatnonzero(K.grid_cover(pts, as_points(lo, "lo"), as_points(hi, "hi"),
+                                             np.asarray(extent[0], dtype=np.float64), inv, g))
+        return cls.from_points(pts[subset]), subset
+
     def _build(self, centre, half, period):
         b, d = centre.shape
         self.dim, self.fanout = d, config.FANOUT          # children per node, fixed per tree
