@@ -77,7 +77,8 @@ def sweep(indptr, indices, data, diagonal, starts, b, x, before, backward):
 
     Parameters
     ----------
-    indptr, indices, data : CSR (n, n)
+    indptr, indices, data : CSR (n, n), sorted indices (a row whose first and last
+        columns are in its block is swept without testing each entry)
     diagonal : (n,) ndarray
         From `l1_diagonal` with the same ``starts``.
     starts : (nb + 1,) int ndarray
@@ -94,8 +95,12 @@ def sweep(indptr, indices, data, diagonal, starts, b, x, before, backward):
         lo, hi = starts[k], starts[k + 1]
         for t in range(hi - lo):
             i = hi - 1 - t if backward else lo + t
-            s = b[i]
-            for p in range(indptr[i], indptr[i + 1]):
-                j = indices[p]
-                s -= data[p] * (x[j] if lo <= j < hi else before[j])
+            first, end = indptr[i], indptr[i + 1]
+            if end == first or (indices[first] >= lo and indices[end - 1] < hi):
+                s = b[i] - _row_product(indptr, indices, data, x, i)     # all in the block
+            else:
+                s = b[i]
+                for p in range(first, end):
+                    j = indices[p]
+                    s -= data[p] * (x[j] if lo <= j < hi else before[j])
             x[i] += s / diagonal[i]

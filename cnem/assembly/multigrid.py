@@ -21,7 +21,7 @@ True
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
@@ -29,6 +29,9 @@ import scipy.sparse.linalg as spla
 
 from ..errors import InputError
 from . import _multigrid_kernels as kernels
+
+if TYPE_CHECKING:
+    import pyamg
 
 __all__ = ["VCycle", "Rows", "hierarchy", "parallel_operator"]
 
@@ -98,7 +101,7 @@ class VCycle(spla.LinearOperator):
     levels : int
     """
 
-    def __init__(self, ml, top: sp.spmatrix | None = None) -> None:
+    def __init__(self, ml: pyamg.MultilevelSolver, top: sp.spmatrix | None = None) -> None:
         levels = ml.levels
         if top is not None and top.shape != levels[0].A.shape:
             raise InputError(f"top: expected shape {levels[0].A.shape} like the hierarchy's "
