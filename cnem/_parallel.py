@@ -11,10 +11,15 @@ costs several times more than a plain ``njit`` (about 28 of the 67 s of CPU the
 main demo compiled, numba 0.68), and on small work a parallel region costs more
 than it saves, so a first run on small models compiles and runs only the serial
 copies; a large model compiles the parallel copies on its first call.
+
+A large job done in small pieces (the smoothed gradients of a 1M-node model, pass by
+pass over 10k cells) would run every piece on the serial copy; inside
+``job_size(n)`` a call counts as ``n`` work items when that is more.
 """
 
 from __future__ import annotations
 
+import contextvars
 import functools
 import inspect
 import types
@@ -27,7 +32,11 @@ from . import _compile  # noqa: F401  (says once when the kernels compile)
 from . import config
 from .errors import InputError
 
-__all__ = ["work_chunks", "one_thread", "parallel_kernel", "ParallelKernel", "always_parallel"]
+__all__ = ["work_chunks", "one_thread", "parallel_kernel", "ParallelKernel", "always_parallel",
+           "job_size"]
+
+#: Work items of the job the calls in progress are pieces of (`job_size`).
+_JOB_SIZE = contextvars.ContextVar("cnem_job_size", default=0)
 
 
 def work_chunks() -> int:
@@ -63,6 +72,24 @@ def always_parallel() -> Iterator[None]:
         config.PARALLEL_MIN = before
 
 
+@contextmanager
+def job_size(items: int) -> Iterator[None]:
+    """Count every `ParallelKernel` call inside as at least ``items`` work items: the
+    pieces of one large job (a model's passes) then run the parallel copies as the whole
+    job would, while a small job's pieces stay on the serial ones.
+
+    Parameters
+    ----------
+    items : int
+        Work items of the whole job (cells, points: what its pieces' kernels count).
+    """
+    token = _JOB_SIZE.set(max(int(items), _JOB_SIZE.get()))
+    try:
+        yield
+    finally:
+        _JOB_SIZE.reset(token)
+
+
 class ParallelKernel:
     """A kernel with a serial and a parallel compiled copy, chosen per call by its work.
 
@@ -71,7 +98,8 @@ class ParallelKernel:
     py_func : function
         The kernel's Python source (``numba.prange`` loops, numba-compilable).
     work : str
-        The parameter whose length (or integer value) counts the work items.
+        The parameter whose length (or integer value) counts the work items (at least
+        the enclosing `job_size`).
 
     Attributes
     ----------
@@ -94,7 +122,7 @@ class ParallelKernel:
 
     def __call__(self, *args, **kwargs):
         item = args[self._position] if self._position < len(args) else kwargs[self._work]
-        size = len(item) if hasattr(item, "__len__") else int(item)
+        size = max(len(item) if hasattr(item, "__len__") else int(item), _JOB_SIZE.get())
         kernel = self.parallel if size >= config.PARALLEL_MIN else self.serial
         return kernel(*args, **kwargs)
 

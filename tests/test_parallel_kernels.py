@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from cnem import config
-from cnem._parallel import ParallelKernel, always_parallel, parallel_kernel
+from cnem._parallel import ParallelKernel, always_parallel, job_size, parallel_kernel
 
 
 def _doubled(x):
@@ -45,6 +45,20 @@ def test_an_integer_counts_as_its_value(monkeypatch):
     with always_parallel():
         np.testing.assert_array_equal(kernel(2, x), x[:2])
     assert kernel.parallel.signatures and config.PARALLEL_MIN == 5
+
+
+def test_a_job_size_makes_its_small_pieces_parallel(monkeypatch):
+    monkeypatch.setattr(config, "PARALLEL_MIN", 10)
+    kernel = parallel_kernel("x")(_doubled)
+    x = np.arange(3.0)
+    with job_size(5):                                   # a small job: serial pieces
+        np.testing.assert_array_equal(kernel(x), 2 * x)
+    assert not kernel.parallel.signatures
+    with job_size(10), job_size(2):                     # the enclosing larger job counts
+        np.testing.assert_array_equal(kernel(x), 2 * x)
+    assert kernel.parallel.signatures
+    kernel.parallel = None                              # left: a piece is serial again
+    np.testing.assert_array_equal(kernel(x), 2 * x)
 
 
 def test_copies_are_cached_apart_and_documented():

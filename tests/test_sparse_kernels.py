@@ -60,7 +60,7 @@ def test_weighted_row_sums_match_scipy(nch, same_values):
     px, py = vx[order], vy[order]
     indptr, indices, x, y = SK.weighted_row_sums(
         wx.indptr, wx.indices, wx.data, wy.data, where, px.indptr[:-1], px.indptr[1:],
-        px.indices, px.data, py.data, n, nch)
+        px.indices, px.data, py.data, nch)
     for got, w, v in ((x, wx, vx), (y, wy, vy)):
         got = sp.csr_matrix((got, indices, indptr), shape=(m, n))
         np.testing.assert_allclose(got.toarray(), (w @ v).toarray(), atol=1e-13)
@@ -71,10 +71,33 @@ def test_weighted_row_sums_match_scipy(nch, same_values):
     ey = sp.csr_matrix((y, indices, indptr), shape=(m, n))
     indptr, indices, cx, cy = SK.weighted_row_sums(
         to_cells.indptr, to_cells.indices, to_cells.data, to_cells.data, np.arange(m),
-        ex.indptr[:-1], ex.indptr[1:], ex.indices, ex.data, ey.data, n, nch)
+        ex.indptr[:-1], ex.indptr[1:], ex.indices, ex.data, ey.data, nch)
     for got, w, v in ((cx, wx, vx), (cy, wy, vy)):
         got = sp.csr_matrix((got, indices, indptr), shape=(12, n))
         np.testing.assert_allclose(got.toarray(), (to_cells @ w @ v).toarray(), atol=1e-13)
+
+
+@pytest.mark.parametrize("nch", [1, 4])
+def test_weighted_row_sums_with_long_rows_and_far_columns(nch):
+    """Rows summing hundreds of entries (the column tables grow) over columns up to
+    10^7, duplicates among them, still equal W @ V."""
+    rng = np.random.default_rng(7)
+    m, q, n = 8, 60, 10_000_000
+    w = _random_csr(rng, (m, q), 0.5)
+    cols = rng.choice(n, 400, replace=False)                 # few distinct, far apart
+    v = sp.csr_matrix((rng.uniform(-1, 1, (q, 40)).ravel(),
+                       rng.choice(cols, (q, 40)).ravel(), np.arange(0, 40 * q + 1, 40)),
+                      shape=(q, n))
+    v.sum_duplicates()
+    indptr, indices, x, y = SK.weighted_row_sums(
+        w.indptr, w.indices, w.data, 2.0 * w.data, np.arange(q), v.indptr[:-1],
+        v.indptr[1:], v.indices, v.data, v.data, nch)
+    want = (w @ v).tocsr()
+    want.sort_indices()
+    np.testing.assert_array_equal(indptr, want.indptr)
+    np.testing.assert_array_equal(indices, want.indices)
+    np.testing.assert_allclose(x, want.data, atol=1e-13)
+    np.testing.assert_allclose(y, 2.0 * want.data, atol=1e-13)
 
 
 @pytest.mark.parametrize("nch", [1, 3, 16])

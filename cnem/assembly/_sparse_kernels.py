@@ -2,7 +2,8 @@
 
 scipy's general sparse-times-sparse products are single-threaded and build
 every intermediate product; these kernels compute each output row at once
-with a dense accumulator per thread (two passes: count, then fill).
+with a dense accumulator per thread (two passes: count, then fill); `weighted_row_sums`,
+called on small pieces of large models, with a small hash table per chunk instead.
 """
 
 import numba
@@ -45,8 +46,45 @@ def _sort_slots(indices, start, end, slot):
         slot[indices[p]] = p
 
 
+#: First size of the per-chunk column tables of `weighted_row_sums` (a power of two;
+#: doubled for a row with more entries than a quarter of it).
+_TABLE_START = 256
+
+
+@numba.njit(cache=True, inline="always")
+def _row_entries(ptr, item, row_of, v_start, v_end, i):
+    """Entries summed into output row ``i`` of `weighted_row_sums` (duplicates counted)."""
+    total = 0
+    for p in range(ptr[i], ptr[i + 1]):
+        r = row_of[item[p]]
+        total += v_end[r] - v_start[r]
+    return total
+
+
+@numba.njit(cache=True)
+def _table_for(table, entries):
+    """``table`` (all -1), or an empty one large enough to hold ``entries`` columns at
+    most a quarter full (open addressing stays short)."""
+    size = table.shape[0]
+    if 4 * entries <= size:
+        return table
+    while 4 * entries > size:
+        size *= 2
+    return np.full(size, -1, dtype=np.int64)
+
+
+@numba.njit(cache=True, inline="always")
+def _probe(table, mask, j):
+    """The slot of column ``j`` in an open-addressing table (``-1``: empty; never full,
+    so the probe ends)."""
+    h = (j * 2654435761) & mask
+    while table[h] >= 0 and table[h] != j:
+        h = (h + 1) & mask
+    return h
+
+
 @parallel_kernel("ptr")
-def weighted_row_sums(ptr, item, wx, wy, row_of, v_start, v_end, v_idx, vx, vy, ncol, nch):
+def weighted_row_sums(ptr, item, wx, wy, row_of, v_start, v_end, v_idx, vx, vy, nch):
     """``X[i] = sum_p wx[p] Vx[row_of[item[p]]]`` over ``p`` in ``ptr[i]:ptr[i + 1]``,
     and ``Y`` alike with ``wy``, ``Vy``: two CSR matrices with one pattern.
 
@@ -64,8 +102,8 @@ def weighted_row_sums(ptr, item, wx, wy, row_of, v_start, v_end, v_idx, vx, vy, 
         The pattern of ``Vx`` and ``Vy``: row ``s`` at ``v_idx[v_start[s]:v_end[s]]``
         (CSR: ``indptr[:-1]``, ``indptr[1:]`` as int64), values ``vx``, ``vy`` (the
         same array for both is fine).
-    ncol, nch : int
-        Columns; work chunks shared between threads.
+    nch : int
+        Work chunks shared between threads.
 
     Returns
     -------
@@ -77,26 +115,41 @@ def weighted_row_sums(ptr, item, wx, wy, row_of, v_start, v_end, v_idx, vx, vy, 
     m = len(ptr) - 1
     counts = np.zeros(m, dtype=np.int64)
     for ch in numba.prange(nch):
-        mark = np.full(ncol, -1, dtype=np.int64)
+        table = np.full(_TABLE_START, -1, dtype=np.int64)
+        used = np.empty(_TABLE_START, dtype=np.int64)
         lo, hi = _chunk(ch, nch, m)
         for i in range(lo, hi):
+            table = _table_for(table, _row_entries(ptr, item, row_of, v_start, v_end, i))
+            if used.shape[0] < table.shape[0]:
+                used = np.empty(table.shape[0], dtype=np.int64)
+            mask = table.shape[0] - 1
             count = 0
             for p in range(ptr[i], ptr[i + 1]):
                 r = row_of[item[p]]
                 for k in range(v_start[r], v_end[r]):
-                    j = v_idx[k]
-                    if mark[j] != i:
-                        mark[j] = i
+                    h = _probe(table, mask, v_idx[k])
+                    if table[h] < 0:
+                        table[h] = v_idx[k]
+                        used[count] = h
                         count += 1
             counts[i] = count
+            for e in range(count):                # empty the row's slots for the next
+                table[used[e]] = -1
     indptr = _offsets(counts)
     indices = np.empty(indptr[m], dtype=np.int32)
     x = np.empty(indptr[m])
     y = np.empty(indptr[m])
     for ch in numba.prange(nch):
-        slot = np.full(ncol, -1, dtype=np.int64)
+        table = np.full(_TABLE_START, -1, dtype=np.int64)
+        slot = np.empty(_TABLE_START, dtype=np.int64)
+        used = np.empty(_TABLE_START, dtype=np.int64)
         lo, hi = _chunk(ch, nch, m)
         for i in range(lo, hi):
+            table = _table_for(table, _row_entries(ptr, item, row_of, v_start, v_end, i))
+            if slot.shape[0] < table.shape[0]:
+                slot = np.empty(table.shape[0], dtype=np.int64)
+                used = np.empty(table.shape[0], dtype=np.int64)
+            mask = table.shape[0] - 1
             start = indptr[i]
             end = start
             for p in range(ptr[i], ptr[i + 1]):
@@ -104,16 +157,20 @@ def weighted_row_sums(ptr, item, wx, wy, row_of, v_start, v_end, v_idx, vx, vy, 
                 sx, sy = wx[p], wy[p]
                 for k in range(v_start[r], v_end[r]):
                     j = v_idx[k]
-                    at = slot[j]
-                    if at < start:                  # first time in this row
-                        at = end
-                        slot[j] = at
-                        indices[at] = j
-                        x[at] = 0.0
-                        y[at] = 0.0
+                    h = _probe(table, mask, j)
+                    if table[h] < 0:                # first time in this row
+                        table[h] = j
+                        slot[h] = end
+                        used[end - start] = h
+                        indices[end] = j
+                        x[end] = 0.0
+                        y[end] = 0.0
                         end += 1
+                    at = slot[h]
                     x[at] += sx * vx[k]
                     y[at] += sy * vy[k]
+            for e in range(end - start):          # empty the row's slots for the next
+                table[used[e]] = -1
             _sort_row(indices, x, y, start, end)
     return indptr, indices, x, y
 

@@ -75,8 +75,8 @@ class BoundaryQuadrature:
         c = self.to_cells
         return csr_pair(*SK.weighted_row_sums(
             c.indptr, c.indices, c.data, c.data, np.arange(c.shape[1], dtype=np.int64),
-            *row_bounds(ex.indptr), ex.indices, ex.data, ey.data, ex.shape[1],
-            work_chunks()), (c.shape[0], ex.shape[1]))
+            *row_bounds(ex.indptr), ex.indices, ex.data, ey.data, work_chunks()),
+            (c.shape[0], ex.shape[1]))
 
     def edge_integrals(self, values: sp.spmatrix | PointRows, rows: np.ndarray | None = None
                        ) -> tuple[sp.csr_matrix, sp.csr_matrix]:
@@ -93,7 +93,7 @@ class BoundaryQuadrature:
         w = self.wx
         return csr_pair(*SK.weighted_row_sums(
             w.indptr, w.indices, w.data, self.wy.data, where, start, end, cols, vals, vals,
-            ncol, work_chunks()), (w.shape[0], ncol))
+            work_chunks()), (w.shape[0], ncol))
 
     def point_rows(self, model: Model) -> PointRows:
         """The shape functions at the points, sides respected, as `point_rows` leaves

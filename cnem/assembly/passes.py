@@ -1,7 +1,9 @@
 """Smoothed gradients computed pass by pass over runs of cells (bounded memory).
 
 A pass takes at most ``config.CELLS_PER_PASS`` cells: their quadrature points
-and shape functions live while it runs, and a small pass works in cache.
+and shape functions live while it runs, and a small pass works in cache. The
+passes of a large model run the kernels' parallel copies, as one pass over all its
+cells would (`cnem._parallel.job_size`).
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import numpy as np
 
 from .. import config
 from .._memory import release_free_memory
+from .._parallel import job_size
 from ..shape.natural import path_order
 from . import _sparse_kernels as SK
 from .csr import csr_pair
@@ -84,12 +87,13 @@ def gradients_in_passes(model: Model, sets: list,
     if runs is None:
         parts, points = _passes(model, quadratures, [(sets, None)], wanted)
         return [part[0] if want else None for part, want in zip(parts, wanted)], points
-    # a generator: one pass's cells alive at a time
-    parts, points = _passes(model, quadratures,
-                            (([cells.subset(i) for cells, i in zip(sets, run)], run) for run in runs),
-                            wanted)
-    out = [_place_runs(parts[i], [run[i] for run in runs]) if wanted[i] else None
-           for i in range(len(sets))]
+    with job_size(sum(len(cells) for cells in sets)):
+        # a generator: one pass's cells alive at a time
+        parts, points = _passes(model, quadratures,
+                                (([cells.subset(i) for cells, i in zip(sets, run)], run)
+                                 for run in runs), wanted)
+        out = [_place_runs(parts[i], [run[i] for run in runs]) if wanted[i] else None
+               for i in range(len(sets))]
     del parts                # the passes' arrays are freed, but the C heap keeps them
     release_free_memory()
     return out, points

@@ -83,7 +83,7 @@ class Cells:
     def subset(self, index: ArrayLike) -> Cells:
         """The cells ``index`` (in that order) as a `Cells` of their own."""
         index = np.asarray(index, dtype=np.int64)
-        counts = np.diff(self.offsets)[index]
+        counts = self.offsets[index + 1] - self.offsets[index]
         offsets = np.zeros(len(index) + 1, dtype=np.int64)
         np.cumsum(counts, out=offsets[1:])
         verts = np.repeat(self.offsets[index] - offsets[:-1], counts) + np.arange(offsets[-1])
