@@ -30,7 +30,8 @@ nothing), so nothing cached by one run serves the next:
   already kept by ``gradients``: the cell bases, their operators and the assembly of K;
 * skfem ``mesh``, ``basis``, ``K``: ``MeshTri.init_tensor``, ``Basis(...)`` and
   ``asm(linear_elasticity(...), basis)``;
-* ``solve`` (both sides, the very same function): ``skfem.condense`` of the clamped dofs, the
+* ``solve`` (both sides, the very same function): ``cnem.assembly.condensation.condense`` of
+  the clamped dofs (skfem.condense's system, by parallel kernels), the
   rigid-body modes of the free dofs, and ``cnem.assembly.linsolve.solve_spd`` (direct up to
   2.5M non-zeros, smoothed aggregation + CG above: pyamg's set-up, cnem's parallel V-cycle,
   ``cnem.assembly.multigrid``; tol 1e-10; on the C-NEM side the
@@ -122,8 +123,7 @@ def condensed_solve(K, f, points, D, solver_options=None):
     """What both sides time as ``solve``: condense, rigid modes of the free dofs, solve_spd
     (C-NEM: with ``solver_options(free dofs)``, ``Elasticity.solver_options``: the P1
     matrix its smoothed aggregation is built on, as in ``Elasticity.solve``)."""
-    from skfem import condense
-
+    from cnem.assembly.condensation import condense
     from cnem.assembly.linsolve import rigid_modes, solve_spd
 
     x = np.zeros(K.shape[0])
@@ -393,7 +393,8 @@ def report(results, warm):
     print()
     print(f"C-NEM elasticity vs scikit-fem P1 on the unit square, plane {PLANE}, E = {E:g}, "
           f"nu = {NU:g}, clamped on x = 0, traction {TRACTION} on x = 1; median wall times in s")
-    print("solve (both sides) = skfem.condense + rigid modes + cnem.assembly.linsolve.solve_spd "
+    print("solve (both sides) = cnem.assembly.condensation.condense + rigid modes + "
+          "cnem.assembly.linsolve.solve_spd "
           "(direct <= 2.5M non-zeros, pyamg + CG above; C-NEM: hierarchy on the P1 matrix of its "
           "triangles, built in the stage): Elasticity.solve's path without its "
           "rigid-motion check (timed in the details)")

@@ -29,10 +29,11 @@ from typing import TYPE_CHECKING, Any, Callable, Literal, Sequence
 import numpy as np
 import triangle
 from shapely.geometry import Polygon
-from skfem import Basis, ElementTriP1, ElementVector, FacetBasis, LinearForm, MeshTri, condense
+from skfem import Basis, ElementTriP1, ElementVector, FacetBasis, LinearForm, MeshTri
 from skfem.helpers import dot, sym_grad
 from skfem.models.elasticity import linear_elasticity
 
+from .assembly.condensation import condense
 from .assembly.quadrature import triangle_quadrature
 from .assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from . import config

@@ -9,12 +9,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import condense
 from skfem.helpers import ddot, sym_grad
 from skfem.models.elasticity import linear_stress
 from tqdm.auto import tqdm
 
 from ..assembly import BilinearForm, CellBasis
+from ..assembly.condensation import condense, principal_submatrix
 from ..assembly.conditions import Conditions, traction_at
 from ..assembly.basis import spread_component
 from ..assembly.quadrature import cell_quadrature, subdivide, tip_cells
@@ -325,8 +325,8 @@ class Elasticity(Conditions):
 
         Parameters
         ----------
-        dofs : (k,) int array_like, optional
-            Keep these rows and columns only (the free dofs).
+        dofs : (k,) int ndarray, optional
+            Keep these rows and columns only (the free dofs, strictly increasing).
 
         Returns
         -------
@@ -343,7 +343,7 @@ class Elasticity(Conditions):
             return None
         lam, mu = self._lame()
         P = elasticity_form.assemble(basis, groups=self.model.triangle_region, lam=lam, mu=mu)
-        return P if dofs is None else P[dofs][:, dofs]
+        return P if dofs is None else principal_submatrix(P, dofs)
 
     # -- solve --------------------------------------------------------------------------
     def solve(self, *, method: Literal["auto", "direct", "amg"] = "auto", tol: float = 1e-10,
