@@ -30,8 +30,8 @@ nothing), so nothing cached by one run serves the next:
   already kept by ``gradients``: the cell bases, their operators and the assembly of K;
 * skfem ``mesh``, ``basis``, ``K``: ``MeshTri.init_tensor``, ``Basis(...)`` and
   ``asm(linear_elasticity(...), basis)``;
-* ``solve`` (both sides, the very same function): ``cnem.assembly.condensation.condense`` of
-  the clamped dofs (skfem.condense's system, by parallel kernels), the
+* ``solve`` (both sides, the very same function): ``cnem.assembly.condensation.free_system``
+  of the clamped dofs (skfem.condense's system, its matrix multiplied on K itself), the
   rigid-body modes of the free dofs, and ``cnem.assembly.linsolve.solve_spd`` (direct up to
   2.5M non-zeros, smoothed aggregation + CG above: pyamg's set-up, cnem's parallel V-cycle,
   ``cnem.assembly.multigrid``; tol 1e-10; on the C-NEM side the
@@ -95,7 +95,7 @@ TARGET_1M, TARGET_1M_SECONDS, TARGET_1M_GB = 1_000_000, 60.0, 6.0
 
 # memory guard (see memory_need): bytes per node and base RSS when no size has been run yet
 # on a side; safety margin; growth exponent of the sparse direct solver's memory; memory of
-# condense + pyamg's hierarchy per byte of K (CSR, 12 bytes a non-zero)
+# the free system + pyamg's hierarchy per byte of K (CSR, 12 bytes a non-zero)
 DEFAULT_BYTES_PER_NODE = {"cnem": 12_000, "skfem": 6_000}
 DEFAULT_BASE_BYTES = 0.3 * 2**30
 MEMORY_MARGIN = 1.3
@@ -120,14 +120,14 @@ def clamped_dofs(points):
 
 
 def condensed_solve(K, f, points, D, solver_options=None):
-    """What both sides time as ``solve``: condense, rigid modes of the free dofs, solve_spd
+    """What both sides time as ``solve``: the free system, rigid modes of the free dofs, solve_spd
     (C-NEM: with ``solver_options(free dofs)``, ``Elasticity.solver_options``: the P1
     matrix its smoothed aggregation is built on, as in ``Elasticity.solve``)."""
-    from cnem.assembly.condensation import condense
+    from cnem.assembly.condensation import free_system
     from cnem.assembly.linsolve import rigid_modes, solve_spd
 
     x = np.zeros(K.shape[0])
-    A, b, _, interior = condense(K, f, x=x, D=D)
+    A, b, interior = free_system(K, f, x=x, D=D)
     options = {} if solver_options is None else solver_options(interior)
     x[interior] = solve_spd(A, b, modes=rigid_modes(points)[interior], **options)
     return x
@@ -393,7 +393,7 @@ def report(results, warm):
     print()
     print(f"C-NEM elasticity vs scikit-fem P1 on the unit square, plane {PLANE}, E = {E:g}, "
           f"nu = {NU:g}, clamped on x = 0, traction {TRACTION} on x = 1; median wall times in s")
-    print("solve (both sides) = cnem.assembly.condensation.condense + rigid modes + "
+    print("solve (both sides) = cnem.assembly.condensation.free_system + rigid modes + "
           "cnem.assembly.linsolve.solve_spd "
           "(direct <= 2.5M non-zeros, pyamg + CG above; C-NEM: hierarchy on the P1 matrix of its "
           "triangles, built in the stage): Elasticity.solve's path without its "

@@ -33,7 +33,7 @@ from skfem import Basis, ElementTriP1, ElementVector, FacetBasis, LinearForm, Me
 from skfem.helpers import dot, sym_grad
 from skfem.models.elasticity import linear_elasticity
 
-from .assembly.condensation import condense
+from .assembly.condensation import free_system
 from .assembly.quadrature import triangle_quadrature
 from .assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from . import config
@@ -363,7 +363,7 @@ class P1Elasticity(Conditions):
                              + "; ".join(free) + ". Fix them with add_dirichlet")
         x = np.zeros(K.shape[0])
         x[D] = values
-        A, b, _, interior = condense(K, f, x=x, D=D)
+        A, b, interior = free_system(K, f, x=x, D=D)
         x[interior] = solve_spd(A, b, modes=rigid_modes(self.nodes)[interior], tol=tol,
                                 method=method)
         t2 = time.perf_counter()

@@ -6,9 +6,12 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 import skfem
+from skfem.models.poisson import laplace
 
 from cnem._parallel import always_parallel
-from cnem.assembly.condensation import condense, free_dofs, principal_submatrix
+from cnem.assembly.condensation import (FreeBlock, condense, free_dofs, free_system,
+                                        principal_submatrix)
+from cnem.assembly.linsolve import solve_spd
 from cnem.errors import InputError
 
 N = 60
@@ -94,6 +97,70 @@ def test_principal_submatrix_matches_fancy_indexing(fmt):
         np.testing.assert_array_equal(S.toarray(), expected)
 
 
+def _symmetric(seed, fmt):
+    """A random SPD (N, N) matrix: a diagonally dominant symmetric pattern."""
+    A = _matrix(seed, "csr")
+    S = A + A.T
+    return (S + sp.diags(abs(S).sum(axis=1).A1 + 1.0)).asformat(fmt)
+
+
+@pytest.mark.parametrize("parallel", [False, True])
+@pytest.mark.parametrize("fixed", list(FIXED))
+@pytest.mark.parametrize("fmt", ["csr", "csc"])
+def test_free_block_is_the_condensed_matrix(fmt, fixed, parallel):
+    """The block's products, entries, count and sub-blocks are those of skfem.condense's
+    matrix; its right-hand side and free dofs too."""
+    K, D = _symmetric(7, fmt), FIXED[fixed]
+    rng = np.random.default_rng(8)
+    f, x = rng.uniform(-1, 1, N), rng.uniform(-1, 1, N)
+    A_ref, b_ref, _, I_ref = skfem.condense(K.tocsr(), f, x=x, D=np.unique(D))
+    if parallel:
+        with always_parallel():
+            A, b, I = free_system(K, f, x=x, D=D)
+    else:
+        A, b, I = free_system(K, f, x=x, D=D)
+    scale = abs(K).max()
+    np.testing.assert_array_equal(I, I_ref)
+    np.testing.assert_array_equal(A.free, I_ref)
+    np.testing.assert_allclose(b, b_ref, rtol=0, atol=1e-14 * scale * N)
+    assert A.shape == A_ref.shape and A.nnz == A_ref.nnz
+    v = rng.uniform(-1, 1, len(I))
+    np.testing.assert_allclose(A @ v, A_ref @ v, rtol=0, atol=1e-14 * scale * N)
+    np.testing.assert_allclose(A.rmatvec(v), A_ref @ v, rtol=0, atol=1e-14 * scale * N)
+    np.testing.assert_array_equal(A.matrix().toarray(), A_ref.toarray())
+    assert A.matrix() is A.matrix()                         # formed once
+    keep = np.arange(0, len(I), 3)
+    np.testing.assert_array_equal(A.submatrix(keep).toarray(),
+                                  A_ref[keep][:, keep].toarray())
+
+
+def test_free_block_of_every_dof_is_the_matrix_itself():
+    K = _symmetric(9, "csr")
+    block = FreeBlock(K)
+    assert block.matrix() is K and block.nnz == K.nnz
+    v = np.random.default_rng(9).uniform(-1, 1, N)
+    np.testing.assert_allclose(block @ v, K @ v, rtol=0, atol=1e-14 * abs(K).max() * N)
+
+
+@pytest.mark.parametrize("method", ["direct", "amg"])
+def test_solve_on_the_free_block_is_the_condensed_solve(method):
+    """solve_spd on a FreeBlock gives the solution of skfem.condense's system; with a
+    preconditioner matrix the iterative path never forms the block's entries."""
+    side = 30
+    K = skfem.asm(laplace,
+                  skfem.Basis(skfem.MeshTri.init_tensor(*[np.linspace(0, 1, side)] * 2),
+                              skfem.ElementTriP1()))
+    D = np.arange(side)                                     # the nodes on y = 0
+    f, x = np.ones(K.shape[0]), np.zeros(K.shape[0])
+    x[D] = 0.5
+    A, b, I = free_system(K, f, x=x, D=D)
+    A_ref, b_ref, _, _ = skfem.condense(K, f, x=x, D=D)
+    u = solve_spd(A, b, method=method, tol=1e-12, preconditioner=A_ref.copy())
+    expected = sp.linalg.spsolve(A_ref.tocsc(), b_ref)
+    np.testing.assert_allclose(u, expected, rtol=0, atol=1e-9 * np.abs(expected).max())
+    assert (A._matrix is None) == (method == "amg")
+
+
 def test_free_dofs_is_the_complement():
     fixed = np.array([3, 3, 0, 9])
     np.testing.assert_array_equal(free_dofs(10, fixed), np.setdiff1d(np.arange(10), fixed))
@@ -123,3 +190,7 @@ def test_bad_matrix_and_vectors_raise():
         principal_submatrix(K[:-1], [0])
     with pytest.raises(InputError, match="x: expected shape"):
         condense(K, np.zeros(N), x=np.zeros(N - 1), D=[0])
+    with pytest.raises(InputError, match="f: expected shape"):
+        free_system(K, np.zeros(N + 1), x=np.zeros(N), D=[0])
+    with pytest.raises(InputError, match="keep"):
+        FreeBlock(K, np.array([3, 2]))

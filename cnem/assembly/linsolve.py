@@ -20,7 +20,8 @@ import scipy.sparse.linalg as spla
 
 from .. import config
 from ..errors import InputError, SolveError, check_choice
-from .multigrid import hierarchy, parallel_operator
+from .condensation import FreeBlock
+from .multigrid import hierarchy
 
 if TYPE_CHECKING:
     from typing import Callable, Literal
@@ -178,7 +179,7 @@ def free_rigid_motions(K: sp.spmatrix, points: np.ndarray, fixed: np.ndarray) ->
     return free
 
 
-def solve_spd(A: sp.spmatrix, b: np.ndarray, *, modes: np.ndarray | None = None, tol: float = 1e-10,
+def solve_spd(A: sp.spmatrix | FreeBlock, b: np.ndarray, *, modes: np.ndarray | None = None, tol: float = 1e-10,
               method: Literal["auto", "direct", "amg"] = "auto",
               preconditioner: sp.spmatrix | Callable[..., np.ndarray] | None = None,
               smooth_with_matrix: bool = False, nodal: np.ndarray | None = None) -> np.ndarray:
@@ -186,7 +187,10 @@ def solve_spd(A: sp.spmatrix, b: np.ndarray, *, modes: np.ndarray | None = None,
 
     Parameters
     ----------
-    A : sparse (N, N)
+    A : sparse (N, N) or FreeBlock
+        A `cnem.assembly.condensation.FreeBlock` (the system on the free dofs) is
+        multiplied on its stiffness; its entries are formed only for the direct
+        solve, a hierarchy on it or smoothing with it.
     b : (N,) ndarray
     modes : (N, k) ndarray, optional
         Near-null space for smoothed aggregation (rigid motions).
@@ -222,10 +226,11 @@ def solve_spd(A: sp.spmatrix, b: np.ndarray, *, modes: np.ndarray | None = None,
         CG stalled (relative residual above ten times ``tol``) and the direct factor
         would not fit in `cnem.config.DIRECT_MEMORY`: the message says what to change.
     """
+    A = A if isinstance(A, FreeBlock) else FreeBlock(A)
     if method == "auto":
         method = "direct" if A.nnz <= config.DIRECT_NNZ else "amg"
     if method == "direct":
-        return spla.spsolve(A.tocsc(), b)
+        return spla.spsolve(A.matrix().tocsc(), b)
     check_choice("method", method, ("auto", "direct", "amg"))
     enriched = nodal is not None and not np.all(nodal)
     if enriched:
@@ -256,7 +261,7 @@ def solve_spd(A: sp.spmatrix, b: np.ndarray, *, modes: np.ndarray | None = None,
     return _fall_back(A, b, rel, its, tol, "pyamg")
 
 
-def direct_factor_bytes(A: sp.spmatrix) -> float:
+def direct_factor_bytes(A: sp.spmatrix | FreeBlock) -> float:
     """Estimated bytes of SuperLU's factors of ``A`` (`cnem.config.DIRECT_FILL`: 12 bytes
     per stored entry, value and index)."""
     fill, unknowns, exponent = config.DIRECT_FILL
@@ -283,7 +288,7 @@ def _fall_back(A, b, rel, its, tol, what):
                f"(wanted {tol:.0e})")
     if need <= budget:
         log.warning("%s; solving directly instead (factor ~%.2g GB)", stalled, need / 1e9)
-        return spla.spsolve(A.tocsc(), b)
+        return spla.spsolve(A.matrix().tocsc(), b)
     raise SolveError(f"{stalled}, and a direct solve would need about {need / 1e9:.2g} GB "
                      f"(budget {budget / 1e9:.2g} GB, cnem.config.DIRECT_MEMORY). Pass "
                      f"method='direct' if that memory is there (or raise DIRECT_MEMORY), a "
@@ -300,10 +305,9 @@ def _schwarz_cg(A, b, nodal, modes, tol):
     rel : float
     its : int
     """
-    A = A.tocsr()
     inner, outer = np.flatnonzero(nodal), np.flatnonzero(~nodal)
-    amg = hierarchy(A[inner][:, inner], None if modes is None else modes[inner])
-    lu = spla.splu(A[outer][:, outer].tocsc(), permc_spec="MMD_AT_PLUS_A",
+    amg = hierarchy(A.submatrix(inner), None if modes is None else modes[inner])
+    lu = spla.splu(A.submatrix(outer).tocsc(), permc_spec="MMD_AT_PLUS_A",
                    diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
 
     def apply(r):
@@ -325,7 +329,7 @@ def _cg(A, b, M, tol, label):
     def count(_):
         its[0] += 1
 
-    x, _ = spla.cg(parallel_operator(A), b, rtol=tol, atol=0.0, maxiter=config.CG_MAXITER, M=M,
+    x, _ = spla.cg(A, b, rtol=tol, atol=0.0, maxiter=config.CG_MAXITER, M=M,
                    callback=count)
     norm = np.linalg.norm(b)
     rel = np.linalg.norm(b - A @ x) / norm if norm > 0 else 0.0
@@ -346,8 +350,8 @@ def _amg_cg(A, b, P, modes, tol, smooth_with_A=False):
         Iterations.
     """
     same = P is A
-    A = A.tocsr()
-    cycle = hierarchy(A if same else P, modes, top=A if smooth_with_A and not same else None)
+    cycle = hierarchy(A.matrix() if same else P, modes,
+                      top=A.matrix() if smooth_with_A and not same else None)
     label = "hierarchy on " + ("the matrix" if same else "the preconditioner matrix" +
                                (", smoothing with the matrix" if smooth_with_A else ""))
     return _cg(A, b, cycle, tol, label)
