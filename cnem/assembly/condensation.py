@@ -126,7 +126,8 @@ class FreeBlock(spla.LinearOperator):
     def nnz(self) -> int:
         """Stored entries of the submatrix (counted without forming it)."""
         if self._nnz is None:
-            self._nnz = self._K.nnz if self._all else int(_kept_counts(self._K, self.free)[0].sum())
+            self._nnz = (self._K.nnz if self._all
+                         else int(_kept_counts(self._K, self.free)[0].sum()))
         return self._nnz
 
     def matrix(self) -> sp.spmatrix:

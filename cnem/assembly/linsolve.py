@@ -179,7 +179,8 @@ def free_rigid_motions(K: sp.spmatrix, points: np.ndarray, fixed: np.ndarray) ->
     return free
 
 
-def solve_spd(A: sp.spmatrix | FreeBlock, b: np.ndarray, *, modes: np.ndarray | None = None, tol: float = 1e-10,
+def solve_spd(A: sp.spmatrix | FreeBlock, b: np.ndarray, *, modes: np.ndarray | None = None,
+              tol: float = 1e-10,
               method: Literal["auto", "direct", "amg"] = "auto",
               preconditioner: sp.spmatrix | Callable[..., np.ndarray] | None = None,
               smooth_with_matrix: bool = False, nodal: np.ndarray | None = None) -> np.ndarray:
