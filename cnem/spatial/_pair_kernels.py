@@ -1,4 +1,4 @@
-"""Numba kernels of family search with one horizon for all points.
+"""Family search with one horizon for all points: its numba kernels and their driver.
 
 With a common horizon the relation is symmetric, so every pair is tested once.
 Points are binned into columns along the first two axes and sorted by the
@@ -368,9 +368,14 @@ def _chunks(start, nc, size, h, period, nch):
     return chunk_cols, lo, hi
 
 
-@numba.njit(cache=True, parallel=True)
 def uniform_family(pts, h, origin, size, nc, period, index_dtype_sample, nch):
     """Family of every point for one horizon ``h``, each pair tested once.
+
+    A counting pass, the row offsets, then a filling pass. The output is
+    allocated here by NumPy, not inside a kernel: NumPy asks the kernel for
+    huge pages on large arrays, and the first touch of the 0.5 GB of a 1M-point
+    lattice's families then costs a fraction of what 4 KiB pages cost (the
+    filling pass 0.29 s instead of 0.52-0.63 s on 2 threads).
 
     Parameters
     ----------
@@ -396,23 +401,27 @@ def uniform_family(pts, h, origin, size, nc, period, index_dtype_sample, nch):
     """
     perm, start = bin_points(pts, origin, size, nc, period)     # nc[2] = 1: columns
     spts, box = _sort_columns(pts, perm, start)
-    h2 = h * h
-    tol = 1e-9 * h + 1e-12 * (max(-pts.min(), pts.max()) + h)     # max |x|, no temporary
-    wrap_z = np.isfinite(period[2]) and 2.0 * h * (1.0 + 1e-9) >= period[2]
-    nch = max(1, min(nch, nc[0] * nc[1]))
+    tol = _tolerance(pts, h)
+    wrap_z = bool(np.isfinite(period[2]) and 2.0 * h * (1.0 + 1e-9) >= period[2])
+    nch = max(1, min(nch, int(nc[0] * nc[1])))
     chunk_cols, lo, hi = _chunks(start, nc, size, h, period, nch)
     woff = np.zeros(nch + 1, dtype=np.int64)
-    for c in range(nch):
-        woff[c + 1] = woff[c] + hi[c] - lo[c]
+    np.cumsum(hi - lo, out=woff[1:])
     rows = np.zeros(woff[nch], dtype=np.int64)
     dif = np.zeros(woff[nch] + nch, dtype=np.int64)
-    dummy = np.empty(0, dtype=index_dtype_sample.dtype)
-    _scan_all(spts, h2, tol, start, box, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
-              False, rows, dif, dummy)
-    offsets, out = _cursors(rows, woff, lo, hi, perm, index_dtype_sample)
-    _scan_all(spts, h2, tol, start, box, perm, nc, size, period, wrap_z, chunk_cols, lo, woff,
-              True, rows, dif, out)
+    scan = (spts, h * h, tol, start, box, perm, nc, size, period, wrap_z, chunk_cols, lo, woff)
+    _scan_all(*scan, False, rows, dif, np.empty(0, dtype=index_dtype_sample.dtype))
+    offsets = _cursors(rows, woff, lo, hi, perm)
+    out = np.empty(offsets[-1], dtype=index_dtype_sample.dtype)
+    _scan_all(*scan, True, rows, dif, out)
     return offsets, out
+
+
+@numba.njit(cache=True)
+def _tolerance(pts, h):
+    """Bound on the rounding of coordinates and of their differences: relative to
+    the horizon and to the largest ``|x|`` (found without an (n, 3) temporary)."""
+    return 1e-9 * h + 1e-12 * (max(-pts.min(), pts.max()) + h)
 
 
 @numba.njit(cache=True)
@@ -426,9 +435,8 @@ def _chunk_range(x, lo, hi):
 
 
 @numba.njit(cache=True, parallel=True)
-def _cursors(rows, woff, lo, hi, perm, index_dtype_sample):
-    """Row offsets; the per-chunk row counts turned into write cursors, in place;
-    the output allocated."""
+def _cursors(rows, woff, lo, hi, perm):
+    """Row offsets; the per-chunk row counts turned into write cursors, in place."""
     n = perm.shape[0]
     counts = np.empty(n, dtype=np.int64)
     for x in numba.prange(n):
@@ -449,4 +457,4 @@ def _cursors(rows, woff, lo, hi, perm, index_dtype_sample):
             v = rows[k]
             rows[k] = t
             t += v
-    return offsets, np.empty(offsets[n], dtype=index_dtype_sample.dtype)
+    return offsets
