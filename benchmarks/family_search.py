@@ -593,6 +593,8 @@ def report_lattice(results):
         if ok(kp):
             parts.append("kd pairs: build {:.3f} + query_pairs {:.3f} + CSR {:.3f}".format(
                 *(median([x[k] for x in kp["runs"]]) for k in ("build", "pairs", "csr"))))
+        if ok(r["cells"]):             # the spread: fresh memory is slow on some machines
+            parts.append("cells runs " + " ".join(f"{t:.3f}" for t in r["cells"]["runs"]))
         rt = r["rtree"]
         if ok(rt):
             parts.append(f"rtree query+CSR ~ {t_of(rt) - t_of(rt, 'builds'):.3f}")
