@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import reference as R
+from cnem import config
 from cnem.spatial import Family, family_search
 
 METHODS = ["auto", "rtree", "cells", "kdtree", "brute"]
@@ -297,12 +298,25 @@ def lines_cloud(rng, dim):
     return pts[rng.permutation(len(pts))]
 
 
+#: Column widths of the one-horizon cell list: the default (by dimension) and one
+#: number for every dimension, wide (a horizon) and narrow (a third of one).
+COLUMNS = ["default", 1.0, 3.0]
+
+
+@pytest.fixture(params=COLUMNS, ids=lambda c: f"columns-{c}")
+def columns(request, monkeypatch):
+    """`cnem.config.COLUMNS_PER_HORIZON` for the test (a number serves every dimension)."""
+    if request.param != "default":
+        monkeypatch.setattr(config, "COLUMNS_PER_HORIZON", request.param)
+    return request.param
+
+
 @pytest.mark.parametrize("seed", range(12))
 @pytest.mark.parametrize("dim", [2, 3])
-def test_cells_on_lines_match_brute(seed, dim):
+def test_cells_on_lines_match_brute(seed, dim, columns):
     """Property: random clouds of lines (lattices and jittered lattices included),
     random horizons (integer ones: ties), open (scaled and shifted) or periodic
-    (scaled): method='cells' gives the brute-force families."""
+    (scaled), columns of any width: method='cells' gives the brute-force families."""
     rng = np.random.default_rng(seed + 100 * dim)
     pts = lines_cloud(rng, dim)
     span = pts.max(axis=0) - pts.min(axis=0) + 1.0
@@ -321,7 +335,7 @@ def test_cells_on_lines_match_brute(seed, dim):
 @pytest.mark.parametrize("rel", [-1e-8, -1e-10, -1e-15, 0.0, 1e-15, 1e-10, 1e-8])
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("periodic", [False, True], ids=["open", "periodic"])
-def test_cells_near_ties_on_a_lattice(rel, dim, periodic):
+def test_cells_near_ties_on_a_lattice(rel, dim, periodic, columns):
     """Lattice distances sqrt(1..10) times a spacing that is not a power of two, the
     horizon within a relative 1e-15 .. 1e-8 of one of them (on either side), the
     lattice far from the origin: the members method='cells' takes without a distance

@@ -120,8 +120,9 @@ def _cells(pts3, horizon, period3, dim):
         if dim == 2:
             axes = [2, 0, 1]
             pts_c, per_c = np.ascontiguousarray(pts3[:, axes]), period3[axes]
-        origin, size, nc = _grid(pts_c, float(horizon[0]), per_c, 2,
-                                 config.COLUMNS_PER_HORIZON[dim])
+        columns = config.COLUMNS_PER_HORIZON        # a number, or one per dimension
+        columns = columns[dim] if isinstance(columns, dict) else columns
+        origin, size, nc = _grid(pts_c, float(horizon[0]), per_c, 2, columns)
         return P.uniform_family(pts_c, float(horizon[0]), origin, size, nc, per_c, sample,
                                 numba.get_num_threads())
     origin, size, nc = _grid(pts3, float(horizon.max()), period3, dim)
