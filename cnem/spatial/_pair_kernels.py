@@ -372,10 +372,14 @@ def uniform_family(pts, h, origin, size, nc, period, index_dtype_sample, nch):
     """Family of every point for one horizon ``h``, each pair tested once.
 
     A counting pass, the row offsets, then a filling pass. The output is
-    allocated here by NumPy, not inside a kernel: NumPy asks the kernel for
-    huge pages on large arrays, and the first touch of the 0.5 GB of a 1M-point
-    lattice's families then costs a fraction of what 4 KiB pages cost (the
-    filling pass 0.29 s instead of 0.52-0.63 s on 2 threads).
+    allocated here by NumPy, not inside a kernel, so that it gets NumPy's huge
+    pages like every other large array: on a 1M-point lattice (0.5 GB of
+    families, 2 threads) the filling pass took 0.24-0.29 s instead of
+    0.52-0.63 s with memory the process had used before. Memory the machine has
+    not handed out for a while costs more to touch on some virtual machines
+    (freed memory returned to the host), in huge pages more than in small ones:
+    a first call in a fresh process there took 0.96-1.23 s, against 0.51-0.64 s
+    with small pages.
 
     Parameters
     ----------
