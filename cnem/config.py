@@ -113,12 +113,12 @@ BRUTE_LIMIT = 20_000
 CELLS_PER_HORIZON = 2
 
 #: Columns per horizon along the binned axes of the family search (one horizon for
-#: all points), by the points' dimension (a single number serves both). Narrow columns cost more windows per point,
-#: wide ones more candidates tested; the values are the fastest measured on 1M
-#: points with a horizon of 3 spacings (2 threads): in 3-D 1.5 (lattice 0.43 s,
-#: random 1.23 s) against 3 (0.46-0.57 s, 1.38-1.53 s) and 2 (0.51 s, 1.07 s); in
-#: 2-D, where the columns are strips, 3 (lattice 0.18 s, random 0.35 s) against 2
-#: (0.23 s, 0.43 s).
+#: all points), by the points' dimension (a single number serves both). Narrow columns
+#: cost more windows per point, wide ones more candidates tested. Measured on 1M points
+#: with a horizon of 3 spacings, 2 threads: in 3-D 1.5 (lattice 0.43 s, random 1.23 s,
+#: best of 6 runs) against 3 (0.46-0.57 s, 1.38-1.53 s) and 2 (0.51 s, 1.07 s); in 2-D,
+#: where the columns are strips, 3 (lattice 0.18 s, random 0.35 s, medians of 5)
+#: against 2 (0.23 s, 0.43 s).
 COLUMNS_PER_HORIZON = {2: 3.0, 3: 1.5}
 
 #: `cnem.fem.mesh_domain` with a node target stops once the node count is within this
