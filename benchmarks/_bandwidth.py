@@ -1,9 +1,11 @@
 """Memory-bandwidth bound of the peridynamic step: streaming kernels over its bond arrays.
 
-The bond-based force loop (``cnem.pd._kernels.pmb_forces``) reads, per bond, the
-reference bond vector ``xi`` (d float64), its length, the partner index, the stiffness
-and the alive flag, once per step; the per-point arrays (displacements, volumes, forces)
-are ~30x smaller. Two kernels measure how fast this machine streams such arrays:
+The bond-based force loop (``cnem.pd._pmb_kernels.pmb_forces``) reads, per bond, the
+length, the partner index, the stiffness and the alive flag, once per step (21 bytes;
+the reference bond vector comes from the points); the per-point arrays (points,
+displacements, volumes, forces) are about 10x smaller and are read from the caches, as
+the bonds of one point reach only nearby points. Two kernels measure how fast this machine
+streams such arrays:
 
 * ``read``: one pass over the step's own bond arrays (or synthetic ones of the same
   sizes and dtypes), summing them -- the bytes the force loop cannot avoid reading; its
@@ -34,13 +36,10 @@ def _kernels():
     import numba
 
     @numba.njit(parallel=True, fastmath=True, cache=False)
-    def read(xi, length, bond_j, stiffness, alive):
+    def read(length, bond_j, stiffness, alive):
         total = 0.0
         for b in numba.prange(length.shape[0]):
-            s = length[b] + stiffness[b] + bond_j[b] + alive[b]
-            for k in range(xi.shape[1]):
-                s += xi[b, k]
-            total += s
+            total += length[b] + stiffness[b] + bond_j[b] + alive[b]
         return total
 
     @numba.njit(parallel=True, fastmath=True, cache=False)
@@ -51,11 +50,11 @@ def _kernels():
     return read, triad
 
 
-def bond_arrays(bonds, d, index_dtype=np.int32):
+def bond_arrays(bonds, index_dtype=np.int32):
     """Synthetic arrays of the force loop's sizes and dtypes:
-    ``(xi (bonds, d), length, bond_j, stiffness, alive)``."""
-    return (np.full((bonds, d), 0.5), np.ones(bonds), np.arange(bonds, dtype=index_dtype),
-            np.full(bonds, 2.0), np.ones(bonds, dtype=np.uint8))
+    ``(length, bond_j, stiffness, alive)``."""
+    return (np.ones(bonds), np.arange(bonds, dtype=index_dtype), np.full(bonds, 2.0),
+            np.ones(bonds, dtype=np.uint8))
 
 
 def nbytes(arrays):
@@ -78,7 +77,7 @@ def measure(arrays, threads, repeat=STREAM_REPEAT):
     Parameters
     ----------
     arrays : tuple of ndarray
-        ``(xi, length, bond_j, stiffness, alive)`` of the force loop.
+        ``(length, bond_j, stiffness, alive)`` of the force loop.
     threads : sequence of int
 
     Returns
@@ -102,15 +101,15 @@ def measure(arrays, threads, repeat=STREAM_REPEAT):
     return out
 
 
-def _read_worker(bonds, d, repeat, barrier, queue):
+def _read_worker(bonds, repeat, barrier, queue):
     read, _ = _kernels()
-    arrays = bond_arrays(bonds, d)
+    arrays = bond_arrays(bonds)
     read(*arrays)                       # compiled and pages touched before the others wait
     barrier.wait()
     queue.put(nbytes(arrays) / _timed(lambda: read(*arrays), repeat) / 1e9)
 
 
-def concurrent_read(bonds, d, procs, repeat=STREAM_REPEAT):
+def concurrent_read(bonds, procs, repeat=STREAM_REPEAT):
     """Aggregate read bandwidth (GB/s) of ``procs`` single-threaded processes that each
     stream ``bonds / procs`` synthetic bonds at the same time (started together at a
     barrier after their warm-up; the sum of each process's own rate)."""
@@ -120,7 +119,7 @@ def concurrent_read(bonds, d, procs, repeat=STREAM_REPEAT):
     os.environ.update(NUMBA_NUM_THREADS="1", OMP_NUM_THREADS="1")
     try:
         workers = [ctx.Process(target=_read_worker,
-                               args=(bonds // procs, d, repeat, barrier, queue))
+                               args=(bonds // procs, repeat, barrier, queue))
                    for _ in range(procs)]
         for w in workers:
             w.start()

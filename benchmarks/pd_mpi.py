@@ -247,7 +247,7 @@ def main(argv=None):
                     rounds.setdefault((mode, ranks), []).append(r)
             during = MachineLoad()
             for procs in streams[case]:
-                streams[case][procs].append(stream.concurrent_read(MEMBERS[d] * k ** d, d, procs))
+                streams[case][procs].append(stream.concurrent_read(MEMBERS[d] * k ** d, procs))
             print(f"  round {round_ + 1}: {case} read bandwidth, 1 process "
                   f"{streams[case][1][-1]:.1f} GB/s, 2 at once {streams[case][2][-1]:.1f} GB/s "
                   f"({during.stop().short()})", flush=True)
@@ -267,8 +267,7 @@ def report_bandwidth(results, streams):
           "synthetic bond arrays of the case's size, split between them, all at once; "
           "medians over the rounds):")
     for case, bw in streams.items():
-        d, k = CASES[case]
-        per_bond = stream.nbytes(stream.bond_arrays(1, d))
+        per_bond = stream.nbytes(stream.bond_arrays(1))
         b1, b2 = median(bw[1]), median(bw[2])
         r1, r2 = results[case].get(("dist", 1)), results[case].get(("dist", 2))
         line = (f"  {case}: {per_bond} bytes per bond; 1 process {b1:.1f} GB/s, 2 at once "

@@ -24,7 +24,7 @@ spinning workers (GNU OpenMP's default wait policy) can make two threads slower 
   subclass whose only change is to time its ``_correction`` call, so the details split the
   Problem into operators and correction at no extra cost.  Setup timings are medians over
   ``--setup-repeat`` runs (default 3 below 1M points, 1 at 1M), each from scratch.
-* ``kernel s/step``: ``cnem.pd._kernels.pmb_forces`` -- the force loop of
+* ``kernel s/step``: ``cnem.pd._pmb_kernels.pmb_forces`` -- the force loop of
   ``Problem.run_dynamic`` -- called with the arrays of the Body, the per-bond stiffness
   ``bond_stiffness * factor * beta`` that ``run_dynamic`` passes, every bond alive
   (uint8 ones), ``limit = inf`` (no breaks) and a random displacement field
@@ -38,8 +38,9 @@ spinning workers (GNU OpenMP's default wait policy) can make two threads slower 
   ``speed-up`` = NumPy s/step / kernel (2 threads) s/step.
 
 * ``stream``: the memory-bandwidth bound (``benchmarks/_bandwidth.py``): a read kernel
-  over the step's own bond arrays (``xi``, lengths, partner indices, stiffness, alive
-  flags: what the force loop must read every step) and STREAM's triad, at 1 and 2
+  over the step's own bond arrays (lengths, partner indices, stiffness, alive flags:
+  what the force loop must read every step; the reference bond vectors come from the
+  points, read from the caches) and STREAM's triad, at 1 and 2
   threads, medians over ``--repeat`` calls; printed beside the kernel as the bond updates
   per second the read rate allows (read GB/s over bytes per bond) and the 2-thread /
   1-thread speed-up it allows (ratio of the read rates).
@@ -132,9 +133,9 @@ def numpy_forces(u, body, stiffness):
 
 
 def kernel_forces(u, body, stiffness, alive, out):
-    from cnem.pd import _kernels as K
-    K.pmb_forces(u, body.xi, body.length, body.family.offsets, body.bond_j, stiffness,
-                 body.volumes, alive, np.inf, out)
+    from cnem.pd._pmb_kernels import pmb_forces
+    pmb_forces(u, body.points, body.image, body.length, body.family.offsets, body.bond_j,
+               stiffness, body.volumes, alive, np.inf, out)
     return out
 
 
@@ -322,7 +323,7 @@ def run_case(name, args, guard, problem_class):
     numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
     r["alive"] = bool(alive.all())
     print(" stream", end="", flush=True)
-    r["stream"] = stream.measure((body.xi, body.length, body.bond_j, stiffness, alive),
+    r["stream"] = stream.measure((body.length, body.bond_j, stiffness, alive),
                                  available_threads(), args.repeat)
 
     if args.no_numpy:

@@ -1,4 +1,5 @@
-"""Numba kernels of the peridynamic force loop (arrays and scalars only)."""
+"""Numba kernels of the peridynamic bond geometry and its surface correction (arrays and
+scalars only); the bond-based force loop is in `_pmb_kernels`."""
 
 import numba
 import numpy as np
@@ -6,92 +7,35 @@ import numpy as np
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
 
 
-@numba.njit(cache=True, fastmath=True, error_model="numpy")
-def _pmb_point(i, u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit, out):
-    """The PMB force density of point ``i`` into ``out[i]`` (see `pmb_forces`); returns
-    the number of its bonds broken.
-
-    One square root and one division per bond: ``s / |y| = (|y| - L) / (L |y|)``, and
-    the break test ``|y| / L - 1 > limit`` as ``|y|^2 > (L (1 + limit))^2`` (every bond
-    breaks when ``limit < -1``: a stretch is at least -1).
-    """
-    d = u.shape[1]
-    grow = 1.0 + limit
-    every = grow < 0.0
-    broken = 0
-    f0 = 0.0
-    f1 = 0.0
-    f2 = 0.0
-    for b in range(offsets[i], offsets[i + 1]):
-        if not alive[b]:
-            continue
-        j = bond_j[b]
-        y0 = xi[b, 0] + u[j, 0] - u[i, 0]
-        y1 = xi[b, 1] + u[j, 1] - u[i, 1]
-        y2 = 0.0
-        if d == 3:
-            y2 = xi[b, 2] + u[j, 2] - u[i, 2]
-        yy = y0 * y0 + y1 * y1 + y2 * y2
-        L = length[b]
-        reach = L * grow
-        if every or yy > reach * reach:
-            alive[b] = 0
-            broken += 1
-            continue
-        ly = np.sqrt(yy)
-        g = stiffness[b] * volumes[j] * (ly - L) / (L * ly)
-        f0 += g * y0
-        f1 += g * y1
-        f2 += g * y2
-    out[i, 0] = f0
-    out[i, 1] = f1
-    if d == 3:
-        out[i, 2] = f2
-    return broken
+def image_factors(period):
+    """``(2, d)``: per axis the period and its inverse, both 0 on an axis of infinite
+    ``period (d,)`` (not periodic), for `periodic_image`."""
+    period = np.asarray(period, dtype=float)
+    finite = np.isfinite(period)
+    return np.ascontiguousarray(np.stack([np.where(finite, period, 0.0),
+                                          np.where(finite, 1.0 / period, 0.0)]))
 
 
-@numba.njit(cache=True, parallel=True, fastmath=True, error_model="numpy")
-def pmb_forces(u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit, out):
-    """Bond-based PMB force density at every point, breaking bonds beyond ``limit``.
-
-    ``out[i] = sum_j stiffness_b s_b (y_b / |y_b|) V_j`` over the live bonds of
-    ``i``, with ``y_b = xi_b + u_j - u_i`` and the stretch ``s_b = |y_b| / L_b - 1``.
-    A bond whose stretch exceeds ``limit`` is marked dead (``alive[b] = 0``)
-    and carries no force from then on. Returns the number of bonds broken.
-    """
-    n = u.shape[0]
-    broken = np.zeros(n, dtype=np.int64)
-    for i in numba.prange(n):
-        broken[i] = _pmb_point(i, u, xi, length, offsets, bond_j, stiffness, volumes, alive,
-                               limit, out)
-    return broken.sum()
-
-
-@numba.njit(cache=True, parallel=True, fastmath=True, error_model="numpy")
-def pmb_forces_rows(rows, u, xi, length, offsets, bond_j, stiffness, volumes, alive, limit,
-                    out):
-    """`pmb_forces` at the points ``rows`` only (``out`` written at those rows)."""
-    broken = np.zeros(len(rows), dtype=np.int64)
-    for k in numba.prange(len(rows)):
-        broken[k] = _pmb_point(rows[k], u, xi, length, offsets, bond_j, stiffness, volumes,
-                               alive, limit, out)
-    return broken.sum()
+@numba.njit(cache=True, inline="always")
+def periodic_image(v, period, inverse):
+    """The coordinate difference ``v`` on an axis of ``period`` (``inverse = 1 / period``,
+    both 0 on an axis that is not periodic): its minimum image ``v - period round(v /
+    period)``, with no branch (``v`` itself when not periodic)."""
+    return v - period * np.round(v * inverse)
 
 
 @numba.njit(cache=True, parallel=True)
-def bond_geometry(points, offsets, bond_j, period, spacing, horizon, xi, length, beta):
-    """Reference bond vectors (minimum image on periodic axes), lengths and the
-    partial-volume factors ``clip((delta + dx/2 - L) / dx, 0, 1)`` with ``dx`` the
-    mean spacing of the two points."""
+def bond_geometry(points, offsets, bond_j, image, spacing, horizon, xi, length, beta):
+    """Reference bond vectors (minimum image on periodic axes, ``image (2, d)`` from
+    `image_factors`), lengths and the partial-volume factors ``clip((delta + dx/2 - L) /
+    dx, 0, 1)`` with ``dx`` the mean spacing of the two points."""
     n, d = points.shape
     for i in numba.prange(n):
         for b in range(offsets[i], offsets[i + 1]):
             j = bond_j[b]
             s = 0.0
             for k in range(d):
-                v = points[j, k] - points[i, k]
-                if np.isfinite(period[k]):
-                    v -= period[k] * np.round(v / period[k])
+                v = periodic_image(points[j, k] - points[i, k], image[0, k], image[1, k])
                 xi[b, k] = v
                 s += v * v
             L = np.sqrt(s)

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import InputError, check_array, check_points
 from ..spatial import family_search, remove_crossing
-from ._kernels import bond_geometry
+from ._kernels import bond_geometry, image_factors
 
 if TYPE_CHECKING:
     from ..geometry.cloud import NodeCloud
@@ -103,6 +103,11 @@ class Body:
     length : (b,) ndarray
     beta : (b,) ndarray
         Partial-volume factors of bonds cut by the horizon.
+    period : (d,) ndarray
+        The period of each axis (``inf``: not periodic).
+    image : (2, d) ndarray
+        Per axis the period and its inverse, both 0 on an axis that is not periodic: the
+        minimum image of a coordinate difference (`cnem.pd._kernels.periodic_image`).
     """
 
     def __init__(self, points: np.ndarray, volumes: float | ArrayLike, horizon: float, *,
@@ -123,14 +128,15 @@ class Body:
                              f"point has a neighbour within it, so the body has no bonds")
         self.family = fam
         self.period = fam.period
+        self.image = image_factors(self.period)
         index = fam.indices.dtype                  # int32 unless the cloud is huge
         self.bond_i = np.repeat(np.arange(n, dtype=index), fam.counts)
         self.bond_j = fam.indices
         nb = len(self.bond_j)
         self.xi, self.length, self.beta = np.empty((nb, d)), np.empty(nb), np.empty(nb)
         spacing = (vol / self.thickness) ** (1.0 / d)
-        bond_geometry(pts, fam.offsets, self.bond_j, np.ascontiguousarray(self.period, dtype=float),
-                      spacing, horizon, self.xi, self.length, self.beta)
+        bond_geometry(pts, fam.offsets, self.bond_j, self.image, spacing, horizon, self.xi,
+                      self.length, self.beta)
 
     @classmethod
     def from_cloud(cls, cloud: NodeCloud, horizon_factor: float = 3.0, *,

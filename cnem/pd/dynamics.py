@@ -15,7 +15,7 @@ from tqdm.auto import tqdm
 
 from ..assembly.conditions import per_point
 from ..errors import InputError
-from . import _kernels as K
+from ._pmb_kernels import pmb_forces
 from .frames import FrameWriter
 from .guards import checked_run, diverged, first_non_finite
 from .relaxation import relax
@@ -67,8 +67,8 @@ class Dynamics:
         b = self.body
         if self.material.kind == "bond":
             out = np.empty_like(u)
-            broken = K.pmb_forces(u, b.xi, b.length, b.family.offsets, b.bond_j, state["stiffness"],
-                                  b.volumes, self.alive, limit, out)
+            broken = pmb_forces(u, b.points, b.image, b.length, b.family.offsets, b.bond_j,
+                                state["stiffness"], b.volumes, self.alive, limit, out)
             return out, broken
         stretch = np.sqrt(((b.xi + u[b.bond_j] - u[b.bond_i]) ** 2).sum(axis=1)) / b.length - 1
         broken = int(((stretch > limit) & (self.alive == 1)).sum())

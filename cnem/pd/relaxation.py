@@ -122,6 +122,26 @@ def unsettled(step: int, norm: float, scale: float, target: float, max_steps: in
         f"(the residual history is the error's .history)", history)
 
 
+def force_round_off(problem: Any, stiffness: np.ndarray | None, at_rest: np.ndarray,
+                    rows: int) -> np.ndarray:
+    """How far round-off alone puts the nodal forces from balance, per dof ``(rows d,)``.
+
+    The force at zero displacement (``at_rest``, nodal, owned rows) says it when the
+    stretches of the reference bonds do not come out exactly zero. A PMB bond's force
+    (``stiffness (b,)`` its ``c_b``) also rounds ``|y| - L`` to about ``eps L`` at any
+    displacement, so it is off by about ``eps c_b V_j``; the bonds of a point add up at
+    random, times its volume. The larger of the two, per dof.
+    """
+    body = problem.body
+    d = problem.dim
+    if stiffness is None:
+        return np.abs(at_rest)
+    per_bond = np.finfo(float).eps * stiffness * body.volumes[body.bond_j]
+    per_point = body.volumes[:rows] * np.sqrt(np.bincount(body.bond_i, weights=per_bond ** 2,
+                                                          minlength=rows))
+    return np.maximum(np.abs(at_rest), np.repeat(per_point, d))
+
+
 def load_steps(x: np.ndarray, forces: Callable[..., np.ndarray], density: np.ndarray,
                external: np.ndarray, load: np.ndarray, prescribe: Callable[..., np.ndarray], *,
                tol: float, noise: float, limit: float, steps: int, max_steps: int, every: int,
@@ -317,9 +337,9 @@ class System:
         self.u = np.zeros((n, d))
         self.flat, self.x = self.u.reshape(-1), np.zeros(len(free))     # x: the free dofs
         self.external = np.zeros(len(free))
-        # the force at zero displacement is the round-off of the bond stretches (it should
-        # vanish): a residual below a few times it cannot be reached
-        self.noise = 10.0 * float(np.linalg.norm(self._nodal_force()[0][free]))
+        # a residual below a few times the forces' round-off cannot be reached
+        floor = force_round_off(problem, self.state.get("stiffness"), self._nodal_force()[0], n)
+        self.noise = 10.0 * float(np.linalg.norm(floor[free]))
 
     def _nodal_force(self, breaking=np.inf):
         """Internal forces times volumes at ``u``, ``(d n,)``, and the bonds broken."""

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...spatial import family_search, remove_crossing
-from .._kernels import bond_geometry
+from .._kernels import bond_geometry, image_factors
 from ..body import checked_input, crack_segments
 from . import _kernels as K
 from .comm import Halo, world
@@ -50,6 +50,8 @@ class Body:
         Bonds of the owned points (ghost rows are empty).
     bond_i, bond_j, xi, length, beta
         As in `cnem.pd.Body`, for the bonds of the owned points (local numbering).
+    period, image
+        As in `cnem.pd.Body`.
     halo : Halo
     interior, boundary : int64 ndarray
         Owned rows without / with a ghost in their family: the forces of the interior
@@ -69,6 +71,7 @@ class Body:
             np.asarray(crossing_points, dtype=float)
         self.period = np.full(d, np.inf) if period is None else \
             np.broadcast_to(np.asarray(period, dtype=float), (d,)).copy()
+        self.image = image_factors(self.period)
         self._period_arg = period
         rank, size = self.comm.rank, self.comm.size
         weights = np.ones(n)
@@ -95,8 +98,8 @@ class Body:
         nb = len(self.bond_j)
         self.xi, self.length, self.beta = np.empty((nb, d)), np.empty(nb), np.empty(nb)
         spacing = (self.volumes / self.thickness) ** (1.0 / d)
-        bond_geometry(self.points, self.offsets, self.bond_j, np.ascontiguousarray(self.period),
-                      spacing, horizon, self.xi, self.length, self.beta)
+        bond_geometry(self.points, self.offsets, self.bond_j, self.image, spacing, horizon,
+                      self.xi, self.length, self.beta)
         self.halo = Halo(self.comm, owned, ghosts, self.part)
         near_ghost = np.bincount(self.bond_i[self.bond_j >= len(owned)], minlength=len(owned)) > 0
         self.interior = np.flatnonzero(~near_ghost)

@@ -22,7 +22,7 @@ from tqdm.auto import tqdm
 
 from ...assembly.conditions import Conditions, per_point
 from ...errors import MaterialError, OptionError
-from .._kernels import pmb_forces_rows
+from .._pmb_kernels import pmb_forces_rows
 from ...material import PLANES
 from ..guards import checked_run, diverged, first_non_finite
 from ..solution import DynamicRun
@@ -175,8 +175,8 @@ class Problem(Conditions, VelocityConditions):
         pending = b.halo.start(u)
         if self.material.kind == "bond":
             out = np.empty((o, self.dim))
-            args = (u, b.xi, b.length, b.offsets, b.bond_j, ops.stiffness, b.volumes,
-                    self.alive, limit, out)
+            args = (u, b.points, b.image, b.length, b.offsets, b.bond_j, ops.stiffness,
+                    b.volumes, self.alive, limit, out)
             broken = pmb_forces_rows(b.interior, *args)
             b.halo.finish(pending)
             broken += pmb_forces_rows(b.boundary, *args)

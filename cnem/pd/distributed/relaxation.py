@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..relaxation import load_steps
+from ..relaxation import force_round_off, load_steps
 from ...errors import InputError
 from ..solution import Relaxation
 
@@ -69,7 +69,10 @@ def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: i
             np.maximum(density, 0.25 * problem.ops.row_bound().reshape(-1)[free], out=density)
         return external + volumes * force.reshape(-1)[free], count
 
-    noise = 10.0 * problem.norm(volumes * problem.internal_force(u, np.inf)[0].reshape(-1)[free])
+    at_rest = np.repeat(body.volumes[:o], d) * problem.internal_force(u, np.inf)[0].reshape(-1)
+    stiffness = problem.ops.stiffness if problem.material.kind == "bond" else None
+    noise = 10.0 * problem.norm(force_round_off(problem, stiffness, at_rest, o)[free])
+
     def prescribe(fraction):
         flat[fixed] = fraction * values
 
