@@ -33,11 +33,12 @@ def _shifted_dist2(pts, q, x0, x1, x2, s0, s1, s2):
     ``_wrap`` computes when the shift is the right periodic image, so all
     methods agree to the last bit.
     """
-    d = (pts[q, 0] - x0) + s0
+    r = np.uint64(q)                # no index is negative: no wrap-around code
+    d = (pts[r, 0] - x0) + s0
     d2 = d * d
-    d = (pts[q, 1] - x1) + s1
+    d = (pts[r, 1] - x1) + s1
     d2 += d * d
-    d = (pts[q, 2] - x2) + s2
+    d = (pts[r, 2] - x2) + s2
     return d2 + d * d
 
 

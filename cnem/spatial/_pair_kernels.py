@@ -168,17 +168,17 @@ def _height(spts, base, m, v, period):
     """Height of point ``v`` of the three copies of a column (``m`` points each)
     shifted by ``-period``, 0 and ``+period``."""
     if v < m:
-        return spts[base + v, 2] - period
+        return spts[np.uint64(base + v), 2] - period
     if v < 2 * m:
-        return spts[base + v - m, 2]
-    return spts[base + v - 2 * m, 2] + period
+        return spts[np.uint64(base + v - m), 2]
+    return spts[np.uint64(base + v - 2 * m), 2] + period
 
 
 @numba.njit(cache=True, inline="always")
 def _at(spts, base, m, v, period, periodic):
     """Height of point ``v`` of a column of ``m`` points (of its three shifted
     copies on a periodic third axis, see `_height`)."""
-    return _height(spts, base, m, v, period) if periodic else spts[base + v, 2]
+    return _height(spts, base, m, v, period) if periodic else spts[np.uint64(base + v), 2]
 
 
 @numba.njit(cache=True)
@@ -293,7 +293,7 @@ def _record(d2, h2, write, rows, lo, out, q, own, perm, mine):
     Returns the new ``mine``."""
     if not write:                    # branch-free: about half the candidates are members
         hit = (d2 < h2) & (d2 > 0.0)
-        rows[q - lo] += hit
+        rows[np.uint64(q - lo)] += hit
         return mine + hit
     if d2 < h2 and d2 > 0.0:
         return _member(rows, lo, out, q, own, perm, mine)
@@ -304,10 +304,11 @@ def _record(d2, h2, write, rows, lo, out, q, own, perm, mine):
 def _member(rows, lo, out, q, own, perm, mine):
     """Write the pair of member ``q`` and the point ``own``: ``own`` at the cursor of
     the row of ``q``, ``q`` at ``mine``. Returns the new ``mine``."""
-    i = rows[q - lo]
-    out[i] = own
-    rows[q - lo] = i + 1
-    out[mine] = perm[q]
+    x = np.uint64(q - lo)           # unsigned: no index is negative, no wrap-around code
+    i = rows[x]
+    out[np.uint64(i)] = own
+    rows[x] = i + 1
+    out[np.uint64(mine)] = perm[np.uint64(q)]
     return mine + 1
 
 
@@ -375,7 +376,8 @@ def uniform_family(pts, h, origin, size, nc, period, index_dtype_sample, nch):
     allocated here by NumPy, not inside a kernel, so that it gets NumPy's huge
     pages like every other large array: on a 1M-point lattice (0.5 GB of
     families, 2 threads) the filling pass took 0.24-0.29 s instead of
-    0.52-0.63 s with memory the process had used before. Memory the machine has
+    0.52-0.63 s with memory the process had used before (0.21-0.23 s since the
+    hot loops index with unsigned integers). Memory the machine has
     not handed out for a while costs more to touch on some virtual machines
     (freed memory returned to the host), in huge pages more than in small ones:
     a first call in a fresh process there took 0.96-1.23 s, against 0.51-0.64 s
