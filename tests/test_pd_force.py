@@ -156,15 +156,16 @@ def test_pmb_kernel_takes_the_minimum_image_in_a_periodic_cell():
     """Bonds across the sides of a periodic cell: the kernel's forces and breaks against a
     NumPy loop over the bonds with the minimum image taken independently, on more points
     than one block of the kernel."""
-    from cnem.pd._pmb_kernels import BLOCK_POINTS
+    from cnem.pd._pmb_kernels import BLOCK_BONDS
     rng = np.random.default_rng(4)
-    period, n = np.array([0.8, 0.5]), 3 * BLOCK_POINTS + 17
+    period, n = np.array([0.8, 0.5]), 3 * BLOCK_BONDS // 20 + 17     # ~28 bonds a point
     points = rng.uniform(0.0, 1.0, (n, 2)) * period
     horizon = 3.0 * np.sqrt(period.prod() / n)
     body = pd.Body(points, period.prod() / n, horizon, period=period)
     i, j = body.bond_i, body.bond_j
     xi = points[j] - points[i]
     assert (np.abs(xi) > 0.5 * period).any()                  # some bonds wrap around
+    assert len(j) > 2 * BLOCK_BONDS                           # several blocks
     xi -= period * np.round(xi / period)
     u = rng.normal(0.0, 0.02 * horizon, points.shape)
     stiffness = rng.uniform(0.5, 1.5, len(j))
@@ -186,9 +187,10 @@ def test_pmb_kernel_on_some_points_gives_their_bits(shape):
     """`pmb_forces_rows` on a sorted subset of the points (runs and isolated points): the
     same forces, to the bit, and the same breaks at those points as `pmb_forces` on all,
     and no other bond touched."""
-    from cnem.pd._pmb_kernels import pmb_forces_rows
+    from cnem.pd._pmb_kernels import BLOCK_BONDS, pmb_forces_rows
     points, volumes, horizon = _irregular_2d(shape=shape)
     body = pd.Body(points, volumes, horizon)
+    assert (len(body.bond_j) > 2 * BLOCK_BONDS) == (shape != (11, 8))
     rng = np.random.default_rng(5)
     u = rng.normal(0.0, 0.02 * horizon, points.shape)
     stiffness = rng.uniform(0.5, 1.5, len(body.bond_j))
