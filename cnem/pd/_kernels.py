@@ -8,20 +8,20 @@ from .. import _compile  # noqa: F401  (says once when the kernels compile)
 
 
 def image_factors(period):
-    """``(2, d)``: per axis the period and its inverse, both 0 on an axis of infinite
-    ``period (d,)`` (not periodic), for `periodic_image`."""
+    """``(2, d)``: per axis the period twice, or 0 and 1 on an axis of infinite ``period
+    (d,)`` (not periodic), for `periodic_image`."""
     period = np.asarray(period, dtype=float)
     finite = np.isfinite(period)
     return np.ascontiguousarray(np.stack([np.where(finite, period, 0.0),
-                                          np.where(finite, 1.0 / period, 0.0)]))
+                                          np.where(finite, period, 1.0)]))
 
 
 @numba.njit(cache=True, inline="always")
-def periodic_image(v, period, inverse):
-    """The coordinate difference ``v`` on an axis of ``period`` (``inverse = 1 / period``,
-    both 0 on an axis that is not periodic): its minimum image ``v - period round(v /
+def periodic_image(v, period, divisor):
+    """The coordinate difference ``v`` on an axis of ``period`` (``divisor`` the period too;
+    0 and 1 on an axis that is not periodic): its minimum image ``v - period round(v /
     period)``, with no branch (``v`` itself when not periodic)."""
-    return v - period * np.round(v * inverse)
+    return v - period * np.round(v / divisor)
 
 
 @numba.njit(cache=True, parallel=True)

@@ -23,6 +23,7 @@ import numba
 import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
+from .._parallel import work_chunks
 from ._kernels import periodic_image
 
 # Bonds per block (a block of one point may hold more): 8192 x 33 B of scratch in 3-D stay in
@@ -69,11 +70,12 @@ def _bond_vectors(start, stop, u, points, image, offsets, bond_j, volumes, y, w)
 
 @numba.njit(cache=True, error_model="numpy")
 def _bond_factors(y, w, length, stiffness, alive, grow, snapped):
-    """Overwrite ``y (d, m)`` with ``g_b y_b`` (see the module) and flag in ``snapped``
+    """Overwrite ``y[:, :m]`` with ``g_b y_b`` (see the module) and flag in ``snapped``
     the live bonds with ``|y_b| > L_b grow`` (every live bond when ``grow < 0``);
     ``length``, ``stiffness`` and ``alive`` are the block's ``(m,)`` slices. Returns the
     number of bonds flagged."""
-    d, m = y.shape
+    d = y.shape[0]
+    m = length.shape[0]
     y0, y1, y2 = y[0], y[1], y[d - 1]
     three = d == 3
     every = grow < 0.0
@@ -116,17 +118,15 @@ def _row_sums(start, stop, offsets, y, out):
 
 @numba.njit(cache=True)
 def _pmb_block(start, stop, u, points, image, length, offsets, bond_j, stiffness, volumes,
-               alive, grow, out):
-    """The three passes (see the module) on the points ``start .. stop - 1``; returns the
-    number of bonds broken."""
+               alive, grow, out, y, w, snapped):
+    """The three passes (see the module) on the points ``start .. stop - 1``, in the
+    scratch ``y (d, s)``, ``w (s,)``, ``snapped (s,)`` (``s`` at least the block's
+    bonds); returns the number of bonds broken."""
     b0, b1 = offsets[start], offsets[stop]
-    y = np.empty((u.shape[1], b1 - b0))
-    w = np.empty(b1 - b0)
-    snapped = np.empty(b1 - b0, dtype=np.bool_)
     _bond_vectors(start, stop, u, points, image, offsets, bond_j, volumes, y, w)
     broken = _bond_factors(y, w, length[b0:b1], stiffness[b0:b1], alive[b0:b1], grow, snapped)
     if broken:
-        alive[b0:b1][snapped] = 0
+        alive[b0:b1][snapped[:b1 - b0]] = 0
     _row_sums(start, stop, offsets, y, out)
     return broken
 
@@ -173,16 +173,27 @@ def _blocks(offsets, runs):
 
 @numba.njit(cache=True, parallel=True)
 def _pmb_blocks(blocks, u, points, image, length, offsets, bond_j, stiffness, volumes, alive,
-                limit, out):
-    """`_pmb_block` on every block ``(k, 2)``, a thread per block; returns the bonds broken."""
-    broken = np.zeros(len(blocks), dtype=np.int64)
-    for k in numba.prange(len(blocks)):
-        broken[k] = _pmb_block(blocks[k, 0], blocks[k, 1], u, points, image, length, offsets,
-                               bond_j, stiffness, volumes, alive, 1.0 + limit, out)
+                limit, out, chunks):
+    """`_pmb_block` on every block ``(k, 2)``, in ``chunks`` groups of consecutive blocks
+    (a few per thread), each group with its own scratch (allocated once, not per block);
+    returns the bonds broken."""
+    groups = min(len(blocks), chunks)
+    broken = np.zeros(groups, dtype=np.int64)
+    for g in numba.prange(groups):
+        first, last = g * len(blocks) // groups, (g + 1) * len(blocks) // groups
+        most = 0
+        for k in range(first, last):
+            most = max(most, offsets[blocks[k, 1]] - offsets[blocks[k, 0]])
+        y = np.empty((u.shape[1], most))
+        w = np.empty(most)
+        snapped = np.empty(most, dtype=np.bool_)
+        for k in range(first, last):
+            broken[g] += _pmb_block(blocks[k, 0], blocks[k, 1], u, points, image, length,
+                                    offsets, bond_j, stiffness, volumes, alive, 1.0 + limit, out,
+                                    y, w, snapped)
     return broken.sum()
 
 
-@numba.njit(cache=True)
 def pmb_forces(u, points, image, length, offsets, bond_j, stiffness, volumes, alive, limit,
                out):
     """Bond-based PMB force density at every point, breaking bonds beyond ``limit``.
@@ -191,18 +202,17 @@ def pmb_forces(u, points, image, length, offsets, bond_j, stiffness, volumes, al
     ``y_b = xi_b + u_j - u_i``, ``xi_b`` from ``points (n, d)`` (minimum image on the
     periodic axes of ``image (2, d)``, see `image_factors`) and the stretch
     ``s_b = |y_b| / L_b - 1``. A bond whose stretch exceeds ``limit`` is marked dead
-    (``alive[b] = 0``) and carries no force from then on. Returns the number of bonds
-    broken.
+    (``alive[b] = 0``) and carries no force from then on. ``u``, ``points`` and ``out``
+    C-contiguous. Returns the number of bonds broken.
     """
     everything = np.array([[0, u.shape[0]]], dtype=np.int64)
-    return _pmb_blocks(_blocks(offsets, everything), u, points, image, length, offsets,
-                       bond_j, stiffness, volumes, alive, limit, out)
+    return int(_pmb_blocks(_blocks(offsets, everything), u, points, image, length, offsets,
+                           bond_j, stiffness, volumes, alive, limit, out, work_chunks()))
 
 
-@numba.njit(cache=True)
 def pmb_forces_rows(rows, u, points, image, length, offsets, bond_j, stiffness, volumes, alive,
                     limit, out):
     """`pmb_forces` at the sorted, distinct points ``rows`` only (``out`` written at those
     rows), with the same bits at each of them."""
-    return _pmb_blocks(_blocks(offsets, _runs(rows)), u, points, image, length, offsets,
-                       bond_j, stiffness, volumes, alive, limit, out)
+    return int(_pmb_blocks(_blocks(offsets, _runs(rows)), u, points, image, length, offsets,
+                           bond_j, stiffness, volumes, alive, limit, out, work_chunks()))

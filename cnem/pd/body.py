@@ -106,8 +106,8 @@ class Body:
     period : (d,) ndarray
         The period of each axis (``inf``: not periodic).
     image : (2, d) ndarray
-        Per axis the period and its inverse, both 0 on an axis that is not periodic: the
-        minimum image of a coordinate difference (`cnem.pd._kernels.periodic_image`).
+        Per axis the period twice (0 and 1 on an axis that is not periodic): the minimum
+        image of a coordinate difference without a branch (`cnem.pd._kernels.periodic_image`).
     """
 
     def __init__(self, points: np.ndarray, volumes: float | ArrayLike, horizon: float, *,

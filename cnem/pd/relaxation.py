@@ -260,7 +260,8 @@ def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: i
         is at most ``tol`` times the load's norm there (or, with no load there,
         times the out-of-balance force at the start of the step, from the
         prescribed displacements), or at most ten times the round-off of the
-        forces (their norm at zero displacement), whichever is larger.
+        forces (`force_round_off`: their norm at zero displacement or, for the
+        PMB, the modelled rounding of the bond forces), whichever is larger.
     max_steps : int
         Iterations allowed per load step.
     steps : int
