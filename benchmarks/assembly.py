@@ -30,11 +30,11 @@ nothing), so nothing cached by one run serves the next:
   already kept by ``gradients``: the cell bases, their operators and the assembly of K;
 * skfem ``mesh``, ``basis``, ``K``: ``MeshTri.init_tensor``, ``Basis(...)`` and
   ``asm(linear_elasticity(...), basis)``;
-* ``solve`` (both sides, the very same function): ``cnem.assembly.condensation.free_system``
+* ``solve`` (both sides, the very same function): ``cnem.solvers.condensation.free_system``
   of the clamped dofs (skfem.condense's system, its matrix multiplied on K itself), the
-  rigid-body modes of the free dofs, and ``cnem.assembly.linsolve.solve_spd`` (direct up to
+  rigid-body modes of the free dofs, and ``cnem.solvers.linsolve.solve_spd`` (direct up to
   2.5M non-zeros, smoothed aggregation + CG above: pyamg's set-up, cnem's parallel V-cycle,
-  ``cnem.assembly.multigrid``; tol 1e-10; on the C-NEM side the
+  ``cnem.solvers.multigrid``; tol 1e-10; on the C-NEM side the
   hierarchy is built on the P1 stiffness of the same nodes on the model's triangles,
   ``Elasticity.solver_options``, whose assembly is timed in the stage).  This is what
   ``Elasticity.solve`` does after K and the load, minus its rigid-motion check
@@ -123,8 +123,8 @@ def condensed_solve(K, f, points, D, solver_options=None):
     """What both sides time as ``solve``: the free system, rigid modes of the free dofs, solve_spd
     (C-NEM: with ``solver_options(free dofs)``, ``Elasticity.solver_options``: the P1
     matrix its smoothed aggregation is built on, as in ``Elasticity.solve``)."""
-    from cnem.assembly.condensation import free_system
-    from cnem.assembly.linsolve import rigid_modes, solve_spd
+    from cnem.solvers.condensation import free_system
+    from cnem.solvers.linsolve import rigid_modes, solve_spd
 
     x = np.zeros(K.shape[0])
     A, b, interior = free_system(K, f, x=x, D=D)
@@ -179,7 +179,7 @@ def cnem_pipeline(cloud, run):
     """C-NEM from the cloud: model, B~, K, rigid-motion check, solve (timed into ``run``)."""
     import cnem
     from cnem.assembly import SmoothedGradients
-    from cnem.assembly.linsolve import free_rigid_motions
+    from cnem.solvers.linsolve import free_rigid_motions
 
     model = staged(run, "model", lambda: cnem.discretize(cloud, progress=False))
     # the smoothed gradients Elasticity needs: with the stabilisation those of the fan
@@ -393,8 +393,8 @@ def report(results, warm):
     print()
     print(f"C-NEM elasticity vs scikit-fem P1 on the unit square, plane {PLANE}, E = {E:g}, "
           f"nu = {NU:g}, clamped on x = 0, traction {TRACTION} on x = 1; median wall times in s")
-    print("solve (both sides) = cnem.assembly.condensation.free_system + rigid modes + "
-          "cnem.assembly.linsolve.solve_spd "
+    print("solve (both sides) = cnem.solvers.condensation.free_system + rigid modes + "
+          "cnem.solvers.linsolve.solve_spd "
           "(direct <= 2.5M non-zeros, pyamg + CG above; C-NEM: hierarchy on the P1 matrix of its "
           "triangles, built in the stage): Elasticity.solve's path without its "
           "rigid-motion check (timed in the details)")

@@ -26,7 +26,7 @@ numba kernels and pyamg first.
 * Newton iteration (cases up to 10k points, ``--no-newton`` skips it): the strip is clamped
   in x on its left edge, pulled to a 1 % stretch on its right edge, one point fixed in y.
   ``newton s`` = one assembly (HDN) + the solve of the free-free tangent with
-  ``cnem.assembly.linsolve.solve_spd`` to the relative tolerance 1e-3 of an early inexact
+  ``cnem.solvers.linsolve.solve_spd`` to the relative tolerance 1e-3 of an early inexact
   Newton iteration (``solve_static``'s forcing term: ``min(1e-3, |R| / reference)``), median
   of ``--repeat`` after a warm-up; ``solve s`` is that solve alone and ``tight s`` the same
   solve to 1e-6 (the forcing term of a last iteration), once. ``static s/it``: a full
@@ -86,7 +86,7 @@ def newton(body, inter, u, repeat):
     """One Newton iteration (assembly + solve) of the stretched strip at ``u`` (median of
     ``repeat`` after a warm-up), the tight solve, and a full ``solve_static``."""
     import cnem.pd as pd
-    from cnem.assembly.linsolve import rigid_modes, solve_spd
+    from cnem.solvers.linsolve import rigid_modes, solve_spd
     prob = strip_problem(body, pd.CPD(1.0, 1.0))
     D, values = prob.prescribed()
     free = np.setdiff1d(np.arange(u.size), D)
@@ -214,7 +214,7 @@ def main(argv=None):
     points, h = lattice(12)
     inter = pd.CPD(1.0, 1.0).interactions(pd.Body(points, h * h, HORIZON_FACTOR * h))
     _, _, K = inter.evaluate(displacement(points, h))
-    from cnem.assembly.linsolve import solve_spd
+    from cnem.solvers.linsolve import solve_spd
     solve_spd(K + sp.identity(K.shape[0]), np.ones(K.shape[0]), method="amg")   # imports pyamg
     print(f"  warm-up {time.perf_counter() - t0:.2f} s", flush=True)
     rows = [run_case(f"{fmt_n(CASES[c] ** 2)}", CASES[c], args.repeat, not args.no_newton)

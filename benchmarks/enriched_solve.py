@@ -13,7 +13,7 @@ Wall times of the model and stiffness, then of each solve of the condensed syste
 ``A x = b``: ``solve_spd`` with ``method="amg"`` and the nodal mask (smoothed aggregation
 on the nodal block + LU of the enriched block), optionally (``--direct``) the direct
 solve, with the relative residual ``|A x - b| / |b|`` and the CG iterations (logged), and
-the estimated direct factor (`cnem.assembly.linsolve.direct_factor_bytes`).
+the estimated direct factor (`cnem.solvers.linsolve.direct_factor_bytes`).
 
 Run: ``python benchmarks/enriched_solve.py --nodes 16000 100000 [--direct]``.
 """
@@ -27,7 +27,7 @@ import time
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from cnem.assembly import linsolve
+from cnem.solvers import linsolve
 
 from _harness import MachineLoad, load_text, peak_rss_bytes
 

@@ -16,12 +16,13 @@ The layers, lowest first (a module imports only from its own layer or lower ones
 
 ========== ==============================================================================
 core       ``errors``, ``config``, ``_compile``, ``_parallel``, ``_memory``, ``_predicates``,
-           ``hyperdual``, ``material``, ``exact``
+           ``hyperdual``, ``material``, ``exact``, ``_deprecated``
 spatial    ``spatial``: packed R-tree (periodic), family search, bond crossing
 shape      ``shape``: constrained natural-neighbour coordinates on a triangulation
 geometry   ``geometry``, ``nodes``: domains, node clouds, ``discretize`` -> ``Model``
 output     ``io``, ``plot``: VTU files and off-screen pictures
-assembly   ``assembly``: SCNI smoothed gradients, bases, forms, conditions, solvers
+solvers    ``solvers``: conditions, solution base, the constrained linear solve, sparse solvers
+assembly   ``assembly``: SCNI smoothed gradients, bases, forms
 fracture   ``fracture``: Williams fields, SIFs, enrichment, crack growth
 problems   ``models`` (C-NEM elasticity), ``fem`` (P1 anchor), ``pd`` (peridynamics)
 front      ``cli``, ``__main__``, the demos
@@ -39,12 +40,16 @@ from .errors import (CNEMError, ConditionError, ConvergenceError, DivergenceErro
                      PlotDependencyError, PlotError, PlotInputError, SIFWarning, SolveError,
                      SpatialError, StabilityWarning, UnsupportedError)
 
+from . import _deprecated
+
+_deprecated.install()
+
 __version__ = "0.1.0"
 
 #: Submodules and subpackages reachable as attributes of ``cnem`` (loaded on first use).
 _MODULES = frozenset({"assembly", "cli", "config", "errors", "exact", "fem", "fracture",
                       "geometry", "hyperdual", "io", "material", "models", "nodes", "pd",
-                      "plot", "shape", "spatial"})
+                      "plot", "shape", "solvers", "spatial"})
 
 #: The core workflow names -> the module that defines them.
 _NAMES = {"Domain": "geometry", "NodeCloud": "geometry", "Model": "geometry",
@@ -68,6 +73,9 @@ def __getattr__(name: str):
         value = getattr(importlib.import_module(f".{_NAMES[name]}", __name__), name)
         globals()[name] = value
         return value
+    moved = _deprecated.moved_submodule(__name__, name)
+    if moved is not None:
+        return moved
     raise AttributeError(f"module 'cnem' has no attribute {name!r}")
 
 

@@ -133,14 +133,14 @@ MESH_NODES_TRIES = 6
 MESH_NODES_RTOL = 0.05
 
 # ---------------------------------------------------------------- linear solves
-#: Above this many matrix non-zeros `cnem.assembly.linsolve.solve_spd` uses
+#: Above this many matrix non-zeros `cnem.solvers.linsolve.solve_spd` uses
 #: pyamg-preconditioned CG: about 200k unknowns of linear triangles (12 non-zeros
 #: per row), about 40k unknowns of an SCNI stiffness (~65 per row), whose sparse
 #: factors fill in much faster (at 200k unknowns: 74 s direct against 7 s for
 #: smoothed aggregation + CG, 36 iterations).
 DIRECT_NNZ = 2_500_000
 
-#: CG iterations `cnem.assembly.linsolve.solve_spd` allows before it calls a solve stalled.
+#: CG iterations `cnem.solvers.linsolve.solve_spd` allows before it calls a solve stalled.
 CG_MAXITER = 2000
 
 #: Memory a sparse direct factor may take when `solve_spd` falls back to it after a

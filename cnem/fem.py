@@ -33,16 +33,16 @@ from skfem import Basis, ElementTriP1, ElementVector, FacetBasis, LinearForm, Me
 from skfem.helpers import dot, sym_grad
 from skfem.models.elasticity import linear_elasticity
 
-from .assembly.condensation import free_system
+
 from .assembly.quadrature import triangle_quadrature
-from .assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
+from .solvers.constrained import solve_constrained
 from . import config
-from .errors import GeometryError, InputError, SolveError
+from .errors import GeometryError, InputError
 from .geometry.cracks import split_cracks
 from .geometry.pslg import BOUNDARY, CRACK
-from .assembly.conditions import Conditions, per_point, traction_at
+from .solvers.conditions import Conditions, per_point, traction_at
 from .material import lame, parse_materials, stiffness_matrix
-from .assembly.solution import Solution, energy_error_density
+from .solvers.solution import Solution, energy_error_density
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
@@ -339,7 +339,7 @@ class P1Elasticity(Conditions):
         Parameters
         ----------
         method : {"auto", "direct", "amg"}
-            See `cnem.assembly.linsolve.solve_spd`.
+            See `cnem.solvers.linsolve.solve_spd`.
         tol : float
             Relative residual of the iterative solver.
 
@@ -357,15 +357,7 @@ class P1Elasticity(Conditions):
         f = self.load()
         t1 = time.perf_counter()
         D, values = self.prescribed()
-        free = free_rigid_motions(K, self.nodes, D)
-        if free:
-            raise SolveError("the system is singular: the Dirichlet conditions leave free the "
-                             + "; ".join(free) + ". Fix them with add_dirichlet")
-        x = np.zeros(K.shape[0])
-        x[D] = values
-        A, b, interior = free_system(K, f, x=x, D=D)
-        x[interior] = solve_spd(A, b, modes=rigid_modes(self.nodes)[interior], tol=tol,
-                                method=method)
+        x = solve_constrained(K, f, D, values, points=self.nodes, tol=tol, method=method)
         t2 = time.perf_counter()
         timings = dict(self.timings, assembly=t1 - t0, solve=t2 - t1)
         log.info("P1 elasticity: %s", ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
@@ -392,7 +384,7 @@ def _vector_load(value, what, *, normal):
 # ----------------------------------------------------------------------- solution
 @dataclass(eq=False, repr=False)
 class P1Solution(Solution):
-    """The solution of a `P1Elasticity` problem (the fields of `cnem.assembly.solution`).
+    """The solution of a `P1Elasticity` problem (the fields of `cnem.solvers.solution`).
 
     Attributes
     ----------

@@ -355,7 +355,7 @@ def nodal_field(sol, field):
 
     Parameters
     ----------
-    sol : cnem.assembly.solution.Solution
+    sol : cnem.solvers.solution.Solution
     field : str or ndarray
         One of `SOLUTION_FIELDS`, or values ``(n,)`` at the nodes or ``(k,)`` at the
         places of ``sol.stress``.
@@ -407,7 +407,7 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *,
 
     Parameters
     ----------
-    sol : cnem.assembly.solution.Solution
+    sol : cnem.solvers.solution.Solution
         An `ElasticSolution`, `cnem.fem.P1Solution` or a `cnem.pd` solution.
     path : str or os.PathLike, optional
         Write a PNG there.

@@ -9,9 +9,9 @@ import skfem
 from skfem.models.poisson import laplace
 
 from cnem._parallel import always_parallel
-from cnem.assembly.condensation import (FreeBlock, condense, free_dofs, free_system,
+from cnem.solvers.condensation import (FreeBlock, condense, free_dofs, free_system,
                                         principal_submatrix)
-from cnem.assembly.linsolve import solve_spd
+from cnem.solvers.linsolve import solve_spd
 from cnem.errors import InputError
 
 N = 60

@@ -64,7 +64,7 @@ def test_stiffness_is_spd_up_to_rigid_motions(name):
     tol = 1e-10 * eig[-1]
     assert (eig > -tol).all(), eig[:4]
     assert (np.abs(eig) <= tol).sum() == 3, eig[:5]
-    modes = cnem.assembly.linsolve.rigid_modes(model.nodes)
+    modes = cnem.solvers.linsolve.rigid_modes(model.nodes)
     np.testing.assert_allclose(K @ modes, 0.0, atol=1e-10 * eig[-1])
 
 

@@ -21,7 +21,8 @@ from skfem.models.poisson import laplace
 
 import cases
 import cnem
-from cnem.assembly import BilinearForm, linsolve
+from cnem.assembly import BilinearForm
+from cnem.solvers import linsolve
 from cnem.assembly.triangles import triangle_basis
 from cnem.models.elasticity import elasticity_form
 from cnem.material import lame
@@ -67,7 +68,7 @@ def test_amg_solution_is_the_direct_one(name, enrich, weight, caplog):
         return prob.solve(method=method, tol=1e-12, progress=False)
 
     direct = solve("direct")
-    with caplog.at_level("INFO", logger="cnem.assembly.linsolve"):
+    with caplog.at_level("INFO", logger="cnem.solvers.linsolve"):
         amg = solve("amg")
     where = "the preconditioner matrix" + (", smoothing with the matrix" if weight == 0 else "")
     assert (re.search(r"pyamg \(nodal block, \d+ enriched dofs by LU\) \+ CG", caplog.text)

@@ -1,4 +1,4 @@
-"""The parallel multigrid cycle (`cnem.assembly.multigrid`): its kernels against scipy and
+"""The parallel multigrid cycle (`cnem.solvers.multigrid`): its kernels against scipy and
 a plain-Python Gauss-Seidel, the cycle's symmetry and definiteness (what CG needs), its
 independence of the thread count, and CG with it on a P1 elasticity system."""
 import contextlib
@@ -10,9 +10,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from cnem._parallel import always_parallel
-from cnem.assembly import _multigrid_kernels as kernels
-from cnem.assembly.linsolve import rigid_modes
-from cnem.assembly.multigrid import _csr, hierarchy, parallel_operator
+from cnem.solvers import _multigrid_kernels as kernels
+from cnem.solvers.linsolve import rigid_modes
+from cnem.solvers.multigrid import _csr, hierarchy, parallel_operator
 from cnem.errors import InputError
 
 

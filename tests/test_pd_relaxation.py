@@ -15,7 +15,7 @@ from test_pd import _grid
 
 import cnem
 import cnem.pd as pd
-from cnem.assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
+from cnem.solvers.linsolve import free_rigid_motions, rigid_modes, solve_spd
 
 H = 0.05
 

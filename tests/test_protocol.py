@@ -14,8 +14,8 @@ import pytest
 import cnem
 import cnem.fem as fem
 import cnem.pd as pd
-from cnem.assembly.conditions import Conditions
-from cnem.assembly.solution import Solution
+from cnem.solvers.conditions import Conditions
+from cnem.solvers.solution import Solution
 from cnem.material import stiffness_matrix
 
 E, NU = 1.0, 0.3

@@ -13,7 +13,7 @@ from skfem import condense
 
 import cnem
 from cnem import config
-from cnem.assembly import linsolve
+from cnem.solvers import linsolve
 
 
 def _centre_cracked(h, radius=0.1):
@@ -49,7 +49,7 @@ def test_enriched_system_converges_with_the_block_preconditioner(small, caplog):
     # a hierarchy built on the whole matrix stalls here (2000 iterations, residual 2.8e-9)
     A, b, nodal, modes = small
     assert 0 < (~nodal).sum() < len(nodal)
-    with caplog.at_level(logging.INFO, logger="cnem.assembly.linsolve"):
+    with caplog.at_level(logging.INFO, logger="cnem.solvers.linsolve"):
         x = linsolve.solve_spd(A, b, modes=modes, method="amg", nodal=nodal, tol=1e-10)
     assert _relative_residual(A, x, b) <= 1e-9
     its = [int(r.getMessage().split(": ")[1].split()[0]) for r in caplog.records
@@ -65,7 +65,7 @@ def test_a_stalled_solve_falls_back_to_direct_when_it_fits(small, monkeypatch, c
     A, b, nodal, modes = small
     monkeypatch.setattr(config, "CG_MAXITER", 2)
     monkeypatch.setattr(config, "DIRECT_MEMORY", 1e12)
-    with caplog.at_level(logging.WARNING, logger="cnem.assembly.linsolve"):
+    with caplog.at_level(logging.WARNING, logger="cnem.solvers.linsolve"):
         x = linsolve.solve_spd(A, b, modes=modes, method="amg", nodal=nodal)
     assert any("solving directly instead" in r.getMessage() for r in caplog.records)
     assert _relative_residual(A, x, b) <= 1e-12

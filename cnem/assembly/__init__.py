@@ -16,7 +16,10 @@ True
 
 from skfem import condense, solve
 
-from .basis import CellBasis, select_nodes
+from .._deprecated import renamed_attributes
+
+from .basis import CellBasis
+from ..solvers.conditions import select_nodes
 from .forms import BilinearForm, Functional, LinearForm, asm
 from .edges import cell_edges
 from .gradients import SmoothedGradient, SmoothedGradients, fan_gradient, smoothed_gradient
@@ -24,3 +27,6 @@ from .gradients import SmoothedGradient, SmoothedGradients, fan_gradient, smooth
 __all__ = ["CellBasis", "BilinearForm", "LinearForm", "Functional", "asm", "condense", "solve",
            "SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient",
            "cell_edges", "select_nodes"]
+
+#: Old names (one release): see `cnem._deprecated`.
+__getattr__ = renamed_attributes(__name__, {})

@@ -11,6 +11,7 @@ import scipy.sparse as sp
 from skfem.element import DiscreteField
 
 from ..errors import ConditionError, InputError
+from ..solvers.conditions import select_nodes
 from .gradients import smoothed_gradient
 
 if TYPE_CHECKING:
@@ -231,39 +232,3 @@ class CellBasis:
         if component not in (0, 1):
             raise ConditionError(f"component: expected 0, 1 or None (both), received {component!r}")
         return 2 * nodes + component
-
-
-def select_nodes(nodes: np.ndarray, where: Callable[..., np.ndarray] | ArrayLike) -> np.ndarray:
-    """Indices of the nodes picked by a predicate, a boolean mask or an index array.
-
-    Parameters
-    ----------
-    nodes : (n, 2) ndarray
-    where : callable ``(p, 2) -> (p,) bool``, (n,) bool array_like, or int array_like
-
-    Returns
-    -------
-    (k,) int64 ndarray, sorted
-    """
-    n = len(nodes)
-    if callable(where):
-        mask = np.asarray(where(nodes))
-        if mask.shape != (n,) or mask.dtype != bool:
-            raise ConditionError(f"where(nodes) must return a (n,) bool array for the {n} nodes, "
-                                 f"received dtype {mask.dtype} shape {mask.shape}; return a "
-                                 f"comparison such as p[:, 0] < 1e-9")
-        return np.flatnonzero(mask)
-    arr = np.asarray(where)
-    if arr.dtype == bool:
-        if arr.shape != (n,):
-            raise ConditionError(f"where: a boolean mask needs one entry per node ({n}), "
-                                 f"received shape {arr.shape}")
-        return np.flatnonzero(arr)
-    if arr.size and not np.issubdtype(arr.dtype, np.integer):
-        raise ConditionError(f"where: expected a callable, a boolean mask or node indices, "
-                             f"received an array of dtype {arr.dtype}")
-    idx = np.unique(arr.astype(np.int64).reshape(-1))
-    if idx.size and (idx[0] < 0 or idx[-1] >= n):
-        raise ConditionError(f"where: node indices must lie in [0, {n}), received "
-                             f"[{idx[0]}, {idx[-1]}]; index the model's nodes")
-    return idx

@@ -6,7 +6,7 @@ stiffness of the same nodes on their triangulation couples only the
 triangles' corners (about 12 non-zeros per row) and is spectrally close to
 it. Smoothed aggregation built on the P1 matrix is a cheaper and leaner
 preconditioner for CG on the SCNI system than smoothed aggregation built on
-the SCNI matrix itself (see `cnem.assembly.linsolve.solve_spd`).
+the SCNI matrix itself (see `cnem.solvers.linsolve.solve_spd`).
 """
 
 from __future__ import annotations

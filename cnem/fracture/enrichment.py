@@ -248,7 +248,7 @@ class Enrichment:
         -------
         (len(self), 2) ndarray
         """
-        from ..assembly.conditions import per_point
+        from ..solvers.conditions import per_point
         x = self.model.nodes
         slot = np.full(len(x), -1)
         slot[self.nodes] = np.arange(len(self.nodes))

@@ -14,14 +14,14 @@ from skfem.models.elasticity import linear_stress
 from tqdm.auto import tqdm
 
 from ..assembly import BilinearForm, CellBasis
-from ..assembly.condensation import free_system, principal_submatrix
-from ..assembly.conditions import Conditions, traction_at
+from ..solvers.condensation import principal_submatrix
+from ..solvers.conditions import Conditions, traction_at
 from ..assembly.basis import spread_component
 from ..assembly.quadrature import cell_quadrature, subdivide, tip_cells
 from ..assembly.gradients import SmoothedGradients
 from ..assembly.triangles import triangle_basis
-from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
-from ..errors import GeometryError, InputError, SolveError
+from ..solvers.constrained import solve_constrained
+from ..errors import GeometryError, InputError
 from ..geometry.topology import constraint_edges
 from ..material import check_stiffness, lame, parse_materials, stiffness_matrix
 from .solution import ElasticSolution
@@ -301,7 +301,7 @@ class Elasticity(Conditions):
         return dofs, values
 
     def solver_options(self, dofs: np.ndarray) -> dict:
-        """The keywords of `cnem.assembly.linsolve.solve_spd` for the system on ``dofs``
+        """The keywords of `cnem.solvers.linsolve.solve_spd` for the system on ``dofs``
         (the free ones): the P1 matrix its smoothed aggregation is built on (made only
         if the iterative path is taken), and for plain SCNI smoothing with K itself
         (its oscillating low-energy modes, which P1 lacks); with enrichment, which
@@ -359,7 +359,7 @@ class Elasticity(Conditions):
             see `preconditioner_matrix`; for plain SCNI, ``stabilization=0``, the
             finest level smoothed with K itself). With enrichment the hierarchy is
             built on the nodal block and the enriched block is factorised (see
-            `cnem.assembly.linsolve.solve_spd`). A stalled CG falls back to the direct
+            `cnem.solvers.linsolve.solve_spd`). A stalled CG falls back to the direct
             solve when its factor fits in memory (`cnem.config.DIRECT_MEMORY`).
         tol : float
             Relative residual of the iterative solver.
@@ -392,24 +392,13 @@ class Elasticity(Conditions):
         t2 = time.perf_counter()
         bar.update()
         D, values = self.prescribed()
-        n2 = 2 * len(self.model.nodes)
-        free = free_rigid_motions(K[:n2, :n2], self.model.nodes, D[D < n2])
-        if free:
-            bar.close()
-            raise SolveError("the system is singular: the Dirichlet conditions leave free the "
-                             + "; ".join(free) + ". Fix them with add_dirichlet")
         bar.set_postfix_str("solve")
-        x = np.zeros(K.shape[0])
-        x[D] = values
-        A, b, interior = free_system(K, f, x=x, D=D)
-        modes = np.zeros((K.shape[0], 3))
-        modes[:n2] = rigid_modes(self.model.nodes)
-        modes = modes[interior]
-        x[interior] = solve_spd(A, b, modes=modes, tol=tol, method=method,
-                                **self.solver_options(interior))
+        try:
+            x = solve_constrained(K, f, D, values, points=self.model.nodes, tol=tol,
+                                  method=method, options=self.solver_options)
+        finally:
+            bar.close()
         t3 = time.perf_counter()
-        bar.update()
-        bar.close()
         timings.update(gradients=t1 - t0, assembly=t2 - t1, solve=t3 - t2)
         log.info("elasticity: %s", ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
         E, nu = self.cell_materials().T

@@ -8,7 +8,7 @@ from typing import Any, Callable, Literal
 import numpy as np
 
 from ..assembly.quadrature import cell_quadrature
-from ..assembly.solution import Solution, energy_error_density, engineering_strain, von_mises
+from ..solvers.solution import Solution, energy_error_density, engineering_strain, von_mises
 from ..errors import check_choice
 
 __all__ = ["ElasticSolution", "von_mises", "energy_error_density"]
@@ -16,7 +16,7 @@ __all__ = ["ElasticSolution", "von_mises", "energy_error_density"]
 
 @dataclass(eq=False, repr=False)
 class ElasticSolution(Solution):
-    """The solution of an `Elasticity` problem (the fields of `cnem.assembly.solution`).
+    """The solution of an `Elasticity` problem (the fields of `cnem.solvers.solution`).
 
     Attributes
     ----------

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from tqdm.auto import tqdm
 
-from ..assembly.conditions import per_point
+from ..solvers.conditions import per_point
 from ..errors import InputError
 from ._pmb_kernels import pmb_forces
 from .frames import FrameWriter

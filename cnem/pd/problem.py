@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly.conditions import Conditions
-from ..assembly.linsolve import free_rigid_motions, rigid_modes, solve_spd
+from ..solvers.conditions import Conditions
+from ..solvers.linsolve import free_rigid_motions, rigid_modes, solve_spd
 from .. import config
 from ..errors import (ConvergenceError, InputError, MaterialError, SolveError, UnsupportedError,
                       check_choice)

@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from tqdm.auto import tqdm
 
-from ..assembly.linsolve import free_rigid_motions
+from ..solvers.linsolve import free_rigid_motions
 from ..errors import ConvergenceError, InputError, SolveError
 from .solution import Relaxation
 

@@ -45,7 +45,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from tqdm.auto import tqdm
 
-from ..assembly.linsolve import free_rigid_motions, rigid_modes
+from ..solvers.linsolve import free_rigid_motions, rigid_modes
 from ..errors import ConvergenceError, InputError, SolveError
 from .quasistatic import LoadStep, QuasiStaticRun
 

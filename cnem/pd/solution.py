@@ -1,6 +1,6 @@
 """Results of peridynamic problems: `StaticSolution`, `DynamicRun`, `Relaxation`.
 
-All three are `cnem.assembly.solution.Solution` dataclasses with the fields of
+All three are `cnem.solvers.solution.Solution` dataclasses with the fields of
 every solver (``u``, ``stress``, ``strain``, ``von_mises``, ``displacement``,
 ``write``, ``plot``); PD's stresses and strains live at the points.
 """
@@ -13,7 +13,7 @@ from functools import cached_property
 import numpy as np
 
 from ..errors import GeometryError
-from ..assembly.solution import Solution, engineering_strain, voigt
+from ..solvers.solution import Solution, engineering_strain, voigt
 
 __all__ = ["PointSolution", "StaticSolution", "DynamicRun", "Relaxation"]
 

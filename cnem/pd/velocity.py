@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..assembly.conditions import dirichlet_dofs, last_wins
+from ..solvers.conditions import dirichlet_dofs, last_wins
 from ..errors import ConditionError
 
 if TYPE_CHECKING:

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from tqdm.auto import tqdm
 
-from ...assembly.conditions import Conditions, per_point
+from ...solvers.conditions import Conditions, per_point
 from ...errors import MaterialError, OptionError
 from .._pmb_kernels import pmb_forces_rows
 from ...material import PLANES
@@ -83,7 +83,7 @@ class Problem(Conditions, VelocityConditions):
     surface_correction : bool, optional
         Default on (as in serial).
 
-    Conditions (`cnem.assembly.conditions.Conditions`): Dirichlet predicates see all the
+    Conditions (`cnem.solvers.conditions.Conditions`): Dirichlet predicates see all the
     points (``body.global_points``) on every rank; body forces are evaluated at the
     owned points. Tractions are not supported.
     """

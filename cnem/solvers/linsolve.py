@@ -189,7 +189,7 @@ def solve_spd(A: sp.spmatrix | FreeBlock, b: np.ndarray, *, modes: np.ndarray | 
     Parameters
     ----------
     A : sparse (N, N) or FreeBlock
-        A `cnem.assembly.condensation.FreeBlock` (the system on the free dofs) is
+        A `cnem.solvers.condensation.FreeBlock` (the system on the free dofs) is
         multiplied on its stiffness; its entries are formed only for the direct
         solve, a hierarchy on it or smoothing with it.
     b : (N,) ndarray
@@ -340,7 +340,7 @@ def _cg(A, b, M, tol, label):
 
 def _amg_cg(A, b, P, modes, tol, smooth_with_A=False):
     """CG on ``A x = b`` preconditioned by a smoothed-aggregation V-cycle built on ``P``
-    (its finest level smoothed with ``A`` if ``smooth_with_A``), `cnem.assembly.multigrid`.
+    (its finest level smoothed with ``A`` if ``smooth_with_A``), `cnem.solvers.multigrid`.
 
     Returns
     -------

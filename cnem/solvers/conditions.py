@@ -6,7 +6,7 @@ them into prescribed dof values; each solver only integrates the loads in its
 own way (`body_forces`, `traction_at`).
 
 >>> import numpy as np
->>> from cnem.assembly.conditions import Conditions
+>>> from cnem.solvers.conditions import Conditions
 >>> class Points(Conditions):
 ...     def __init__(self, points):
 ...         super().__init__()
@@ -26,15 +26,51 @@ from typing import TYPE_CHECKING, Any, Callable, Union
 import numpy as np
 
 from ..errors import ConditionError, UnsupportedError
-from .basis import select_nodes
+
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-__all__ = ["Conditions", "Traction", "per_point", "traction_at", "dirichlet_dofs", "last_wins"]
+__all__ = ["Conditions", "select_nodes", "Traction", "per_point", "traction_at", "dirichlet_dofs", "last_wins"]
 
 #: What `where` may be: a predicate over points, a boolean mask or indices.
 Where = Union[Callable[[np.ndarray], np.ndarray], np.ndarray, list]
+
+
+def select_nodes(nodes: np.ndarray, where: Callable[..., np.ndarray] | ArrayLike) -> np.ndarray:
+    """Indices of the nodes picked by a predicate, a boolean mask or an index array.
+
+    Parameters
+    ----------
+    nodes : (n, 2) ndarray
+    where : callable ``(p, 2) -> (p,) bool``, (n,) bool array_like, or int array_like
+
+    Returns
+    -------
+    (k,) int64 ndarray, sorted
+    """
+    n = len(nodes)
+    if callable(where):
+        mask = np.asarray(where(nodes))
+        if mask.shape != (n,) or mask.dtype != bool:
+            raise ConditionError(f"where(nodes) must return a (n,) bool array for the {n} nodes, "
+                                 f"received dtype {mask.dtype} shape {mask.shape}; return a "
+                                 f"comparison such as p[:, 0] < 1e-9")
+        return np.flatnonzero(mask)
+    arr = np.asarray(where)
+    if arr.dtype == bool:
+        if arr.shape != (n,):
+            raise ConditionError(f"where: a boolean mask needs one entry per node ({n}), "
+                                 f"received shape {arr.shape}")
+        return np.flatnonzero(arr)
+    if arr.size and not np.issubdtype(arr.dtype, np.integer):
+        raise ConditionError(f"where: expected a callable, a boolean mask or node indices, "
+                             f"received an array of dtype {arr.dtype}")
+    idx = np.unique(arr.astype(np.int64).reshape(-1))
+    if idx.size and (idx[0] < 0 or idx[-1] >= n):
+        raise ConditionError(f"where: node indices must lie in [0, {n}), received "
+                             f"[{idx[0]}, {idx[-1]}]; index the model's nodes")
+    return idx
 
 
 def per_point(value: ArrayLike | Callable[..., np.ndarray], points: np.ndarray, width: int,

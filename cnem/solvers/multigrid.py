@@ -4,14 +4,14 @@ cnem's parallel kernels run the cycle.
 pyamg's set-up (aggregation, prolongation, Galerkin products) is kept; its cycle is
 single-threaded. `VCycle` runs the same V-cycle, a symmetric Gauss-Seidel smoothing
 (a forward then a backward sweep) before and after the coarse correction, with hybrid
-sweeps (`cnem.assembly._multigrid_kernels`): every product and sweep parallel over rows.
+sweeps (`cnem.solvers._multigrid_kernels`): every product and sweep parallel over rows.
 (One forward sweep before and one backward after is also symmetric and half the
 smoothing, but CG then needs 82 iterations instead of 66 on the stabilised 1M-node
 system, and twice as many for plain SCNI, whose oscillating modes only smoothing
 with K itself removes.)
 
 >>> import numpy as np, scipy.sparse as sp
->>> from cnem.assembly.multigrid import hierarchy
+>>> from cnem.solvers.multigrid import hierarchy
 >>> A = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(500, 500), format="csr")
 >>> M = hierarchy(A)
 >>> x = M.matvec(np.ones(500))
@@ -156,7 +156,7 @@ class VCycle(spla.LinearOperator):
 
 def parallel_operator(A: sp.spmatrix) -> spla.LinearOperator:
     """``A`` as a `scipy.sparse.linalg.LinearOperator` whose product runs in parallel
-    (`cnem.assembly._multigrid_kernels.multiply`); ``A`` CSR ``(m, n)`` (converted if not)."""
+    (`cnem.solvers._multigrid_kernels.multiply`); ``A`` CSR ``(m, n)`` (converted if not)."""
     A = _csr(A)
 
     def product(x):

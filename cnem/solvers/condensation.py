@@ -3,7 +3,7 @@ stiffness on them and the right-hand side lifted by the prescribed values.
 
 `condense` gives what ``skfem.condense(K, f, x=x, D=D)`` gives for a vector right-hand
 side, with the submatrix and the lifting computed by parallel kernels
-(`cnem.assembly._condense_kernels`, `cnem.assembly._multigrid_kernels.multiply`) and the
+(`cnem.solvers._condense_kernels`, `cnem.solvers._multigrid_kernels.multiply`) and the
 free dofs by a mask (skfem's single-threaded fancy indexing and ``setdiff1d`` took 6 s of
 a 2M-dof solve). ``cnem.assembly.condense`` stays scikit-fem's, with its wider interface
 (``I``, matrix right-hand sides).

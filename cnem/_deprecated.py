@@ -1,0 +1,111 @@
+"""Old names kept working for one release after a module moved or a name changed.
+
+Two tables, one per kind of change, are the only place an old name lives:
+
+* `MOVED_MODULES`: old dotted module name -> new one. ``import cnem.assembly.linsolve``
+  still works (it loads ``cnem.solvers.linsolve`` and warns once with a
+  `DeprecationWarning` naming the new place); so does the attribute access
+  ``cnem.assembly.linsolve`` once the old parent package is imported.
+* `renamed_attributes`: for a name that changed inside a module, the module's
+  ``__getattr__`` returns the new object and warns.
+
+>>> import warnings
+>>> with warnings.catch_warnings(record=True) as caught:
+...     warnings.simplefilter("always")
+...     import cnem.assembly.linsolve as old
+>>> import cnem.solvers.linsolve as new
+>>> old is new and caught[0].category is DeprecationWarning
+True
+
+Remove an entry one release after the move it records.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.abc
+import importlib.util
+import sys
+import warnings
+from typing import Callable
+
+__all__ = ["MOVED_MODULES", "install", "renamed_attributes"]
+
+#: Old module name -> the module that replaced it (one release of grace).
+MOVED_MODULES = {
+    "cnem.assembly.conditions": "cnem.solvers.conditions",
+    "cnem.assembly.solution": "cnem.solvers.solution",
+    "cnem.assembly.linsolve": "cnem.solvers.linsolve",
+    "cnem.assembly.multigrid": "cnem.solvers.multigrid",
+    "cnem.assembly.condensation": "cnem.solvers.condensation",
+}
+
+
+def _warn_moved(old: str, new: str, stacklevel: int) -> None:
+    warnings.warn(f"{old} has moved to {new}; import it from there ({old} goes in the next "
+                  f"release)", DeprecationWarning, stacklevel=stacklevel)
+
+
+class _MovedModuleFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """Finds an old module name of `MOVED_MODULES` and loads the new module in its place."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        if fullname in MOVED_MODULES:
+            return importlib.util.spec_from_loader(fullname, self)
+        return None
+
+    def create_module(self, spec):
+        return None
+
+    def exec_module(self, module):
+        new = MOVED_MODULES[module.__name__]
+        _warn_moved(module.__name__, new, stacklevel=4)
+        # the import system hands out whatever sys.modules holds under the old name
+        sys.modules[module.__name__] = importlib.import_module(new)
+
+
+def install() -> None:
+    """Put the finder of moved modules on ``sys.meta_path`` (once; `cnem` does it on import)."""
+    if not any(isinstance(finder, _MovedModuleFinder) for finder in sys.meta_path):
+        sys.meta_path.append(_MovedModuleFinder())
+
+
+def moved_submodule(package: str, name: str):
+    """The module that replaced ``package.name``, or None when it is no moved module.
+
+    For a package's ``__getattr__``: ``cnem.assembly.linsolve`` as an attribute.
+    """
+    old = f"{package}.{name}"
+    if old not in MOVED_MODULES:
+        return None
+    return importlib.import_module(old)
+
+
+def renamed_attributes(module: str, renames: dict[str, tuple[str, str]]) -> Callable:
+    """A module ``__getattr__`` that serves old names of `renames` with a warning.
+
+    Parameters
+    ----------
+    module : str
+        The module's ``__name__`` (for the message).
+    renames : dict
+        Old name -> ``(module of the new object, new name)``.
+
+    Returns
+    -------
+    callable
+        ``__getattr__(name)``; unknown names raise `AttributeError` as usual.
+    """
+
+    def __getattr__(name: str):
+        if name in renames:
+            where, new = renames[name]
+            warnings.warn(f"{module}.{name} is now {where}.{new}; use that name ({name} goes in "
+                          f"the next release)", DeprecationWarning, stacklevel=2)
+            return getattr(importlib.import_module(where), new)
+        moved = moved_submodule(module, name)
+        if moved is not None:
+            return moved
+        raise AttributeError(f"module {module!r} has no attribute {name!r}")
+
+    return __getattr__
