@@ -7,13 +7,12 @@ conditions and bond operators.
 
 from __future__ import annotations
 
-import sys
 from typing import TYPE_CHECKING
 
 import numpy as np
-from tqdm.auto import tqdm
 
 from ..solvers.conditions import per_point
+from ..solvers.stepping import Prescribed, velocity_verlet
 from ..errors import InputError
 from ._pmb_kernels import pmb_forces
 from .frames import FrameWriter
@@ -117,51 +116,40 @@ class Dynamics:
         b, d, n = self.body, self.dim, len(self.body)
         stable = self.stable_time_step(1.0)
         dt, steps = checked_run(dt, steps, stable)
-        every = max(1, steps // 10) if every is None else int(every)
-        rho = self.material.density
         limit = self.material.stretch_limit(d, self.plane, b.horizon)
         state = self._force_state()
-        D, values = self.prescribed()
-        M, speeds = self.prescribed_velocity()
+        prescribed = Prescribed(*self.prescribed(), *self.prescribed_velocity())
         u = np.zeros((n, d))
-        u.reshape(-1)[D] = values
-        u.reshape(-1)[M] = 0.0
         v = np.zeros((n, d))
         if velocity is not None:
             v[:] = per_point(velocity, b.points, d, "velocity")
-        v.reshape(-1)[D] = 0.0
-        v.reshape(-1)[M] = speeds
+        prescribed.start(u, v)
         fext = self.load().reshape(n, d) / b.volumes[:, None]
-        force, broken = self._internal_force(u, limit, state)
-        acc = (force + fext) / rho
+        total_broken = 0
+
+        def forces(u):
+            nonlocal total_broken
+            force, broken = self._internal_force(u, limit, state)
+            total_broken += broken
+            return force + fext
+
+        def check(step, u, v):
+            if (bad := first_non_finite(u, v)) >= 0:
+                raise diverged(step, dt, bad, b.points[bad], stable)
+
         writer = None if output is None else FrameWriter(output, b.points, steps)
         times, frames, energy, files = [], [], [], []
 
-        def store(step):
+        def store(step, u, v):
             times.append(step * dt)
             frames.append((u.copy(), self.damage()))
             energy.append(self._energy(u, v))
             if writer is not None:
                 files.append(writer.write(step, u=u, damage=frames[-1][1], velocity=v))
 
-        store(0)
-        total_broken = broken
-        show = sys.stderr.isatty() if progress is None else progress
-        for step in tqdm(range(1, steps + 1), desc="PD steps", disable=not show, leave=False):
-            v += 0.5 * dt * acc
-            u += dt * v
-            u.reshape(-1)[D] = values
-            u.reshape(-1)[M] = speeds * (step * dt)
-            force, broken = self._internal_force(u, limit, state)
-            total_broken += broken
-            acc = (force + fext) / rho
-            v += 0.5 * dt * acc
-            v.reshape(-1)[D] = 0.0
-            v.reshape(-1)[M] = speeds
-            if (bad := first_non_finite(u, v)) >= 0:
-                raise diverged(step, dt, bad, b.points[bad], stable)
-            if step % every == 0 or step == steps:
-                store(step)
+        velocity_verlet(u, v, dt, steps, forces=forces, mass=self.material.density,
+                        prescribed=prescribed, after_step=check, frame=store, every=every,
+                        progress=progress, desc="PD steps")
         return DynamicRun(self, u, velocity=v, damage=self.damage(), times=np.array(times),
                           frames=frames, energy=np.array(energy), broken=total_broken,
                           files=files)

@@ -13,14 +13,13 @@ run.
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from tqdm.auto import tqdm
 
 from ...solvers.conditions import Conditions, per_point
+from ...solvers.stepping import Prescribed, velocity_verlet
 from ...errors import MaterialError, OptionError
 from .._pmb_kernels import pmb_forces_rows
 from ...material import PLANES
@@ -288,21 +287,15 @@ class Problem(Conditions, VelocityConditions):
         b, d, o = self.body, self.dim, self.body.n_owned
         stable = self.stable_time_step(1.0)
         dt, steps = checked_run(dt, steps, stable)
-        every = max(1, steps // 10) if every is None else int(every)
         save_every = steps if checkpoint_every is None else int(checkpoint_every)
-        rho = self.material.density
         limit = self.material.stretch_limit(d, self.plane, b.horizon)
-        D, values = self.owned_prescribed()
-        M, speeds = self.owned_prescribed(velocity=True)
+        prescribed = Prescribed(*self.owned_prescribed(), *self.owned_prescribed(velocity=True))
         u = np.zeros((len(b.points), d))
         owned_u = u[:o]
-        owned_u.reshape(-1)[D] = values
-        owned_u.reshape(-1)[M] = 0.0
         v = np.zeros((o, d))
         if velocity is not None:
             v[:] = per_point(velocity, b.points[:o], d, "velocity")
-        v.reshape(-1)[D] = 0.0
-        v.reshape(-1)[M] = speeds
+        prescribed.start(owned_u, v)
         first, earlier, broken_here = 0, 0, 0      # earlier: broken before a restart
         if restart is not None:
             state = ckpt.load(restart, self.comm, b.owned)
@@ -312,46 +305,39 @@ class Problem(Conditions, VelocityConditions):
             if self.material.kind == "state":
                 self.ops.follow_breaking(self.alive)
         fext = self.load() / b.volumes[:o, None]
-        force, broken_here = self.internal_force(u, limit)
-        acc = (force + fext) / rho
+
+        def forces(owned):                         # a view of u, whose ghost rows it fills
+            nonlocal broken_here
+            force, broken = self.internal_force(u, limit)
+            broken_here += broken
+            return force + fext
+
         writer = None if output is None else PieceWriter(output, self.comm, b.points[:o], steps)
         times, frames, energy, files = [], [], [], []
 
-        def store(step):
+        def store(step, owned, v):
             damage = self.damage()
             times.append(step * dt)
             if gather:
-                gu, gd = self.gather(owned_u), self.gather(damage)
+                gu, gd = self.gather(owned), self.gather(damage)
                 if self.root:
                     frames.append((gu, gd))
             energy.append(self.energy(u, v))
             if writer is not None:
-                files.append(writer.write(step, u=owned_u, damage=damage, velocity=v))
+                files.append(writer.write(step, u=owned, damage=damage, velocity=v))
 
-        def save(step):
-            total = earlier + self.comm.allreduce(broken_here)
-            ckpt.save(checkpoint, self.comm, step=step, broken=total, owned=b.owned,
-                      u=owned_u, velocity=v, alive=self.alive, alive_reverse=self.alive_reverse)
-
-        store(first)
-        show = (sys.stderr.isatty() if progress is None else progress) and self.root
-        for step in tqdm(range(first + 1, steps + 1), desc="PD steps", disable=not show,
-                         leave=False):
-            v += 0.5 * dt * acc
-            owned_u += dt * v
-            owned_u.reshape(-1)[D] = values
-            owned_u.reshape(-1)[M] = speeds * (step * dt)
-            force, broken = self.internal_force(u, limit)
-            broken_here += broken
-            acc = (force + fext) / rho
-            v += 0.5 * dt * acc
-            v.reshape(-1)[D] = 0.0
-            v.reshape(-1)[M] = speeds
-            self._check_finite(step, dt, owned_u, v, stable)
-            if step % every == 0 or step == steps:
-                store(step)
+        def check_and_save(step, owned, v):
+            self._check_finite(step, dt, owned, v, stable)
             if checkpoint is not None and step % save_every == 0:
-                save(step)
+                total = earlier + self.comm.allreduce(broken_here)
+                ckpt.save(checkpoint, self.comm, step=step, broken=total, owned=b.owned,
+                          u=owned, velocity=v, alive=self.alive,
+                          alive_reverse=self.alive_reverse)
+
+        velocity_verlet(owned_u, v, dt, steps, forces=forces, mass=self.material.density,
+                        prescribed=prescribed, after_step=check_and_save, frame=store,
+                        every=every, start=first, progress=progress if self.root else False,
+                        desc="PD steps")
         damage = self.damage()
         local = dict(owned=b.owned, u=owned_u.copy(), velocity=v.copy(), damage=damage)
         return DistributedRun(
