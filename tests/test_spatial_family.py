@@ -352,3 +352,30 @@ def test_cells_near_ties_on_a_lattice(rel, dim, periodic, columns):
         ref = R.brute_family(pts, horizon, period)
         fam = family_search(pts, horizon, period=period, method="cells")
         assert_family(fam, len(pts), ref, f"|v|^2 = {k2}")
+
+
+@pytest.mark.parametrize("method", ["cells", "rtree", "kdtree", "brute"])
+@pytest.mark.parametrize("period", [None, (1.0, 1.0)])
+def test_a_horizon_far_beyond_the_body_takes_every_pair(method, period):
+    """A horizon of 1e200 on a unit square: every other point is in each family (the
+    scale is no longer set by the horizon alone, which underflowed the distances)."""
+    pts = np.random.default_rng(3).random((60, 2))
+    fam = family_search(pts, 1e200, method=method, period=period)
+    for i in range(len(pts)):
+        row = np.sort(fam.indices[fam.offsets[i]:fam.offsets[i + 1]])
+        np.testing.assert_array_equal(row, np.delete(np.arange(len(pts)), i))
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-150, 1e-3, 1e3, 1e140])
+def test_family_of_a_lattice_is_the_same_at_every_scale(scale):
+    """The same lattice and horizon in any unit give the same families (brute force at
+    unit scale as the reference)."""
+    g = np.arange(6.0)
+    pts = np.array([(x, y) for x in g for y in g])
+    expected = family_search(pts, 1.5, method="brute")
+    for method in ("cells", "rtree", "kdtree"):
+        fam = family_search(pts * scale, 1.5 * scale, method=method)
+        for i in range(len(pts)):
+            np.testing.assert_array_equal(
+                np.sort(fam.indices[fam.offsets[i]:fam.offsets[i + 1]]),
+                np.sort(expected.indices[expected.offsets[i]:expected.offsets[i + 1]]))

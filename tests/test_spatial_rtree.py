@@ -600,3 +600,20 @@ def test_a_tree_over_the_points_near_boxes_finds_every_point_in_them(kind):
             assert np.array_equal(np.sort(got[inside]), want)
     if kind == "uniform":
         assert len(subset) < n / 2
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-200, 1.0, 1e100])
+@pytest.mark.parametrize("strict", [False, True])
+def test_query_ball_is_the_same_at_every_scale(scale, strict):
+    """A lattice of spacing ``scale`` queried at 1.5 spacings finds each point's
+    neighbours within 1.5 spacings — the brute-force answer at unit scale — also where
+    the squared distances would underflow (1e-300: they used to give every point)."""
+    g = np.arange(10.0)
+    pts = np.array([(x, y) for x in g for y in g[:3]])
+    gaps = np.linalg.norm(pts[:, None] - pts[None], axis=2)
+    expected = (gaps < 1.5) if strict else (gaps <= 1.5)
+    offsets, indices = RTree.from_points(pts * scale).query_ball(pts * scale, 1.5 * scale,
+                                                                 strict=strict)
+    for i in range(len(pts)):
+        np.testing.assert_array_equal(np.sort(indices[offsets[i]:offsets[i + 1]]),
+                                      np.flatnonzero(expected[i]))

@@ -160,6 +160,24 @@ def _unit_scale(horizon):
     return float(np.ldexp(1.0, -int(np.frexp(horizon.max())[1])))
 
 
+def _search_horizons(horizon, points, period):
+    """The horizons the kernels search with: each capped at a bound above every distance
+    in the body.
+
+    ``2 d`` times the largest extent of the points (per axis, the minimum-image extent
+    of a periodic one: at most half its period) exceeds twice the body's diameter,
+    so every pair within the original horizon is within the capped one and the
+    families do not change; but a horizon far larger than the body (1e200 on a
+    unit square) no longer sets `_unit_scale`, which would push the scaled
+    coordinate differences into underflow and lose every pair.
+    """
+    span = np.ptp(points, axis=0)
+    periodic = np.isfinite(period)
+    span[periodic] = np.minimum(span[periodic], 0.5 * period[periodic])
+    bound = 2.0 * points.shape[1] * span.max()
+    return np.minimum(horizon, bound) if bound > 0.0 else horizon
+
+
 def choose_method(horizon):
     """The fastest method for the data: the R-tree when the horizon varies a lot
     (graded clouds; a cell list would size its cells for the largest horizon),
@@ -214,8 +232,9 @@ def family_search(points: ArrayLike, horizon: float | ArrayLike, *,
         return Family(np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int32), h, per)
     if method == "auto":
         method = choose_method(h)
-    scale = _unit_scale(h)
-    xs, hs, ps = pts * scale, h * scale, per * scale       # exact: a power of two
+    searched = _search_horizons(h, pts, per)
+    scale = _unit_scale(searched)
+    xs, hs, ps = pts * scale, searched * scale, per * scale     # exact: a power of two
     if method == "brute":
         if n > config.BRUTE_LIMIT:
             raise LimitError(f"method='brute' tests all n^2 pairs and is limited to "

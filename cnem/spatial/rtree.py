@@ -253,7 +253,18 @@ class RTree:
         radius = check_array("r", r, shape=(len(pts),), broadcast=True, nonnegative=True,
                              error=SpatialError, fix="pass one distance >= 0, or one per point")
         kind = K.BALL_OPEN if strict else K.BALL_CLOSED
-        return self._query(pts, np.zeros_like(pts), radius, kind, exclude_self)
+        if self.size == 0 or len(pts) == 0 or radius.max() == 0.0:
+            return self._query(pts, np.zeros_like(pts), radius, kind, exclude_self)
+        # the ball test squares distances: at radii near the ends of the float range
+        # (1e-300, 1e300) they would underflow or overflow, so the test runs on a copy
+        # scaled by the power of two that brings the largest radius to about 1 (exact)
+        scale = float(np.ldexp(1.0, -int(np.frexp(radius.max())[1])))
+        if 2.0 ** -400 <= scale <= 2.0 ** 400:
+            return self._query(pts, np.zeros_like(pts), radius, kind, exclude_self)
+        return K.query(self.centre * scale, self.half * scale, self.first, self.count, self.size,
+                       self.depth, self.fanout, self.order, pts * scale, np.zeros_like(pts),
+                       radius * scale, kind, self.period * scale, exclude_self, work_chunks(),
+                       self.lo * scale, self.hi * scale, pts * scale, pts * scale)
 
     def nearest(self, points: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Nearest box to each point.
