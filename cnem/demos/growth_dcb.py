@@ -129,7 +129,7 @@ def run(theta_deg, h, increment, steps, progress=False, scheme="explicit"):
 
     Returns
     -------
-    (CrackPath, str or None)
+    (GrowthHistory, str or None)
         The history and, when an arm came off, the error's message.
     """
     dom = domain(theta_deg)
@@ -211,7 +211,7 @@ def _paths_figure(runs, path):
 
 
 def _load_figure(r, path):
-    """`CrackPath.plot` ``kind="load"`` with the straight crack of beam theory beside it."""
+    """`GrowthHistory.plot` ``kind="load"`` with the straight crack of beam theory beside it."""
     import matplotlib.pyplot as plt
     fig = r["history"].plot(None, kind="load", length_unit="$H$",
                             load_unit=r"$K_\mathrm{Ic}\sqrt{H}$",

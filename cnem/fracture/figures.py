@@ -1,4 +1,4 @@
-"""Pictures of a crack-growth run (`CrackPath.plot`): matplotlib, off-screen, PNG.
+"""Pictures of a crack-growth run (`GrowthHistory.plot`): matplotlib, off-screen, PNG.
 
 * `paths`: the geometry, the final von Mises field (at load factor 1) and the
   crack paths with a dot at every increment's tip;
@@ -55,7 +55,7 @@ def paths(hist: Any, path: str | None = None, *, length_unit: str = "", stress_u
 
     Parameters
     ----------
-    hist : CrackPath
+    hist : GrowthHistory
     path : str or os.PathLike, optional
         PNG to write.
     length_unit, stress_unit : str

@@ -10,7 +10,7 @@
 True
 """
 
-from .elasticity import Elasticity, elasticity_form
+from .linear import Elasticity, elasticity_form
 from ..material import lame, stiffness_matrix
 from .solution import ElasticSolution, von_mises
 

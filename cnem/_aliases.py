@@ -1,11 +1,13 @@
-"""Old names kept working for one release after a module moved or a name changed.
+"""Other names of modules and attributes: old ones kept for one release, and public aliases.
 
-Two tables, one per kind of change, are the only place an old name lives:
+Three tables are the only place such a name lives:
 
 * `MOVED_MODULES`: old dotted module name -> new one. ``import cnem.assembly.linsolve``
   still works (it loads ``cnem.solvers.linsolve`` and warns once with a
   `DeprecationWarning` naming the new place); so does the attribute access
   ``cnem.assembly.linsolve`` once the old parent package is imported.
+* `PUBLIC_ALIASES`: a public module name that is not where the code lives
+  (``cnem.nodes`` is ``cnem.geometry.nodes``): served the same way, without a warning.
 * `renamed_attributes`: for a name that changed inside a module, the module's
   ``__getattr__`` returns the new object and warns.
 
@@ -17,7 +19,7 @@ Two tables, one per kind of change, are the only place an old name lives:
 >>> old is new and caught[0].category is DeprecationWarning
 True
 
-Remove an entry one release after the move it records.
+Remove an entry of `MOVED_MODULES` one release after the move it records.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import sys
 import warnings
 from typing import Callable
 
-__all__ = ["MOVED_MODULES", "install", "renamed_attributes"]
+__all__ = ["MOVED_MODULES", "PUBLIC_ALIASES", "install", "renamed_attributes"]
 
 #: Old module name -> the module that replaced it (one release of grace).
 MOVED_MODULES = {
@@ -38,6 +40,19 @@ MOVED_MODULES = {
     "cnem.assembly.linsolve": "cnem.solvers.linsolve",
     "cnem.assembly.multigrid": "cnem.solvers.multigrid",
     "cnem.assembly.condensation": "cnem.solvers.condensation",
+    "cnem.elasticity": "cnem.elasticity",
+    "cnem.elasticity.linear": "cnem.elasticity.linear",
+    "cnem.elasticity.solution": "cnem.elasticity.solution",
+    "cnem.elasticity.operator_update": "cnem.elasticity.operator_update",
+    "cnem.geometry.model_update": "cnem.geometry.model_update",
+    "cnem.assembly.gradient_update": "cnem.assembly.gradient_update",
+    "cnem.demos.damage.ridge": "cnem.demos.growth.ridge",
+    "cnem.fracture.figures": "cnem.fracture.pictures",
+}
+
+#: Public module name -> the module that holds the code (served without a warning).
+PUBLIC_ALIASES = {
+    "cnem.nodes": "cnem.geometry.nodes",
 }
 
 
@@ -47,10 +62,11 @@ def _warn_moved(old: str, new: str, stacklevel: int) -> None:
 
 
 class _MovedModuleFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Finds an old module name of `MOVED_MODULES` and loads the new module in its place."""
+    """Finds a module name of `MOVED_MODULES` or `PUBLIC_ALIASES` and loads the module it
+    names in its place (warning for a moved one)."""
 
     def find_spec(self, fullname, path=None, target=None):
-        if fullname in MOVED_MODULES:
+        if fullname in MOVED_MODULES or fullname in PUBLIC_ALIASES:
             return importlib.util.spec_from_loader(fullname, self)
         return None
 
@@ -58,8 +74,10 @@ class _MovedModuleFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
         return None
 
     def exec_module(self, module):
-        new = MOVED_MODULES[module.__name__]
-        _warn_moved(module.__name__, new, stacklevel=4)
+        new = PUBLIC_ALIASES.get(module.__name__)
+        if new is None:
+            new = MOVED_MODULES[module.__name__]
+            _warn_moved(module.__name__, new, stacklevel=4)
         # the import system hands out whatever sys.modules holds under the old name
         sys.modules[module.__name__] = importlib.import_module(new)
 
@@ -71,12 +89,12 @@ def install() -> None:
 
 
 def moved_submodule(package: str, name: str):
-    """The module that replaced ``package.name``, or None when it is no moved module.
+    """The module that ``package.name`` stands for, or None when it is in neither table.
 
     For a package's ``__getattr__``: ``cnem.assembly.linsolve`` as an attribute.
     """
     old = f"{package}.{name}"
-    if old not in MOVED_MODULES:
+    if old not in MOVED_MODULES and old not in PUBLIC_ALIASES:
         return None
     return importlib.import_module(old)
 
