@@ -47,7 +47,6 @@ MOVED_MODULES = {
     "cnem.geometry.model_update": "cnem.geometry.model_update",
     "cnem.assembly.gradient_update": "cnem.assembly.gradient_update",
     "cnem.demos.damage.ridge": "cnem.demos.growth.ridge",
-    "cnem.fracture.figures": "cnem.fracture.pictures",
 }
 
 #: Public module name -> the module that holds the code (served without a warning).

@@ -221,9 +221,8 @@ def table(rows):
 
 
 def plot_convergence(rows, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     for kind, marker in (("regular", "o"), ("irregular", "s")):
         sel = [r for r in rows if r["kind"] == kind]
@@ -263,9 +262,8 @@ def polar_stress(sol):
 
 
 def plot_profiles(sol, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     exact = exact_solution()
     x = sol.model.nodes
     rn = np.hypot(x[:, 0], x[:, 1])

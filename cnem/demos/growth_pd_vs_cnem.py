@@ -422,9 +422,8 @@ def table(results: list) -> str:
 
 
 def _plot(results, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     fig, axes = plt.subplots(len(results), 1, figsize=(9.0, 4.6 * len(results)), squeeze=False)
     for ax, r in zip(axes[:, 0], results):
         sc = ax.scatter(*r["points"].T, c=r["damage"], s=4.0 * (0.25 / r["h"]) ** 2, cmap="Greys",

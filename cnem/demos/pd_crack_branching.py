@@ -253,9 +253,8 @@ def measure(problem: Problem, shape: np.ndarray, run: DynamicRun, h: float,
 
 def _plots(problem, shape, run, res, h, out, montage=6):
     """The damage montage and the history plot; returns their paths."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     times = res["times"]
     picks = np.unique(np.linspace(0, len(times) - 1, montage).round().astype(int))
     rows = (len(picks) + 1) // 2

@@ -142,9 +142,8 @@ def table(rows):
 
 
 def _plots(rows, out):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.5))
     xx = np.linspace(-A, A, 300)
     ax.plot(xx, griffith(xx), "k-", label="Griffith (infinite plate)")

@@ -1,4 +1,4 @@
-"""Pictures with pyvista, off-screen: a `Model` (cells, triangles, nodes, cracks) and
+"""Scenes with pyvista, off-screen: a `Model` (cells, triangles, nodes, cracks) and
 a solution (deformed shape coloured by a field).
 
 pyvista is imported only here, and only when a picture is drawn, so
@@ -22,14 +22,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import PlotDependencyError, PlotError, PlotInputError
-from .geometry.pslg import SegmentKind
-from .io import cell_topology
+from ..errors import PlotDependencyError, PlotError, PlotInputError
+from ..geometry.pslg import SegmentKind
+from ..io import cell_topology
 
 if TYPE_CHECKING:
     import pyvista
 
-    from .geometry.model import Model
+    from ..geometry.model import Model
 
 __all__ = ["model", "solution", "cells_polydata", "region_color", "PlotError", "REGION_COLORS",
            "SOLUTION_FIELDS", "FIELD_LABELS"]
