@@ -1,6 +1,6 @@
 """Other names of modules and attributes: old ones kept for one release, and public aliases.
 
-Three tables are the only place such a name lives:
+These tables are the only place such a name lives:
 
 * `MOVED_MODULES`: old dotted module name -> new one. ``import cnem.assembly.linsolve``
   still works (it loads ``cnem.solvers.linsolve`` and warns once with a
@@ -8,6 +8,7 @@ Three tables are the only place such a name lives:
   ``cnem.assembly.linsolve`` once the old parent package is imported.
 * `PUBLIC_ALIASES`: a public module name that is not where the code lives
   (``cnem.nodes`` is ``cnem.geometry.nodes``): served the same way, without a warning.
+* `RENAMED_DEMOS`: old command-line names of the demos (``cnem demo bimaterial-cylinder``).
 * `renamed_attributes`: for a name that changed inside a module, the module's
   ``__getattr__`` returns the new object and warns.
 
@@ -31,7 +32,7 @@ import sys
 import warnings
 from typing import Callable
 
-__all__ = ["MOVED_MODULES", "PUBLIC_ALIASES", "install", "renamed_attributes"]
+__all__ = ["MOVED_MODULES", "PUBLIC_ALIASES", "RENAMED_DEMOS", "install", "renamed_attributes"]
 
 #: Old module name -> the module that replaced it (one release of grace).
 MOVED_MODULES = {
@@ -47,6 +48,15 @@ MOVED_MODULES = {
     "cnem.geometry.model_update": "cnem.geometry.model_update",
     "cnem.assembly.gradient_update": "cnem.assembly.gradient_update",
     "cnem.demos.damage.ridge": "cnem.demos.growth.ridge",
+}
+
+#: Old command-line names of the demos (one release): ``cnem <command> <old>`` runs
+#: ``cnem <command> <new>`` with a notice on stderr (`cnem.cli.current_name`).
+RENAMED_DEMOS = {
+    "demo": {"cylinder": "bimaterial-cylinder", "pd-crack": "pd-vs-cnem-crack",
+             "cracked-plate": "cracked-plate-geometry"},
+    "pd": {"crack": "pd-vs-cnem-crack", "branching": "pd-crack-branching",
+           "cpd": "cpd-examples"},
 }
 
 #: Public module name -> the module that holds the code (served without a warning).

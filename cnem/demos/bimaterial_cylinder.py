@@ -334,7 +334,8 @@ def main(grids: tuple = GRIDS, *, irregular: tuple = (False, True), fem: bool = 
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
-    """Command line: ``python demos/bimaterial_cylinder.py --help`` or ``cnem demo cylinder``."""
+    """Command line: ``python demos/bimaterial_cylinder.py --help`` or
+    ``cnem demo bimaterial-cylinder``."""
     parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--nodes", type=int, nargs="+",
                         help="node counts (default the paper's 147 315 687 1863)")

@@ -400,7 +400,8 @@ def report(r, h, horizon, material, mat):
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
-    """Command line: ``python demos/pd_crack_branching.py --help`` or ``cnem pd branching``."""
+    """Command line: ``python demos/pd_crack_branching.py --help`` or
+    ``cnem pd pd-crack-branching``."""
     parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--h", type=float, default=0.25, help="grid spacing in mm")
     parser.add_argument("--m", type=float, default=4.0, help="horizon / spacing")

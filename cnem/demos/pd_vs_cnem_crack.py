@@ -201,7 +201,8 @@ def main(spacings: tuple = SPACINGS, *, outdir: str = "results/pd_vs_cnem_crack"
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
-    """Command line: ``python demos/pd_vs_cnem_crack.py --help`` or ``cnem demo pd-crack``."""
+    """Command line: ``python demos/pd_vs_cnem_crack.py --help`` or
+    ``cnem demo pd-vs-cnem-crack``."""
     parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--n", type=int, nargs="+", default=[16, 32, 64],
                         help="nodes per unit length (h = 1 / n)")
