@@ -41,13 +41,13 @@ MOVED_MODULES = {
     "cnem.assembly.linsolve": "cnem.solvers.linsolve",
     "cnem.assembly.multigrid": "cnem.solvers.multigrid",
     "cnem.assembly.condensation": "cnem.solvers.condensation",
-    "cnem.elasticity": "cnem.elasticity",
-    "cnem.elasticity.linear": "cnem.elasticity.linear",
-    "cnem.elasticity.solution": "cnem.elasticity.solution",
-    "cnem.elasticity.operator_update": "cnem.elasticity.operator_update",
-    "cnem.geometry.model_update": "cnem.geometry.model_update",
-    "cnem.assembly.gradient_update": "cnem.assembly.gradient_update",
-    "cnem.demos.damage.ridge": "cnem.demos.growth.ridge",
+    "cnem.models": "cnem.elasticity",
+    "cnem.models.elasticity": "cnem.elasticity.linear",
+    "cnem.models.solution": "cnem.elasticity.solution",
+    "cnem.models.local_update": "cnem.elasticity.operator_update",
+    "cnem.geometry.update": "cnem.geometry.model_update",
+    "cnem.assembly.update": "cnem.assembly.gradient_update",
+    "cnem.geometry.ridge": "cnem.demos.damage.ridge",
 }
 
 #: Old command-line names of the demos (one release): ``cnem <command> <old>`` runs
@@ -92,9 +92,11 @@ class _MovedModuleFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
 
 def install() -> None:
-    """Put the finder of moved modules on ``sys.meta_path`` (once; `cnem` does it on import)."""
+    """Put the finder of moved modules first on ``sys.meta_path`` (once; `cnem` does it on
+    import): the tables decide where these names live, before any other finder (an
+    editable install of another checkout, a stale file) is asked."""
     if not any(isinstance(finder, _MovedModuleFinder) for finder in sys.meta_path):
-        sys.meta_path.append(_MovedModuleFinder())
+        sys.meta_path.insert(0, _MovedModuleFinder())
 
 
 def moved_submodule(package: str, name: str):
@@ -116,7 +118,8 @@ def renamed_attributes(module: str, renames: dict[str, tuple[str, str]]) -> Call
     module : str
         The module's ``__name__`` (for the message).
     renames : dict
-        Old name -> ``(module of the new object, new name)``.
+        Old name -> ``(module of the new object, new name)``; the new object may be a
+        submodule of that module.
 
     Returns
     -------
@@ -129,7 +132,10 @@ def renamed_attributes(module: str, renames: dict[str, tuple[str, str]]) -> Call
             where, new = renames[name]
             warnings.warn(f"{module}.{name} is now {where}.{new}; use that name ({name} goes in "
                           f"the next release)", DeprecationWarning, stacklevel=2)
-            return getattr(importlib.import_module(where), new)
+            owner = importlib.import_module(where)
+            if not hasattr(owner, new):                  # a submodule not imported yet
+                return importlib.import_module(f"{where}.{new}")
+            return getattr(owner, new)
         moved = moved_submodule(module, name)
         if moved is not None:
             return moved

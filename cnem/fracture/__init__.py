@@ -29,7 +29,7 @@ __all__ = ["sif", "SIFResult", "Enrichment", "tip_frame", "williams", "nodal_wil
            "effective_modulus", "grow", "Refinement", "GrowthHistory", "Step", "GrowthEvent", "kink", "CRITERIA"]
 
 #: Old names (one release): see `cnem._aliases`.
-__getattr__ = renamed_attributes(__name__, {"GrowthHistory": ("cnem.fracture.history", "GrowthHistory")})
+__getattr__ = renamed_attributes(__name__, {"CrackPath": ("cnem.fracture.history", "GrowthHistory")})
 
 #: `Domain.tip_frame` as a function of ``(domain, tip)``.
 tip_frame = Domain.tip_frame

@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 __all__ = ["GrowthEvent", "Step", "GrowthHistory", "EVENT_KINDS"]
 
 #: Old names (one release): see `cnem._aliases`.
-__getattr__ = renamed_attributes(__name__, {"GrowthHistory": (__name__, "GrowthHistory")})
+__getattr__ = renamed_attributes(__name__, {"CrackPath": (__name__, "GrowthHistory")})
 
 #: What can happen to a tip, by name.
 EVENT_KINDS = {
