@@ -14,10 +14,11 @@ with the command that installs them (``pip install "cnem[plot]"``).
 """
 
 from .charts import offscreen_pyplot
-from .fields import (BAR, BAR_TITLE_GAP, FIELD_LABELS, INSTALL_HINT, REGION_COLORS,
-                     SOLUTION_FIELDS, PlotError, cells_polydata, colour_bar_font, font_file,
-                     model, nice_length, nodal_field, region_color, solution, use_font)
+from .fields import (FIELD_LABELS, REGION_COLORS, SOLUTION_FIELDS, PlotError, cells_polydata,
+                     model, region_color, solution)
+# the scenes' helpers stay reachable as ``cnem.plot.<name>`` (not in __all__)
+from .fields import (BAR, BAR_TITLE_GAP, INSTALL_HINT, colour_bar_font,  # noqa: F401
+                     font_file, nice_length, nodal_field, use_font)
 
 __all__ = ["model", "solution", "cells_polydata", "region_color", "PlotError", "REGION_COLORS",
-           "SOLUTION_FIELDS", "FIELD_LABELS", "offscreen_pyplot", "nodal_field", "nice_length",
-           "font_file", "use_font", "colour_bar_font", "BAR", "BAR_TITLE_GAP", "INSTALL_HINT"]
+           "SOLUTION_FIELDS", "FIELD_LABELS", "offscreen_pyplot"]
