@@ -127,7 +127,7 @@ def test_parts_whose_dofs_do_not_couple_across_components():
 def test_degenerate_triangles_leave_the_hierarchy_on_k(monkeypatch, caplog):
     """A triangulation P1 cannot use (degenerate triangles) costs the cheaper
     preconditioner, not the solve."""
-    from cnem.elasticity import elasticity
+    from cnem.elasticity import linear as elasticity
     _, _, model = cases.model("plate_hole_irregular")
 
     def degenerate(model, *, vector=False):

@@ -1,15 +1,8 @@
 """Scenes with pyvista, off-screen: a `Model` (cells, triangles, nodes, cracks) and
 a solution (deformed shape coloured by a field).
 
-pyvista is imported only here, and only when a picture is drawn, so
-``import cnem.plot`` works without it; drawing without it raises `PlotError`
-with the command that installs it (``pip install "cnem[plot]"``).
-
->>> import cnem, cnem.plot                                  # doctest: +SKIP
->>> from cnem.geometry import rectangle                     # doctest: +SKIP
->>> dom = rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.5, 0.5]]])   # doctest: +SKIP
->>> m = cnem.discretize(cnem.nodes.regular(dom, 0.1))      # doctest: +SKIP
->>> cnem.plot.model(m, "cells.png").close()                # doctest: +SKIP
+pyvista is imported only here, and only when a picture is drawn (`_pyvista`); the
+package's docstring (`cnem.plot`) shows the use.
 """
 
 from __future__ import annotations
