@@ -9,7 +9,7 @@ seed=0)``. The crack grows straight by ``1.5 h`` per increment; the new vertex b
 a node (``cnem.nodes.from_points`` of the previous points in the grown domain).
 Every increment is done both ways on the same cloud, in one run:
 
-* **local**: ``cnem.geometry.update.update(old_model, cloud)`` (``model``), then
+* **local**: ``cnem.geometry.model_update.update(old_model, cloud)`` (``model``), then
   ``setup(new_model).update_from(old_problem, change)`` (``B~ + K``: copied rows and
   cells, only the changed cells integrated), then ``problem.solve()`` (``solve``);
 * **full**: ``cnem.discretize(cloud)`` then ``setup(model).solve()``, which builds
@@ -57,7 +57,7 @@ def setup(model):
 def run_size(n, steps):
     """Time ``steps`` increments both ways; one dict of lists of seconds per path."""
     import cnem
-    from cnem.geometry.update import update
+    from cnem.geometry.model_update import update
 
     h = np.sqrt(W * H / n)
     crack = np.array([[0.0, H / 2], [A0, H / 2]])

@@ -16,15 +16,15 @@ The layers, lowest first (a module imports only from its own layer or lower ones
 
 ========== ==============================================================================
 core       ``errors``, ``config``, ``_compile``, ``_parallel``, ``_memory``, ``_predicates``,
-           ``hyperdual``, ``material``, ``exact``, ``_deprecated``
+           ``hyperdual``, ``material``, ``exact``, ``_aliases``
 spatial    ``spatial``: packed R-tree (periodic), family search, bond crossing
 shape      ``shape``: constrained natural-neighbour coordinates on a triangulation
-geometry   ``geometry``, ``nodes``: domains, node clouds, ``discretize`` -> ``Model``
+geometry   ``geometry`` (``nodes`` is ``geometry.nodes``): domains, node clouds, ``discretize``
 output     ``io``, ``plot``: VTU files and off-screen pictures
 solvers    ``solvers``: conditions, solution base, the constrained linear solve, sparse solvers
 assembly   ``assembly``: SCNI smoothed gradients, bases, forms
 fracture   ``fracture``: Williams fields, SIFs, enrichment, crack growth
-problems   ``models`` (C-NEM elasticity), ``fem`` (P1 anchor), ``pd`` (peridynamics)
+problems   ``elasticity`` (C-NEM), ``fem`` (P1 anchor), ``pd`` (peridynamics)
 front      ``cli``, ``__main__``, the demos
 ========== ==============================================================================
 """
@@ -40,23 +40,23 @@ from .errors import (CNEMError, ConditionError, ConvergenceError, DivergenceErro
                      PlotDependencyError, PlotError, PlotInputError, SIFWarning, SolveError,
                      SpatialError, StabilityWarning, UnsupportedError)
 
-from . import _deprecated
+from . import _aliases
 
-_deprecated.install()
+_aliases.install()
 
 __version__ = "0.1.0"
 
 #: Submodules and subpackages reachable as attributes of ``cnem`` (loaded on first use).
-_MODULES = frozenset({"assembly", "cli", "config", "errors", "exact", "fem", "fracture",
-                      "geometry", "hyperdual", "io", "material", "models", "nodes", "pd",
+_MODULES = frozenset({"assembly", "cli", "config", "elasticity", "errors", "exact", "fem",
+                      "fracture", "geometry", "hyperdual", "io", "material", "nodes", "pd",
                       "plot", "shape", "solvers", "spatial"})
 
 #: The core workflow names -> the module that defines them.
 _NAMES = {"Domain": "geometry", "NodeCloud": "geometry", "Model": "geometry",
-          "discretize": "geometry", "Elasticity": "models", "ElasticSolution": "models"}
+          "discretize": "geometry", "Elasticity": "elasticity", "ElasticSolution": "elasticity"}
 
 __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
-           "nodes", "geometry", "assembly", "models", "exact", "fracture", "io", "plot", "shape",
+           "nodes", "geometry", "assembly", "elasticity", "exact", "fracture", "io", "plot", "shape",
            "spatial", "hyperdual", "pd", "fem", "material",
            "CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError", "FormError",
            "ConditionError", "SpatialError", "FractureError", "GrowthError", "FormatError",
@@ -73,7 +73,7 @@ def __getattr__(name: str):
         value = getattr(importlib.import_module(f".{_NAMES[name]}", __name__), name)
         globals()[name] = value
         return value
-    moved = _deprecated.moved_submodule(__name__, name)
+    moved = _aliases.moved_submodule(__name__, name)
     if moved is not None:
         return moved
     raise AttributeError(f"module 'cnem' has no attribute {name!r}")

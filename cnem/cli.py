@@ -1,20 +1,20 @@
 """The ``cnem`` command: run the demos, compile the kernels ahead, show what is installed.
 
     cnem demo list                                   # the demos
-    cnem demo cylinder --nodes 687 --irregular       # pictures in results/bimaterial_cylinder/
-    cnem demo cracked-plate --gamma 45 --out my/folder/
+    cnem demo bimaterial-cylinder --nodes 687 --irregular   # results/bimaterial_cylinder/
+    cnem demo cracked-plate-geometry --gamma 45 --out my/folder/
     cnem pd list                                     # the peridynamics demos
-    cnem pd crack --n 16 32                          # PD and C-NEM on one cloud
-    cnem pd branching --help                         # dynamic crack branching
-    cnem pd cpd --example tension2d                  # CPD examples (Javili et al. §6)
+    cnem pd pd-vs-cnem-crack --n 16 32               # PD and C-NEM on one cloud
+    cnem pd pd-crack-branching --help                # dynamic crack branching
+    cnem pd cpd-examples --example tension2d         # CPD examples (Javili et al. §6)
     cnem warmup                                      # compile every kernel now (first run only)
     cnem warmup --parallel                           # and their parallel copies (large models)
     cnem info                                        # versions, threads
 
-Each demo keeps its own options (``cnem demo cylinder --help``, defaults shown); the
-demos are the modules of `cnem.demos` (``python -m cnem.demos.bimaterial_cylinder``),
-installed with the package. Every demo writes its files to ``--out``, by default
-``results/<module>/`` (`output_folder`).
+Each demo keeps its own options (``cnem demo bimaterial-cylinder --help``, defaults
+shown); the demos are the modules of `cnem.demos` (``python -m cnem.demos.bimaterial_cylinder``),
+installed with the package, each called by its module's name with dashes. Every demo
+writes its files to ``--out``, by default ``results/<module>/`` (`output_folder`).
 """
 
 from __future__ import annotations
@@ -26,34 +26,28 @@ import pathlib
 import sys
 from typing import TYPE_CHECKING
 
+from ._aliases import RENAMED_DEMOS
+
 if TYPE_CHECKING:
     from typing import Sequence
 
-__all__ = ["main", "DEMOS", "PD_DEMOS", "HelpFormatter", "demo_parser", "dynamic_run_options",
+__all__ = ["main", "DEMOS", "PD_DEMOS", "current_name", "HelpFormatter", "demo_parser",
+           "dynamic_run_options",
            "output_folder", "show_compile_notice", "warmup", "build_parser"]
 
-#: Command-line name -> module of `cnem.demos`.
-DEMOS = {
-    "cylinder": "bimaterial_cylinder",
-    "inclined-crack": "inclined_crack",
-    "mode1-crack": "mode1_crack",
-    "pd-crack": "pd_vs_cnem_crack",
-    "cracked-plate": "cracked_plate_geometry",
-    "growth-sent": "growth_sent",
-    "growth-kink": "growth_kink",
-    "growth-two-holes": "growth_two_holes",
-    "growth-pd-vs-cnem": "growth_pd_vs_cnem",
-    "growth-dcb": "growth_dcb",
-    "kalthoff-winkler": "kalthoff_winkler",
-}
+def _named(*modules: str) -> dict[str, str]:
+    """Command-line name -> module of `cnem.demos`: each demo is called by its module's
+    name with dashes (``bimaterial_cylinder`` -> ``bimaterial-cylinder``)."""
+    return {module.replace("_", "-"): module for module in modules}
+
+
+#: ``cnem demo <name>`` -> module of `cnem.demos`.
+DEMOS = _named("bimaterial_cylinder", "inclined_crack", "mode1_crack", "pd_vs_cnem_crack",
+               "cracked_plate_geometry", "growth_sent", "growth_kink", "growth_two_holes",
+               "growth_pd_vs_cnem", "growth_dcb", "kalthoff_winkler")
 
 #: ``cnem pd <name>`` -> module of `cnem.demos` (add a PD demo here).
-PD_DEMOS = {
-    "crack": "pd_vs_cnem_crack",
-    "branching": "pd_crack_branching",
-    "cpd": "cpd_examples",
-    "kalthoff-winkler": "kalthoff_winkler",
-}
+PD_DEMOS = _named("pd_vs_cnem_crack", "pd_crack_branching", "cpd_examples", "kalthoff_winkler")
 
 #: Subcommand -> its table of demos.
 _TABLES = {"demo": DEMOS, "pd": PD_DEMOS}
@@ -86,7 +80,7 @@ def demo_command(module_file: str) -> str | None:
     ``cnem pd <name>``), None for a module in no table.
 
     >>> demo_command("/any/where/cnem/demos/cracked_plate_geometry.py")
-    'cnem demo cracked-plate'
+    'cnem demo cracked-plate-geometry'
     """
     stem = pathlib.PurePath(module_file).stem
     for sub, table in _TABLES.items():
@@ -162,6 +156,17 @@ def show_compile_notice() -> None:
         logger.setLevel(logging.INFO)
 
 
+def current_name(name: str, command: str = "demo") -> str:
+    """The name of a demo of ``cnem <command>``; an old name of `cnem._aliases.RENAMED_DEMOS`
+    gives the new one, with a one-line notice on stderr."""
+    new = RENAMED_DEMOS[command].get(name)
+    if new is None:
+        return name
+    print(f"cnem: '{command} {name}' is now '{command} {new}' ({name} goes in the next release)",
+          file=sys.stderr)
+    return new
+
+
 def _module_name(name, command):
     """The full module name of a demo (``SystemExit`` naming the choices if unknown)."""
     table = _TABLES[command]
@@ -201,10 +206,11 @@ def _summary(module):
 
 def _list(command):
     """Print each demo of ``cnem <command>`` with its module and its first docstring line."""
+    width = max(map(len, _TABLES[command]))
     for name in _TABLES[command]:
         module = _module_name(name, command)
         doc = _summary(module)
-        print(f"{name:15s} {module}  {'(not installed)' if doc is None else doc}")
+        print(f"{name:{width}s} {module}  {'(not installed)' if doc is None else doc}")
 
 
 def _info():
@@ -330,7 +336,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.name == "list":
         _list(args.command)
         return 0
-    load_demo(args.name, args.command).cli(rest, prog=f"cnem {args.command} {args.name}")
+    name = current_name(args.name, args.command)
+    load_demo(name, args.command).cli(rest, prog=f"cnem {args.command} {name}")
     return 0
 
 

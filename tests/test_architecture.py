@@ -21,15 +21,15 @@ ROOT = pathlib.Path(cnem.__file__).resolve().parent
 #: The layers, lowest first: the first part of a module's name below ``cnem`` -> rank.
 LAYERS = [
     ("core", {"errors", "config", "_compile", "_parallel", "_memory", "_predicates", "hyperdual", "material",
-              "exact", "_deprecated"}),
+              "exact", "_aliases"}),
     ("spatial", {"spatial"}),
     ("shape", {"shape"}),
-    ("geometry", {"geometry", "nodes"}),
+    ("geometry", {"geometry"}),
     ("output", {"io", "plot"}),
     ("solvers", {"solvers"}),
     ("assembly", {"assembly"}),
     ("fracture", {"fracture"}),
-    ("problems", {"models", "fem", "pd"}),
+    ("problems", {"elasticity", "fem", "pd"}),
     ("front", {"cli", "__main__", "demos"}),
 ]
 RANK = {part: rank for rank, (_, parts) in enumerate(LAYERS) for part in parts}
@@ -173,7 +173,7 @@ def test_import_is_lazy():
     loads on first use."""
     code = ("import sys, cnem; heavy = sorted(m for m in sys.modules if m.split('.')[0] in "
             "('numba', 'scipy', 'shapely', 'triangle', 'skfem', 'pyvista', 'matplotlib') or "
-            "m.startswith('cnem.') and m not in ('cnem.errors', 'cnem._deprecated')); print(heavy); "
+            "m.startswith('cnem.') and m not in ('cnem.errors', 'cnem._aliases')); print(heavy); "
             "body = cnem.pd.Body; print(body.__module__, 'cnem.fracture' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.splitlines()

@@ -27,7 +27,7 @@ def test_demo_list(capsys):
 
 @pytest.mark.slow
 def test_demo_cylinder_writes_its_files(tmp_path, capsys):
-    cli.main(["demo", "cylinder", "--nodes", "147", "--irregular", "--no-plot",
+    cli.main(["demo", "bimaterial-cylinder", "--nodes", "147", "--irregular", "--no-plot",
               "--out", str(tmp_path)])
     out = capsys.readouterr().out
     assert f"wrote {tmp_path / 'cylinder.vtu'}" in out
@@ -51,16 +51,36 @@ def test_pd_list_names_every_pd_demo(capsys, monkeypatch):
     assert lines[-1].endswith("(not installed)")
 
 
+def test_every_demo_is_called_by_its_module_name():
+    for table in cli._TABLES.values():
+        assert all(name == module.replace("_", "-") for name, module in table.items())
+
+
+@pytest.mark.parametrize("command, old, new", [
+    (command, old, new) for command, table in cli.RENAMED_DEMOS.items()
+    for old, new in table.items()])
+def test_old_demo_names_run_the_demo_with_a_notice(command, old, new, capsys):
+    """An old name of a demo still runs it for one release, saying the new name on stderr."""
+    with pytest.raises(SystemExit) as done:
+        cli.main([command, old, "--help"])
+    assert done.value.code == 0
+    out, err = capsys.readouterr()
+    assert out.startswith(f"usage: cnem {command} {new}")
+    assert f"cnem: '{command} {old}' is now '{command} {new}'" in err
+    assert len(err.strip().splitlines()) == 1
+    assert new in cli._TABLES[command] and old not in cli._TABLES[command]
+
+
 def test_pd_crack_help_exits_cleanly(capsys):
     with pytest.raises(SystemExit) as done:
-        cli.main(["pd", "crack", "--help"])
+        cli.main(["pd", "pd-vs-cnem-crack", "--help"])
     assert done.value.code == 0
     assert "--n N [N ...]" in capsys.readouterr().out
 
 
 def test_unknown_or_missing_pd_demo_is_named(monkeypatch):
-    with pytest.raises(SystemExit, match=r"unknown pd demo 'brnaching'; choose one of crack, "
-                                         r"branching.*cnem pd list"):
+    with pytest.raises(SystemExit, match=r"unknown pd demo 'brnaching'; choose one of "
+                                         r"pd-vs-cnem-crack, pd-crack-branching.*cnem pd list"):
         cli.main(["pd", "brnaching"])
     monkeypatch.setitem(cli.PD_DEMOS, "cpd-later", "no_such_demo")
     with pytest.raises(SystemExit, match=r"pd demo 'cpd-later' runs cnem.demos.no_such_demo, "
@@ -87,13 +107,13 @@ def test_bad_cpd_options_are_named():
     with pytest.raises(ValueError, match="expected names from .*received \\['bending'\\]"):
         cpd_examples.main(("bending",))
     with pytest.raises(SystemExit) as done:
-        cli.main(["pd", "cpd", "--example", "bending"])
+        cli.main(["pd", "cpd-examples", "--example", "bending"])
     assert done.value.code == 2
 
 
 @pytest.mark.slow
 def test_cnem_pd_cpd_runs_the_demo(tmp_path, capsys):
-    cli.main(["pd", "cpd", "--example", "lshape", "--quick", "--no-plot", "--out",
+    cli.main(["pd", "cpd-examples", "--example", "lshape", "--quick", "--no-plot", "--out",
               str(tmp_path)])
     assert "delta/D" in capsys.readouterr().out
 
@@ -238,7 +258,8 @@ def test_warmup_runs_every_listed_demo(monkeypatch):
     assert all(name.startswith("cnem.") for name in compiled)
 
 
-@pytest.mark.parametrize("command, name", [("pd", "branching"), ("pd", "kalthoff-winkler")])
+@pytest.mark.parametrize("command, name", [("pd", "pd-crack-branching"),
+                                           ("pd", "kalthoff-winkler")])
 def test_dynamic_demos_describe_their_quick_run(command, name, monkeypatch, capsys):
     """The time-stepped demos share ``--frames``, ``--quick`` and ``--no-progress``
     (`cli.dynamic_run_options`); ``--quick``'s help states the demo's own small run."""

@@ -9,7 +9,7 @@ import skfem
 from skfem.models.poisson import laplace
 
 from cnem._parallel import always_parallel
-from cnem.solvers.condensation import (FreeBlock, condense, free_dofs, free_system,
+from cnem.solvers.condensation import (FreeBlock, condensed_system, free_dofs, free_system,
                                         principal_submatrix)
 from cnem.solvers.linsolve import solve_spd
 from cnem.errors import InputError
@@ -55,9 +55,9 @@ def _check(K, reference, D, parallel):
     f, x = rng.uniform(-1, 1, N), rng.uniform(-1, 1, N)
     if parallel:
         with always_parallel():
-            A, b, x_out, I = condense(K, f, x=x, D=D)
+            A, b, x_out, I = condensed_system(K, f, x=x, D=D)
     else:
-        A, b, x_out, I = condense(K, f, x=x, D=D)
+        A, b, x_out, I = condensed_system(K, f, x=x, D=D)
     A_ref, b_ref, _, I_ref = skfem.condense(reference.tocsr(), f, x=x, D=np.unique(D))
     np.testing.assert_array_equal(I, I_ref)
     assert A.shape == A_ref.shape and A.format == (K.format if K.format == "csc" else "csr")
@@ -172,7 +172,7 @@ def test_free_dofs_is_the_complement():
 def test_bad_fixed_dofs_raise(D):
     K = _matrix(4, "csr")
     with pytest.raises(InputError, match="fixed dofs"):
-        condense(K, np.zeros(N), x=np.zeros(N), D=D)
+        condensed_system(K, np.zeros(N), x=np.zeros(N), D=D)
 
 
 @pytest.mark.parametrize("keep", [np.array([2, 1]), np.array([1, 1]), np.array([0, N]),
@@ -185,11 +185,11 @@ def test_bad_kept_dofs_raise(keep):
 def test_bad_matrix_and_vectors_raise():
     K = _matrix(6, "csr")
     with pytest.raises(InputError, match="sparse"):
-        condense(K.toarray(), np.zeros(N), x=np.zeros(N), D=[0])
+        condensed_system(K.toarray(), np.zeros(N), x=np.zeros(N), D=[0])
     with pytest.raises(InputError, match="square"):
         principal_submatrix(K[:-1], [0])
     with pytest.raises(InputError, match="x: expected shape"):
-        condense(K, np.zeros(N), x=np.zeros(N - 1), D=[0])
+        condensed_system(K, np.zeros(N), x=np.zeros(N - 1), D=[0])
     with pytest.raises(InputError, match="f: expected shape"):
         free_system(K, np.zeros(N + 1), x=np.zeros(N), D=[0])
     with pytest.raises(InputError, match="keep"):

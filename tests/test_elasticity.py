@@ -47,7 +47,7 @@ def test_patch_test(name, plane):
     np.testing.assert_allclose(sol.u, exact, atol=1e-10 * np.abs(exact).max())
     strain = 1e-3 * np.array([2.0, 0.7, -3.0 + 1.5])
     np.testing.assert_allclose(sol.strain, np.broadcast_to(strain, sol.strain.shape), atol=1e-10 * 3e-3)
-    C = cnem.models.stiffness_matrix(E, NU, plane)
+    C = cnem.elasticity.stiffness_matrix(E, NU, plane)
     np.testing.assert_allclose(sol.stress, np.broadcast_to(C @ strain, sol.stress.shape),
                                atol=1e-10 * np.abs(C @ strain).max())
 
@@ -76,8 +76,8 @@ def test_stabilised_stiffness_is_the_difference_form(name, weight):
     built here term by term from the fan sub-cells (slow reference); the sub-cells'
     spokes integrated whole or cut, their integrals cancel between neighbours."""
     import scipy.sparse as sp
-    from cnem.assembly.quadrature import subdivide, tip_cells
-    from cnem.models.elasticity import elasticity_form, lame
+    from cnem.assembly.subdivision import subdivide, tip_cells
+    from cnem.elasticity.linear import elasticity_form, lame
     _, _, model = cases.model(name)
     nreg = len(model.domain.regions)
     mats = [(E * (1 + r), NU - 0.1 * r) for r in range(nreg)]
@@ -233,7 +233,7 @@ def test_poisson_converges():
 def test_block_assembly_equals_the_general_one(name, monkeypatch):
     """Forms that see only gradients of a vector field are assembled by 2 x 2 node
     blocks; the result is the general descriptor-by-descriptor assembly's."""
-    from cnem.models.elasticity import elasticity_form, lame
+    from cnem.elasticity.linear import elasticity_form, lame
     _, _, model = cases.model(name)
     nreg = len(model.domain.regions)
     prob = cnem.Elasticity(model, [(E * (1 + r), NU - 0.1 * r) for r in range(nreg)])

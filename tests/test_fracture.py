@@ -114,7 +114,7 @@ def test_williams_derivatives_and_hooke():
         fd1 = (disp(x1 + h, x2) - disp(x1 - h, x2)) / (2 * h)
         fd2 = (disp(x1, x2 + h) - disp(x1, x2 - h)) / (2 * h)
         np.testing.assert_allclose(du, fd1, atol=1e-8 * np.abs(du).max())
-        C = cnem.models.stiffness_matrix(2.0, NU, plane)
+        C = cnem.elasticity.stiffness_matrix(2.0, NU, plane)
         strain = np.stack([fd1[:, 0], fd2[:, 1], fd1[:, 1] + fd2[:, 0]], axis=-1)
         np.testing.assert_allclose(strain @ C.T, s, atol=1e-8 * np.abs(s).max())
 

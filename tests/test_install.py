@@ -82,7 +82,7 @@ def test_cnem_demo_runs_from_an_installed_wheel(tmp_path):
     help_text = _run([cnem, "demo", "--help"], cwd=elsewhere, env=env).stdout
     assert "cylinder" in help_text and "cnem.demos.bimaterial_cylinder" in help_text
 
-    out = _run([cnem, "demo", "cracked-plate", "--h", "0.4", "--h-min", "0.1", "--no-plot",
+    out = _run([cnem, "demo", "cracked-plate-geometry", "--h", "0.4", "--h-min", "0.1", "--no-plot",
                 "--out", str(elsewhere / "out")], cwd=elsewhere, env=env).stdout
     counts = re.search(r"(\d+) cloud nodes -> (\d+) nodes \((\d+) crack nodes split", out)
     assert counts, out
@@ -94,4 +94,4 @@ def test_cnem_demo_runs_from_an_installed_wheel(tmp_path):
 
     module = _run([str(python), "-m", "cnem.demos.cracked_plate_geometry", "--help"],
                   cwd=elsewhere, env=env).stdout
-    assert "usage: cnem demo cracked-plate" in module
+    assert "usage: cnem demo cracked-plate-geometry" in module

@@ -24,7 +24,7 @@ import cnem
 from cnem.assembly import BilinearForm
 from cnem.solvers import linsolve
 from cnem.assembly.triangles import triangle_basis
-from cnem.models.elasticity import elasticity_form
+from cnem.elasticity.linear import elasticity_form
 from cnem.material import lame
 
 E, NU = 1000.0, 0.3
@@ -127,7 +127,7 @@ def test_parts_whose_dofs_do_not_couple_across_components():
 def test_degenerate_triangles_leave_the_hierarchy_on_k(monkeypatch, caplog):
     """A triangulation P1 cannot use (degenerate triangles) costs the cheaper
     preconditioner, not the solve."""
-    from cnem.models import elasticity
+    from cnem.elasticity import linear as elasticity
     _, _, model = cases.model("plate_hole_irregular")
 
     def degenerate(model, *, vector=False):

@@ -13,9 +13,9 @@ import pytest
 import shapely
 
 import cnem
-from cnem.assembly.update import updated_gradient
+from cnem.assembly.gradient_update import updated_gradient
 from cnem.errors import CNEMError, GeometryError
-from cnem.geometry.update import update
+from cnem.geometry.model_update import update
 
 TOL = 1e-12
 SQUARE = [[0.0, 0.0], [1.0, 0.0], [1.0, 2.0], [0.0, 2.0]]

@@ -8,7 +8,7 @@ from scipy.spatial import cKDTree
 
 import cnem.pd as pd
 from cnem.errors import InputError, MaterialError, UnsupportedError
-from cnem.geometry.ridge import ridge_path
+from cnem.demos.damage.ridge import ridge_path
 from cnem.pd import critical_stretch as cs
 from cnem.pd.quasistatic import load_drop, quasistatic
 

@@ -9,7 +9,7 @@ from scipy.spatial import cKDTree
 
 import cnem.pd as pd
 from cnem.errors import InputError, SolveError
-from cnem.geometry.ridge import ridge_path
+from cnem.demos.damage.ridge import ridge_path
 from cnem.pd.quasistatic import load_drop, quasistatic
 from cnem.pd.sequential import sequential
 

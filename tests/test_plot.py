@@ -116,5 +116,5 @@ def test_field_symbols_are_mathtext_that_vtk_draws():
     for label in cnem.plot.FIELD_LABELS.values():
         assert label.startswith("$") and label.endswith("$") and label.count("$") == 2, label
         parser.parse(label)                       # raises on TeX that mathtext cannot draw
-    cnem.plot._pyvista().Plotter(off_screen=True).close()
+    cnem.plot.fields._pyvista().Plotter(off_screen=True).close()
     assert vtkMathTextUtilities.GetInstance() is not None

@@ -128,7 +128,7 @@ def test_graded_rule_integrates_sqrt_ends(gauss):
 
 @pytest.mark.parametrize("name", ["whole", "node_apex"])
 def test_subdivide_checks_its_per_cell_flags(name):
-    from cnem.assembly.quadrature import subdivide
+    from cnem.assembly.subdivision import subdivide
     model = cnem.discretize(cnem.nodes.regular(cnem.geometry.rectangle(), 0.25))
     m = len(model.cells.area)
     with pytest.raises(ValueError, match=rf"{name}: expected one flag per cell, shape \({m},\), "

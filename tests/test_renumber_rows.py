@@ -1,10 +1,10 @@
-"""`cnem.assembly.update.renumber_rows` against a dense reference."""
+"""`cnem.assembly.gradient_update.renumber_rows` against a dense reference."""
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from cnem.assembly.update import renumber_rows
+from cnem.assembly.gradient_update import renumber_rows
 from cnem.errors import CNEMError
 
 

@@ -1,4 +1,4 @@
-"""The crack path through a damage field (`cnem.geometry.ridge.ridge_path`): a synthetic
+"""The crack path through a damage field (`cnem.demos.damage.ridge.ridge_path`): a synthetic
 damage band around a known polyline, in any direction, at any origin and scale, on
 regular and perturbed clouds, is traced back to that polyline."""
 
@@ -7,7 +7,7 @@ import pytest
 import shapely
 
 from cnem.errors import GeometryError
-from cnem.geometry.ridge import ridge_bands, ridge_path
+from cnem.demos.damage.ridge import ridge_bands, ridge_path
 
 #: A kinked crack (+37 and -37 degrees) in units of the scale.
 KINKED = np.array([[0.0, 0.0], [0.4, 0.0], [0.7, 0.25], [0.9, 0.1]])

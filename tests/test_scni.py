@@ -29,7 +29,7 @@ NAMES = cases.NAMES
 def _boundary_integral(model):
     """∮ phi_j n over the domain boundary and crack faces, ``(n, 2)``: phi is linear
     on every boundary edge, so each end gets half the edge's ``n * length``."""
-    from cnem.models import Elasticity
+    from cnem.elasticity import Elasticity
     edges, normal = Elasticity(model, (1.0, 0.3)).boundary_edges()
     length = np.linalg.norm(model.nodes[edges[:, 1]] - model.nodes[edges[:, 0]], axis=1)
     out = np.zeros((len(model.nodes), 2))
@@ -196,7 +196,7 @@ def test_fan_gradient_shares_the_cells_points(name, per_pass, cells_cached, monk
     points (in one pass or many), equal each computed alone; with the cells' B~
     already kept only the sub-cells' is computed, and no second copy of it is made."""
     from cnem.assembly import gradients as owner
-    from cnem.assembly.quadrature import subdivide, tip_cells
+    from cnem.assembly.subdivision import subdivide, tip_cells
     _, _, model = cases.model(name)
     alone = smoothed_gradient(model, cells=model.cells)
     sub, _ = subdivide(model.cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
@@ -263,7 +263,7 @@ def test_fan_quadratures_take_the_sub_cells_edges_from_their_cells(name, node_ap
     points and the operators of the search by coordinates; fans from the cells'
     nodes put the apex on a vertex for boundary nodes, where a spoke is a cell
     edge: it is that edge (cut at the circles), not a spoke."""
-    from cnem.assembly.quadrature import subdivide
+    from cnem.assembly.subdivision import subdivide
     from cnem.assembly.edge_quadrature import boundary_quadratures
     from cnem.assembly.fan_quadrature import fan_quadratures
     _, _, model = cases.model(name)

@@ -16,7 +16,7 @@ True
 
 from skfem import condense, solve
 
-from .._deprecated import renamed_attributes
+from .._aliases import renamed_attributes
 
 from .basis import CellBasis
 from ..solvers.conditions import select_nodes
@@ -28,5 +28,5 @@ __all__ = ["CellBasis", "BilinearForm", "LinearForm", "Functional", "asm", "cond
            "SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient",
            "cell_edges", "select_nodes"]
 
-#: Old names (one release): see `cnem._deprecated`.
+#: Old names (one release): see `cnem._aliases`.
 __getattr__ = renamed_attributes(__name__, {})

@@ -1,4 +1,4 @@
-"""Numba kernels of `cnem.assembly.update.renumber_rows`: rows of a CSR matrix taken
+"""Numba kernels of `cnem.assembly.gradient_update.renumber_rows`: rows of a CSR matrix taken
 in a new order with their columns renumbered, in two passes (count, then fill and
 sort each row), instead of NumPy's gathers over every non-zero."""
 

@@ -12,7 +12,7 @@ from ..errors import GeometryError
 from .edge_quadrature import boundary_quadratures, check_gauss
 from .fan_quadrature import fan_quadratures
 from .passes import cell_runs, gradients_in_passes
-from .quadrature import subdivide, tip_cells
+from .subdivision import subdivide, tip_cells
 
 if TYPE_CHECKING:
     from ..geometry.model import Cells, Model
@@ -78,7 +78,7 @@ def fan_gradient(model: Model, *, gauss: int = 2) -> tuple[Cells, SmoothedGradie
     """Smoothed gradients on the fan sub-cells of the model's cells, computed afresh
     (`SmoothedGradients.fan` computes them with the cells' and keeps them).
 
-    The sub-cells (`cnem.assembly.quadrature.subdivide`, spokes marked; crack-tip
+    The sub-cells (`cnem.assembly.subdivision.subdivide`, spokes marked; crack-tip
     cells fanned from their node) share every edge but their spokes with their
     cells: only the spokes add points to the cells' (`fan_quadratures`).
 

@@ -221,9 +221,8 @@ def table(rows):
 
 
 def plot_convergence(rows, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     for kind, marker in (("regular", "o"), ("irregular", "s")):
         sel = [r for r in rows if r["kind"] == kind]
@@ -263,9 +262,8 @@ def polar_stress(sol):
 
 
 def plot_profiles(sol, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     exact = exact_solution()
     x = sol.model.nodes
     rn = np.hypot(x[:, 0], x[:, 1])
@@ -336,7 +334,8 @@ def main(grids: tuple = GRIDS, *, irregular: tuple = (False, True), fem: bool = 
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
-    """Command line: ``python demos/bimaterial_cylinder.py --help`` or ``cnem demo cylinder``."""
+    """Command line: ``python demos/bimaterial_cylinder.py --help`` or
+    ``cnem demo bimaterial-cylinder``."""
     parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--nodes", type=int, nargs="+",
                         help="node counts (default the paper's 147 315 687 1863)")

@@ -59,7 +59,7 @@ Expected result
 
 The code: ``cnem/demos/cpd/common.py`` (solve, tables, pictures),
 ``cnem/demos/cpd/stretch.py`` (examples 1-2), ``cnem/demos/cpd/structures.py`` (3-5).
-Run ``python demos/cpd_examples.py --help`` or ``cnem pd cpd --help``.
+Run ``python demos/cpd_examples.py --help`` or ``cnem pd cpd-examples --help``.
 """
 
 from __future__ import annotations
@@ -107,7 +107,7 @@ def main(examples: tuple = EXAMPLES, *, quick: bool = False, outdir: str = "resu
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
-    """Command line: ``python demos/cpd_examples.py --help`` or ``cnem pd cpd``."""
+    """Command line: ``python demos/cpd_examples.py --help`` or ``cnem pd cpd-examples``."""
     parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--example", choices=EXAMPLES + ("all",), default="all",
                         help="the example to run (all: the five)")

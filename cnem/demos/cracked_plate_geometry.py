@@ -139,7 +139,8 @@ def main(h: float = 0.1, h_min: float = 0.01, gamma_deg: float = 30.0, growth: f
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
-    """Command line: ``python demos/cracked_plate_geometry.py --help`` or ``cnem demo cracked-plate``."""
+    """Command line: ``python demos/cracked_plate_geometry.py --help`` or
+    ``cnem demo cracked-plate-geometry``."""
     parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--h", type=float, default=0.1, help="spacing away from the crack")
     parser.add_argument("--h-min", type=float, default=0.01, help="spacing at the tips")

@@ -129,7 +129,7 @@ def run(theta_deg, h, increment, steps, progress=False, scheme="explicit"):
 
     Returns
     -------
-    (CrackPath, str or None)
+    (GrowthHistory, str or None)
         The history and, when an arm came off, the error's message.
     """
     dom = domain(theta_deg)
@@ -183,9 +183,8 @@ def _record(theta, hist, message):
 
 
 def _paths_figure(runs, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     fig, ax = plt.subplots(figsize=(10.0, 4.2))
     ax.plot([0, L, L, 0, 0], [-H, -H, H, H, -H], "k-", lw=1.0)
     ax.plot([0, A0], [0, 0], "k-", lw=2.0, label="initial crack")
@@ -211,8 +210,9 @@ def _paths_figure(runs, path):
 
 
 def _load_figure(r, path):
-    """`CrackPath.plot` ``kind="load"`` with the straight crack of beam theory beside it."""
-    import matplotlib.pyplot as plt
+    """`GrowthHistory.plot` ``kind="load"`` with the straight crack of beam theory beside it."""
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     fig = r["history"].plot(None, kind="load", length_unit="$H$",
                             load_unit=r"$K_\mathrm{Ic}\sqrt{H}$",
                             displacement_unit=r"$K_\mathrm{Ic} / E\sqrt{H}$",

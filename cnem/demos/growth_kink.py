@@ -105,9 +105,8 @@ def main(angles: tuple = ANGLES, *, cloud: tuple = CLOUD, outdir: str = "results
             keep = hist
     files = []
     if plot:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        from cnem.plot.charts import offscreen_pyplot
+        plt = offscreen_pyplot()
         gg = np.linspace(0.0, 89.0, 200)
         fig, ax = plt.subplots(figsize=(6.0, 4.5))
         ax.plot(gg, np.degrees(exact(gg)[2]), "k-",

@@ -20,7 +20,7 @@ The plate, holes, edge cracks, material and supports of
   bottom and top edges (a single prescribed row over-stretches the bonds next
   to it: 1.8x the mean strain, measured on a strip), u_x = 0 at the origin.
 * The PD crack paths are the ridges of damage >= 0.5 from each initial tip
-  (`cnem.geometry.ridge.ridge_path`).
+  (`cnem.demos.damage.ridge.ridge_path`).
 
 Compared: the Hausdorff distance between the paths (shapely; the longer path
 cut to the length of the shorter one), the first kink angle (the chord over the
@@ -84,7 +84,7 @@ first direction, not on the failure: PD's strength (the hole breaks at a stress
 ~ E s_c that grows like delta^-1/2) still lets the holes nucleate before a
 notch crack gets there. The picture (``pd_cnem_paths.png``) draws the paths
 over the geometry on the PD damage field, one panel per spacing, with the PD
-cracks that did not grow from a notch (`cnem.geometry.ridge.ridge_bands`).
+cracks that did not grow from a notch (`cnem.demos.damage.ridge.ridge_bands`).
 """
 
 from __future__ import annotations
@@ -102,7 +102,7 @@ from cnem._parallel import one_thread
 from cnem.cli import demo_parser
 from cnem.errors import GeometryError
 from cnem.demos import growth_two_holes as plate
-from cnem.geometry.ridge import ridge_bands, ridge_path
+from cnem.demos.damage.ridge import ridge_bands, ridge_path
 from cnem.pd.critical_stretch import fracture_energy
 from cnem.pd.quasistatic import load_drop, quasistatic
 from cnem.pd.sequential import sequential
@@ -422,9 +422,8 @@ def table(results: list) -> str:
 
 
 def _plot(results, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     fig, axes = plt.subplots(len(results), 1, figsize=(9.0, 4.6 * len(results)), squeeze=False)
     for ax, r in zip(axes[:, 0], results):
         sc = ax.scatter(*r["points"].T, c=r["damage"], s=4.0 * (0.25 / r["h"]) ** 2, cmap="Greys",

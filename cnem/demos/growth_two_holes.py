@@ -294,9 +294,8 @@ def study(runs: Sequence[tuple] = STUDY, outdir: str = "results/growth_two_holes
         print(f"{h:>6g} {inc:>5g} {ring_s:>6} {'pub' if corners else 'ours':>5} | {cells} | {tail}")
     out = pathlib.Path(outdir)
     out.mkdir(parents=True, exist_ok=True)
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     fig, ax = plt.subplots(figsize=(9, 4.8))
     for c in HOLES:
         ax.add_patch(plt.Circle(c, R, fill=False, color="black"))

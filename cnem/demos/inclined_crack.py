@@ -143,9 +143,8 @@ def table(rows):
 
 
 def _plots(rows, ahead, out):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     r, s22 = ahead
     fig, ax = plt.subplots(figsize=(6, 4.5))
     rr = np.linspace(max(r.min(), 1e-4), r.max(), 300)

@@ -253,8 +253,9 @@ def measure(points: np.ndarray, damage: np.ndarray, horizon: float) -> dict:
 def _picture(points, damage, h, horizon, angles, t_end, path):
     """Damage of the plate, axes in mm, colour bar, the fitted crack directions."""
     import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     fig, ax = plt.subplots(figsize=(5.2, 8.4), layout="constrained")
     image = np.full((round(DEPTH / h), round(WIDTH / h)), np.nan)     # the slots stay empty
     cell = np.floor((points + [0.0, 0.5 * WIDTH]) / h).astype(int)

@@ -159,9 +159,8 @@ def table(rows):
 
 
 def _plot(rows, rates, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     fig, ax = plt.subplots(figsize=(6, 4.5))
     names = {"cnem": "C-NEM", "enriched": "C-NEM + branch enrichment", "fem": "FEM P1"}
     for m, marker in (("cnem", "o-"), ("enriched", "s-"), ("fem", "^:")):

@@ -253,9 +253,8 @@ def measure(problem: Problem, shape: np.ndarray, run: DynamicRun, h: float,
 
 def _plots(problem, shape, run, res, h, out, montage=6):
     """The damage montage and the history plot; returns their paths."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     times = res["times"]
     picks = np.unique(np.linspace(0, len(times) - 1, montage).round().astype(int))
     rows = (len(picks) + 1) // 2
@@ -401,7 +400,8 @@ def report(r, h, horizon, material, mat):
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
-    """Command line: ``python demos/pd_crack_branching.py --help`` or ``cnem pd branching``."""
+    """Command line: ``python demos/pd_crack_branching.py --help`` or
+    ``cnem pd pd-crack-branching``."""
     parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--h", type=float, default=0.25, help="grid spacing in mm")
     parser.add_argument("--m", type=float, default=4.0, help="horizon / spacing")

@@ -142,9 +142,8 @@ def table(rows):
 
 
 def _plots(rows, out):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.5))
     xx = np.linspace(-A, A, 300)
     ax.plot(xx, griffith(xx), "k-", label="Griffith (infinite plate)")
@@ -202,7 +201,8 @@ def main(spacings: tuple = SPACINGS, *, outdir: str = "results/pd_vs_cnem_crack"
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
-    """Command line: ``python demos/pd_vs_cnem_crack.py --help`` or ``cnem demo pd-crack``."""
+    """Command line: ``python demos/pd_vs_cnem_crack.py --help`` or
+    ``cnem demo pd-vs-cnem-crack``."""
     parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--n", type=int, nargs="+", default=[16, 32, 64],
                         help="nodes per unit length (h = 1 / n)")

@@ -14,18 +14,22 @@
 True
 """
 
+from .._aliases import renamed_attributes
 from .criteria import CRITERIA, kink
 from .enrichment import Enrichment
 from ..geometry.domain import Domain
 from .growth import grow
 from .refine import Refinement
-from .history import CrackPath, GrowthEvent, Step
+from .history import GrowthHistory, GrowthEvent, Step
 from .interaction import SIFResult, sif
 from ..material import effective_modulus, kappa
 from .williams import nodal_williams, polar, williams
 
 __all__ = ["sif", "SIFResult", "Enrichment", "tip_frame", "williams", "nodal_williams", "polar", "kappa",
-           "effective_modulus", "grow", "Refinement", "CrackPath", "Step", "GrowthEvent", "kink", "CRITERIA"]
+           "effective_modulus", "grow", "Refinement", "GrowthHistory", "Step", "GrowthEvent", "kink", "CRITERIA"]
+
+#: Old names (one release): see `cnem._aliases`.
+__getattr__ = renamed_attributes(__name__, {"CrackPath": ("cnem.fracture.history", "GrowthHistory")})
 
 #: `Domain.tip_frame` as a function of ``(domain, tip)``.
 tip_frame = Domain.tip_frame

@@ -27,7 +27,7 @@ from shapely.ops import nearest_points, split
 from ..errors import GeometryError
 from ..geometry.domain import Domain
 from ..geometry.pslg import segment_projection
-from ..nodes import from_points
+from ..geometry.nodes import from_points
 
 if TYPE_CHECKING:
     from typing import Literal, Sequence

@@ -1,4 +1,5 @@
-"""Pictures of a crack-growth run (`CrackPath.plot`): matplotlib, off-screen, PNG.
+"""Pictures of a crack-growth run (`GrowthHistory.plot`): matplotlib charts, off-screen
+(`cnem.plot.charts`), PNG.
 
 * `paths`: the geometry, the final von Mises field (at load factor 1) and the
   crack paths with a dot at every increment's tip;
@@ -16,19 +17,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..io import cell_topology
+from ..plot.charts import offscreen_pyplot
 
 if TYPE_CHECKING:
     from typing import Any
     from matplotlib.figure import Figure
 
 __all__ = ["paths", "sif_curves", "load_curves"]
-
-
-def _pyplot():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
 
 
 def _unit(u):
@@ -55,7 +50,7 @@ def paths(hist: Any, path: str | None = None, *, length_unit: str = "", stress_u
 
     Parameters
     ----------
-    hist : CrackPath
+    hist : GrowthHistory
     path : str or os.PathLike, optional
         PNG to write.
     length_unit, stress_unit : str
@@ -68,7 +63,7 @@ def paths(hist: Any, path: str | None = None, *, length_unit: str = "", stress_u
     -------
     matplotlib.figure.Figure
     """
-    plt = _pyplot()
+    plt = offscreen_pyplot()
     xmin, ymin, xmax, ymax = hist.domain.bounds
     aspect = (xmax - xmin) / (ymax - ymin)
     fig, ax = plt.subplots(figsize=(min(12.0, max(5.0, 5.0 * aspect + 2.2)), 5.5))
@@ -116,7 +111,7 @@ def sif_curves(hist: Any, path: str | None = None, *, length_unit: str = "", sif
     -------
     matplotlib.figure.Figure
     """
-    plt = _pyplot()
+    plt = offscreen_pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     length, K, K_eq = hist.array("crack_length"), hist.array("K"), hist.array("K_eq")
     if reference is not None:
@@ -147,7 +142,7 @@ def load_curves(hist: Any, path: str | None = None, *, length_unit: str = "", lo
     -------
     matplotlib.figure.Figure
     """
-    plt = _pyplot()
+    plt = offscreen_pyplot()
     measure = hist.array("measure")
     panels = 2 if np.isfinite(measure).any() else 1
     fig, axes = plt.subplots(1, panels, figsize=(6.0 * panels, 4.5), squeeze=False)

@@ -38,14 +38,14 @@ from tqdm.auto import tqdm
 from ..errors import CNEMError, GeometryError, GrowthError, GrowthWarning
 from ..geometry.cloud import NodeCloud
 from ..geometry.model import discretize
-from ..geometry.update import update
+from ..geometry.model_update import update
 from ..material import kappa as kolosov
-from ..nodes import irregular
+from ..geometry.nodes import irregular
 from . import advance
 from .corrector import SCHEMES, corrections
 from .refine import Refinement, as_refinement, auto_refinement, refined_cloud
 from .criteria import CRITERIA, kink
-from .history import CrackPath, GrowthEvent, Step
+from .history import GrowthHistory, GrowthEvent, Step
 from .interaction import sif
 
 if TYPE_CHECKING:
@@ -167,7 +167,7 @@ class _Run:
 
     def _problem(self):
         """``setup`` on the model of the current cloud: by a local update of the previous
-        model and problem (`cnem.geometry.update.update`, the problem's ``update_from``)
+        model and problem (`cnem.geometry.model_update.update`, the problem's ``update_from``)
         while ``local``, else (and when the problem refuses the update) from scratch."""
         cloud = self.nodes()
         if not self.local or self.problem is None:
@@ -352,7 +352,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
          continue_with: Literal["largest"] | int | Callable[[list], int] | None = None,
          refine: Refinement | float | Literal["auto"] | None = "auto",
          scheme: Literal["explicit", "corrector"] = "explicit",
-         progress: bool = True) -> CrackPath:
+         progress: bool = True) -> GrowthHistory:
     """Grow the cracks of a domain step by step (quasi-static LEFM).
 
     Parameters
@@ -387,9 +387,9 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         Nodes closer than ``clearance`` local spacings to a new segment are dropped,
         and a tip that ends this close to the boundary is carried on to it.
     keep : bool
-        Keep every step's solution (`CrackPath.write` needs them).
+        Keep every step's solution (`GrowthHistory.write` needs them).
     local : bool
-        Re-discretise each increment by a local update (`cnem.geometry.update.update`
+        Re-discretise each increment by a local update (`cnem.geometry.model_update.update`
         and the problem's ``update_from``: only the cells the new segments reach are
         recomputed, the result equals a fresh build); False rebuilds the model and the
         operators from scratch. A problem that refuses the update (enrichment, other
@@ -430,7 +430,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
 
     Returns
     -------
-    CrackPath
+    GrowthHistory
 
     Raises
     ------
@@ -517,6 +517,6 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
 def _history(run, now, sol, mark):
     final = Step(**now, increment=np.zeros(len(run.rows)), events=tuple(run.events[mark:]),
                  solution=sol if run.keep else None, correction=np.zeros(len(run.rows)))
-    return CrackPath(steps=run.steps, final=final, cracks=[c.copy() for c in run.cracks],
+    return GrowthHistory(steps=run.steps, final=final, cracks=[c.copy() for c in run.cracks],
                      domain=run.domain, model=run.model, solution=sol, criterion=run.criterion,
                      events=list(run.events))

@@ -1,4 +1,4 @@
-"""The record of a crack-growth run: one `Step` per increment, events, and the `CrackPath`.
+"""The record of a crack-growth run: one `Step` per increment, events, and the `GrowthHistory`.
 
 Every tip of the initial domain keeps its row ``i`` in every step's arrays
 (``tips (t, 2)``, ``K (t, 2)``, ...); a tip that stopped growing is inactive
@@ -13,12 +13,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .._aliases import renamed_attributes
+
 if TYPE_CHECKING:
     import os
     from typing import Any, Literal
     from matplotlib.figure import Figure
 
-__all__ = ["GrowthEvent", "Step", "CrackPath", "EVENT_KINDS"]
+__all__ = ["GrowthEvent", "Step", "GrowthHistory", "EVENT_KINDS"]
+
+#: Old names (one release): see `cnem._aliases`.
+__getattr__ = renamed_attributes(__name__, {"CrackPath": (__name__, "GrowthHistory")})
 
 #: What can happen to a tip, by name.
 EVENT_KINDS = {
@@ -126,7 +131,7 @@ class Step:
 
 
 @dataclass(frozen=True, repr=False)
-class CrackPath:
+class GrowthHistory:
     """The history of a crack-growth run (`cnem.fracture.grow`).
 
     Attributes
@@ -157,7 +162,7 @@ class CrackPath:
         return len(self.steps)
 
     def __repr__(self):
-        return (f"<CrackPath {len(self.steps)} steps, {len(self.final.tips)} tips "
+        return (f"<GrowthHistory {len(self.steps)} steps, {len(self.final.tips)} tips "
                 f"({int(self.final.active.sum())} growing at the end), criterion {self.criterion}, "
                 f"{len(self.events)} events>")
 

@@ -12,7 +12,7 @@ hole or the boundary it gets a node on that edge, and its nodes closer than
 half their spacing to an edge go. When a tip moves on, its old disc gets the
 background nodes back: the cloud keeps the same size as the crack grows, and
 away from the tips it is the background cloud. The local update
-(`cnem.geometry.update.update`) takes any cloud change, so the refined model
+(`cnem.geometry.model_update.update`) takes any cloud change, so the refined model
 equals `discretize` of the refined cloud.
 
 By default (``refine="auto"``) rings go only where the interaction integral needs
@@ -44,7 +44,7 @@ from scipy.spatial import cKDTree
 
 from .. import config
 from ..errors import GrowthError
-from ..nodes import from_points
+from ..geometry.nodes import from_points
 from .discs import clearance
 
 if TYPE_CHECKING:

@@ -8,6 +8,7 @@
 True
 """
 
+from .._aliases import renamed_attributes
 from .cloud import NodeCloud
 from .domain import Domain
 from .model import Cells, Model, discretize
@@ -16,3 +17,6 @@ from .shapes import annulus, arc, l_shape, plate_with_hole, rectangle
 
 __all__ = ["Domain", "NodeCloud", "Model", "Cells", "PSLG", "SegmentKind", "discretize",
            "rectangle", "plate_with_hole", "annulus", "l_shape", "arc"]
+
+#: Old names (one release): see `cnem._aliases`.
+__getattr__ = renamed_attributes(__name__, {})

@@ -438,7 +438,7 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     only : (w,) int array_like, optional
         Compute the cells of these nodes alone (default: of every node); a
         cell depends only on the triangulation, so these are the same cells
-        as those of the whole diagram (`cnem.geometry.update` relies on it).
+        as those of the whole diagram (`cnem.geometry.model_update` relies on it).
     frame : cnem._predicates.Frame, optional
         The local frame ``nodes`` are given in (`cnem._predicates.local_frame`): the
         points and lengths named in errors are mapped back to the caller's coordinates.

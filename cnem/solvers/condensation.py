@@ -1,7 +1,7 @@
 """The linear system on the free dofs: the free dofs, the principal submatrix of the
 stiffness on them and the right-hand side lifted by the prescribed values.
 
-`condense` gives what ``skfem.condense(K, f, x=x, D=D)`` gives for a vector right-hand
+`condensed_system` gives what ``skfem.condense(K, f, x=x, D=D)`` gives for a vector right-hand
 side, with the submatrix and the lifting computed by parallel kernels
 (`cnem.solvers._condense_kernels`, `cnem.solvers._multigrid_kernels.multiply`) and the
 free dofs by a mask (skfem's single-threaded fancy indexing and ``setdiff1d`` took 6 s of
@@ -15,7 +15,7 @@ iterative solve holds one copy of the stiffness, not two (1.3 GB at 1M nodes).
 
 >>> import numpy as np, scipy.sparse as sp
 >>> K = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(5, 5), format="csr")
->>> A, b, x, I = condense(K, np.zeros(5), x=np.array([1.0, 0, 0, 0, 0]), D=[0, 4])
+>>> A, b, x, I = condensed_system(K, np.zeros(5), x=np.array([1.0, 0, 0, 0, 0]), D=[0, 4])
 >>> I.tolist(), b.tolist()
 ([1, 2, 3], [1.0, 0.0, 0.0])
 """
@@ -26,11 +26,15 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .._aliases import renamed_attributes
 from ..errors import InputError
 from . import _condense_kernels as kernels
 from .multigrid import parallel_operator
 
-__all__ = ["free_dofs", "principal_submatrix", "FreeBlock", "free_system", "condense"]
+__all__ = ["free_dofs", "principal_submatrix", "FreeBlock", "free_system", "condensed_system"]
+
+#: Old names (one release): see `cnem._aliases`.
+__getattr__ = renamed_attributes(__name__, {"condense": (__name__, "condensed_system")})
 
 _INT32_MAX = np.iinfo(np.int32).max
 
@@ -203,7 +207,7 @@ def free_system(K: sp.spmatrix, f: np.ndarray, *, x: np.ndarray, D: np.ndarray
     return FreeBlock(K, I), f[I] - lifted[I], I
 
 
-def condense(K: sp.spmatrix, f: np.ndarray, *, x: np.ndarray, D: np.ndarray
+def condensed_system(K: sp.spmatrix, f: np.ndarray, *, x: np.ndarray, D: np.ndarray
              ) -> tuple[sp.spmatrix, np.ndarray, np.ndarray, np.ndarray]:
     """The system on the free dofs ``I``: ``K[I][:, I] u_I = f[I] - K[I][:, D] x[D]``.
 

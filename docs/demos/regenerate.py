@@ -28,13 +28,13 @@ IMAGES = ROOT / "docs" / "images" / "demos"
 
 #: Page name (``docs/demos/<name>.md``) -> the command line after ``cnem`` that its text shows.
 PAGES = {
-    "bimaterial_cylinder": ("demo", "cylinder"),
-    "cracked_plate_geometry": ("demo", "cracked-plate"),
+    "bimaterial_cylinder": ("demo", "bimaterial-cylinder"),
+    "cracked_plate_geometry": ("demo", "cracked-plate-geometry"),
     "inclined_crack": ("demo", "inclined-crack"),
     "mode1_crack": ("demo", "mode1-crack", "--n", "8", "16", "32"),
-    "pd_vs_cnem_crack": ("pd", "crack", "--n", "16", "32"),
-    "pd_crack_branching": ("pd", "branching", "--quick"),
-    "cpd_examples": ("pd", "cpd", "--quick"),
+    "pd_vs_cnem_crack": ("pd", "pd-vs-cnem-crack", "--n", "16", "32"),
+    "pd_crack_branching": ("pd", "pd-crack-branching", "--quick"),
+    "cpd_examples": ("pd", "cpd-examples", "--quick"),
     "growth_sent": ("demo", "growth-sent"),
     "growth_kink": ("demo", "growth-kink", "--angles", "30", "60"),
     "growth_two_holes": ("demo", "growth-two-holes", "--h", "0.5", "--steps", "4"),

@@ -29,7 +29,7 @@ prob.add_traction(lambda x, n: np.abs(x[:, 0] - 2.0) < tol,      # edges on x = 
 sol = prob.solve()
 
 # stresses: one [sxx, syy, sxy] per integration cell (MPa)
-vm = cnem.models.von_mises(sol.stress)
+vm = cnem.elasticity.von_mises(sol.stress)
 print(f"max von Mises {vm.max():.1f} MPa; largest deflection {-sol.u[:, 1].min() * 1e3:.3f} um down")
 
 # reaction forces at the clamped nodes: K u - f on their dofs (N per mm of thickness)

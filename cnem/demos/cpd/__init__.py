@@ -1,4 +1,5 @@
-"""The CPD examples of Javili et al. §6, run by `cnem.demos.cpd_examples` (``cnem pd cpd``)."""
+"""The CPD examples of Javili et al. §6, run by `cnem.demos.cpd_examples`
+(``cnem pd cpd-examples``)."""
 
 
 from . import common, stretch, structures

@@ -75,9 +75,8 @@ def picture(path: str, panels: list[dict], *, dim: int,
     (`picture_3d`). ``window`` is the size in pixels."""
     if dim == 3:
         return picture_3d(path, panels, window=window)
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     from matplotlib.collections import LineCollection
     from matplotlib.ticker import MaxNLocator
     from mpl_toolkits.axes_grid1 import make_axes_locatable
@@ -129,7 +128,7 @@ def picture_3d(path: str, panels: list[dict], *, window: tuple = (1200, 600)) ->
     """`picture` of 3-D lattices (pyvista, off-screen, one camera): each body shaded, the
     colour bar upright beside it, axes with the body's coordinates (length 1 = the cube's
     side) and the panel's title on top."""
-    from cnem.plot import _pyvista, colour_bar_font, use_font
+    from cnem.plot.fields import _pyvista, colour_bar_font, use_font
     pv = _pyvista()
     pl = pv.Plotter(off_screen=True, window_size=window, shape=(1, len(panels)),
                     border=False)

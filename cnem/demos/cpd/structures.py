@@ -205,9 +205,8 @@ def lshape(spacing: float = 1 / 40, *, ratios: tuple = (2.0, 3.0, 4.0, 5.0), pul
 def _profiles(out, distance, results, h):
     """von Mises along the row and the column through the corner (Figure 10); returns
     the file written."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
     out.mkdir(parents=True, exist_ok=True)
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), sharey=True)
     for m, r in results.items():

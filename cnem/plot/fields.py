@@ -1,15 +1,8 @@
-"""Pictures with pyvista, off-screen: a `Model` (cells, triangles, nodes, cracks) and
+"""Scenes with pyvista, off-screen: a `Model` (cells, triangles, nodes, cracks) and
 a solution (deformed shape coloured by a field).
 
-pyvista is imported only here, and only when a picture is drawn, so
-``import cnem.plot`` works without it; drawing without it raises `PlotError`
-with the command that installs it (``pip install "cnem[plot]"``).
-
->>> import cnem, cnem.plot                                  # doctest: +SKIP
->>> from cnem.geometry import rectangle                     # doctest: +SKIP
->>> dom = rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.5, 0.5]]])   # doctest: +SKIP
->>> m = cnem.discretize(cnem.nodes.regular(dom, 0.1))      # doctest: +SKIP
->>> cnem.plot.model(m, "cells.png").close()                # doctest: +SKIP
+pyvista is imported only here, and only when a picture is drawn (`_pyvista`); the
+package's docstring (`cnem.plot`) shows the use.
 """
 
 from __future__ import annotations
@@ -22,14 +15,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import PlotDependencyError, PlotError, PlotInputError
-from .geometry.pslg import SegmentKind
-from .io import cell_topology
+from ..errors import PlotDependencyError, PlotError, PlotInputError
+from ..geometry.pslg import SegmentKind
+from ..io import cell_topology
 
 if TYPE_CHECKING:
     import pyvista
 
-    from .geometry.model import Model
+    from ..geometry.model import Model
 
 __all__ = ["model", "solution", "cells_polydata", "region_color", "PlotError", "REGION_COLORS",
            "SOLUTION_FIELDS", "FIELD_LABELS"]

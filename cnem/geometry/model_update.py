@@ -24,7 +24,7 @@ reach them:
   so a cell that does not meet the changed region (nor has a changed triangle
   at its node) is the same cell; the natural neighbours of a point outside
   the region are the same nodes, so the smoothed gradient of such a cell is the
-  same row too (`cnem.assembly.update`).
+  same row too (`cnem.assembly.gradient_update`).
 
 A sliver along a constraint (a node almost on a crack segment) has a large
 circumcircle, and the update then recomputes the cells it covers: still exact,

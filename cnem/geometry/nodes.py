@@ -21,13 +21,13 @@ import shapely
 from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
-from . import config
-from .errors import GeometryError, LimitError
-from .geometry.cloud import NodeCloud
-from .geometry.pslg import SegmentKind, segment_projection
+from .. import config
+from ..errors import GeometryError, LimitError
+from .cloud import NodeCloud
+from .pslg import SegmentKind, segment_projection
 
 if TYPE_CHECKING:
-    from .geometry.domain import Domain
+    from .domain import Domain
 
 __all__ = ["regular", "irregular", "graded", "from_points", "NodeCloud"]
 

@@ -17,7 +17,8 @@ from ..assembly import BilinearForm, CellBasis
 from ..solvers.condensation import principal_submatrix
 from ..solvers.conditions import Conditions, traction_at
 from ..assembly.basis import spread_component
-from ..assembly.quadrature import cell_quadrature, subdivide, tip_cells
+from ..assembly.quadrature import cell_quadrature
+from ..assembly.subdivision import subdivide, tip_cells
 from ..assembly.gradients import SmoothedGradients
 from ..assembly.triangles import triangle_basis
 from ..solvers.constrained import solve_constrained
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
     from typing import Literal, Sequence
     from ..fracture.enrichment import Enrichment
     from ..geometry.model import Model
-    from ..geometry.update import ModelUpdate
+    from ..geometry.model_update import ModelUpdate
 
 __all__ = ["Elasticity", "elasticity_form"]
 
@@ -153,13 +154,13 @@ class Elasticity(Conditions):
     def update_from(self, old: Elasticity, change: ModelUpdate) -> Elasticity:
         """Take ``B~`` and ``K`` from the problem ``old`` on the model before a local
         update, recomputing only the cells the change reaches
-        (`cnem.models.local_update.updated_operators`); equal to building them here.
+        (`cnem.elasticity.operator_update.updated_operators`); equal to building them here.
 
         Parameters
         ----------
         old : Elasticity
             On ``change.old``, with the same materials, plane, gauss and stabilisation.
-        change : cnem.geometry.update.ModelUpdate
+        change : cnem.geometry.model_update.ModelUpdate
             With ``change.model`` this problem's model.
 
         Returns
@@ -167,7 +168,7 @@ class Elasticity(Conditions):
         Elasticity
             ``self``.
         """
-        from .local_update import updated_operators
+        from .operator_update import updated_operators
         gradient, self._K = updated_operators(old, self, change, elasticity_form)
         self.gradients = SmoothedGradients(self.model, gauss=self.gauss, cells=gradient)
         self._basis = CellBasis(self.model, vector=True, cells=self.cells,

@@ -10,9 +10,15 @@
 True
 """
 
-from .elasticity import Elasticity, elasticity_form
+from .._aliases import renamed_attributes
+from .linear import Elasticity, elasticity_form
 from ..material import lame, stiffness_matrix
 from .solution import ElasticSolution, von_mises
 
 __all__ = ["Elasticity", "ElasticSolution", "elasticity_form", "lame", "stiffness_matrix",
            "von_mises"]
+
+#: Old names (one release): the modules of ``cnem.elasticity`` as attributes
+#: (``cnem.elasticity.linear``); see `cnem._aliases`.
+__getattr__ = renamed_attributes(__name__, {"elasticity": ("cnem.elasticity", "linear"),
+                                            "local_update": ("cnem.elasticity", "operator_update")})

@@ -1,6 +1,6 @@
 """Smoothed gradients after a local model update: only the changed cells' rows recomputed.
 
-A cell that `cnem.geometry.update.update` copied from the old model lies outside
+A cell that `cnem.geometry.model_update.update` copied from the old model lies outside
 every changed circumcircle, so the natural neighbours of the points on its
 boundary, their shape functions and its row of ``B~`` are those of the old
 model: the row is copied with its columns renumbered to the new nodes. The
@@ -20,7 +20,7 @@ from . import _renumber_kernels as RK
 from .gradients import SmoothedGradient, smoothed_gradient
 
 if TYPE_CHECKING:
-    from ..geometry.update import ModelUpdate
+    from ..geometry.model_update import ModelUpdate
 
 __all__ = ["updated_gradient", "renumber_rows"]
 
@@ -77,7 +77,7 @@ def updated_gradient(old: SmoothedGradient, change: ModelUpdate, *,
     ----------
     old : SmoothedGradient
         ``B~`` of ``change.old`` (its cells), ``x, y`` ``(m_old, n_old)``.
-    change : cnem.geometry.update.ModelUpdate
+    change : cnem.geometry.model_update.ModelUpdate
     gauss : int
         As in `smoothed_gradient` (the one ``old`` was computed with).
 

@@ -17,7 +17,7 @@ from scipy import sparse
 from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
-from ..errors import GeometryError
+from cnem.errors import GeometryError
 
 __all__ = ["ridge_path", "ridge_bands"]
 

@@ -1,7 +1,7 @@
 """``B~`` and ``K`` of an elasticity problem after a local model update.
 
 ``K`` is a sum over the integration cells (eq. 33; with the stabilisation over
-their fan sub-cells, which lie inside them), so after `cnem.geometry.update.update`::
+their fan sub-cells, which lie inside them), so after `cnem.geometry.model_update.update`::
 
     K_new = P K_old P^T - K_old(dropped cells) + K_new(recomputed cells)
 
@@ -19,9 +19,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..assembly import CellBasis
-from ..assembly.quadrature import subdivide, tip_cells
+from ..assembly.subdivision import subdivide, tip_cells
 from ..assembly.gradients import smoothed_gradient
-from ..assembly.update import renumber_rows, updated_gradient
+from ..assembly.gradient_update import renumber_rows, updated_gradient
 from .._parallel import one_thread
 from ..errors import CNEMError
 
@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from typing import Any
     from ..assembly.forms import BilinearForm
     from ..assembly.scni import SmoothedGradient
-    from ..geometry.update import ModelUpdate
+    from ..geometry.model_update import ModelUpdate
 
 __all__ = ["updated_operators", "cells_stiffness"]
 
@@ -47,7 +47,7 @@ def cells_stiffness(prob: Any, index: np.ndarray, gradient: SmoothedGradient,
     gradient : SmoothedGradient
         ``B~`` of those cells, ``(c, n)``.
     form : BilinearForm
-        `cnem.models.elasticity.elasticity_form`.
+        `cnem.elasticity.linear.elasticity_form`.
 
     Returns
     -------
@@ -85,9 +85,9 @@ def updated_operators(old: Any, new: Any, change: ModelUpdate,
     new : Elasticity
         The problem on ``change.model``: the same materials, plane, ``gauss`` and
         stabilisation, no enrichment.
-    change : cnem.geometry.update.ModelUpdate
+    change : cnem.geometry.model_update.ModelUpdate
     form : BilinearForm
-        The problem's bilinear form (`cnem.models.elasticity.elasticity_form`).
+        The problem's bilinear form (`cnem.elasticity.linear.elasticity_form`).
 
     Returns
     -------
