@@ -12,11 +12,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..solvers.conditions import Conditions
-from ..solvers.linsolve import free_rigid_motions, rigid_modes, solve_spd
-from .. import config
-from ..errors import (ConvergenceError, InputError, MaterialError, SolveError, UnsupportedError,
-                      check_choice)
-from . import _kernels as K
+from ..solvers.newton import LINE_SEARCH_HALVINGS, newton
+from ..errors import InputError, MaterialError, UnsupportedError, check_choice
 from .correction import SurfaceCorrection
 from .dynamics import Dynamics
 from .moments import moment_tensors, live_inverse
@@ -327,7 +324,7 @@ class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
 
     # -- statics ------------------------------------------------------------------------
     #: Most step halvings of the backtracking line search of `solve`.
-    LINE_SEARCH_HALVINGS = 10
+    LINE_SEARCH_HALVINGS = LINE_SEARCH_HALVINGS
 
     def _static_system(self):
         """``evaluate(u, tangent) -> (f_int (d n,), K or None)`` and the tangent's pattern:
@@ -389,87 +386,14 @@ class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
             (named, with its residuals; the error's ``history`` holds those of every
             load step so far).
         """
-        d, n = self.dim, len(self.body)
-        steps, max_iterations = int(steps), int(max_iterations)
-        if steps < 1 or max_iterations < 1:
-            raise InputError(f"expected steps >= 1 and max_iterations >= 1, received "
-                             f"steps={steps}, max_iterations={max_iterations}")
         self.static_only("solve")
         evaluate, pattern = self._static_system()
         D, values = self.prescribed()
-        free = free_rigid_motions(pattern, self.body.points, D)
-        if free:
-            raise SolveError("the system is singular: the Dirichlet conditions leave free "
-                             "the " + "; ".join(free) + ". Fix them with add_dirichlet")
-        F = self.load()
-        u = np.zeros(d * n) if initial is None else np.asarray(initial, float).reshape(-1).copy()
-        interior = np.setdiff1d(np.arange(d * n), D)
-        modes = rigid_modes(self.body.points)[interior]
-        linear = self.material.kind != "cpd"
-        cache = {}
-
-        def blocks(Kt):
-            """The tangent's free-free and free-prescribed parts (kept while it is unchanged)."""
-            if cache.get("K") is not Kt:
-                rows = Kt[interior]
-                cache.update(K=Kt, A=rows[:, interior].tocsr(), B=rows[:, D].tocsr())
-            return cache["A"], cache["B"]
-
-        f, Kt = evaluate(u, True)
-        history = []
-        for step in range(1, steps + 1):
-            load, target = step / steps * F, step / steps * values
-            r = (f - load)[interior] + blocks(Kt)[1] @ (target - u[D])   # linearised
-            u[D] = target
-            res = [float(np.linalg.norm(r))]
-            while not (res[-1] <= tol * (ref := self._reference(load[interior], f[D], res))
-                       or res[-1] == 0.0):
-                if not np.isfinite(res[-1]):
-                    raise ConvergenceError(
-                        f"load step {step} of {steps}, Newton iteration {len(res) - 1}: the "
-                        f"internal forces are not finite (an interaction inverted or collapsed "
-                        f"where its energy is undefined); try more load steps or "
-                        f"line_search=True", history + [res])
-                if len(res) > max_iterations:
-                    raise ConvergenceError(
-                        f"Newton did not converge in load step {step} of {steps}: residual "
-                        f"{res[-1]:.3e} (wanted {tol * ref:.3e}) after {len(res) - 1} "
-                        f"iteration(s), residuals {', '.join(f'{r:.2e}' for r in res)}; try "
-                        f"more load steps, line_search=True or a larger max_iterations",
-                        history + [res])
-                floor = config.NEWTON_INNER_FLOOR
-                rtol = min(tol, floor) if linear else min(config.NEWTON_FORCING,
-                                                          max(res[-1] / ref, floor))
-                try:
-                    du = solve_spd(blocks(Kt)[0], r, modes=modes, tol=rtol)
-                except SolveError as exc:
-                    raise SolveError(f"load step {step} of {steps}, Newton iteration "
-                                     f"{len(res)}: {exc}") from exc
-                u = self._newton_update(u, du, interior, load, evaluate, res[-1],
-                                        self.LINE_SEARCH_HALVINGS if line_search else 0)
-                f, Kt = evaluate(u, True)
-                r = (f - load)[interior]
-                res.append(float(np.linalg.norm(r)))
-            history.append(res)
-        return StaticSolution(self, u.reshape(n, d), residual_history=history)
-
-    @staticmethod
-    def _reference(load, reactions, res):
-        """What a load step's residual is measured against: the largest of its load, the
-        reactions at the prescribed dofs (round-off in the residual scales with the
-        internal forces) and its first residual."""
-        return max(float(np.linalg.norm(load)), float(np.linalg.norm(reactions)), res[0])
-
-    @staticmethod
-    def _newton_update(u, du, interior, load, evaluate, current, halvings):
-        """``u - du`` on the free dofs or, with ``halvings > 0``, the first of
-        ``u - du / 2^k`` (k <= halvings) whose residual norm is below ``current`` (the
-        last one tried if none is)."""
-        for k in range(halvings + 1):
-            trial = u.copy()
-            trial[interior] -= du / 2 ** k
-            if not halvings or np.linalg.norm(
-                    (evaluate(trial, False)[0] - load)[interior]) < current:
-                break
-        return trial
+        u, history = newton(evaluate, self.load(), D, values, points=self.body.points,
+                            pattern=pattern, initial=initial, tol=tol, steps=steps,
+                            max_iterations=max_iterations, line_search=line_search,
+                            linear=self.material.kind != "cpd",
+                            halvings=self.LINE_SEARCH_HALVINGS)
+        return StaticSolution(self, u.reshape(len(self.body), self.dim),
+                              residual_history=history)
 

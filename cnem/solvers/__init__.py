@@ -1,6 +1,6 @@
 """Solver layer: what every problem shares, whatever its method (C-NEM, P1, PD), its
 dimension or its linearity — boundary conditions, the solution base, the one
-constrained linear solve and the sparse solvers under it.
+constrained linear solve and the sparse solvers under it, and the one Newton solver.
 
 >>> import numpy as np, scipy.sparse as sp
 >>> from cnem.solvers import solve_constrained
@@ -13,8 +13,9 @@ constrained linear solve and the sparse solvers under it.
 from .conditions import Conditions, per_point, select_nodes, traction_at
 from .constrained import check_supports, solve_constrained
 from .linsolve import free_rigid_motions, rigid_modes, solve_spd
+from .newton import newton
 from .solution import Solution
 
 __all__ = ["Conditions", "Solution", "select_nodes", "per_point", "traction_at",
            "solve_constrained", "check_supports", "solve_spd", "rigid_modes",
-           "free_rigid_motions"]
+           "free_rigid_motions", "newton"]
