@@ -15,7 +15,7 @@ import numpy as np
 from .. import _kernels as PK
 from ..moments import live_inverse, moment_tensors
 from ...errors import InputError
-from ..problem import Problem as SerialProblem
+from ..correction import classical_density, fit, state_test_fields, unit_strain_targets
 from . import _kernels as K
 
 if TYPE_CHECKING:
@@ -131,28 +131,23 @@ class LocalOperators:
         """Per-point fits of the owned rows, copied to the ghosts: ``(o + g, k)``."""
         b = self.body
         coef = np.zeros((len(b.points), Q.shape[-1]))
-        coef[:b.n_owned] = SerialProblem._fit(Q[:b.n_owned], target)
+        coef[:b.n_owned] = fit(Q[:b.n_owned], target)
         return b.halo.exchange(coef)
 
     def _pmb_correction(self):
         b, d = self.body, self.dim
-        pairs = np.array([(a, c) for a in range(d) for c in range(a, d)], dtype=np.int64)
+        pairs, target = unit_strain_targets(d, *self.material.moduli(d, self.plane))
         Q = np.zeros((len(b.points), len(pairs), len(pairs)))
         PK.pmb_correction_moments(b.xi, b.length, self.weight, b.offsets, pairs, Q)
         Q *= 0.25 * self.bond_stiffness
-        target = []
-        for a, c in pairs:
-            eps = np.zeros((d, d))
-            eps[a, c] = eps[c, a] = 1.0
-            target.append(SerialProblem._classical_density(self, eps))
-        coef = self._coefficients(Q, np.array(target))
+        coef = self._coefficients(Q, target)
         factor = np.empty(len(b.bond_j))
         PK.pmb_bond_factors(b.xi, b.length, b.offsets, b.bond_j, pairs, coef, factor)
         return factor
 
     def _state_correction(self):
         b, d = self.body, self.dim
-        tests, basis = SerialProblem._test_fields(self)
+        tests, basis = state_test_fields(self.unit, d)
         rows = []
         for eps in tests:
             u = b.points @ eps.T
@@ -162,7 +157,7 @@ class LocalOperators:
             rows.append([np.bincount(b.bond_i, weights=w * P, minlength=b.n_owned)
                          for P in basis])
         Q = np.array(rows).transpose(2, 0, 1)
-        target = np.array([SerialProblem._classical_density(self, eps) -
+        target = np.array([classical_density(eps, self.bulk, self.shear) -
                            0.5 * self.bulk * np.trace(eps) ** 2 for eps in tests])
         coef = self._coefficients(Q, target)
         G = np.array(basis)
