@@ -29,9 +29,7 @@ from ._pmb_kernels import pmb_forces
 from .correction import fit, pmb_factors, state_test_fields, classical_density
 
 if TYPE_CHECKING:
-    from typing import Callable
-
-    from .problem import Problem
+    from typing import Any, Callable
 
 __all__ = ["LinearBehaviour", "BondBehaviour", "StateBehaviour", "CPDBehaviour"]
 
@@ -39,6 +37,11 @@ __all__ = ["LinearBehaviour", "BondBehaviour", "StateBehaviour", "CPDBehaviour"]
 class LinearBehaviour:
     """A linear (small-displacement) peridynamic model: the internal forces are ``K u``
     with the stiffness of the live bonds.
+
+    Parameters
+    ----------
+    problem : cnem.pd.Problem
+        The problem whose bonds these are (its material, operators and state are read).
 
     Subclasses give `stiffness`, `energy_density`, `stiffness`, `stress_tensor`, `correction`,
     `stable_diagonal`, `force_state`, `internal_force`, `elastic_energy` and
@@ -57,7 +60,7 @@ class LinearBehaviour:
     linear = True
     has_stress = True
 
-    def __init__(self, problem: Problem):
+    def __init__(self, problem: Any):
         self.problem = problem
 
     def evaluate(self, u: np.ndarray, tangent: bool = True) -> tuple[np.ndarray, sp.csr_matrix]:
@@ -114,7 +117,7 @@ class BondBehaviour(LinearBehaviour):
         The micromodulus ``c`` (one value for every bond).
     """
 
-    def __init__(self, problem: Problem):
+    def __init__(self, problem: Any):
         super().__init__(problem)
         b = problem.body
         c = problem.material.micromodulus(problem.dim, problem.plane, b.horizon, b.thickness)
@@ -221,7 +224,7 @@ class StateBehaviour(LinearBehaviour):
         ``mu d (d + 2) / m``.
     """
 
-    def __init__(self, problem: Problem):
+    def __init__(self, problem: Any):
         super().__init__(problem)
         b, d, n = problem.body, problem.dim, len(problem.body)
         self.m = np.bincount(b.bond_i, weights=problem.weight * b.length ** 2, minlength=n)
@@ -300,7 +303,7 @@ class CPDBehaviour:
     linear = False
     has_stress = False
 
-    def __init__(self, problem: Problem):
+    def __init__(self, problem: Any):
         self.problem = problem
         self.interactions = problem.material.interactions(problem.body)
 

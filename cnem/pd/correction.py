@@ -9,9 +9,14 @@ unit test strains of the PMB and the per-point fits; the serial behaviours
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from . import _kernels as K
+
+if TYPE_CHECKING:
+    from .body import Body
 
 __all__ = ["classical_density", "unit_strain_targets", "fit", "pmb_factors",
            "state_test_fields"]
@@ -67,7 +72,7 @@ def fit(Q: np.ndarray, target: np.ndarray) -> np.ndarray:
         return np.array([np.linalg.lstsq(q, target, rcond=None)[0] for q in Q])
 
 
-def pmb_factors(body, weight: np.ndarray, bond_stiffness: float, bulk: float,
+def pmb_factors(body: Body, weight: np.ndarray, bond_stiffness: float, bulk: float,
                 shear: float) -> np.ndarray:
     """The energy-method factors ``(b,)`` of the PMB bonds of a serial body, from per-bond
     sums (numba): every unit strain stores the classical density of the moduli

@@ -50,10 +50,9 @@ from ._cpd_assembly import Interactions
 from .behaviour import CPDBehaviour
 
 if TYPE_CHECKING:
-    from typing import Callable
+    from typing import Any, Callable
 
     from .body import Body
-    from .problem import Problem
 
 __all__ = ["CPD", "Interactions", "seth_hill", "DERIVATIVES"]
 
@@ -146,8 +145,8 @@ class CPD:
         self.psi = tuple(default if p is None else p for p in given)
         self.user = tuple(p is not None for p in given)
 
-    def behaviour(self, problem: Problem) -> CPDBehaviour:
-        """The interactions of ``problem``'s body as its behaviour
+    def behaviour(self, problem: Any) -> CPDBehaviour:
+        """The interactions of ``problem``'s body (a `cnem.pd.Problem`) as its behaviour
         (`cnem.pd.behaviour.CPDBehaviour`)."""
         return CPDBehaviour(problem)
 

@@ -11,9 +11,9 @@ from .behaviour import BondBehaviour, StateBehaviour
 from . import critical_stretch as from_energy
 
 if TYPE_CHECKING:
-    from typing import Literal
+    from typing import Any, Literal
 
-    from .problem import Problem
+    from .distributed.operators import BondOperators, StateOperators
 
 __all__ = ["BondBased", "StateBased"]
 
@@ -74,9 +74,17 @@ class BondBased:
             "fracture_energy", fracture_energy)
         self.density = _positive("density", density)
 
-    def behaviour(self, problem: Problem) -> BondBehaviour:
-        """The PMB bonds of ``problem`` (`cnem.pd.behaviour.BondBehaviour`)."""
+    def behaviour(self, problem: Any) -> BondBehaviour:
+        """The PMB bonds of ``problem`` (a `cnem.pd.Problem`;
+        `cnem.pd.behaviour.BondBehaviour`)."""
         return BondBehaviour(problem)
+
+    def local_operators(self, body: Any, plane: Literal['stress', 'strain'],
+                        surface_correction: bool) -> BondOperators:
+        """The PMB bonds of one MPI rank's points (``body`` a `cnem.pd.distributed.Body`):
+        a `cnem.pd.distributed.operators.BondOperators`."""
+        from .distributed.operators import BondOperators      # (the package imports us)
+        return BondOperators(body, self, plane, surface_correction)
 
     def poisson(self, dim: int, plane: Literal['stress', 'strain']) -> float:
         return 1.0 / 3.0 if (dim == 2 and plane == "stress") else 0.25
@@ -144,9 +152,17 @@ class StateBased:
             "fracture_energy", fracture_energy)
         self.density = _positive("density", density)
 
-    def behaviour(self, problem: Problem) -> StateBehaviour:
-        """The linear peridynamic solid on ``problem`` (`cnem.pd.behaviour.StateBehaviour`)."""
+    def behaviour(self, problem: Any) -> StateBehaviour:
+        """The linear peridynamic solid on ``problem`` (a `cnem.pd.Problem`;
+        `cnem.pd.behaviour.StateBehaviour`)."""
         return StateBehaviour(problem)
+
+    def local_operators(self, body: Any, plane: Literal['stress', 'strain'],
+                        surface_correction: bool) -> StateOperators:
+        """The linear peridynamic solid on one MPI rank's points (``body`` a
+        `cnem.pd.distributed.Body`): a `cnem.pd.distributed.operators.StateOperators`."""
+        from .distributed.operators import StateOperators     # (the package imports us)
+        return StateOperators(body, self, plane, surface_correction)
 
     def moduli(self, dim: int, plane: Literal['stress', 'strain']) -> tuple:
         """Bulk modulus of the d-dimensional law and the shear modulus."""

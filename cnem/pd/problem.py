@@ -27,17 +27,12 @@ if TYPE_CHECKING:
 
     from .behaviour import BondBehaviour, CPDBehaviour, StateBehaviour
     from .body import Body
-    from .cpd import CPD
+    from .cpd import CPD, Interactions
     from .materials import BondBased, StateBased
 
 __all__ = ["Problem"]
 
 log = logging.getLogger(__name__)
-
-
-def _behaviour_attribute(name: str, doc: str) -> property:
-    """A read-only attribute of the problem that is its behaviour's ``name``."""
-    return property(lambda self: getattr(self.behaviour, name), doc=doc)
 
 
 class Problem(Conditions, VelocityConditions, Dynamics):
@@ -92,14 +87,36 @@ class Problem(Conditions, VelocityConditions, Dynamics):
         self.factor = self.behaviour.correction() if self.surface_correction else \
             np.ones(len(b.bond_i))
 
-    bond_stiffness = _behaviour_attribute(
-        "bond_stiffness", "BondBased: the PMB micromodulus (one value for every bond).")
-    m = _behaviour_attribute("m", "StateBased: ``(n,)`` weighted volumes.")
-    bulk = _behaviour_attribute("bulk", "StateBased: the d-dimensional bulk modulus.")
-    shear = _behaviour_attribute("shear", "StateBased: the shear modulus.")
-    alpha = _behaviour_attribute("alpha", "StateBased: ``(n,)`` ``mu d (d + 2) / m``.")
-    interactions = _behaviour_attribute(
-        "interactions", "CPD: the interactions of the body (`cnem.pd.cpd.Interactions`).")
+    # the behaviour's constants, where users have read them
+    @property
+    def bond_stiffness(self) -> float:
+        """BondBased: the PMB micromodulus (one value for every bond)."""
+        return self.behaviour.bond_stiffness
+
+    @property
+    def m(self) -> np.ndarray:
+        """StateBased: ``(n,)`` weighted volumes."""
+        return self.behaviour.m
+
+    @property
+    def bulk(self) -> float:
+        """StateBased: the d-dimensional bulk modulus."""
+        return self.behaviour.bulk
+
+    @property
+    def shear(self) -> float:
+        """StateBased: the shear modulus."""
+        return self.behaviour.shear
+
+    @property
+    def alpha(self) -> np.ndarray:
+        """StateBased: ``(n,)`` ``mu d (d + 2) / m``."""
+        return self.behaviour.alpha
+
+    @property
+    def interactions(self) -> Interactions:
+        """CPD: the interactions of the body (`cnem.pd.cpd.Interactions`)."""
+        return self.behaviour.interactions
 
     @cached_property
     def unit(self) -> np.ndarray:
