@@ -43,7 +43,7 @@ class LinearBehaviour:
     problem : cnem.pd.Problem
         The problem whose bonds these are (its material, operators and state are read).
 
-    Subclasses give `stiffness`, `energy_density`, `stiffness`, `stress_tensor`, `correction`,
+    Subclasses give `stiffness`, `energy_density`, `_stress_parts`, `correction`,
     `stable_diagonal`, `force_state`, `internal_force`, `elastic_energy` and
     `stiffness_without`.
 
@@ -74,6 +74,17 @@ class LinearBehaviour:
         assembled once, and that stiffness (its pattern): for one static solve."""
         K = self.stiffness()
         return lambda u, tangent: (K @ u, K), K
+
+    def stress_tensor(self, u: np.ndarray) -> np.ndarray:
+        """Stress of every point from its bonds, ``(n, d, d)`` (``dW_i / d eps`` for a
+        uniform strain): the points' own part and their live bonds' (`_stress_parts`)."""
+        p = self.problem
+        x = np.asarray(u, dtype=float).reshape(-1)
+        nn = p.unit[:, :, None] * p.unit[:, None, :]
+        live = p.alive.astype(bool)
+        out, per = self._stress_parts(x, nn, live)
+        np.add.at(out, p.body.bond_i, per)
+        return out
 
     def stable_diagonal(self) -> np.ndarray:
         """``(n d,)`` or ``(n,)``: the row sums ``sum_j C_ij V_j`` per unit volume whose largest
@@ -147,18 +158,12 @@ class BondBehaviour(LinearBehaviour):
         w = self.pmb_weights() * p.alive.astype(float)
         return (p.A.T @ sp.diags(w) @ p.A).tocsr()
 
-    def stress_tensor(self, u: np.ndarray) -> np.ndarray:
-        """Stress of every point from its bonds, ``(n, d, d)``."""
+    def _stress_parts(self, x, nn, live):
+        """No stress of the points' own, ``(n, d, d)``, and the bonds' ``(b, d, d)``."""
         p = self.problem
-        b, d = p.body, p.dim
-        x = np.asarray(u, dtype=float).reshape(-1)
-        nn = p.unit[:, :, None] * p.unit[:, None, :]
-        live = p.alive.astype(bool)
         e = p.A @ x
         per = (0.5 * self.bond_stiffness * p.factor * p.weight * e * live)[:, None, None] * nn
-        out = np.zeros((len(b), d, d))
-        np.add.at(out, b.bond_i, per)
-        return out
+        return np.zeros((len(p.body), p.dim, p.dim)), per
 
     def correction(self) -> np.ndarray:
         """The energy-method bond factors ``(b,)`` (`cnem.pd.correction.pmb_factors`)."""
@@ -252,21 +257,17 @@ class StateBehaviour(LinearBehaviour):
         dil = p.T.T @ sp.diags(self.bulk * b.volumes) @ p.T
         return (dil + p.Edev.T @ sp.diags(w) @ p.Edev).tocsr()
 
-    def stress_tensor(self, u: np.ndarray) -> np.ndarray:
-        """Stress of every point from its bonds, ``(n, d, d)``."""
+    def _stress_parts(self, x, nn, live):
+        """The dilatation's pressure of every point ``(n, d, d)`` and the bonds'
+        deviatoric stress ``(b, d, d)``."""
         p = self.problem
         b, d = p.body, p.dim
-        x = np.asarray(u, dtype=float).reshape(-1)
-        nn = p.unit[:, :, None] * p.unit[:, None, :]
-        live = p.alive.astype(bool)
         theta = p.T @ x
         ed = p.Edev @ x
         L = b.length[:, None, None]
         per = (self.alpha[b.bond_i] * p.factor * p.weight * ed * live)[:, None, None] * \
             (L * nn - (L / d) * np.eye(d))
-        out = self.bulk * theta[:, None, None] * np.eye(d)
-        np.add.at(out, b.bond_i, per)
-        return out
+        return self.bulk * theta[:, None, None] * np.eye(d), per
 
     def correction(self) -> np.ndarray:
         """The energy-method bond factors ``(b,)``: at every point, a function of the bond
