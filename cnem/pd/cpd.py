@@ -47,9 +47,11 @@ from .. import config
 from .. import hyperdual as hd
 from ..errors import MaterialError, check_choice
 from ._cpd_assembly import Interactions
+from .behaviour import CPDBehaviour
 
 if TYPE_CHECKING:
-    from typing import Callable
+    from typing import Any, Callable
+
     from .body import Body
 
 __all__ = ["CPD", "Interactions", "seth_hill", "DERIVATIVES"]
@@ -109,7 +111,10 @@ class CPD:
     Surface corrections do not apply: the plain body volumes are used.
     """
 
+    #: A label of the model (the problem asks the `behaviour`, not the label).
     kind = "cpd"
+    #: The energy-method surface correction does not apply (plain volumes).
+    correctable = False
 
     def __init__(self, C1: float, C2: float = 0.0, C3: float = 0.0, *, exponent: float = 2.0,
                  psi1: Callable[..., np.ndarray] | None = None,
@@ -139,6 +144,11 @@ class CPD:
         default = seth_hill(self.exponent)
         self.psi = tuple(default if p is None else p for p in given)
         self.user = tuple(p is not None for p in given)
+
+    def behaviour(self, problem: Any) -> CPDBehaviour:
+        """The interactions of ``problem``'s body (a `cnem.pd.Problem`) as its behaviour
+        (`cnem.pd.behaviour.CPDBehaviour`)."""
+        return CPDBehaviour(problem)
 
     def interactions(self, body: Body) -> Interactions:
         """The interactions of ``body`` this material needs.

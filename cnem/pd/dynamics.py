@@ -2,7 +2,7 @@
 breaking and damage, and adaptive dynamic relaxation.
 
 `Dynamics` is a part of `cnem.pd.Problem`: it reads the problem's body, material,
-conditions and bond operators.
+conditions and the forces of its behaviour (`cnem.pd.behaviour`).
 """
 
 from __future__ import annotations
@@ -14,7 +14,6 @@ import numpy as np
 from ..solvers.conditions import per_point
 from ..solvers.stepping import Prescribed, velocity_verlet
 from ..errors import InputError
-from ._pmb_kernels import pmb_forces
 from .frames import FrameWriter
 from .guards import checked_run, diverged, first_non_finite
 from .relaxation import relax
@@ -37,13 +36,7 @@ class Dynamics:
         """Silling & Askari's bound ``sqrt(2 rho / sum_j C_ij V_j)`` (the smallest
         over points) times ``safety``."""
         self._linear_only("stable_time_step")
-        b = self.body
-        if self.material.kind == "bond":          # sum_j c_ij V_j / L_ij per point
-            per = self.bond_stiffness * self.factor * b.beta * b.volumes[b.bond_j] / b.length
-            diag = np.bincount(b.bond_i, weights=per, minlength=len(b))
-        else:
-            Kmat = self.stiffness()
-            diag = np.abs(Kmat).sum(axis=1).A.reshape(-1) / np.repeat(b.volumes, self.dim)
+        diag = self.behaviour.stable_diagonal()
         return safety * float(np.sqrt(2.0 * self.material.density / diag.max()))
 
     def damage(self) -> np.ndarray:
@@ -54,27 +47,12 @@ class Dynamics:
         return 1.0 - live / np.maximum(total, 1e-300)
 
     def _force_state(self):
-        """What `_internal_force` keeps between calls: the PMB bond stiffnesses, or the
-        stiffness matrix of the live bonds (state-based)."""
-        if self.material.kind == "bond":
-            return {"stiffness": np.ascontiguousarray(self.bond_stiffness * self.factor *
-                                                      self.body.beta)}
-        return {"K": self.stiffness()}
+        """What `_internal_force` keeps between calls (the behaviour's ``force_state``)."""
+        return self.behaviour.force_state()
 
     def _internal_force(self, u, limit, state):
         """Force per unit volume ``(n, d)``, breaking bonds (returns count broken)."""
-        b = self.body
-        if self.material.kind == "bond":
-            out = np.empty_like(u)
-            broken = pmb_forces(u, b.points, b.image, b.length, b.family.offsets, b.bond_j,
-                                state["stiffness"], b.volumes, self.alive, limit, out)
-            return out, broken
-        stretch = np.sqrt(((b.xi + u[b.bond_j] - u[b.bond_i]) ** 2).sum(axis=1)) / b.length - 1
-        broken = int(((stretch > limit) & (self.alive == 1)).sum())
-        if broken:
-            self.alive[stretch > limit] = 0
-            state["K"] = self.stiffness()
-        return -(state["K"] @ u.reshape(-1)).reshape(u.shape) / b.volumes[:, None], broken
+        return self.behaviour.internal_force(u, limit, state)
 
     def run_dynamic(self, dt: float, steps: int, *,
                     velocity: np.ndarray | Callable[..., np.ndarray] | None = None,
@@ -170,13 +148,7 @@ class Dynamics:
                      progress=progress)
 
     def _energy(self, u, v):
-        """Kinetic plus elastic energy (the linearised elastic energy)."""
+        """Kinetic plus elastic energy (the behaviour's, linearised for the state-based solid)."""
         b = self.body
         kinetic = 0.5 * self.material.density * float(b.volumes @ (v * v).sum(axis=1))
-        if self.material.kind == "bond":          # the exact PMB energy of the deformed bonds
-            y = b.xi + u[b.bond_j] - u[b.bond_i]
-            s = np.sqrt((y * y).sum(axis=1)) / b.length - 1
-            per = 0.25 * self.bond_stiffness * self.factor * b.beta * s * s * b.length * \
-                b.volumes[b.bond_j] * self.alive
-            return kinetic + float(b.volumes @ np.bincount(b.bond_i, weights=per, minlength=len(b)))
-        return kinetic + float(b.volumes @ self.energy_density(u))
+        return kinetic + self.behaviour.elastic_energy(u)

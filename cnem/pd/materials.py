@@ -7,12 +7,28 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import MaterialError
+from .behaviour import BondBehaviour, StateBehaviour
 from . import critical_stretch as from_energy
 
 if TYPE_CHECKING:
-    from typing import Literal
+    from typing import Any, Literal
+
+    from .distributed.operators import BondOperators, StateOperators
 
 __all__ = ["BondBased", "StateBased"]
+
+
+def isotropic_moduli(E: float, nu: float, dim: int,
+                     plane: Literal['stress', 'strain']) -> tuple[float, float]:
+    """Bulk modulus of the d-dimensional isotropic law (plane stress or strain in 2-D) and
+    the shear modulus, from ``E`` and ``nu``."""
+    mu = E / (2.0 * (1.0 + nu))
+    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    if dim == 3:
+        return lam + 2.0 * mu / 3.0, mu
+    if plane == "stress":
+        lam = 2.0 * lam * mu / (lam + 2.0 * mu)
+    return lam + mu, mu
 
 
 def _positive(name, value):
@@ -44,7 +60,10 @@ class BondBased:
         Mass density (dynamics).
     """
 
+    #: A label of the model (the problem asks the `behaviour`, not the label).
     kind = "bond"
+    #: The energy-method surface correction applies (`cnem.pd.Problem`'s default).
+    correctable = True
 
     def __init__(self, E: float, *, critical_stretch: float | None = None,
                  fracture_energy: float | None = None, density: float = 1.0):
@@ -55,8 +74,25 @@ class BondBased:
             "fracture_energy", fracture_energy)
         self.density = _positive("density", density)
 
+    def behaviour(self, problem: Any) -> BondBehaviour:
+        """The PMB bonds of ``problem`` (a `cnem.pd.Problem`;
+        `cnem.pd.behaviour.BondBehaviour`)."""
+        return BondBehaviour(problem)
+
+    def local_operators(self, body: Any, plane: Literal['stress', 'strain'],
+                        surface_correction: bool) -> BondOperators:
+        """The PMB bonds of one MPI rank's points (``body`` a `cnem.pd.distributed.Body`):
+        a `cnem.pd.distributed.operators.BondOperators`."""
+        from .distributed.operators import BondOperators      # (the package imports us)
+        return BondOperators(body, self, plane, surface_correction)
+
     def poisson(self, dim: int, plane: Literal['stress', 'strain']) -> float:
         return 1.0 / 3.0 if (dim == 2 and plane == "stress") else 0.25
+
+    def moduli(self, dim: int, plane: Literal['stress', 'strain']) -> tuple:
+        """Bulk and shear modulus of the classical law the PMB matches (Poisson ratio
+        `poisson`), as `StateBased.moduli`."""
+        return isotropic_moduli(self.E, self.poisson(dim, plane), dim, plane)
 
     def micromodulus(self, dim: int, plane: Literal['stress', 'strain'], horizon: float,
                      thickness: float) -> float:
@@ -98,7 +134,10 @@ class StateBased:
     density : float
     """
 
+    #: A label of the model (the problem asks the `behaviour`, not the label).
     kind = "state"
+    #: The energy-method surface correction applies (`cnem.pd.Problem`'s default).
+    correctable = True
 
     def __init__(self, E: float, nu: float, *, critical_stretch: float | None = None,
                  fracture_energy: float | None = None, density: float = 1.0):
@@ -113,16 +152,21 @@ class StateBased:
             "fracture_energy", fracture_energy)
         self.density = _positive("density", density)
 
+    def behaviour(self, problem: Any) -> StateBehaviour:
+        """The linear peridynamic solid on ``problem`` (a `cnem.pd.Problem`;
+        `cnem.pd.behaviour.StateBehaviour`)."""
+        return StateBehaviour(problem)
+
+    def local_operators(self, body: Any, plane: Literal['stress', 'strain'],
+                        surface_correction: bool) -> StateOperators:
+        """The linear peridynamic solid on one MPI rank's points (``body`` a
+        `cnem.pd.distributed.Body`): a `cnem.pd.distributed.operators.StateOperators`."""
+        from .distributed.operators import StateOperators     # (the package imports us)
+        return StateOperators(body, self, plane, surface_correction)
+
     def moduli(self, dim: int, plane: Literal['stress', 'strain']) -> tuple:
         """Bulk modulus of the d-dimensional law and the shear modulus."""
-        E, nu = self.E, self.nu
-        mu = E / (2.0 * (1.0 + nu))
-        lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-        if dim == 3:
-            return lam + 2.0 * mu / 3.0, mu
-        if plane == "stress":
-            lam = 2.0 * lam * mu / (lam + 2.0 * mu)
-        return lam + mu, mu
+        return isotropic_moduli(self.E, self.nu, dim, plane)
 
     def stretch_limit(self, dim: int, plane: Literal['stress', 'strain'], horizon: float) -> float:
         """The critical stretch (given, or from the fracture energy; inf if neither)."""

@@ -1,6 +1,6 @@
 """`Problem`: a peridynamic body, its material and conditions; the bond operators and
-statics (sparse tangent, Newton). Explicit dynamics live in `cnem.pd.dynamics`, the
-surface correction in `cnem.pd.correction`."""
+statics (the solver layer's Newton). What differs between the materials is the material's
+behaviour (`cnem.pd.behaviour`); explicit dynamics live in `cnem.pd.dynamics`."""
 
 from __future__ import annotations
 
@@ -12,12 +12,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..solvers.conditions import Conditions
-from ..solvers.linsolve import free_rigid_motions, rigid_modes, solve_spd
-from .. import config
-from ..errors import (ConvergenceError, InputError, MaterialError, SolveError, UnsupportedError,
-                      check_choice)
-from . import _kernels as K
-from .correction import SurfaceCorrection
+from ..solvers.newton import LINE_SEARCH_HALVINGS, newton
+from ..errors import InputError, MaterialError, UnsupportedError, check_choice
 from .dynamics import Dynamics
 from .moments import moment_tensors, live_inverse
 from ..material import PLANES
@@ -29,7 +25,9 @@ if TYPE_CHECKING:
 
     from numpy.typing import ArrayLike
 
+    from .behaviour import BondBehaviour, CPDBehaviour, StateBehaviour
     from .body import Body
+    from .cpd import CPD, Interactions
     from .materials import BondBased, StateBased
 
 __all__ = ["Problem"]
@@ -37,7 +35,7 @@ __all__ = ["Problem"]
 log = logging.getLogger(__name__)
 
 
-class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
+class Problem(Conditions, VelocityConditions, Dynamics):
     """A peridynamic body with a material, loads and displacement conditions.
 
     Parameters
@@ -56,22 +54,23 @@ class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
         which uses the plain volumes.
     """
 
-    def __init__(self, body: Body, material: BondBased | StateBased, *, plane: str = "stress",
-                 surface_correction: bool | None = None):
+    def __init__(self, body: Body, material: BondBased | StateBased | CPD, *,
+                 plane: str = "stress", surface_correction: bool | None = None):
         check_choice("plane", plane, PLANES)
-        kind = getattr(material, "kind", None)
-        if kind not in ("bond", "state", "cpd"):
+        if not callable(getattr(material, "behaviour", None)):
             raise MaterialError(f"material: expected cnem.pd.BondBased, StateBased or CPD, "
                                 f"received {type(material).__name__}")
-        if kind == "cpd" and surface_correction:
-            raise MaterialError("surface_correction=True: the surface correction does not apply "
-                                "to CPD (its energies use the plain volumes); leave it unset")
+        if not material.correctable and surface_correction:
+            raise MaterialError(f"surface_correction=True: the surface correction does not apply "
+                                f"to {type(material).__name__} (its energies use the plain "
+                                f"volumes); leave it unset")
         self.body, self.material, self.plane = body, material, plane
         self.dim = body.dim
-        self.surface_correction = kind != "cpd" if surface_correction is None else \
+        self.surface_correction = material.correctable if surface_correction is None else \
             bool(surface_correction)
         super().__init__()
         self.alive = np.ones(len(body.bond_i), dtype=np.uint8)
+        self._live_operators = None
         self._operators()
 
     def __repr__(self):
@@ -81,18 +80,43 @@ class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
     def _operators(self):
         b = self.body
         self.weight = b.beta * b.volumes[b.bond_j]            # omega beta V_j, omega = 1
-        if self.material.kind == "cpd":
-            #: the CPD interactions of the body (`cnem.pd.cpd.Interactions`)
-            self.interactions = self.material.interactions(b)
-            self.factor = np.ones(len(b.bond_i))
-            return
-        if self.material.kind == "bond":
-            c = self.material.micromodulus(self.dim, self.plane, b.horizon, b.thickness)
-            #: the PMB micromodulus (one value for every bond)
-            self.bond_stiffness = float(c)
-        else:
-            self._state_operators()
-        self.factor = self._correction() if self.surface_correction else np.ones(len(b.bond_i))
+        #: how the material responds on these bonds (`cnem.pd.behaviour`)
+        self.behaviour: BondBehaviour | StateBehaviour | CPDBehaviour = \
+            self.material.behaviour(self)
+        #: the energy-method bond factors (`cnem.pd.correction`), ones without the correction
+        self.factor = self.behaviour.correction() if self.surface_correction else \
+            np.ones(len(b.bond_i))
+
+    # the behaviour's constants, where users have read them
+    @property
+    def bond_stiffness(self) -> float:
+        """BondBased: the PMB micromodulus (one value for every bond)."""
+        return self.behaviour.bond_stiffness
+
+    @property
+    def m(self) -> np.ndarray:
+        """StateBased: ``(n,)`` weighted volumes."""
+        return self.behaviour.m
+
+    @property
+    def bulk(self) -> float:
+        """StateBased: the d-dimensional bulk modulus."""
+        return self.behaviour.bulk
+
+    @property
+    def shear(self) -> float:
+        """StateBased: the shear modulus."""
+        return self.behaviour.shear
+
+    @property
+    def alpha(self) -> np.ndarray:
+        """StateBased: ``(n,)`` ``mu d (d + 2) / m``."""
+        return self.behaviour.alpha
+
+    @property
+    def interactions(self) -> Interactions:
+        """CPD: the interactions of the body (`cnem.pd.cpd.Interactions`)."""
+        return self.behaviour.interactions
 
     @cached_property
     def unit(self) -> np.ndarray:
@@ -178,19 +202,6 @@ class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
         np.add.at(out, b.bond_i, per)
         return out
 
-    def _state_operators(self):
-        b, d, n = self.body, self.dim, len(self.body)
-        w = self.weight
-        # the weighted volume m is of the reference family and stays so when bonds break
-        # (Silling et al. 2007, as Peridigm): damage softens the deviatoric energy through
-        # its live bonds only. The dilatation `T` sums the live bonds with their own moment
-        # tensors (`live_gradient_weights`): with the reference ones a rotation would dilate.
-        self.m = np.bincount(b.bond_i, weights=w * b.length ** 2, minlength=n)
-        k, mu = self.material.moduli(d, self.plane)
-        self.bulk, self.shear = k, mu
-        self.alpha = mu * d * (d + 2) / self.m
-        self._live_operators = None
-
     def _state_live(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
         """``(T, Edev)`` of the bonds alive now (built again only after a bond broke)."""
         cached = self._live_operators
@@ -225,8 +236,9 @@ class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
         return self._state_live()[1]
 
     def _linear_only(self, what):
-        """Refuse CPD in the methods of the linear (bond- and state-based) models."""
-        if self.material.kind == "cpd":
+        """Refuse a nonlinear behaviour (CPD) in the methods of the linear (bond- and
+        state-based) models."""
+        if not self.behaviour.linear:
             raise UnsupportedError(
                 f"{what} is available for BondBased and StateBased materials, not for CPD "
                 "(nonlinear, nonlocal measures): use solve, its displacements u, or "
@@ -236,63 +248,25 @@ class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
     def energy_density(self, u: np.ndarray, factor: np.ndarray | None = None) -> np.ndarray:
         """Strain energy density of every point, ``(n,)``."""
         self._linear_only("energy_density")
-        b = self.body
-        factor = self.factor if factor is None else factor
-        x = np.asarray(u, dtype=float).reshape(-1)
-        live = self.alive.astype(bool)
-        if self.material.kind == "bond":
-            e = self.A @ x
-            per = 0.25 * self.bond_stiffness * factor * e * e / b.length * self.weight * live
-            return np.bincount(b.bond_i, weights=per, minlength=len(b))
-        theta = self.T @ x
-        ed = self.Edev @ x
-        per = 0.5 * self.alpha[b.bond_i] * factor * self.weight * ed * ed * live
-        return 0.5 * self.bulk * theta ** 2 + np.bincount(b.bond_i, weights=per, minlength=len(b))
+        return self.behaviour.energy_density(u, self.factor if factor is None else factor)
 
     def stiffness(self) -> sp.csr_matrix:
         """Sparse stiffness ``(d n, d n)``: the Hessian of the total strain energy
         ``sum_i V_i W_i`` (exact tangent of the linear models), live bonds only."""
         self._linear_only("stiffness")
-        b = self.body
-        live = self.alive.astype(float)
-        Vi = b.volumes[b.bond_i]
-        if self.material.kind == "bond":
-            w = self.pmb_weights() * live
-            return (self.A.T @ sp.diags(w) @ self.A).tocsr()
-        w = self.alpha[b.bond_i] * self.factor * self.weight * Vi * live
-        dil = self.T.T @ sp.diags(self.bulk * b.volumes) @ self.T
-        return (dil + self.Edev.T @ sp.diags(w) @ self.Edev).tocsr()
+        return self.behaviour.stiffness()
 
     def pmb_weights(self) -> np.ndarray:
         """``(b,)`` the PMB stiffness of every bond, live or not: the stiffness is
-        ``A^T diag(w alive) A`` (`stiffness`)."""
-        b = self.body
-        return 0.5 * self.bond_stiffness * self.factor * self.weight * b.volumes[b.bond_i] / \
-            b.length
+        ``A^T diag(w alive) A`` (`stiffness`; BondBased only)."""
+        return self.behaviour.pmb_weights()
 
     def stress_tensor(self, u: np.ndarray) -> np.ndarray:
         """Stress of every point from its bonds, ``(n, d, d)`` (``dW_i / d eps`` for a
         uniform strain: the classical stress in a uniform field). The solutions give
         it in Voigt form as ``stress``."""
         self._linear_only("stress_tensor")
-        b, d = self.body, self.dim
-        x = np.asarray(u, dtype=float).reshape(-1)
-        nn = self.unit[:, :, None] * self.unit[:, None, :]
-        live = self.alive.astype(bool)
-        if self.material.kind == "bond":
-            e = self.A @ x
-            per = (0.5 * self.bond_stiffness * self.factor * self.weight * e * live)[:, None, None] * nn
-            out = np.zeros((len(b), d, d))
-            np.add.at(out, b.bond_i, per)
-            return out
-        theta = self.T @ x
-        ed = self.Edev @ x
-        L = b.length[:, None, None]
-        per = (self.alpha[b.bond_i] * self.factor * self.weight * ed * live)[:, None, None] * \
-            (L * nn - (L / d) * np.eye(d))
-        out = self.bulk * theta[:, None, None] * np.eye(d)
-        np.add.at(out, b.bond_i, per)
-        return out
+        return self.behaviour.stress_tensor(u)
 
     # -- conditions (`Conditions`: add_dirichlet, add_body_force) ----------------------
     points_name = "body.points"
@@ -327,17 +301,7 @@ class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
 
     # -- statics ------------------------------------------------------------------------
     #: Most step halvings of the backtracking line search of `solve`.
-    LINE_SEARCH_HALVINGS = 10
-
-    def _static_system(self):
-        """``evaluate(u, tangent) -> (f_int (d n,), K or None)`` and the tangent's pattern:
-        ``K u`` with the constant stiffness of the linear materials, the CPD energy's
-        gradient and Hessian otherwise."""
-        if self.material.kind == "cpd":
-            inter = self.interactions
-            return lambda u, tangent: inter.evaluate(u, tangent=tangent)[1:], inter.pattern()
-        Kmat = self.stiffness()
-        return lambda u, tangent: (Kmat @ u, Kmat), Kmat
+    LINE_SEARCH_HALVINGS = LINE_SEARCH_HALVINGS
 
     def solve_static(self, *, tol: float = 1e-10, steps: int = 1, initial: ArrayLike | None = None,
                      max_iterations: int = 20, line_search: bool = False) -> StaticSolution:
@@ -389,87 +353,14 @@ class Problem(Conditions, VelocityConditions, SurfaceCorrection, Dynamics):
             (named, with its residuals; the error's ``history`` holds those of every
             load step so far).
         """
-        d, n = self.dim, len(self.body)
-        steps, max_iterations = int(steps), int(max_iterations)
-        if steps < 1 or max_iterations < 1:
-            raise InputError(f"expected steps >= 1 and max_iterations >= 1, received "
-                             f"steps={steps}, max_iterations={max_iterations}")
         self.static_only("solve")
-        evaluate, pattern = self._static_system()
+        evaluate, pattern = self.behaviour.static_system()
         D, values = self.prescribed()
-        free = free_rigid_motions(pattern, self.body.points, D)
-        if free:
-            raise SolveError("the system is singular: the Dirichlet conditions leave free "
-                             "the " + "; ".join(free) + ". Fix them with add_dirichlet")
-        F = self.load()
-        u = np.zeros(d * n) if initial is None else np.asarray(initial, float).reshape(-1).copy()
-        interior = np.setdiff1d(np.arange(d * n), D)
-        modes = rigid_modes(self.body.points)[interior]
-        linear = self.material.kind != "cpd"
-        cache = {}
-
-        def blocks(Kt):
-            """The tangent's free-free and free-prescribed parts (kept while it is unchanged)."""
-            if cache.get("K") is not Kt:
-                rows = Kt[interior]
-                cache.update(K=Kt, A=rows[:, interior].tocsr(), B=rows[:, D].tocsr())
-            return cache["A"], cache["B"]
-
-        f, Kt = evaluate(u, True)
-        history = []
-        for step in range(1, steps + 1):
-            load, target = step / steps * F, step / steps * values
-            r = (f - load)[interior] + blocks(Kt)[1] @ (target - u[D])   # linearised
-            u[D] = target
-            res = [float(np.linalg.norm(r))]
-            while not (res[-1] <= tol * (ref := self._reference(load[interior], f[D], res))
-                       or res[-1] == 0.0):
-                if not np.isfinite(res[-1]):
-                    raise ConvergenceError(
-                        f"load step {step} of {steps}, Newton iteration {len(res) - 1}: the "
-                        f"internal forces are not finite (an interaction inverted or collapsed "
-                        f"where its energy is undefined); try more load steps or "
-                        f"line_search=True", history + [res])
-                if len(res) > max_iterations:
-                    raise ConvergenceError(
-                        f"Newton did not converge in load step {step} of {steps}: residual "
-                        f"{res[-1]:.3e} (wanted {tol * ref:.3e}) after {len(res) - 1} "
-                        f"iteration(s), residuals {', '.join(f'{r:.2e}' for r in res)}; try "
-                        f"more load steps, line_search=True or a larger max_iterations",
-                        history + [res])
-                floor = config.NEWTON_INNER_FLOOR
-                rtol = min(tol, floor) if linear else min(config.NEWTON_FORCING,
-                                                          max(res[-1] / ref, floor))
-                try:
-                    du = solve_spd(blocks(Kt)[0], r, modes=modes, tol=rtol)
-                except SolveError as exc:
-                    raise SolveError(f"load step {step} of {steps}, Newton iteration "
-                                     f"{len(res)}: {exc}") from exc
-                u = self._newton_update(u, du, interior, load, evaluate, res[-1],
-                                        self.LINE_SEARCH_HALVINGS if line_search else 0)
-                f, Kt = evaluate(u, True)
-                r = (f - load)[interior]
-                res.append(float(np.linalg.norm(r)))
-            history.append(res)
-        return StaticSolution(self, u.reshape(n, d), residual_history=history)
-
-    @staticmethod
-    def _reference(load, reactions, res):
-        """What a load step's residual is measured against: the largest of its load, the
-        reactions at the prescribed dofs (round-off in the residual scales with the
-        internal forces) and its first residual."""
-        return max(float(np.linalg.norm(load)), float(np.linalg.norm(reactions)), res[0])
-
-    @staticmethod
-    def _newton_update(u, du, interior, load, evaluate, current, halvings):
-        """``u - du`` on the free dofs or, with ``halvings > 0``, the first of
-        ``u - du / 2^k`` (k <= halvings) whose residual norm is below ``current`` (the
-        last one tried if none is)."""
-        for k in range(halvings + 1):
-            trial = u.copy()
-            trial[interior] -= du / 2 ** k
-            if not halvings or np.linalg.norm(
-                    (evaluate(trial, False)[0] - load)[interior]) < current:
-                break
-        return trial
+        u, history = newton(evaluate, self.load(), D, values, points=self.body.points,
+                            pattern=pattern, initial=initial, tol=tol, steps=steps,
+                            max_iterations=max_iterations, line_search=line_search,
+                            linear=self.behaviour.linear,
+                            halvings=self.LINE_SEARCH_HALVINGS)
+        return StaticSolution(self, u.reshape(len(self.body), self.dim),
+                              residual_history=history)
 

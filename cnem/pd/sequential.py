@@ -41,7 +41,6 @@ import sys
 from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from tqdm.auto import tqdm
 
@@ -115,10 +114,7 @@ def _without(problem, K, over):
     subtracting theirs, the state-based one assembled again (a point's dilatation changes
     with its live bonds)."""
     problem.alive[over] = 0
-    if problem.material.kind != "bond":
-        return problem.stiffness()
-    A = problem.A[over]
-    return (K - A.T @ sp.diags(problem.pmb_weights()[over]) @ A).tocsr()
+    return problem.behaviour.stiffness_without(K, over)
 
 
 def sequential(problem: Any, factor_max: float, *, tol: float = 1e-9, max_solves: int = 100_000,
@@ -165,7 +161,7 @@ def sequential(problem: Any, factor_max: float, *, tol: float = 1e-9, max_solves
     SolveError
         Free rigid motions.
     """
-    if getattr(problem.material, "kind", None) not in ("bond", "state"):
+    if not getattr(getattr(problem, "behaviour", None), "linear", False):
         raise InputError("sequential: expected a BondBased or StateBased problem (a linear "
                          "model between breaks), received "
                          f"{type(problem.material).__name__}; use quasistatic for others")

@@ -56,7 +56,7 @@ class PointSolution(Solution):
     def fields(self) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
         """`Solution.fields` at the points (``u`` and ``strain`` only for CPD, which has
         no stress of its own here)."""
-        if self.problem.material.kind == "cpd":
+        if not self.problem.behaviour.has_stress:
             return {"u": self.u, "strain": self.strain}, {}
         return super().fields()
 

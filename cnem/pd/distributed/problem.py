@@ -21,14 +21,11 @@ import numpy as np
 from ...solvers.conditions import Conditions, per_point
 from ...solvers.stepping import Prescribed, velocity_verlet
 from ...errors import MaterialError, OptionError
-from .._pmb_kernels import pmb_forces_rows
 from ...material import PLANES
 from ..guards import checked_run, diverged, first_non_finite
 from ..solution import DynamicRun
 from ..velocity import VelocityConditions
-from . import _kernels as K
 from . import checkpoint as ckpt
-from .operators import LocalOperators
 from .output import PieceWriter
 from .relaxation import relax
 
@@ -65,10 +62,6 @@ class DistributedRun(DynamicRun):
                 f"broken>")
 
 
-#: Points per block of the energy sums (their bonds' temporaries stay small).
-ENERGY_BLOCK = 65536
-
-
 class Problem(Conditions, VelocityConditions):
     """`cnem.pd.Problem` for a `cnem.pd.distributed.Body`: the same conditions and the
     same dynamic solvers (`run_dynamic`, `relax`, `stable_time_step`, `damage`), every
@@ -93,8 +86,7 @@ class Problem(Conditions, VelocityConditions):
                  surface_correction: bool | None = None):
         if plane not in PLANES:
             raise OptionError(f"plane: expected 'stress' or 'strain', received {plane!r}")
-        kind = getattr(material, "kind", None)
-        if kind not in ("bond", "state"):
+        if not callable(getattr(material, "local_operators", None)):
             raise MaterialError(f"material: expected cnem.pd.BondBased or StateBased (CPD runs "
                              f"serially only), received {type(material).__name__}")
         super().__init__()
@@ -102,7 +94,8 @@ class Problem(Conditions, VelocityConditions):
         self.comm = body.comm
         self.surface_correction = True if surface_correction is None else \
             bool(surface_correction)
-        self.ops = LocalOperators(body, material, plane, self.surface_correction)
+        #: the material's bonds on this rank (`cnem.pd.distributed.operators`)
+        self.ops = material.local_operators(body, plane, self.surface_correction)
         self.alive = np.ones(len(body.bond_j), dtype=np.uint8)
         self.alive_reverse = np.ones(len(body.bond_j), dtype=np.uint8)
 
@@ -164,63 +157,17 @@ class Problem(Conditions, VelocityConditions):
         bonds beyond ``limit`` break. Returns the force and the number of owned bonds
         broken.
 
-        Bond-based: the exchange runs while the bonds of the interior points
-        (`Body.interior`, no ghost in their families) are computed, and the boundary
-        points follow it. State-based: the exchange first, then the dilatations, one
-        more exchange (of them and the pressures) and the forces.
+        The material's operators compute them (`BondOperators.forces`: the exchange runs
+        while the bonds of the interior points are computed; `StateOperators.forces`: the
+        exchange first, then the dilatations, one more exchange and the forces).
         """
-        b, ops = self.body, self.ops
-        o = b.n_owned
-        pending = b.halo.start(u)
-        if self.material.kind == "bond":
-            out = np.empty((o, self.dim))
-            args = (u, b.points, b.image, b.length, b.offsets, b.bond_j, ops.stiffness,
-                    b.volumes, self.alive, limit, out)
-            broken = pmb_forces_rows(b.interior, *args)
-            b.halo.finish(pending)
-            broken += pmb_forces_rows(b.boundary, *args)
-            return out, int(broken)
-        b.halo.finish(pending)
-        broken = K.break_bonds(u, b.xi, b.length, b.offsets[:o + 1], b.bond_j, limit,
-                               self.alive, self.alive_reverse)
-        if self.comm.allreduce(int(broken)):
-            ops.follow_breaking(self.alive)
-        fields = np.zeros((len(b.points), 2))          # theta and P, copied to the ghosts
-        fields[:o, 0] = ops.dilatation(u, self.alive)
-        theta = np.ascontiguousarray(fields[:o, 0])
-        P = np.empty(o)
-        K.pressure(u, b.xi, b.length, b.offsets[:o + 1], b.bond_j, theta, ops.bulk_volume,
-                   ops.c, self.alive, P)
-        fields[:o, 1] = P
-        b.halo.exchange(fields)
-        out = np.empty((o, self.dim))
-        K.lps_forces(u, b.xi, b.length, b.offsets[:o + 1], b.bond_j, b.volumes, ops.g,
-                     ops.g_reverse, np.ascontiguousarray(fields[:, 0]),
-                     np.ascontiguousarray(fields[:, 1]), ops.c, ops.c_reverse, self.alive,
-                     self.alive_reverse, out)
-        return out, int(broken)
+        return self.ops.forces(u, limit, self.alive, self.alive_reverse)
 
     def energy(self, u: np.ndarray, v: np.ndarray) -> float:
         """Kinetic plus elastic energy of the whole body (all ranks)."""
         b, ops, o = self.body, self.ops, self.body.n_owned
         kinetic = 0.5 * self.material.density * float(b.volumes[:o] @ (v * v).sum(axis=1))
-        if self.material.kind == "bond":
-            elastic = 0.0
-            for start in range(0, o, ENERGY_BLOCK):      # blocks of points: small temporaries
-                stop = min(start + ENERGY_BLOCK, o)
-                sl = slice(b.offsets[start], b.offsets[stop])
-                i, j = b.bond_i[sl], b.bond_j[sl]
-                y = b.xi[sl] + u[j] - u[i]
-                s = np.sqrt((y * y).sum(axis=1)) / b.length[sl] - 1
-                per = 0.25 * ops.bond_stiffness * ops.factor[sl] * b.beta[sl] * s * s * \
-                    b.length[sl] * b.volumes[j] * self.alive[sl]
-                elastic += float(b.volumes[start:stop] @ np.bincount(
-                    i - start, weights=per, minlength=stop - start))
-        else:
-            theta = ops.dilatation(u, self.alive)
-            ed = ops.deviatoric(u, theta)
-            elastic = 0.5 * float(ops.bulk_volume @ (theta * theta)) + \
-                0.5 * float((ops.c * self.alive) @ (ed * ed))
+        elastic = ops.elastic_energy(u, self.alive)
         return self.allsum(kinetic + elastic)
 
     # -- per-point results ---------------------------------------------------------------
@@ -244,12 +191,7 @@ class Problem(Conditions, VelocityConditions):
         """`cnem.pd.Problem.stable_time_step` over all ranks. State-based: from an upper
         bound of the stiffness rows (`LocalOperators.row_bound`), so at most the serial
         step."""
-        b, ops, o = self.body, self.ops, self.body.n_owned
-        if self.material.kind == "bond":
-            per = ops.bond_stiffness * ops.factor * b.beta * b.volumes[b.bond_j] / b.length
-            diag = np.bincount(b.bond_i, weights=per, minlength=o)
-        else:
-            diag = (ops.row_bound() / b.volumes[:o, None]).reshape(-1)
+        diag = self.ops.stable_diagonal()
         top = self.comm.allreduce(float(diag.max()) if len(diag) else 0.0, op=_max())
         return safety * float(np.sqrt(2.0 * self.material.density / top))
 
@@ -302,8 +244,7 @@ class Problem(Conditions, VelocityConditions):
             first, earlier = int(state["step"]), int(state["broken"])
             owned_u[:], v[:] = state["u"], state["velocity"]
             self.alive[:], self.alive_reverse[:] = state["alive"], state["alive_reverse"]
-            if self.material.kind == "state":
-                self.ops.follow_breaking(self.alive)
+            self.ops.follow_breaking(self.alive)
         fext = self.load() / b.volumes[:o, None]
 
         def forces(owned):                         # a view of u, whose ghost rows it fills

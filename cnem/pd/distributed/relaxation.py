@@ -65,13 +65,13 @@ def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: i
         flat[free] = x
         force, count = problem.internal_force(u, breaking)
         count = problem.comm.allreduce(count)
-        if count and problem.material.kind == "state":      # the rows may grow (as serial)
+        if count and problem.ops.grows_when_breaking:        # the rows may grow (as serial)
             np.maximum(density, 0.25 * problem.ops.row_bound().reshape(-1)[free], out=density)
         return external + volumes * force.reshape(-1)[free], count
 
     at_rest = np.repeat(body.volumes[:o], d) * problem.internal_force(u, np.inf)[0].reshape(-1)
-    stiffness = problem.ops.stiffness if problem.material.kind == "bond" else None
-    noise = 10.0 * problem.norm(force_round_off(problem, stiffness, at_rest, o)[free])
+    noise = 10.0 * problem.norm(force_round_off(problem, problem.ops.round_off_stiffness,
+                                                at_rest, o)[free])
 
     def prescribe(fraction):
         flat[fixed] = fraction * values
