@@ -41,7 +41,7 @@ from .errors import GeometryError, InputError
 from .geometry.cracks import split_cracks
 from .geometry.pslg import BOUNDARY, CRACK
 from .solvers.conditions import Conditions, per_point, traction_at
-from .material import lame, parse_materials, stiffness_matrix
+from .material import check_plane, lame, moduli, parse_materials, stiffness_matrix
 from .solvers.solution import Solution, energy_error_density
 
 if TYPE_CHECKING:
@@ -221,7 +221,7 @@ class P1Elasticity(Conditions):
     Parameters
     ----------
     domain : Domain
-    materials : (E, nu) pair, or a list of pairs indexed by region
+    materials : (E, nu) pair or `cnem.material.LinearElastic`, or a list of either indexed by region
     plane : {"stress", "strain"}
     nodes : int, optional
         Target node count of the mesh (within about 5 %).
@@ -240,6 +240,10 @@ class P1Elasticity(Conditions):
         Vector P1 basis; dofs interleaved ``[u0x, u0y, u1x, ...]``.
     timings : dict
         Seconds spent meshing (``"mesh"``).
+    region_materials : tuple of cnem.material.LinearElastic
+        One per region.
+    materials : (r, 2) ndarray
+        Their ``(E, nu)``.
     """
 
     def __init__(self, domain: Domain,
@@ -247,8 +251,9 @@ class P1Elasticity(Conditions):
                  plane: str = "stress", nodes: np.ndarray | None = None,
                  max_area: float | None = None, quality: float = 30.0):
         self.domain = domain
-        lame(1.0, 0.0, plane)                       # validates `plane`
-        self.materials = parse_materials(materials, len(domain.regions), plane)
+        check_plane(2, plane)
+        self.region_materials = parse_materials(materials, len(domain.regions), plane)
+        self.materials = moduli(self.region_materials)
         self.plane = plane
         t0 = time.perf_counter()
         points, tri, self.region = mesh_domain(domain, nodes=nodes, max_area=max_area,
