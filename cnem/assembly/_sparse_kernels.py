@@ -369,6 +369,95 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
     return out_ptr, out_idx, data
 
 
+@parallel_kernel("ncol")
+def gradient_block_gram_nd(ptr, idx, grads, coeff, group, weight, ncol, nch):
+    """`gradient_block_gram` in any dimension: ``K`` by ``d x d`` node blocks.
+
+    Parameters
+    ----------
+    ptr, idx : CSR pattern (m, ncol)
+    grads : (d, nnz) float64
+        Values of the derivatives along each axis (one pattern).
+    coeff : (G, d d, d d) float64
+        ``coeff[g, a, b]`` for trial descriptor ``a = d c + e`` (component ``c``,
+        direction ``e``) and test descriptor ``b``, in the cells of group ``g``.
+    group : (m,) int64
+    weight : (m,) float64
+    ncol, nch : int
+
+    Returns
+    -------
+    indptr : (d ncol + 1,) int64
+    indices : (nnz,) int32
+    data : (nnz,) float64
+        ``K`` in CSR over the interleaved dofs, ``(d ncol, d ncol)``; in 2-D the
+        same numbers as `gradient_block_gram`.
+    """
+    d = grads.shape[0]
+    t_ptr, t_row, t_pos = _transpose_pattern(ptr, idx, ncol)
+    counts = np.zeros(ncol, dtype=np.int64)
+    for ch in numba.prange(nch):
+        mark = np.full(ncol, -1, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            count = 0
+            for t in range(t_ptr[i], t_ptr[i + 1]):
+                k = t_row[t]
+                for p in range(ptr[k], ptr[k + 1]):
+                    if mark[idx[p]] != i:
+                        mark[idx[p]] = i
+                        count += 1
+            counts[i] = count
+    indptr = _offsets(counts)                   # of the node blocks
+    out_ptr = np.empty(d * ncol + 1, dtype=np.int64)     # of the dofs: d rows per node
+    out_ptr[0] = 0
+    for i in range(ncol):
+        for r in range(d):
+            out_ptr[d * i + r + 1] = d * d * indptr[i] + (r + 1) * d * counts[i]
+    indices = np.empty(indptr[ncol], dtype=np.int32)
+    out_idx = np.empty(d * d * indptr[ncol], dtype=np.int32)
+    data = np.zeros(d * d * indptr[ncol])
+    for ch in numba.prange(nch):
+        slot = np.full(ncol, -1, dtype=np.int64)
+        v = np.empty((d, d * d))
+        gi = np.empty(d)
+        row = np.empty(d, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            start = indptr[i]
+            end = start
+            for t in range(t_ptr[i], t_ptr[i + 1]):         # the row's columns ...
+                k = t_row[t]
+                for p in range(ptr[k], ptr[k + 1]):
+                    end = _add_column(idx[p], start, end, slot, indices)
+            _sort_slots(indices, start, end, slot)          # ... in order
+            for r in range(d):
+                row[r] = out_ptr[d * i + r] - d * start     # block q -> row[r] + d q
+                for q in range(start, end):
+                    for c in range(d):
+                        out_idx[row[r] + d * q + c] = d * indices[q] + c
+            for t in range(t_ptr[i], t_ptr[i + 1]):         # then their values
+                k = t_row[t]
+                c = group[k]
+                for e in range(d):
+                    gi[e] = weight[k] * grads[e, t_pos[t]]
+                for r in range(d):                          # test component r
+                    for a in range(d * d):
+                        total = 0.0
+                        for e in range(d):
+                            total += gi[e] * coeff[c, a, d * r + e]
+                        v[r, a] = total
+                for p in range(ptr[k], ptr[k + 1]):
+                    q = d * slot[idx[p]]
+                    for r in range(d):
+                        for s in range(d):                  # trial component s
+                            total = 0.0
+                            for e in range(d):
+                                total += v[r, d * s + e] * grads[e, p]
+                            data[row[r] + q + s] += total
+    return out_ptr, out_idx, data
+
+
 @parallel_kernel("target")
 def place_rows(indptr, indices, x, y, target, out_ptr, out_idx, out_x, out_y):
     """Copy row ``r`` of a CSR (values ``x`` and ``y`` on one pattern) into row
