@@ -44,16 +44,16 @@ def elasticity_form(u, v, w):
 
 
 class Elasticity(Conditions):
-    """Linear elasticity on a C-NEM model (plane; the dofs, assembly and solution
-    carry the model's dimension ``dim``).
+    """Linear elasticity on a C-NEM model: plane stress or strain in 2-D; the dofs,
+    the assembly and the solution carry the model's dimension ``dim``.
 
     Parameters
     ----------
     model : Model
         From `cnem.discretize`: ``n`` nodes, ``m`` integration cells.
     materials : (E, nu) pair or `cnem.material.LinearElastic`, or a list of either indexed by region
-    plane : {"stress", "strain"}
-        The 2-D idealisation (default "stress"); None for a 3-D model.
+    plane : {"stress", "strain"}, optional
+        The 2-D idealisation (default "stress"); none for a 3-D model.
     gauss : int
         Gauss points per cell-edge piece in the smoothed gradients.
     enrich : dict(tips=..., radius=..., functions=...) or cnem.fracture.Enrichment, optional
@@ -97,7 +97,7 @@ class Elasticity(Conditions):
     """
 
     def __init__(self, model: Model, materials: tuple[float, float] | Sequence[tuple[float, float]],
-                 *, plane: str | None = "stress", gauss: int = 2, enrich: Enrichment | None = None,
+                 *, plane: str | None = None, gauss: int = 2, enrich: Enrichment | None = None,
                  stabilization: float = 1.0, gradients: SmoothedGradients | None = None):
         from ..fracture.enrichment import Enrichment
         self.model = model
@@ -107,8 +107,8 @@ class Elasticity(Conditions):
         self.cells = (model.cells if self.enrichment is None
                       else subdivide(model.cells, model.nodes, node_apex=tip_cells(model))[0])
         self.dim = model.nodes.shape[1]
-        if self.dim == 3 and plane == "stress":       # the default: no plane in 3-D
-            plane = None
+        if self.dim == 2 and plane is None:
+            plane = "stress"
         check_plane(self.dim, plane)
         self.region_materials = parse_materials(materials, len(model.domain.regions), plane,
                                                 dim=self.dim)
