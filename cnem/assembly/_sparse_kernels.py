@@ -283,6 +283,40 @@ def _transpose_pattern(ptr, idx, ncol):
     return t_ptr, t_row, t_pos
 
 
+@numba.njit(cache=True, inline="always")
+def _block_counts(t_ptr, t_row, ptr, idx, ncol, nch):
+    """Number of node columns in every block row of ``G^T G`` (``G`` the CSR pattern
+    ``ptr, idx``, its columns ``t_ptr, t_row``), ``(ncol,)`` (inlined: its loop over
+    chunks runs in parallel in the parallel copy of the caller)."""
+    counts = np.zeros(ncol, dtype=np.int64)
+    for ch in numba.prange(nch):
+        mark = np.full(ncol, -1, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            count = 0
+            for t in range(t_ptr[i], t_ptr[i + 1]):
+                k = t_row[t]
+                for p in range(ptr[k], ptr[k + 1]):
+                    if mark[idx[p]] != i:
+                        mark[idx[p]] = i
+                        count += 1
+            counts[i] = count
+    return counts
+
+
+@numba.njit(cache=True, inline="always")
+def _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices):
+    """Write the node columns of block row ``i`` (see `_block_row_count`) sorted into
+    ``indices[start:end]``, ``slot`` pointing at them; returns ``end``."""
+    end = start
+    for t in range(t_ptr[i], t_ptr[i + 1]):
+        k = t_row[t]
+        for p in range(ptr[k], ptr[k + 1]):
+            end = _add_column(idx[p], start, end, slot, indices)
+    _sort_slots(indices, start, end, slot)
+    return end
+
+
 @parallel_kernel("ncol")
 def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
     """``K`` of a vector form that sees only gradients, by 2 x 2 node blocks.
@@ -312,19 +346,7 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
         ``K`` in CSR over the interleaved dofs, ``(2 ncol, 2 ncol)``.
     """
     t_ptr, t_row, t_pos = _transpose_pattern(ptr, idx, ncol)
-    counts = np.zeros(ncol, dtype=np.int64)
-    for ch in numba.prange(nch):
-        mark = np.full(ncol, -1, dtype=np.int64)
-        lo, hi = _chunk(ch, nch, ncol)
-        for i in range(lo, hi):
-            count = 0
-            for t in range(t_ptr[i], t_ptr[i + 1]):
-                k = t_row[t]
-                for p in range(ptr[k], ptr[k + 1]):
-                    if mark[idx[p]] != i:
-                        mark[idx[p]] = i
-                        count += 1
-            counts[i] = count
+    counts = _block_counts(t_ptr, t_row, ptr, idx, ncol, nch)
     indptr = _offsets(counts)                   # of the node blocks
     out_ptr = np.empty(2 * ncol + 1, dtype=np.int64)     # of the dofs: two rows per node
     out_ptr[0] = 0
@@ -340,12 +362,7 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
         lo, hi = _chunk(ch, nch, ncol)
         for i in range(lo, hi):
             start = indptr[i]
-            end = start
-            for t in range(t_ptr[i], t_ptr[i + 1]):         # the row's columns ...
-                k = t_row[t]
-                for p in range(ptr[k], ptr[k + 1]):
-                    end = _add_column(idx[p], start, end, slot, indices)
-            _sort_slots(indices, start, end, slot)          # ... in order
+            end = _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices)
             row0 = out_ptr[2 * i] - 2 * start               # block q -> row0 + 2 q
             row1 = out_ptr[2 * i + 1] - 2 * start
             for q in range(start, end):
@@ -395,19 +412,7 @@ def gradient_block_gram_nd(ptr, idx, grads, coeff, group, weight, ncol, nch):
     """
     d = grads.shape[0]
     t_ptr, t_row, t_pos = _transpose_pattern(ptr, idx, ncol)
-    counts = np.zeros(ncol, dtype=np.int64)
-    for ch in numba.prange(nch):
-        mark = np.full(ncol, -1, dtype=np.int64)
-        lo, hi = _chunk(ch, nch, ncol)
-        for i in range(lo, hi):
-            count = 0
-            for t in range(t_ptr[i], t_ptr[i + 1]):
-                k = t_row[t]
-                for p in range(ptr[k], ptr[k + 1]):
-                    if mark[idx[p]] != i:
-                        mark[idx[p]] = i
-                        count += 1
-            counts[i] = count
+    counts = _block_counts(t_ptr, t_row, ptr, idx, ncol, nch)
     indptr = _offsets(counts)                   # of the node blocks
     out_ptr = np.empty(d * ncol + 1, dtype=np.int64)     # of the dofs: d rows per node
     out_ptr[0] = 0
@@ -425,12 +430,7 @@ def gradient_block_gram_nd(ptr, idx, grads, coeff, group, weight, ncol, nch):
         lo, hi = _chunk(ch, nch, ncol)
         for i in range(lo, hi):
             start = indptr[i]
-            end = start
-            for t in range(t_ptr[i], t_ptr[i + 1]):         # the row's columns ...
-                k = t_row[t]
-                for p in range(ptr[k], ptr[k + 1]):
-                    end = _add_column(idx[p], start, end, slot, indices)
-            _sort_slots(indices, start, end, slot)          # ... in order
+            end = _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices)
             for r in range(d):
                 row[r] = out_ptr[d * i + r] - d * start     # block q -> row[r] + d q
                 for q in range(start, end):
