@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike
 
 from .errors import MaterialError, OptionError, check_choice
 
-__all__ = ["PLANES", "Material", "LinearElastic", "parse_materials", "moduli", "check_stiffness",
+__all__ = ["PLANES", "Material", "LinearElastic", "parse_materials", "moduli", "check_plane", "check_stiffness",
            "lame", "stiffness_matrix", "kappa", "effective_modulus"]
 
 #: The 2-D idealisations: plane stress or plane strain.

@@ -66,8 +66,8 @@ def patch():
     nodes, value, gradients, volume, centroids = _tetrahedral_patch()
     model = SimpleNamespace(nodes=nodes)
     basis = CellBasis.from_operators(model, value, gradients, volume, centroids, vector=True)
-    return SimpleNamespace(model=model, nodes=nodes, basis=basis, gradients=gradients,
-                           volume=volume)
+    return SimpleNamespace(model=model, nodes=nodes, basis=basis, value=value,
+                           gradients=gradients, volume=volume)
 
 
 def _reference_C(lam, mu):
@@ -169,8 +169,11 @@ def small_model():
 def test_smoothed_gradient_carries_its_dimension(patch):
     g = SmoothedGradient(*patch.gradients, points=0)
     assert g.dim == 3 and g.z is patch.gradients[2] and tuple(g) == patch.gradients
+    assert SmoothedGradient(*patch.gradients, 5).points == 5            # points last, as in 2-D
     flat = SmoothedGradient(*patch.gradients[:2], points=0)
     assert flat.dim == 2 and flat.y is patch.gradients[1]
+    with pytest.raises(cnem.GeometryError, match="2 or 3 derivative matrices"):
+        SmoothedGradient(patch.gradients[0], 0)
     with pytest.raises(AttributeError):
         flat.z
 
@@ -216,7 +219,7 @@ def test_3d_stiffness_is_the_sum_of_bt_c_b(patch):
     K_some = elasticity_form.assemble(basis, lam=lam * mask, mu=mu * mask)
     np.testing.assert_allclose(K_some.toarray(), K_ref, atol=1e-12 * np.abs(K_ref).max())
     assert basis.component_gradients() is not None
-    general = CellBasis.from_operators(patch.model, basis._node_ops[0], patch.gradients,
+    general = CellBasis.from_operators(patch.model, patch.value, patch.gradients,
                                        basis.dx, basis.x.T, vector=True)
     general.__dict__["operators"] = list(general.operators)       # not the block path
     assert general.component_gradients() is None

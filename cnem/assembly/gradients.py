@@ -22,12 +22,14 @@ __all__ = ["SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gr
 
 class SmoothedGradient:
     """The operator ``B~`` of eq. 30: smoothed derivatives of every shape function,
-    one sparse matrix per direction.
+    one sparse matrix per direction: ``SmoothedGradient(x, y, points)`` in 2-D,
+    ``SmoothedGradient(x, y, z, points)`` in 3-D (``points`` also by keyword).
 
     Parameters
     ----------
-    *components : scipy.sparse matrices, shape (m, n)
-        ``d`` of them (d = 2 or 3): the derivatives along x, y (and z).
+    *parts : scipy.sparse matrices, shape (m, n), then int
+        ``d`` derivative matrices (d = 2 or 3), along x, y (and z), then
+        ``points`` unless given by keyword.
     points : int
         Number of quadrature points evaluated for it on the cell boundaries (with
         the other sets of cells computed in the same passes, `fan_gradient`: their
@@ -50,10 +52,16 @@ class SmoothedGradient:
     (2, True)
     """
 
-    def __init__(self, *components: sp.csr_matrix, points: int):
-        if len(components) not in (2, 3) or len({c.shape for c in components}) != 1:
-            raise GeometryError(f"expected 2 or 3 derivative matrices of one shape (m, n), "
-                                f"received shapes {[c.shape for c in components]}")
+    def __init__(self, *parts: sp.csr_matrix | int, points: int | None = None):
+        if points is None:
+            *components, points = parts or (None,)
+        else:
+            components = parts
+        shapes = [getattr(c, "shape", None) for c in components]
+        if len(components) not in (2, 3) or None in shapes or len(set(shapes)) != 1:
+            raise GeometryError(f"expected 2 or 3 derivative matrices of one shape (m, n) and "
+                                f"the number of points, received {len(parts)} arguments, "
+                                f"shapes {shapes}")
         self.components, self.points = tuple(components), points
 
     @property
