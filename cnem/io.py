@@ -3,7 +3,8 @@
 `write` stores one unstructured grid that ParaView opens directly:
 
 * points: the ``n`` nodes first (point ``i`` is node ``i``), then every
-  distinct vertex of the integration cells, as float64 with ``z = 0``;
+  distinct vertex of the integration cells, as float64 with ``z = 0`` in 2-D
+  (`read` gives back ``(n, 2)`` nodes then, ``(n, 3)`` when a ``z`` is not 0);
 * cells: one ``vertex`` cell per node, then the integration cells as
   ``polygon`` cells, grouped by vertex count (meshio keeps one block per
   polygon size);
@@ -162,8 +163,8 @@ def write(model: Model, path: str | os.PathLike, *, point_data: Mapping[str, Arr
     n, m = len(nodes), len(cells)
     vpoints, offsets, connectivity = cell_topology(cells)
     points = np.zeros((n + len(vpoints), 3))
-    points[:n, :2] = nodes
-    points[n:, :2] = vpoints
+    points[:n, :nodes.shape[1]] = nodes
+    points[n:, :vpoints.shape[1]] = vpoints
     blocks, ids = _blocks(offsets, connectivity, n)
     all_ids = [np.full(n, -1, dtype=np.int64)] + ids
 
@@ -230,7 +231,7 @@ def write_nodes(model: Model, path: str | os.PathLike, *,
     nodes = np.asarray(model.nodes, np.float64)
     n = len(nodes)
     points = np.zeros((n, 3))
-    points[:, :2] = nodes
+    points[:, :nodes.shape[1]] = nodes
     tri = np.asarray(model.triangles, np.int64)
     seg = np.asarray(model.segments, np.int64)
     pdata = {"node_of_point": np.asarray(model.node_of_point, np.int64)}
@@ -296,10 +297,11 @@ class CellMesh:
 
     Attributes
     ----------
-    nodes : (n, 2) float64 ndarray
+    nodes : (n, d) float64 ndarray
+        d = 2 unless the file holds a point off the plane z = 0.
     node_of_point : (n,) int64 ndarray
     offsets : (m + 1,) int64 ndarray
-    vertices : (k, 2) float64 ndarray
+    vertices : (k, d) float64 ndarray
         Cell ``c`` is ``vertices[offsets[c]:offsets[c + 1]]``, in the order
         and orientation of ``model.cells``.
     node : (m,) int64 ndarray
@@ -367,7 +369,9 @@ def read(path: str | os.PathLike) -> CellMesh:
     if missing:
         raise FormatError(f"{str(path)!r} lacks the cell data {missing} that cnem.io.write "
                           f"stores; it was not written by cnem.io.write")
-    points = np.asarray(mesh.points, np.float64)[:, :2]
+    points = np.asarray(mesh.points, np.float64)
+    dim = 3 if points.shape[1] == 3 and np.any(points[:, 2] != 0.0) else 2
+    points = points[:, :dim]
     node_ids, polys = [], []
     for k, block in enumerate(mesh.cells):
         data = {name: np.asarray(mesh.cell_data[name][k]) for name in mesh.cell_data}
@@ -391,7 +395,7 @@ def read(path: str | os.PathLike) -> CellMesh:
     for conn, d in polys:
         sizes[d["cell"].astype(np.int64)] = conn.shape[1]
     offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    vertices = np.empty((offsets[-1], 2))
+    vertices = np.empty((offsets[-1], dim))
     for conn, d in polys:
         rows = offsets[d["cell"].astype(np.int64)][:, None] + np.arange(conn.shape[1])
         vertices[rows] = points[conn]

@@ -283,6 +283,40 @@ def _transpose_pattern(ptr, idx, ncol):
     return t_ptr, t_row, t_pos
 
 
+@numba.njit(cache=True, inline="always")
+def _block_counts(t_ptr, t_row, ptr, idx, ncol, nch):
+    """Number of node columns in every block row of ``G^T G`` (``G`` the CSR pattern
+    ``ptr, idx``, its columns ``t_ptr, t_row``), ``(ncol,)`` (inlined: its loop over
+    chunks runs in parallel in the parallel copy of the caller)."""
+    counts = np.zeros(ncol, dtype=np.int64)
+    for ch in numba.prange(nch):
+        mark = np.full(ncol, -1, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            count = 0
+            for t in range(t_ptr[i], t_ptr[i + 1]):
+                k = t_row[t]
+                for p in range(ptr[k], ptr[k + 1]):
+                    if mark[idx[p]] != i:
+                        mark[idx[p]] = i
+                        count += 1
+            counts[i] = count
+    return counts
+
+
+@numba.njit(cache=True, inline="always")
+def _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices):
+    """Write the node columns of block row ``i`` (see `_block_row_count`) sorted into
+    ``indices[start:end]``, ``slot`` pointing at them; returns ``end``."""
+    end = start
+    for t in range(t_ptr[i], t_ptr[i + 1]):
+        k = t_row[t]
+        for p in range(ptr[k], ptr[k + 1]):
+            end = _add_column(idx[p], start, end, slot, indices)
+    _sort_slots(indices, start, end, slot)
+    return end
+
+
 @parallel_kernel("ncol")
 def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
     """``K`` of a vector form that sees only gradients, by 2 x 2 node blocks.
@@ -312,19 +346,7 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
         ``K`` in CSR over the interleaved dofs, ``(2 ncol, 2 ncol)``.
     """
     t_ptr, t_row, t_pos = _transpose_pattern(ptr, idx, ncol)
-    counts = np.zeros(ncol, dtype=np.int64)
-    for ch in numba.prange(nch):
-        mark = np.full(ncol, -1, dtype=np.int64)
-        lo, hi = _chunk(ch, nch, ncol)
-        for i in range(lo, hi):
-            count = 0
-            for t in range(t_ptr[i], t_ptr[i + 1]):
-                k = t_row[t]
-                for p in range(ptr[k], ptr[k + 1]):
-                    if mark[idx[p]] != i:
-                        mark[idx[p]] = i
-                        count += 1
-            counts[i] = count
+    counts = _block_counts(t_ptr, t_row, ptr, idx, ncol, nch)
     indptr = _offsets(counts)                   # of the node blocks
     out_ptr = np.empty(2 * ncol + 1, dtype=np.int64)     # of the dofs: two rows per node
     out_ptr[0] = 0
@@ -340,12 +362,7 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
         lo, hi = _chunk(ch, nch, ncol)
         for i in range(lo, hi):
             start = indptr[i]
-            end = start
-            for t in range(t_ptr[i], t_ptr[i + 1]):         # the row's columns ...
-                k = t_row[t]
-                for p in range(ptr[k], ptr[k + 1]):
-                    end = _add_column(idx[p], start, end, slot, indices)
-            _sort_slots(indices, start, end, slot)          # ... in order
+            end = _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices)
             row0 = out_ptr[2 * i] - 2 * start               # block q -> row0 + 2 q
             row1 = out_ptr[2 * i + 1] - 2 * start
             for q in range(start, end):
@@ -366,6 +383,78 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
                     data[row0 + q + 1] += v[0, 2] * gj0 + v[0, 3] * gj1
                     data[row1 + q] += v[1, 0] * gj0 + v[1, 1] * gj1
                     data[row1 + q + 1] += v[1, 2] * gj0 + v[1, 3] * gj1
+    return out_ptr, out_idx, data
+
+
+@parallel_kernel("ncol")
+def gradient_block_gram_nd(ptr, idx, grads, coeff, group, weight, ncol, nch):
+    """`gradient_block_gram` in any dimension: ``K`` by ``d x d`` node blocks.
+
+    Parameters
+    ----------
+    ptr, idx : CSR pattern (m, ncol)
+    grads : (d, nnz) float64
+        Values of the derivatives along each axis (one pattern).
+    coeff : (G, d d, d d) float64
+        ``coeff[g, a, b]`` for trial descriptor ``a = d c + e`` (component ``c``,
+        direction ``e``) and test descriptor ``b``, in the cells of group ``g``.
+    group : (m,) int64
+    weight : (m,) float64
+    ncol, nch : int
+
+    Returns
+    -------
+    indptr : (d ncol + 1,) int64
+    indices : (nnz,) int32
+    data : (nnz,) float64
+        ``K`` in CSR over the interleaved dofs, ``(d ncol, d ncol)``; in 2-D the
+        same numbers as `gradient_block_gram`.
+    """
+    d = grads.shape[0]
+    t_ptr, t_row, t_pos = _transpose_pattern(ptr, idx, ncol)
+    counts = _block_counts(t_ptr, t_row, ptr, idx, ncol, nch)
+    indptr = _offsets(counts)                   # of the node blocks
+    out_ptr = np.empty(d * ncol + 1, dtype=np.int64)     # of the dofs: d rows per node
+    out_ptr[0] = 0
+    for i in range(ncol):
+        for r in range(d):
+            out_ptr[d * i + r + 1] = d * d * indptr[i] + (r + 1) * d * counts[i]
+    indices = np.empty(indptr[ncol], dtype=np.int32)
+    out_idx = np.empty(d * d * indptr[ncol], dtype=np.int32)
+    data = np.zeros(d * d * indptr[ncol])
+    for ch in numba.prange(nch):
+        slot = np.full(ncol, -1, dtype=np.int64)
+        v = np.empty((d, d * d))
+        gi = np.empty(d)
+        row = np.empty(d, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            start = indptr[i]
+            end = _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices)
+            for r in range(d):
+                row[r] = out_ptr[d * i + r] - d * start     # block q -> row[r] + d q
+                for q in range(start, end):
+                    for c in range(d):
+                        out_idx[row[r] + d * q + c] = d * indices[q] + c
+            for t in range(t_ptr[i], t_ptr[i + 1]):         # then their values
+                k = t_row[t]
+                c = group[k]
+                for e in range(d):
+                    gi[e] = weight[k] * grads[e, t_pos[t]]
+                for r in range(d):                          # test component r
+                    for a in range(d * d):
+                        total = 0.0
+                        for e in range(d):
+                            total += gi[e] * coeff[c, a, d * r + e]
+                        v[r, a] = total
+                for p in range(ptr[k], ptr[k + 1]):
+                    q = d * slot[idx[p]]
+                    for r in range(d):
+                        for s in range(d):                  # trial component s
+                            total = 0.0
+                            for e in range(d):
+                                total += v[r, d * s + e] * grads[e, p]
+                            data[row[r] + q + s] += total
     return out_ptr, out_idx, data
 
 

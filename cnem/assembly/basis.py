@@ -36,14 +36,15 @@ class CellBasis:
     At cell ``k`` a field has the value at the cell's node (nodal integration,
     the Kronecker delta property) and the smoothed gradient ``b~`` of eq.
     26-32. Vector fields interleave their dofs like scikit-fem and the paper
-    (eq. 30): ``[u_x(0), u_y(0), u_x(1), ...]``.
+    (eq. 30): ``[u_x(0), u_y(0), u_x(1), ...]`` (``u_z`` after ``u_y`` in 3-D).
+    The dimension ``dim`` (2 or 3) is that of the gradient (of the model's nodes).
 
     Parameters
     ----------
     model : Model
         ``n`` nodes, ``m`` integration cells.
     vector : bool
-        Two components per node.
+        ``dim`` components per node.
     gauss : int
         Gauss points per edge piece for ``b~`` (see `smoothed_gradient`).
     cells : Cells, optional
@@ -52,19 +53,23 @@ class CellBasis:
         ``b~`` on ``cells`` when already computed (from a
         `cnem.assembly.gradients.SmoothedGradients`, which keeps it); by default
         it is computed afresh (`smoothed_gradient`).
-    extra : (gx, gy) sparse (m, e), optional
+    extra : (gx, gy) or (gx, gy, gz) sparse (m, e), optional
         Smoothed gradients of ``e`` more functions that vanish at every node
         (enrichment); their dofs follow the nodes' (function ``n + i``).
 
     Attributes
     ----------
+    dim : int
+        2 or 3.
+    ncomp : int
+        Components per node: ``dim`` for a vector basis, 1 for a scalar one.
     N : int
-        Number of dofs, ``nfun`` or ``2 nfun`` (``nfun = n`` without extra functions).
+        Number of dofs, ``ncomp nfun`` (``nfun = n`` without extra functions).
     dx : (m,) ndarray
-        Quadrature weights: the cell areas.
-    x : (2, m) ndarray
+        Quadrature weights: the cell areas (volumes in 3-D).
+    x : (dim, m) ndarray
         Cell centroids (``w.x`` in forms).
-    nodes : (2, m) ndarray
+    nodes : (dim, m) ndarray
         The node of each cell.
     """
 
@@ -77,18 +82,21 @@ class CellBasis:
             smoothed_gradient(model, gauss=gauss, cells=None if cells is model.cells else cells)
         m, n = len(cells.area), len(model.nodes)
         value = sp.csr_matrix((np.ones(m), (np.arange(m), cells.node)), shape=(m, n))
-        gx, gy = self.grad.x, self.grad.y
+        grads = tuple(self.grad)
         if extra is not None:           # functions that vanish at the nodes (enrichment)
-            ex, ey = extra
-            value = sp.hstack([value, sp.csr_matrix(ex.shape)], format="csr")
-            gx, gy = sp.hstack([gx, ex], format="csr"), sp.hstack([gy, ey], format="csr")
-        self._setup(model, vector, (value, gx, gy), cells.area, cells.centroid().T,
+            value = sp.hstack([value, sp.csr_matrix(extra[0].shape)], format="csr")
+            grads = tuple(sp.hstack([g, e], format="csr") for g, e in zip(grads, extra, strict=True))
+        self._setup(model, vector, (value,) + grads, cells.area, cells.centroid().T,
                     model.nodes[cells.node].T)
 
     def _setup(self, model, vector, node_ops, dx, x, nodes):
         self.model = model
         self.vector = bool(vector)
-        self.ncomp = 2 if vector else 1
+        self.dim = len(node_ops) - 1
+        if self.dim not in (2, 3):
+            raise InputError(f"expected the derivatives along 2 or 3 axes, received "
+                             f"{self.dim}; pass one gradient operator per axis")
+        self.ncomp = self.dim if vector else 1
         self.dx, self.x, self.nodes = dx, x, nodes
         #: number of functions: the nodes' shape functions, then the extra ones
         self.nfun = node_ops[0].shape[1]
@@ -97,7 +105,7 @@ class CellBasis:
         self._built = None                  # the operators as built from _node_ops
 
     @classmethod
-    def from_operators(cls, model: Model, value: sp.spmatrix, gx: sp.spmatrix, gy: sp.spmatrix,
+    def from_operators(cls, model: Model, value: sp.spmatrix, gradient: Sequence[sp.spmatrix],
                        weights: np.ndarray, points: np.ndarray, *,
                        vector: bool = False) -> CellBasis:
         """A basis over other integration points, from the scalar operators of the
@@ -106,11 +114,14 @@ class CellBasis:
         Parameters
         ----------
         model : Model
-        value, gx, gy : sparse (q, nfun)
-            Values and x, y derivatives of the functions at the points.
+            Its ``nodes`` (for `get_dofs`).
+        value : sparse (q, nfun)
+            Values of the functions at the points.
+        gradient : sequence of ``dim`` sparse (q, nfun)
+            Their x, y (and z) derivatives there.
         weights : (q,) ndarray
             Quadrature weights (``dx``).
-        points : (q, 2) ndarray
+        points : (q, dim) ndarray
             The points (``w.x``).
         vector : bool
 
@@ -122,13 +133,13 @@ class CellBasis:
         out = cls.__new__(cls)
         out.cells = out.grad = None
         x = np.asarray(points, dtype=float).T
-        out._setup(model, vector, tuple(op.tocsr() for op in (value, gx, gy)),
+        out._setup(model, vector, tuple(op.tocsr() for op in (value, *gradient)),
                    np.asarray(weights, dtype=float), x, None)
         return out
 
     def __repr__(self):
         kind = "vector" if self.vector else "scalar"
-        return f"<CellBasis {kind}, {self.N} dofs, {len(self.dx)} cells>"
+        return f"<CellBasis {self.dim}-D {kind}, {self.N} dofs, {len(self.dx)} cells>"
 
     @cached_property
     def operators(self) -> list[sp.spmatrix]:
@@ -137,57 +148,67 @@ class CellBasis:
         Returns
         -------
         list of scipy.sparse.csr_matrix, shape (m, N)
-            Scalar: ``[value, d/dx, d/dy]``. Vector: ``[u_0, u_1, du_0/dx,
-            du_0/dy, du_1/dx, du_1/dy]`` (row-major ``grad[i, j] = du_i/dx_j``).
+            ``(1 + dim) ncomp`` of them. Scalar: ``[value, d/dx, d/dy]`` (then
+            ``d/dz`` in 3-D). Vector: ``[u_0, u_1, du_0/dx, du_0/dy, du_1/dx,
+            du_1/dy]`` in 2-D, ``[u_0, u_1, u_2, du_0/dx, du_0/dy, du_0/dz, du_1/dx,
+            ...]`` in 3-D (row-major ``grad[i, j] = du_i/dx_j``).
         """
-        value, gx, gy = self._node_ops
+        value, *grads = self._node_ops
         if not self.vector:
-            self._built = [op.tocsr() for op in (value, gx, gy)]
+            self._built = [op.tocsr() for op in self._node_ops]
         else:
-            values = [spread_component(value, c, 2) for c in range(2)]
-            self._built = values + [spread_component(g, c, 2) for c in range(2) for g in (gx, gy)]
+            d = self.ncomp
+            values = [spread_component(value, c, d) for c in range(d)]
+            self._built = values + [spread_component(g, c, d) for c in range(d) for g in grads]
         return self._built
 
-    def component_gradients(self) -> tuple[sp.csr_matrix, sp.csr_matrix] | None:
-        """The scalar x and y derivatives ``(m, nfun)`` CSR behind the gradient
-        operators of a vector basis, when both have one pattern (then forms that
-        see only gradients are assembled by 2 x 2 node blocks); None for a scalar
-        basis or operators set otherwise (`at_points`, assignment)."""
+    def component_gradients(self) -> tuple[sp.csr_matrix, ...] | None:
+        """The scalar derivatives ``(m, nfun)`` CSR along each axis behind the
+        gradient operators of a vector basis, when all have one pattern (then forms
+        that see only gradients are assembled by ``dim x dim`` node blocks); None
+        for a scalar basis or operators set otherwise (`at_points`, assignment)."""
         given = self.__dict__.get("operators", self._built)
         if not self.vector or given is not self._built:
             return None
-        gx, gy = (g.tocsr() for g in self._node_ops[1:])
-        if not (np.array_equal(gx.indptr, gy.indptr) and np.array_equal(gx.indices, gy.indices)):
+        first, *others = (g.tocsr() for g in self._node_ops[1:])
+        if not all(np.array_equal(first.indptr, g.indptr) and np.array_equal(first.indices, g.indices)
+                   for g in others):
             return None
-        return gx, gy
+        return (first, *others)
 
     def at_points(self, operators: Sequence[sp.spmatrix], weights: np.ndarray,
                   points: np.ndarray) -> CellBasis:
         """The same dofs seen at other integration points: a shallow copy with
         ``operators`` (``(q, N)`` each, in the order of `operators`), quadrature
-        ``weights`` ``(q,)`` and ``points`` ``(q, 2)`` (``w.x``), for forms
+        ``weights`` ``(q,)`` and ``points`` ``(q, dim)`` (``w.x``), for forms
         integrated by a point quadrature instead of over the cells."""
         out = copy.copy(self)
         out.__dict__["operators"] = [op.tocsr() for op in operators]
         out.dx, out.x = np.asarray(weights, dtype=float), np.asarray(points, dtype=float).T
         return out
 
-    @staticmethod
-    def _field(flat, vector):
-        """A DiscreteField from descriptor values ``flat`` (c, ...)."""
-        if vector:
-            return DiscreteField(flat[:2], flat[2:6].reshape((2, 2) + flat.shape[1:]))
-        return DiscreteField(flat[0], flat[1:3])
+    @property
+    def descriptors(self) -> int:
+        """Number of field descriptors per cell (values and derivatives),
+        ``(1 + dim) ncomp``: the length of `operators`."""
+        return (1 + self.dim) * self.ncomp
+
+    def _field(self, flat):
+        """A DiscreteField from descriptor values ``flat`` (descriptors, ...)."""
+        d = self.dim
+        if self.vector:
+            return DiscreteField(flat[:d], flat[d:d + d * d].reshape((d, d) + flat.shape[1:]))
+        return DiscreteField(flat[0], flat[1:1 + d])
 
     def unit_fields(self) -> list[DiscreteField]:
         """One DiscreteField per descriptor, with that descriptor 1 and the rest 0
         (a trailing axis of length 1 broadcasts against per-cell arrays ``(m,)``)."""
-        eye = np.eye(3 * self.ncomp)[:, :, None]
-        return [self._field(row, self.vector) for row in eye]
+        eye = np.eye(self.descriptors)[:, :, None]
+        return [self._field(row) for row in eye]
 
     def zero_field(self) -> DiscreteField:
         """A DiscreteField with every descriptor 0."""
-        return self._field(np.zeros((3 * self.ncomp, 1)), self.vector)
+        return self._field(np.zeros((self.descriptors, 1)))
 
     def interpolate(self, u: np.ndarray) -> DiscreteField:
         """A dof vector seen at the cells.
@@ -199,23 +220,23 @@ class CellBasis:
         Returns
         -------
         DiscreteField
-            Value ``(m,)`` or ``(2, m)``, ``grad`` ``(2, m)`` or ``(2, 2, m)``.
+            Value ``(m,)`` or ``(dim, m)``, ``grad`` ``(dim, m)`` or ``(dim, dim, m)``.
         """
         u = np.asarray(u, dtype=float)
         if u.shape != (self.N,):
             raise InputError(f"u: expected {self.N} dof values, received shape {u.shape}; "
                              f"pass one value per dof of this basis")
-        return self._field(np.array([op @ u for op in self.operators]), self.vector)
+        return self._field(np.array([op @ u for op in self.operators]))
 
     def get_dofs(self, where: Callable[..., np.ndarray] | ArrayLike,
-                 component: Literal[0, 1] | None = None) -> np.ndarray:
+                 component: Literal[0, 1, 2] | None = None) -> np.ndarray:
         """Dofs of the nodes selected by ``where``.
 
         Parameters
         ----------
-        where : callable ``(p, 2) -> (p,) bool``, or a boolean mask or index array over nodes
-        component : {None, 0, 1}
-            For a vector basis: one component, or both.
+        where : callable ``(p, dim) -> (p,) bool``, or a boolean mask or index array over nodes
+        component : {None, 0, 1} (2 too in 3-D)
+            For a vector basis: one component, or all.
 
         Returns
         -------
@@ -227,8 +248,10 @@ class CellBasis:
                 raise ConditionError(f"component: a scalar basis has component 0 only, "
                                      f"received {component!r}; pass None or 0")
             return nodes
+        d = self.ncomp
         if component is None:
-            return np.sort(np.concatenate([2 * nodes, 2 * nodes + 1]))
-        if component not in (0, 1):
-            raise ConditionError(f"component: expected 0, 1 or None (both), received {component!r}")
-        return 2 * nodes + component
+            return np.sort(np.concatenate([d * nodes + c for c in range(d)]))
+        if component not in range(d):
+            names = {2: "0, 1 or None (both)", 3: "0, 1, 2 or None (all)"}[d]
+            raise ConditionError(f"component: expected {names}, received {component!r}")
+        return d * nodes + component

@@ -2,7 +2,7 @@
 
 A form is written once for one cell, in terms of `skfem.element.DiscreteField`
 arguments (``u``, ``grad(u)``, ``v``, ``grad(v)``) and extras ``w`` (``w.x``
-the cell centroids ``(2, m)``, ``w.h`` a cell size ``(m,)``, plus any keyword
+the cell centroids ``(dim, m)``, ``w.h`` a cell size ``(m,)`` (the square root of its area, cube root of its volume), plus any keyword
 given to ``assemble``, passed through as it is: use ``basis.interpolate`` for
 dof vectors). Since the form is (bi)linear in its field arguments, it is
 evaluated with unit fields, one per field descriptor (value and smoothed
@@ -31,7 +31,8 @@ __all__ = ["BilinearForm", "LinearForm", "Functional", "asm"]
 
 
 def _extras(basis, kwargs):
-    w = FormExtraParams({"x": basis.x, "h": np.sqrt(basis.dx)})
+    size = np.sqrt(basis.dx) if basis.dim == 2 else np.cbrt(basis.dx)
+    w = FormExtraParams({"x": basis.x, "h": size})
     w.update(kwargs)
     return w
 
@@ -100,7 +101,7 @@ class BilinearForm(_Form):
 
     def coefficients(self, basis: CellBasis, **kwargs: Any) -> np.ndarray:
         """``D[a][b]``: the form at unit descriptors ``u = e_a``, ``v = e_b``, per cell."""
-        c = 3 * basis.ncomp
+        c = basis.descriptors
         out = [[np.zeros(len(basis.dx)) for _ in range(c)] for _ in range(c)]
         for a, b, value in self._nonzero_coefficients(basis, kwargs):
             out[a][b] = value
@@ -143,13 +144,14 @@ class BilinearForm(_Form):
             Extras ``w`` of the form, per cell (or per group).
         """
         m, g = len(basis.dx), basis.ncomp             # descriptors g, g + 1, ...: gradients
+        ng = basis.descriptors - g
         if groups is None:
             group, count = np.arange(m), m
         else:
             group, count = _check_groups(groups, m, kwargs)
         # D_ab per group (per cell without groups), one descriptor pair at a time:
         # gradient pairs in one array, scaled by A_k where used
-        grad_coeff = np.zeros((count, 2 * g, 2 * g))
+        grad_coeff = np.zeros((count, ng, ng))
         other, active = {}, set()
         for a, b, value in self._nonzero_coefficients(basis, kwargs,
                                                       None if groups is None else count):
@@ -161,12 +163,8 @@ class BilinearForm(_Form):
         if not active:
             return sp.csr_matrix((basis.N, basis.N))
         grads = basis.component_gradients() if basis.vector and not other else None
-        if grads is not None:          # 2 x 2 node blocks from the scalar gradients
-            gx, gy = grads
-            indptr, indices, data = SK.gradient_block_gram(gx.indptr, gx.indices, gx.data,
-                                                           gy.data, grad_coeff, group, basis.dx,
-                                                           basis.N // 2, work_chunks())
-            return sp.csr_matrix((data, indices, indptr), shape=(basis.N, basis.N))
+        if grads is not None:          # dim x dim node blocks from the scalar gradients
+            return _gradient_blocks(grads, grad_coeff, group, basis.dx, basis.N)
         ops = basis.operators
         used = sorted({a for a, _ in active} | {b for _, b in active})
         weights = np.zeros((m, len(used), len(used)))
@@ -182,6 +180,23 @@ class BilinearForm(_Form):
                                                  t.indptr, t.indices, t.data, weights, m,
                                                  basis.N, work_chunks())
         return sp.csr_matrix((data, indices, indptr), shape=(basis.N, basis.N))
+
+
+def _gradient_blocks(grads, coeff, group, weight, N):
+    """``K`` ``(N, N)`` CSR of a vector form that sees only gradients, by node blocks
+    (`cnem.assembly._sparse_kernels.gradient_block_gram`, its 2-D specialisation, or
+    `gradient_block_gram_nd`) from the scalar derivatives ``grads`` (one pattern)."""
+    first, d = grads[0], len(grads)
+    if d == 2:
+        indptr, indices, data = SK.gradient_block_gram(first.indptr, first.indices, first.data,
+                                                       grads[1].data, coeff, group, weight,
+                                                       N // 2, work_chunks())
+    else:
+        stacked = np.stack([g.data for g in grads])
+        indptr, indices, data = SK.gradient_block_gram_nd(first.indptr, first.indices, stacked,
+                                                          coeff, group, weight, N // d,
+                                                          work_chunks())
+    return sp.csr_matrix((data, indices, indptr), shape=(N, N))
 
 
 class LinearForm(_Form):

@@ -105,4 +105,4 @@ def updated_gradient(old: SmoothedGradient, change: ModelUpdate, *,
         copied = renumber_rows(old_part, change.old_cell, columns, (m, n))
         return copied + renumber_rows(new_part, place, np.arange(n), (m, n))
 
-    return SmoothedGradient(merged(old.x, fresh.x), merged(old.y, fresh.y), fresh.points)
+    return SmoothedGradient(*map(merged, old, fresh), points=fresh.points)

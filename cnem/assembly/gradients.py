@@ -21,27 +21,83 @@ __all__ = ["SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gr
 
 
 class SmoothedGradient:
-    """The operator ``B~`` of eq. 30: smoothed derivatives of every shape function.
+    """The operator ``B~`` of eq. 30: smoothed derivatives of every shape function,
+    one sparse matrix per direction: ``SmoothedGradient(x, y, points)`` in 2-D,
+    ``SmoothedGradient(x, y, z, points)`` in 3-D (``points`` also by keyword).
 
-    Attributes
+    Parameters
     ----------
-    x, y : scipy.sparse.csr_matrix, shape (m, n)
-        ``x[k, j] = b~_xj(cell k)`` and ``y[k, j] = b~_yj(cell k)``.
+    *parts : scipy.sparse matrices, shape (m, n), then int
+        ``d`` derivative matrices (d = 2 or 3), along x, y (and z), then
+        ``points`` unless given by keyword.
     points : int
         Number of quadrature points evaluated for it on the cell boundaries (with
         the other sets of cells computed in the same passes, `fan_gradient`: their
         shared count).
+
+    Attributes
+    ----------
+    components : tuple of scipy.sparse.csr_matrix, shape (m, n)
+        ``components[i][k, j] = b~_ij(cell k)``, the derivative along axis ``i``.
+    dim : int
+    x, y, z : scipy.sparse.csr_matrix, shape (m, n)
+        ``components[0]``, ``[1]``, ``[2]`` (``z`` in 3-D only).
+    points : int
+
+    Examples
+    --------
+    >>> import scipy.sparse as sp
+    >>> g = SmoothedGradient(sp.eye(2, format="csr"), sp.eye(2, format="csr"), points=0)
+    >>> g.dim, g.y is g.components[1]
+    (2, True)
     """
 
-    def __init__(self, x: sp.csr_matrix, y: sp.csr_matrix, points: int):
-        self.x, self.y, self.points = x, y, points
+    def __init__(self, *parts: sp.csr_matrix | int, points: int | None = None):
+        if points is None:
+            *components, points = parts or (None,)
+        else:
+            components = parts
+        shapes = [getattr(c, "shape", None) for c in components]
+        if len(components) not in (2, 3) or None in shapes or len(set(shapes)) != 1:
+            raise GeometryError(f"expected 2 or 3 derivative matrices of one shape (m, n) and "
+                                f"the number of points, received {len(parts)} arguments, "
+                                f"shapes {shapes}")
+        self.components, self.points = tuple(components), points
+
+    @property
+    def dim(self) -> int:
+        """The dimension: the number of `components`."""
+        return len(self.components)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(m, n)``: cells by functions."""
+        return self.components[0].shape
+
+    @property
+    def x(self) -> sp.csr_matrix:
+        """The derivatives along x, ``(m, n)``."""
+        return self.components[0]
+
+    @property
+    def y(self) -> sp.csr_matrix:
+        """The derivatives along y, ``(m, n)``."""
+        return self.components[1]
+
+    @property
+    def z(self) -> sp.csr_matrix:
+        """The derivatives along z, ``(m, n)`` (3-D only)."""
+        if self.dim < 3:
+            raise AttributeError("a 2-D SmoothedGradient has no z component")
+        return self.components[2]
 
     def __iter__(self):
-        return iter((self.x, self.y))
+        return iter(self.components)
 
     def __repr__(self):
-        m, n = self.x.shape
-        return f"<SmoothedGradient {m} cells x {n} nodes, {self.x.nnz} non-zeros, {self.points} points>"
+        m, n = self.shape
+        return (f"<SmoothedGradient {self.dim}-D, {m} cells x {n} nodes, {self.x.nnz} "
+                f"non-zeros, {self.points} points>")
 
 
 def smoothed_gradient(model: Model, *, gauss: int = 2, cells: Cells | None = None
@@ -63,7 +119,7 @@ def smoothed_gradient(model: Model, *, gauss: int = 2, cells: Cells | None = Non
     Returns
     -------
     SmoothedGradient
-        ``x, y`` sparse ``(m, n)``.
+        ``x, y`` sparse ``(m, n)`` (``dim`` 2).
     """
     gauss = check_gauss(gauss)
     every = model.cells if cells is None else cells
@@ -71,7 +127,7 @@ def smoothed_gradient(model: Model, *, gauss: int = 2, cells: Cells | None = Non
     (grad,), points = gradients_in_passes(
         model, [every], lambda sets, _: boundary_quadratures(model, sets, gauss=gauss),
         None if runs is None else [[run] for run in runs])
-    return SmoothedGradient(*grad, points)
+    return SmoothedGradient(*grad, points=points)
 
 
 def fan_gradient(model: Model, *, gauss: int = 2) -> tuple[Cells, SmoothedGradient]:
@@ -122,8 +178,8 @@ def _fan_gradients(model, gauss, with_cells):
 
     (of_cells, of_sub), points = gradients_in_passes(model, [cells, sub], quadratures, passes,
                                                      wanted=[with_cells, True])
-    return (None if of_cells is None else SmoothedGradient(*of_cells, points),
-            sub, SmoothedGradient(*of_sub, points))
+    return (None if of_cells is None else SmoothedGradient(*of_cells, points=points),
+            sub, SmoothedGradient(*of_sub, points=points))
 
 
 class SmoothedGradients:
@@ -156,10 +212,10 @@ class SmoothedGradients:
     def __init__(self, model: Model, *, gauss: int = 2, cells: SmoothedGradient | None = None):
         self.model = model
         self.gauss = check_gauss(gauss)
-        if cells is not None and cells.x.shape != (len(model.cells.area), len(model.nodes)):
+        if cells is not None and cells.shape != (len(model.cells.area), len(model.nodes)):
             raise GeometryError(f"cells: expected the smoothed gradient of this model's "
                                 f"{len(model.cells.area)} cells and {len(model.nodes)} nodes, "
-                                f"received shape {cells.x.shape}")
+                                f"received shape {cells.shape}")
         self._cells = cells
         self._fan = None
 

@@ -60,5 +60,5 @@ def triangle_basis(model: Model, *, vector: bool = False) -> CellBasis:
     def op(values):
         return sp.csr_matrix((values.reshape(-1), cols, indptr), shape=(t, n))
 
-    return CellBasis.from_operators(model, op(np.full((t, 3), 1.0 / 3.0)), op(dx), op(dy),
+    return CellBasis.from_operators(model, op(np.full((t, 3), 1.0 / 3.0)), (op(dx), op(dy)),
                                     0.5 * twice, corners.mean(axis=1), vector=vector)

@@ -24,7 +24,7 @@ from ..assembly.triangles import triangle_basis
 from ..solvers.constrained import solve_constrained
 from ..errors import GeometryError, InputError
 from ..geometry.topology import constraint_edges
-from ..material import check_stiffness, lame, parse_materials, stiffness_matrix
+from ..material import check_plane, check_stiffness, lame, moduli, parse_materials, stiffness_matrix
 from .solution import ElasticSolution
 
 if TYPE_CHECKING:
@@ -45,14 +45,16 @@ def elasticity_form(u, v, w):
 
 
 class Elasticity(Conditions):
-    """Plane linear elasticity on a C-NEM model.
+    """Linear elasticity on a C-NEM model: plane stress or strain in 2-D; the dofs,
+    the assembly and the solution carry the model's dimension ``dim``.
 
     Parameters
     ----------
     model : Model
         From `cnem.discretize`: ``n`` nodes, ``m`` integration cells.
-    materials : (E, nu) pair, or a list of pairs indexed by region
-    plane : {"stress", "strain"}
+    materials : (E, nu) pair or `cnem.material.LinearElastic`, or a list of either indexed by region
+    plane : {"stress", "strain"}, optional
+        The 2-D idealisation (default "stress"); none for a 3-D model.
     gauss : int
         Gauss points per cell-edge piece in the smoothed gradients.
     enrich : dict(tips=..., radius=..., functions=...) or cnem.fracture.Enrichment, optional
@@ -73,6 +75,15 @@ class Elasticity(Conditions):
         problems on the model (what it has computed is not computed again); by
         default the problem keeps its own (`gradients`).
 
+    Attributes
+    ----------
+    dim : int
+        The model's dimension.
+    region_materials : tuple of cnem.material.LinearElastic
+        One material per region.
+    materials : (r, 2) ndarray
+        Their ``(E, nu)``.
+
     Examples
     --------
     >>> import numpy as np, cnem
@@ -87,7 +98,7 @@ class Elasticity(Conditions):
     """
 
     def __init__(self, model: Model, materials: tuple[float, float] | Sequence[tuple[float, float]],
-                 *, plane: str = "stress", gauss: int = 2, enrich: Enrichment | None = None,
+                 *, plane: str | None = None, gauss: int = 2, enrich: Enrichment | None = None,
                  stabilization: float = 1.0, gradients: SmoothedGradients | None = None):
         from ..fracture.enrichment import Enrichment
         self.model = model
@@ -96,8 +107,13 @@ class Elasticity(Conditions):
         #: smoothed strain per cell cannot control the extra dofs)
         self.cells = (model.cells if self.enrichment is None
                       else subdivide(model.cells, model.nodes, node_apex=tip_cells(model))[0])
-        lame(1.0, 0.0, plane)                       # validates `plane`
-        self.materials = parse_materials(materials, len(model.domain.regions), plane)
+        self.dim = model.nodes.shape[1]
+        if self.dim == 2 and plane is None:
+            plane = "stress"
+        check_plane(self.dim, plane)
+        self.region_materials = parse_materials(materials, len(model.domain.regions), plane,
+                                                dim=self.dim)
+        self.materials = moduli(self.region_materials)
         self.stabilization = float(stabilization)
         if not (np.isfinite(self.stabilization) and self.stabilization >= 0):
             raise InputError(f"stabilization: expected a number >= 0, received {stabilization!r}")
@@ -125,7 +141,7 @@ class Elasticity(Conditions):
 
     @property
     def condition_points(self) -> np.ndarray:
-        """``(n, 2)`` the nodes that conditions refer to (``model.nodes``)."""
+        """``(n, dim)`` the nodes that conditions refer to (``model.nodes``)."""
         return self.model.nodes
 
     def boundary_edges(self) -> tuple:
@@ -180,7 +196,7 @@ class Elasticity(Conditions):
         return self.materials[self.cells.region]
 
     def stiffness(self) -> sp.csr_matrix:
-        """Global stiffness ``K`` (eq. 33), ``(2 n, 2 n)`` CSR."""
+        """Global stiffness ``K`` (eq. 33), ``(dim n, dim n)`` CSR."""
         if self._K is None:
             a = self.stabilization
             sub_cells = self._sub_cells()
@@ -216,7 +232,9 @@ class Elasticity(Conditions):
         spokes cancel, so ``sum_s A_s B~_s = A_k B~_k`` and the stabilised
         stiffness ``K_k + a sum_s A_s (B~_s - B~_k)^T C (B~_s - B~_k)`` equals
         ``(1 - a) K_k + a sum_s A_s B~_s^T C B~_s``: no difference operators
-        (whose rows would carry both patterns) are formed.
+        (whose rows would carry both patterns) are formed. The identity needs a
+        constant ``C`` per cell (a linear law); a state-dependent tangent needs the
+        difference form.
         """
         sub, grad = self.gradients.fan(release=True)
         fine = CellBasis(self.model, vector=True, cells=sub, gradient=grad)
@@ -239,24 +257,24 @@ class Elasticity(Conditions):
         near[owner[enrichment.in_support(points)]] = True        # whole cells
         keep = np.flatnonzero(near[owner])
         owner, points = owner[keep], points[keep]
-        phi, dx, dy = self.model.shape_functions(points, gradient=True)
-        _, ex, ey = enrichment.values(points, phi, gradient=(dx, dy))
-        gx, gy = sp.hstack([dx, ex], format="csr"), sp.hstack([dy, ey], format="csr")
+        shape = self.model.shape_functions(points, gradient=True)
+        _, *extra = enrichment.values(points, shape.value, gradient=shape.gradient)
+        grads = [sp.hstack([g, e], format="csr") for g, e in zip(shape.gradient, extra)]
         to_cell = sp.csr_matrix((np.ones(len(owner)), (np.arange(len(owner)), owner)),
                                 shape=(len(owner), len(cells.area)))
-        ops = basis.operators
-        pointwise = [spread_component(g, c, 2) for c in range(2) for g in (gx, gy)]
-        diff = [p - to_cell @ b for p, b in zip(pointwise, ops[2:])]
-        at_points = basis.at_points([to_cell @ ops[0], to_cell @ ops[1]] + diff,
+        ops, d = basis.operators, basis.ncomp
+        pointwise = [spread_component(g, c, d) for c in range(d) for g in grads]
+        diff = [p - to_cell @ b for p, b in zip(pointwise, ops[d:])]
+        at_points = basis.at_points([to_cell @ op for op in ops[:d]] + diff,
                                     weights[keep], points)
         lam, mu = self._lame(weight)
         return elasticity_form.assemble(at_points, groups=cells.region[owner], lam=lam, mu=mu)
 
     def load(self) -> np.ndarray:
-        """Load vector ``f`` (eq. 21), ``(2 n,)`` (then the enriched dofs' loads)."""
-        n = len(self.model.nodes)
-        f = np.zeros((n, 2))
-        enriched = np.zeros((0 if self.enrichment is None else len(self.enrichment), 2))
+        """Load vector ``f`` (eq. 21), ``(dim n,)`` (then the enriched dofs' loads)."""
+        n, d = self.model.nodes.shape
+        f = np.zeros((n, d))
+        enriched = np.zeros((0 if self.enrichment is None else len(self.enrichment), d))
         g, w = np.polynomial.legendre.leggauss(3)
         s, w = 0.5 * (g + 1.0), 0.5 * w
         x = self.model.nodes
@@ -294,9 +312,10 @@ class Elasticity(Conditions):
             size = self.enrichment.size
             slot = np.full(n, -1)
             slot[self.enrichment.nodes] = np.arange(len(self.enrichment.nodes))
-            hit = slot[dofs // 2] >= 0
-            first = n + slot[dofs[hit] // 2] * size               # the node's first function
-            extra = (2 * (first[:, None] + np.arange(size)) + (dofs[hit] % 2)[:, None]).reshape(-1)
+            d = self.dim
+            hit = slot[dofs // d] >= 0
+            first = n + slot[dofs[hit] // d] * size               # the node's first function
+            extra = (d * (first[:, None] + np.arange(size)) + (dofs[hit] % d)[:, None]).reshape(-1)
             dofs = np.concatenate([dofs, extra])
             values = np.concatenate([values, np.zeros(len(extra))])
         return dofs, values
@@ -316,7 +335,7 @@ class Elasticity(Conditions):
         options = dict(preconditioner=lambda: self.preconditioner_matrix(dofs),
                        smooth_with_matrix=self.stabilization == 0)
         if self.enrichment is not None:
-            options["nodal"] = np.asarray(dofs) < 2 * len(self.model.nodes)
+            options["nodal"] = np.asarray(dofs) < self.model.nodes.size
         return options
 
     def preconditioner_matrix(self, dofs: np.ndarray | None = None) -> sp.spmatrix | None:
@@ -331,7 +350,7 @@ class Elasticity(Conditions):
 
         Returns
         -------
-        scipy.sparse.csr_matrix, shape (2 n, 2 n) or (k, k)
+        scipy.sparse.csr_matrix, shape (dim n, dim n) or (k, k)
             None with enrichment (P1 has no enriched dofs) or degenerate triangles
             (the solver then builds its hierarchy on K).
         """

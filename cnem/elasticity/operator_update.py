@@ -132,7 +132,7 @@ def updated_operators(old: Any, new: Any, change: ModelUpdate,
 def _rows(gradient, index):
     """``B~`` of the cells ``index`` alone."""
     from ..assembly.gradients import SmoothedGradient
-    return SmoothedGradient(gradient.x[index], gradient.y[index], 0)
+    return SmoothedGradient(*(g[index] for g in gradient), points=0)
 
 
 def _dof_map(new_node):

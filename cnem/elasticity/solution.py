@@ -20,27 +20,30 @@ class ElasticSolution(Solution):
 
     Attributes
     ----------
-    u : (n, 2) ndarray
+    u : (n, d) ndarray
         Nodal displacements (the displacement at node ``i`` is ``u[i]``).
-    stress : (m, 3) ndarray
-        ``[sxx, syy, sxy]`` per integration cell (eq. 34).
-    strain : (m, 3) ndarray
-        ``[exx, eyy, 2 exy]`` per integration cell (smoothed, eq. 29).
+    stress : (m, 3) or (m, 6) ndarray
+        ``[sxx, syy, sxy]`` per integration cell (eq. 34); in 3-D
+        ``[sxx, syy, szz, syz, sxz, sxy]``.
+    strain : (m, 3) or (m, 6) ndarray
+        ``[exx, eyy, 2 exy]`` per integration cell (smoothed, eq. 29); in 3-D
+        ``[exx, eyy, ezz, 2 eyz, 2 exz, 2 exy]``.
     cells : Cells
         The integration cells of ``stress`` and ``strain`` (``model.cells``, or
         their sub-cells with enrichment).
-    gradient : (m, 2, 2) ndarray
+    gradient : (m, d, d) ndarray
         Smoothed displacement gradient per cell, ``[k, i, j] = du_i/dx_j``.
-    dofs : (2 n + 2 e,) ndarray
+    dofs : (d n + d e,) ndarray
         All unknowns.
-    enriched : (e, 2) ndarray
+    enriched : (e, d) ndarray
         Coefficients of the enrichment functions (empty without enrichment).
-    C : (m, 3, 3) ndarray
+    C : (m, 3, 3) or (m, 6, 6) ndarray
         Elastic matrix of each cell.
     timings : dict
         Seconds spent in each stage.
     model : Model
-    plane : {"stress", "strain"}
+    plane : {"stress", "strain"} or None
+        None in 3-D.
     """
 
     stress: np.ndarray
@@ -60,17 +63,17 @@ class ElasticSolution(Solution):
     def from_dofs(cls, problem: Any, dofs: np.ndarray, C: np.ndarray,
                   timings: dict[str, float]) -> ElasticSolution:
         """The solution of ``problem`` with unknowns ``dofs`` and cell elastic matrices ``C``."""
-        n = len(problem.model.nodes)
-        ops = problem.basis.operators[2:]               # du0/dx, du0/dy, du1/dx, du1/dy
-        gradient = np.stack([op @ dofs for op in ops], axis=1).reshape(-1, 2, 2)
+        n, d = problem.model.nodes.shape
+        ops = problem.basis.operators[d:]               # du0/dx, du0/dy, du1/dx, du1/dy (2-D)
+        gradient = np.stack([op @ dofs for op in ops], axis=1).reshape(-1, d, d)
         strain = engineering_strain(gradient)
-        return cls(problem=problem, u=dofs[:2 * n].reshape(-1, 2),
+        return cls(problem=problem, u=dofs[:d * n].reshape(-1, d),
                    stress=np.einsum("kij,kj->ki", C, strain), strain=strain, cells=problem.cells,
-                   gradient=gradient, dofs=dofs, enriched=dofs[2 * n:].reshape(-1, 2), C=C,
+                   gradient=gradient, dofs=dofs, enriched=dofs[d * n:].reshape(-1, d), C=C,
                    timings=timings, model=problem.model, plane=problem.plane)
 
     def displacement(self, points: np.ndarray) -> np.ndarray:
-        """Displacements ``(p, 2)`` at points ``(p, 2)`` through the shape functions (and
+        """Displacements ``(p, d)`` at points ``(p, d)`` through the shape functions (and
         the enrichment functions)."""
         phi = self.model.shape_functions(points)
         out = phi @ self.u
@@ -85,22 +88,22 @@ class ElasticSolution(Solution):
 
         Parameters
         ----------
-        points : (p, 2) array_like
+        points : (p, d) array_like
             Off the nodes' cell boundaries where the gradients jump, and off the
             crack tips.
 
         Returns
         -------
-        (p, 2, 2) ndarray
+        (p, d, d) ndarray
             ``[q, i, j] = du_i/dx_j``.
         """
         pts = np.asarray(points, dtype=float)
-        phi, dx, dy = self.model.shape_functions(pts, gradient=True)
-        out = np.stack([dx @ self.u, dy @ self.u], axis=2)
+        shape = self.model.shape_functions(pts, gradient=True)
+        out = np.stack([g @ self.u for g in shape.gradient], axis=2)
         enrichment = self.problem.enrichment
         if enrichment is not None:
-            _, ex, ey = enrichment.values(pts, phi, gradient=(dx, dy))
-            out += np.stack([ex @ self.enriched, ey @ self.enriched], axis=2)
+            _, *extra = enrichment.values(pts, shape.value, gradient=shape.gradient)
+            out += np.stack([e @ self.enriched for e in extra], axis=2)
         return out
 
     def energy_error(self, exact_stress: Callable[..., np.ndarray], *, order: int = 4,

@@ -17,7 +17,7 @@ from skfem.models.elasticity import linear_elasticity
 
 from ..solvers.constrained import solve_constrained
 from ..solvers.conditions import Conditions, per_point, traction_at
-from ..material import lame, parse_materials
+from ..material import check_plane, lame, moduli, parse_materials
 from .mesh import mesh_domain
 from .solution import P1Solution
 
@@ -40,7 +40,7 @@ class P1Elasticity(Conditions):
     Parameters
     ----------
     domain : Domain
-    materials : (E, nu) pair, or a list of pairs indexed by region
+    materials : (E, nu) pair or `cnem.material.LinearElastic`, or a list of either indexed by region
     plane : {"stress", "strain"}
     nodes : int, optional
         Target node count of the mesh (within about 5 %).
@@ -59,6 +59,10 @@ class P1Elasticity(Conditions):
         Vector P1 basis; dofs interleaved ``[u0x, u0y, u1x, ...]``.
     timings : dict
         Seconds spent meshing (``"mesh"``).
+    region_materials : tuple of cnem.material.LinearElastic
+        One per region.
+    materials : (r, 2) ndarray
+        Their ``(E, nu)``.
     """
 
     def __init__(self, domain: Domain,
@@ -66,8 +70,9 @@ class P1Elasticity(Conditions):
                  plane: str = "stress", nodes: np.ndarray | None = None,
                  max_area: float | None = None, quality: float = 30.0):
         self.domain = domain
-        lame(1.0, 0.0, plane)                       # validates `plane`
-        self.materials = parse_materials(materials, len(domain.regions), plane)
+        check_plane(2, plane)
+        self.region_materials = parse_materials(materials, len(domain.regions), plane)
+        self.materials = moduli(self.region_materials)
         self.plane = plane
         t0 = time.perf_counter()
         points, tri, self.region = mesh_domain(domain, nodes=nodes, max_area=max_area,

@@ -217,13 +217,14 @@ class Model:
                         triangles: ArrayLike | None = None, gradient: bool = False,
                         in_order: bool = True
                         ) -> (sp.csr_matrix | tuple[sp.csr_matrix, np.ndarray]
-                              | tuple[sp.csr_matrix, sp.csr_matrix, sp.csr_matrix]):
+                              | tuple[sp.csr_matrix, ...]):
         """Constrained natural-neighbour coordinates, see `cnem.shape.shape_functions`.
 
         Returns
         -------
         scipy.sparse.csr_matrix, shape (p, n)
-            Or ``(Phi, dPhi_dx, dPhi_dy)`` with ``gradient=True``.
+            Or ``(Phi, dPhi_dx, dPhi_dy)`` with ``gradient=True`` (a
+            `cnem.shape.natural.ShapeGradients`: also ``value``, ``gradient``, ``dim``).
         """
         return shape_functions(self, points, kind=kind, triangles=triangles, gradient=gradient,
                                in_order=in_order)

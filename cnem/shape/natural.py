@@ -13,9 +13,44 @@ from ..errors import CNEMError, GeometryError, UnsupportedError, check_choice
 from .._parallel import work_chunks
 from . import _kernels as K
 
-__all__ = ["shape_functions", "point_rows", "PointRows", "KINDS"]
+__all__ = ["shape_functions", "point_rows", "PointRows", "ShapeGradients", "KINDS"]
 
 KINDS = ("sibson", "laplace")
+
+
+class ShapeGradients(tuple):
+    """Shape functions at points with their derivatives: ``(Phi, dPhi_dx, dPhi_dy)``
+    in 2-D (``dPhi_dz`` too in 3-D), CSR ``(p, n)`` of one pattern, and unpacked like
+    that tuple.
+
+    Attributes
+    ----------
+    value : scipy.sparse.csr_matrix, shape (p, n)
+        ``Phi``.
+    gradient : tuple of scipy.sparse.csr_matrix, shape (p, n)
+        The derivatives along each axis, ``dim`` of them.
+    dim : int
+    """
+
+    __slots__ = ()
+
+    def __new__(cls, value: sp.csr_matrix, *gradient: sp.csr_matrix) -> ShapeGradients:
+        return super().__new__(cls, (value,) + gradient)
+
+    @property
+    def value(self) -> sp.csr_matrix:
+        """``Phi``, ``(p, n)``."""
+        return self[0]
+
+    @property
+    def gradient(self) -> tuple[sp.csr_matrix, ...]:
+        """``(dPhi_dx, dPhi_dy[, dPhi_dz])``, ``(p, n)`` each."""
+        return tuple(self[1:])
+
+    @property
+    def dim(self) -> int:
+        """The dimension: the number of derivatives."""
+        return len(self) - 1
 
 def path_order(pts, bounds, per_tile=4):
     """Order of points along a serpentine path through a square grid of tiles.
@@ -71,8 +106,7 @@ def _candidates(tree, local_points, tol):
 def shape_functions(model: Any, points: ArrayLike, *, kind: Literal["sibson", "laplace"] = "sibson",
                     triangles: ArrayLike | None = None, gradient: bool = False,
                     in_order: bool = True
-                    ) -> (sp.csr_matrix | tuple[sp.csr_matrix, np.ndarray]
-                          | tuple[sp.csr_matrix, sp.csr_matrix, sp.csr_matrix]):
+                    ) -> sp.csr_matrix | tuple[sp.csr_matrix, np.ndarray] | ShapeGradients:
     """Constrained natural-neighbour coordinates of points.
 
     Parameters
@@ -99,8 +133,9 @@ def shape_functions(model: Any, points: ArrayLike, *, kind: Literal["sibson", "l
     Returns
     -------
     Phi : scipy.sparse.csr_matrix, shape (p, n)
-        With ``gradient=True`` the tuple ``(Phi, dPhi_dx, dPhi_dy)``, three CSR
-        matrices with the same pattern.
+        With ``gradient=True`` a `ShapeGradients`, the tuple ``(Phi, dPhi_dx,
+        dPhi_dy)`` of three CSR matrices with the same pattern (``value``,
+        ``gradient``, ``dim``).
         Row ``k`` holds the coordinates of ``points[k]`` with respect to the
         nodes: rows sum to 1, ``Phi @ model.nodes`` gives back the points, a
         point at a node gets its unit row, a point on a boundary, interface or
@@ -125,7 +160,7 @@ def shape_functions(model: Any, points: ArrayLike, *, kind: Literal["sibson", "l
     if len(pts) == 0:
         empty = sp.csr_matrix((0, n))
         if gradient:
-            return empty, empty.copy(), empty.copy()
+            return ShapeGradients(empty, empty.copy(), empty.copy())
         return empty if in_order else (empty, np.zeros(0, dtype=np.int64))
     order, start, size, cols, vals, gx, gy, kinds = _coordinates(model, pts, kind, triangles,
                                                                  gradient)
@@ -143,8 +178,8 @@ def shape_functions(model: Any, points: ArrayLike, *, kind: Literal["sibson", "l
             f"segment, where the gradients are not defined, first {pts[singular[:3]].tolist()}; "
             "evaluate gradients inside the cells")
     # own index arrays: scipy may sort one matrix's indices in place
-    return (phi, sp.csr_matrix((gx, cols.copy(), offsets.copy()), shape=phi.shape),
-            sp.csr_matrix((gy, cols.copy(), offsets.copy()), shape=phi.shape))
+    return ShapeGradients(phi, sp.csr_matrix((gx, cols.copy(), offsets.copy()), shape=phi.shape),
+                          sp.csr_matrix((gy, cols.copy(), offsets.copy()), shape=phi.shape))
 
 
 class PointRows(NamedTuple):

@@ -66,14 +66,14 @@ def energy_error_density(points: np.ndarray, region: np.ndarray, stress: np.ndar
 
     Parameters
     ----------
-    points : (q, 2) ndarray
+    points : (q, d) ndarray
     region : (q,) int ndarray
         Region of the cell (or element) holding each point.
-    stress : (q, 3) ndarray
-        The approximate stress ``σh`` at the points.
-    C : (q, 3, 3) ndarray
+    stress : (q, s) ndarray
+        The approximate stress ``σh`` at the points, Voigt (``s`` = 3 in 2-D, 6 in 3-D).
+    C : (q, s, s) ndarray
         The elastic matrix at the points.
-    exact_stress : callable ``(q, 2) -> (q, 3)`` or ``(q, 2), (q,) -> (q, 3)``
+    exact_stress : callable ``(q, d) -> (q, s)`` or ``(q, d), (q,) -> (q, s)``
 
     Returns
     -------
@@ -84,9 +84,11 @@ def energy_error_density(points: np.ndarray, region: np.ndarray, stress: np.ndar
     else:
         exact = exact_stress(points)
     exact = np.asarray(exact, dtype=float)
-    if exact.shape != (len(points), 3):
-        raise InputError(f"exact_stress must return ({len(points)}, 3) values "
-                         f"[sxx, syy, sxy], received shape {exact.shape}; return one row per point")
+    size = np.shape(stress)[-1]
+    if exact.shape != (len(points), size):
+        names = "[sxx, syy, sxy]" if size == 3 else "[sxx, syy, szz, syz, sxz, sxy]"
+        raise InputError(f"exact_stress must return ({len(points)}, {size}) values "
+                         f"{names}, received shape {exact.shape}; return one row per point")
     bad = ~np.isfinite(exact).all(axis=1)
     if bad.any():
         raise InputError(f"exact_stress must return finite values, received NaN or inf at "
