@@ -24,7 +24,7 @@ nothing), so nothing cached by one run serves the next:
 * C-NEM ``B~``: the smoothed gradients on the fresh model (which holds only the
   triangle-neighbour table ``discretize`` built), so it includes the once-per-model setup it
   triggers (the circumcircles and their R-tree): ``gradients.fan()`` of a
-  ``cnem.assembly.SmoothedGradients(model)`` (B~ of the cells and of their fan sub-cells,
+  ``cnem.assembly.GradientCache(model)`` (B~ of the cells and of their fan sub-cells,
   for the default stabilisation), ``gradients.cells()`` with ``--stabilization 0``;
 * C-NEM ``K``: ``Elasticity(..., gradients=gradients).stiffness()`` with the gradients
   already kept by ``gradients``: the cell bases, their operators and the assembly of K;
@@ -178,13 +178,13 @@ def lattice_cloud(k):
 def cnem_pipeline(cloud, run):
     """C-NEM from the cloud: model, B~, K, rigid-motion check, solve (timed into ``run``)."""
     import cnem
-    from cnem.assembly import SmoothedGradients
+    from cnem.assembly import GradientCache
     from cnem.solvers.linsolve import free_rigid_motions
 
     model = staged(run, "model", lambda: cnem.discretize(cloud, progress=False))
     # the smoothed gradients Elasticity needs: with the stabilisation those of the fan
     # sub-cells too, computed with the cells' (one set of shape-function values)
-    gradients = SmoothedGradients(model)
+    gradients = GradientCache(model)
     staged(run, "B~", lambda: gradients.fan() if CLOUD["stabilization"] > 0
            else gradients.cells())
     grad = gradients.cells()
@@ -399,7 +399,7 @@ def report(results, warm):
           "triangles, built in the stage): Elasticity.solve's path without its "
           "rigid-motion check (timed in the details)")
     print("B~ = the smoothed gradients on a fresh model (includes the shape-function "
-          "setup): SmoothedGradients.fan (cells and their fan sub-cells, one set of points) with "
+          "setup): GradientCache.fan (cells and their fan sub-cells, one set of points) with "
           "the stabilisation, .cells() without; K = Elasticity.stiffness() from them; "
           "total = sum of the stages")
     import numba

@@ -63,6 +63,8 @@ def test_nodes_is_the_public_name_of_the_node_clouds():
 RENAMED = [
     ("cnem.solvers.condensation", "condense", "cnem.solvers.condensation", "condensed_system"),
     ("cnem.fracture", "CrackPath", "cnem.fracture.history", "GrowthHistory"),
+    ("cnem.assembly", "SmoothedGradients", "cnem.assembly.gradients", "GradientCache"),
+    ("cnem.assembly.gradients", "SmoothedGradients", "cnem.assembly.gradients", "GradientCache"),
     ("cnem.fracture.history", "CrackPath", "cnem.fracture.history", "GrowthHistory"),
     ("cnem.assembly.quadrature", "subdivide", "cnem.assembly.subdivision", "subdivide"),
     ("cnem.assembly.quadrature", "tip_cells", "cnem.assembly.subdivision", "tip_cells"),

@@ -20,7 +20,7 @@ import scipy.sparse as sp
 import cases
 import reference
 from cnem import config
-from cnem.assembly import SmoothedGradients, cell_edges, smoothed_gradient
+from cnem.assembly import GradientCache, cell_edges, smoothed_gradient
 from cnem.assembly.edges import circle_pieces
 
 NAMES = cases.NAMES
@@ -156,10 +156,10 @@ def test_crack_faces_do_not_see_each_other(name):
 
 
 def test_kept_by_their_owner_and_validated():
-    """`SmoothedGradients` computes B~ once and hands the same operator to every
+    """`GradientCache` computes B~ once and hands the same operator to every
     caller; it is the operator `smoothed_gradient` computes afresh."""
     _, _, model = cases.model("square_regular")
-    gradients = SmoothedGradients(model)
+    gradients = GradientCache(model)
     kept = gradients.cells()
     assert gradients.cells() is kept and gradients.of(model.cells) is kept
     fresh = smoothed_gradient(model)
@@ -169,7 +169,7 @@ def test_kept_by_their_owner_and_validated():
     with pytest.raises(ValueError, match="positive number of Gauss points"):
         smoothed_gradient(model, gauss=0)
     with pytest.raises(ValueError, match="positive number of Gauss points"):
-        SmoothedGradients(model, gauss=0)
+        GradientCache(model, gauss=0)
 
 
 @pytest.mark.slow
@@ -203,7 +203,7 @@ def test_fan_gradient_shares_the_cells_points(name, per_pass, cells_cached, monk
     sub_alone = smoothed_gradient(model, cells=sub)
     if per_pass is not None:
         monkeypatch.setattr(config, "CELLS_PER_PASS", per_pass)
-    gradients = SmoothedGradients(model)
+    gradients = GradientCache(model)
     kept = gradients.cells() if cells_cached else None
     computed = []                          # the cells' B~ computed on its own
     monkeypatch.setattr(owner, "smoothed_gradient",

@@ -22,11 +22,12 @@ from .basis import CellBasis
 from ..solvers.conditions import select_nodes
 from .forms import BilinearForm, Functional, LinearForm, asm
 from .edges import cell_edges
-from .gradients import SmoothedGradient, SmoothedGradients, fan_gradient, smoothed_gradient
+from .gradients import SmoothedGradient, GradientCache, fan_gradient, smoothed_gradient
 
 __all__ = ["CellBasis", "BilinearForm", "LinearForm", "Functional", "asm", "condense", "solve",
-           "SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient",
+           "SmoothedGradient", "GradientCache", "smoothed_gradient", "fan_gradient",
            "cell_edges", "select_nodes"]
 
 #: Old names (one release): see `cnem._aliases`.
-__getattr__ = renamed_attributes(__name__, {})
+__getattr__ = renamed_attributes(
+    __name__, {"SmoothedGradients": ("cnem.assembly.gradients", "GradientCache")})

@@ -51,7 +51,7 @@ class CellBasis:
         Integration cells (default ``model.cells``; sub-cells for enrichment).
     gradient : SmoothedGradient, optional
         ``b~`` on ``cells`` when already computed (from a
-        `cnem.assembly.gradients.SmoothedGradients`, which keeps it); by default
+        `cnem.assembly.gradients.GradientCache`, which keeps it); by default
         it is computed afresh (`smoothed_gradient`).
     extra : (gx, gy) or (gx, gy, gz) sparse (m, e), optional
         Smoothed gradients of ``e`` more functions that vanish at every node

@@ -1,5 +1,5 @@
 """The SCNI smoothed gradient operator ``B~`` (C-NEM paper §4.2, eq. 26-32), and
-`SmoothedGradients`, the owner that computes it once for a model."""
+`GradientCache`, the owner that computes it once for a model."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.sparse as sp
 
+from .._aliases import renamed_attributes
 from ..errors import GeometryError
 from .edge_quadrature import boundary_quadratures, check_gauss
 from .fan_quadrature import fan_quadratures
@@ -17,7 +18,7 @@ from .subdivision import subdivide, tip_cells
 if TYPE_CHECKING:
     from ..geometry.model import Cells, Model
 
-__all__ = ["SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient"]
+__all__ = ["SmoothedGradient", "GradientCache", "smoothed_gradient", "fan_gradient"]
 
 
 class SmoothedGradient:
@@ -103,7 +104,7 @@ class SmoothedGradient:
 def smoothed_gradient(model: Model, *, gauss: int = 2, cells: Cells | None = None
                       ) -> SmoothedGradient:
     """The smoothed gradient operator ``B~`` of a model's cells, computed afresh
-    (`SmoothedGradients` keeps it for the next users).
+    (`GradientCache` keeps it for the next users).
 
     Parameters
     ----------
@@ -132,7 +133,7 @@ def smoothed_gradient(model: Model, *, gauss: int = 2, cells: Cells | None = Non
 
 def fan_gradient(model: Model, *, gauss: int = 2) -> tuple[Cells, SmoothedGradient]:
     """Smoothed gradients on the fan sub-cells of the model's cells, computed afresh
-    (`SmoothedGradients.fan` computes them with the cells' and keeps them).
+    (`GradientCache.fan` computes them with the cells' and keeps them).
 
     The sub-cells (`cnem.assembly.subdivision.subdivide`, spokes marked; crack-tip
     cells fanned from their node) share every edge but their spokes with their
@@ -182,7 +183,7 @@ def _fan_gradients(model, gauss, with_cells):
             sub, SmoothedGradient(*of_sub, points=points))
 
 
-class SmoothedGradients:
+class GradientCache:
     """The smoothed gradients of one model at one Gauss order, each computed when
     first asked for and kept: the owner of ``B~`` for everyone who needs it.
 
@@ -264,5 +265,9 @@ class SmoothedGradients:
     def __repr__(self):
         kept = [name for name, value in (("cells", self._cells), ("fan", self._fan))
                 if value is not None]
-        return (f"<SmoothedGradients gauss {self.gauss} of a {len(self.model.nodes)}-node model, "
+        return (f"<GradientCache gauss {self.gauss} of a {len(self.model.nodes)}-node model, "
                 f"kept: {', '.join(kept) or 'none'}>")
+
+
+#: Old names (one release): see `cnem._aliases`.
+__getattr__ = renamed_attributes(__name__, {"SmoothedGradients": (__name__, "GradientCache")})

@@ -21,7 +21,7 @@ fields exactly and Gauss quadrature integrates linear functions exactly.
   sub-cells from one set of points;
 - `cnem.assembly.passes`: the memory-bounded passes over runs of cells;
 - `cnem.assembly.gradients`: the operator `SmoothedGradient` and its owner
-  `SmoothedGradients`.
+  `GradientCache`.
 
 This module gathers their public names under one roof.
 """
@@ -31,8 +31,8 @@ from __future__ import annotations
 from .edge_quadrature import BoundaryQuadrature, boundary_quadrature, boundary_quadratures
 from .edges import cell_edges
 from .fan_quadrature import fan_quadratures
-from .gradients import SmoothedGradient, SmoothedGradients, fan_gradient, smoothed_gradient
+from .gradients import SmoothedGradient, GradientCache, fan_gradient, smoothed_gradient
 
-__all__ = ["SmoothedGradient", "SmoothedGradients", "smoothed_gradient", "fan_gradient",
+__all__ = ["SmoothedGradient", "GradientCache", "smoothed_gradient", "fan_gradient",
            "fan_quadratures", "BoundaryQuadrature", "boundary_quadrature", "boundary_quadratures",
            "cell_edges"]

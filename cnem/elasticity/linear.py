@@ -19,7 +19,7 @@ from ..solvers.conditions import Conditions, traction_at
 from ..assembly.basis import spread_component
 from ..assembly.quadrature import cell_quadrature
 from ..assembly.subdivision import subdivide, tip_cells
-from ..assembly.gradients import SmoothedGradients
+from ..assembly.gradients import GradientCache
 from ..assembly.triangles import triangle_basis
 from ..solvers.constrained import solve_constrained
 from ..errors import GeometryError, InputError
@@ -70,7 +70,7 @@ class Elasticity(Conditions):
         patch test still holds) and stiffens the low-energy oscillating modes
         that plain SCNI (``a = 0``, the paper's method) leaves almost free, which
         otherwise show as node-to-node oscillations along free crack faces.
-    gradients : SmoothedGradients, optional
+    gradients : GradientCache, optional
         The model's smoothed gradients at ``gauss``, to share with other
         problems on the model (what it has computed is not computed again); by
         default the problem keeps its own (`gradients`).
@@ -99,7 +99,7 @@ class Elasticity(Conditions):
 
     def __init__(self, model: Model, materials: tuple[float, float] | Sequence[tuple[float, float]],
                  *, plane: str | None = None, gauss: int = 2, enrich: Enrichment | None = None,
-                 stabilization: float = 1.0, gradients: SmoothedGradients | None = None):
+                 stabilization: float = 1.0, gradients: GradientCache | None = None):
         from ..fracture.enrichment import Enrichment
         self.model = model
         self.enrichment = Enrichment.from_spec(model, enrich)
@@ -120,11 +120,11 @@ class Elasticity(Conditions):
         self.plane = plane
         self.gauss = gauss
         if gradients is None:
-            gradients = SmoothedGradients(model, gauss=gauss)
+            gradients = GradientCache(model, gauss=gauss)
         elif gradients.model is not model or gradients.gauss != gauss:
-            raise GeometryError(f"gradients: expected the SmoothedGradients of this model with "
+            raise GeometryError(f"gradients: expected the GradientCache of this model with "
                                 f"gauss={gauss}, received {gradients!r}; build them with "
-                                f"SmoothedGradients(model, gauss={gauss})")
+                                f"GradientCache(model, gauss={gauss})")
         #: the owner of the smoothed gradients this problem uses
         self.gradients = gradients
         super().__init__()
@@ -186,7 +186,7 @@ class Elasticity(Conditions):
         """
         from .operator_update import updated_operators
         gradient, self._K = updated_operators(old, self, change, elasticity_form)
-        self.gradients = SmoothedGradients(self.model, gauss=self.gauss, cells=gradient)
+        self.gradients = GradientCache(self.model, gauss=self.gauss, cells=gradient)
         self._basis = CellBasis(self.model, vector=True, cells=self.cells,
                                 gradient=self.gradients.cells())
         return self
