@@ -1,4 +1,4 @@
-"""Solves that do not give up (issue 19, item 8): branch-enriched systems converge with
+"""Solves that do not give up: branch-enriched systems converge with
 the nodal-block AMG + enriched-block LU preconditioner, a stalled CG falls back to the
 direct solve when its factor fits in memory and otherwise says what to change."""
 
