@@ -76,8 +76,8 @@ import time
 import numpy as np
 
 import _bandwidth as stream
-from _harness import (MachineLoad, load_text, median, mem_available_bytes, memory_skip,
-                      peak_rss_bytes, print_targets, reset_peak_rss, warm_median)
+from _harness import (MachineLoad, load_text, median, mem_available_bytes, memory_limit,
+                      memory_skip, peak_rss_bytes, print_targets, reset_peak_rss, warm_median)
 
 HORIZON_FACTOR = 3.015                  # horizon / h (delta = 3h)
 DISPLACEMENT = 1e-4                     # |u| ~ DISPLACEMENT * h
@@ -230,8 +230,7 @@ class Guard:
 
     def current_limit(self):
         """The user's limit or 80 % of the MemAvailable of the moment, whichever is lower."""
-        avail = mem_available_bytes()
-        return self.limit if avail is None else min(self.limit, 0.8 * avail)
+        return min(self.limit, memory_limit())
 
     def describe(self):
         avail = mem_available_bytes()
