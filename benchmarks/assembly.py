@@ -74,14 +74,13 @@ How to run
 """
 import argparse
 import gc
-import os
 import sys
 import time
 
 import numpy as np
 
-from _harness import (MachineLoad, fmt_n, load_text, mem_available_bytes, median, peak_rss_bytes,
-                      reset_peak_rss, warm_both)
+from _harness import (MachineLoad, fmt_n, load_text, mem_available_bytes, median, memory_skip,
+                      peak_rss_bytes, print_targets, reset_peak_rss, warm_both)
 
 E, NU, PLANE = 1.0, 0.3, "strain"
 TRACTION = (1.0, 0.0)
@@ -321,10 +320,10 @@ def run(sizes, repeat, skip_fem_above, memory_check):
                 continue
             need, source = memory_need(side, n, results)
             avail = mem_available_bytes()
-            if memory_check and avail is not None and need > avail:
-                r[side] = dict(skipped=f"not enough memory: needs ~{need / 2**30:.1f} GB "
-                                       f"({source}, x{MEMORY_MARGIN:g} margin), "
-                                       f"MemAvailable {avail / 2**30:.1f} GB")
+            short = memory_skip(need, avail if avail is not None else float("inf"),
+                                detail=f" ({source}, x{MEMORY_MARGIN:g} margin)")
+            if memory_check and short:
+                r[side] = dict(skipped=f"not enough memory: {short} (MemAvailable)")
                 print(f" {side} SKIPPED (memory)", end="", flush=True)
                 continue
             print(f" {side} (est. {need / 2**30:.1f} GB)", end="", flush=True)
@@ -364,10 +363,6 @@ def cell(x, fmt="{:7.3f}", width=7):
 
 def gb(res):
     return res["rss"] / 2**30 if ok(res) else None
-
-
-def verdict(good):
-    return "MET" if good else "MISSED"
 
 
 def describe(side, res):
@@ -457,24 +452,24 @@ def report(results, warm):
             print(f"  {fmt_n(r['n'])}: {'OK' if good else 'FAILED'}: " + "; ".join(line))
 
     print()
-    print("targets (issue):")
     by_n = {r["n"]: r for r in results}
     ratio = assembly_ratio(by_n[TARGET_RATIO_AT]) if TARGET_RATIO_AT in by_n else None
-    print(f"  C-NEM (B~ + K) within {TARGET_RATIO:g}x of skfem (basis + K) at "
-          f"{fmt_n(TARGET_RATIO_AT)}: "
-          + (f"{ratio:.2f}x -> {verdict(ratio <= TARGET_RATIO)}" if ratio is not None
-             else f"({fmt_n(TARGET_RATIO_AT)} not run on both sides)"))
+    label = (f"C-NEM (B~ + K) within {TARGET_RATIO:g}x of skfem (basis + K) at "
+             f"{fmt_n(TARGET_RATIO_AT)}")
+    rows = [(label, f"{ratio:.2f}x", ratio <= TARGET_RATIO) if ratio is not None else
+            (label, f"({fmt_n(TARGET_RATIO_AT)} not run on both sides)", None)]
     cn = by_n[TARGET_1M]["cnem"] if TARGET_1M in by_n else None
     if ok(cn):
         t, mem = total_time(cn), gb(cn)
-        print(f"  {fmt_n(TARGET_1M)} C-NEM total at most {TARGET_1M_SECONDS:g} s: {t:.1f} s -> "
-              f"{verdict(t <= TARGET_1M_SECONDS)}")
-        print(f"  {fmt_n(TARGET_1M)} C-NEM peak memory at most {TARGET_1M_GB:g} GB: {mem:.2f} GB "
-              f"-> {verdict(mem <= TARGET_1M_GB)}")
+        rows.append((f"{fmt_n(TARGET_1M)} C-NEM total at most {TARGET_1M_SECONDS:g} s",
+                     f"{t:.1f} s", t <= TARGET_1M_SECONDS))
+        rows.append((f"{fmt_n(TARGET_1M)} C-NEM peak memory at most {TARGET_1M_GB:g} GB",
+                     f"{mem:.2f} GB", mem <= TARGET_1M_GB))
     else:
         why = (cn.get("skipped") or cn.get("error")) if cn else "not run"
-        print(f"  {fmt_n(TARGET_1M)} C-NEM total under {TARGET_1M_SECONDS:g} s and peak memory "
-              f"under {TARGET_1M_GB:g} GB: ({why})")
+        rows.append((f"{fmt_n(TARGET_1M)} C-NEM total under {TARGET_1M_SECONDS:g} s and peak "
+                     f"memory under {TARGET_1M_GB:g} GB", f"({why})", None))
+    print_targets(rows)
 
 
 def stage_peaks(res, side):

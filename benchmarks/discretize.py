@@ -57,17 +57,16 @@ How to run
     python benchmarks/discretize.py --sizes 20000 200000 --repeat 5 --geometries cracked
 """
 import argparse
-import multiprocessing as mp
 import os
 import statistics
 import sys
 import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from _harness import MachineLoad, fmt_n, load_text, peak_rss_bytes, warm_both
+from _harness import (MachineLoad, fmt_n, in_child, load_text, peak_rss_bytes,
+                      print_targets, warm_both)
 
 CRACK = [[[0.0, 0.5], [0.5, 0.5]]]
 GEOMETRIES = {"square": None, "cracked": CRACK}
@@ -174,10 +173,12 @@ def _baseline_child(points_file, repeat):
     return dict(area=area, runs=runs, rss_before=rss_before, rss=peak_rss_bytes())
 
 
-def _in_child(fn, *args):
-    """Run ``fn(*args)`` in a fresh spawned interpreter and return its result."""
-    with ProcessPoolExecutor(max_workers=1, mp_context=mp.get_context("spawn")) as ex:
-        return ex.submit(fn, *args).result()
+def _measured(fn, *args):
+    """``fn(*args)`` in a fresh child process (`_harness.in_child`); its error stops the run."""
+    out = in_child(fn, *args)
+    if "error" in out:
+        raise RuntimeError(out["error"])
+    return out
 
 
 # --------------------------------------------------------------------------- driver
@@ -197,11 +198,11 @@ def run(geometries, sizes, repeat=3):
                 load_before = load_text()
                 print(f"  {geometry} n = {fmt_n(n)}: triangle + cnem x{repeat} ...", end="",
                       flush=True)
-                cn = _in_child(_cnem_child, geometry, n, repeat, points_file)
+                cn = _measured(_cnem_child, geometry, n, repeat, points_file)
                 bl = None
                 if GEOMETRIES[geometry] is not None:
                     print(f" voronoi baseline x{repeat} ...", end="", flush=True)
-                    bl = _in_child(_baseline_child, points_file, repeat)
+                    bl = _measured(_baseline_child, points_file, repeat)
                 print(" done", flush=True)
                 results.append(dict(geometry=geometry, n=n, repeat=repeat, cnem=cn, baseline=bl,
                                     load_before=load_before, load_after=load_text()))
@@ -288,37 +289,36 @@ def report(results):
               f"{cn['warmup']:.2f} s; RSS before timed runs {cn['rss_before'] / 2**20:.0f} MB")
         print(f"  {'':>14} load average before {r['load_before']}, after {r['load_after']}")
     print()
-    print("targets:")
+    rows = []
     for geometry in dict.fromkeys(r["geometry"] for r in results):
         at = [r for r in results if r["geometry"] == geometry and r["n"] == TARGET_TRIANGLE_AT]
+        label = (f"{geometry}: discretize within {TARGET_RATIO:g}x of bare triangle at "
+                 f"{fmt_n(TARGET_TRIANGLE_AT)}")
         if at:
             wall, cpu = _ratios(at[0])
-            print(f"  {geometry}: discretize within {TARGET_RATIO:g}x of bare triangle at "
-                  f"{fmt_n(TARGET_TRIANGLE_AT)}: ratio {wall:.2f} (CPU {cpu:.2f}) "
-                  f"-> {'MET' if wall <= TARGET_RATIO else 'MISSED'}")
+            rows.append((label, f"ratio {wall:.2f} (CPU {cpu:.2f})", wall <= TARGET_RATIO))
         else:
-            print(f"  {geometry}: discretize within {TARGET_RATIO:g}x of bare triangle at "
-                  f"{fmt_n(TARGET_TRIANGLE_AT)}: (not run)")
+            rows.append((label, "(not run)", None))
     by_n = {r["n"]: r for r in results if r["baseline"] is not None}
+    label = f"discretize within {TARGET_RATIO:g}x of the Voronoi baseline at 100k"
     if TARGET_RATIO_AT in by_n:
         r = by_n[TARGET_RATIO_AT]
         ratio = _median(r["cnem"]["runs"], "total") / _median(r["baseline"]["runs"], "total")
-        print(f"  discretize within {TARGET_RATIO:g}x of the Voronoi baseline at 100k: ratio "
-              f"{ratio:.2f} -> {'MET' if ratio <= TARGET_RATIO else 'MISSED'}")
+        rows.append((label, f"ratio {ratio:.2f}", ratio <= TARGET_RATIO))
     else:
-        print(f"  discretize within {TARGET_RATIO:g}x of the Voronoi baseline at 100k: "
-              "(cracked 100k not run)")
+        rows.append((label, "(cracked 100k not run)", None))
     big = [r for r in results if r["n"] == 1_000_000]
     for r in big:
         cn = r["cnem"]
         t, gb = _median(cn["runs"], "total"), cn["rss"] / 2**30
-        print(f"  {r['geometry']}: 1M nodes under {TARGET_1M_SECONDS:g} s: {t:.1f} s "
-              f"-> {'MET' if t < TARGET_1M_SECONDS else 'MISSED'}; peak memory under "
-              f"{TARGET_1M_MEMORY_GB:g} GB: {gb:.2f} GB "
-              f"-> {'MET' if gb < TARGET_1M_MEMORY_GB else 'MISSED'}")
+        rows.append((f"{r['geometry']}: 1M nodes under {TARGET_1M_SECONDS:g} s", f"{t:.1f} s",
+                     t < TARGET_1M_SECONDS))
+        rows.append((f"{r['geometry']}: 1M nodes peak memory under {TARGET_1M_MEMORY_GB:g} GB",
+                     f"{gb:.2f} GB", gb < TARGET_1M_MEMORY_GB))
     if not big:
-        print(f"  1M nodes under {TARGET_1M_SECONDS:g} s, peak memory under "
-              f"{TARGET_1M_MEMORY_GB:g} GB: (1M not run)")
+        rows.append((f"1M nodes under {TARGET_1M_SECONDS:g} s, peak memory under "
+                     f"{TARGET_1M_MEMORY_GB:g} GB", "(1M not run)", None))
+    print_targets(rows, "targets:")
 
 
 def main(argv=None):

@@ -15,7 +15,11 @@ on the nodal block + LU of the enriched block), optionally (``--direct``) the di
 solve, with the relative residual ``|A x - b| / |b|`` and the CG iterations (logged), and
 the estimated direct factor (`cnem.solvers.linsolve.direct_factor_bytes`).
 
-Run: ``python benchmarks/enriched_solve.py --nodes 16000 100000 [--direct]``.
+``docs/elasticity.md`` quotes its 16k-node run (``--nodes 16000 --direct``): the
+hierarchy, the LU of the enriched block and the CG iterations against the direct solve.
+
+Run: ``python benchmarks/enriched_solve.py --nodes 16000 100000 [--direct]``;
+``--quick``: 2.5k nodes, with the direct solve (a smoke run).
 """
 
 import argparse
@@ -31,13 +35,17 @@ from cnem.solvers import linsolve
 
 from _harness import MachineLoad, load_text, peak_rss_bytes
 
+# the plate is the tests' case (tests/cases.py, used by tests/test_errors_solve.py)
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
+import cases  # noqa: E402
+
+QUICK_NODES = 2_500
+
 
 def build(nodes, radius):
-    """The condensed system, its nodal mask and rigid modes (the tests' plate,
-    `tests/test_robust_solve.py`)."""
-    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
-    from test_robust_solve import _centre_cracked
-    return _centre_cracked(1.0 / np.sqrt(nodes), radius)
+    """The condensed system, its nodal mask and rigid modes
+    (`cases.enriched_centre_crack_system`)."""
+    return cases.enriched_centre_crack_system(1.0 / np.sqrt(nodes), radius)
 
 
 def main():
@@ -45,7 +53,11 @@ def main():
     parser.add_argument("--nodes", type=int, nargs="+", default=[16_000])
     parser.add_argument("--radius", type=float, default=0.1)
     parser.add_argument("--direct", action="store_true", help="time the direct solve too")
+    parser.add_argument("--quick", action="store_true",
+                        help=f"a smoke run: {QUICK_NODES} nodes, with the direct solve")
     args = parser.parse_args()
+    if args.quick:
+        args.nodes, args.direct = [QUICK_NODES], True
     logging.basicConfig(level=logging.INFO, format="  %(message)s")
     machine = MachineLoad()
     print(f"benchmarks/enriched_solve.py: load average {load_text(machine.before.load)}")

@@ -93,18 +93,15 @@ requested size (or at the largest requested size if none is).  Non-cubic sizes a
 to the nearest cube.
 """
 import argparse
-import multiprocessing as mp
 import os
 import sys
 import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
 
-from _harness import (MachineLoad, fmt_n, load_text, median, mem_available_bytes, peak_rss_bytes,
-                      warm_both)
+from _harness import (MachineLoad, fmt_n, in_child, load_text, median, mem_available_bytes,
+                      memory_limit, memory_skip, peak_rss_bytes, print_targets, warm_both)
 
 HORIZON = 3.0001
 DEFAULT_SIZES = [27_000, 125_000, 343_000, 1_000_000]
@@ -306,10 +303,10 @@ def _ours_child(task):
         del tree
         need = BASE_BYTES + BYTES_PER_POINT * n + KD_METHOD_BYTES_PER_PAIR * pairs
         out.update(candidate_pairs=pairs, need=need)
-        if need > task["mem_limit"]:
+        skip = memory_skip(need, task["mem_limit"])
+        if skip:
             out["skipped"] = (f"query_pairs at the largest horizon {h.max():.4g} would return "
-                              f"~{pairs:.2g} candidate pairs, ~{need / 2**30:.0f} GB > "
-                              f"limit {task['mem_limit'] / 2**30:.1f} GB")
+                              f"~{pairs:.2g} candidate pairs: {skip}")
             return out
 
     out["rss_before"] = peak_rss_bytes()
@@ -399,17 +396,6 @@ CHILDREN = {"cells": _ours_child, "rtree": _ours_child, "kdtree": _ours_child,
             "kd pairs": _kd_pairs_child, "kd ball": _kd_ball_child}
 
 
-def in_child(task):
-    """Run one measurement in a fresh spawned interpreter; a dead child becomes an error."""
-    try:
-        with ProcessPoolExecutor(max_workers=1, mp_context=mp.get_context("spawn")) as ex:
-            return ex.submit(CHILDREN[task["method"]], task).result()
-    except BrokenProcessPool:
-        return dict(error="child process died (killed -- out of memory?)")
-    except Exception as exc:          # noqa: BLE001 - report, keep the other measurements
-        return dict(error=f"{type(exc).__name__}: {exc}")
-
-
 # --------------------------------------------------------------------------- driver
 
 
@@ -426,7 +412,7 @@ def run_one(label, task):
     if task.get("skip"):
         print(" (skipped)", end="", flush=True)
         return dict(skipped=task["skip"])
-    res = in_child(task)
+    res = in_child(CHILDREN[task["method"]], task)
     if "error" in res:
         print(" (FAILED)", end="", flush=True)
     elif "skipped" in res:
@@ -450,10 +436,9 @@ def run_lattice(sizes, args, mem_limit, tmp):
         bonds = lattice_bonds(m)
         skip = {}
         for method in BYTES_PER_BOND:
-            need = estimated_bytes(method, n, bonds)
-            if need > mem_limit:
-                skip[method] = (f"needs ~{need / 2**30:.1f} GB > limit {mem_limit / 2**30:.1f} GB "
-                                "(--mem-limit-gb)")
+            too_big = memory_skip(estimated_bytes(method, n, bonds), mem_limit)
+            if too_big:
+                skip[method] = too_big + " (--mem-limit-gb)"
         if n > BALL_MAX_N and not args.big:
             skip["kd ball"] = f"N > {fmt_n(BALL_MAX_N)} (use --big)"
         print(f"  N = {fmt_n(n)} ({m}^3) x{rep}:", end="", flush=True)
@@ -490,8 +475,7 @@ def run_graded(n, args, mem_limit):
     r = dict(n=n, repeat=rep)
     for method in ("cells", "rtree", "kdtree"):
         need = estimated_bytes(method, n, 130 * n) if method in BYTES_PER_BOND else 0
-        skip = None if need <= mem_limit else \
-            f"needs ~{need / 2**30:.1f} GB > limit {mem_limit / 2**30:.1f} GB"
+        skip = memory_skip(need, mem_limit)
         r[method] = run_one(method, dict(method=method, cloud=("graded", n), repeat=rep,
                                          mem_limit=mem_limit, skip=skip))
     print(" done", flush=True)
@@ -511,8 +495,7 @@ def run_periodic(sizes, args, mem_limit):
             for periodic in (False, True):
                 key = (method, "periodic" if periodic else "open")
                 need = estimated_bytes(method, n, r["bonds_periodic"])
-                skip = None if need <= mem_limit else \
-                    f"needs ~{need / 2**30:.1f} GB > limit {mem_limit / 2**30:.1f} GB"
+                skip = memory_skip(need, mem_limit)
                 r[key] = run_one(f"{method}/{key[1]}",
                                  dict(method=method, cloud=("lattice", m, periodic), repeat=rep,
                                       mem_limit=mem_limit, skip=skip))
@@ -640,30 +623,28 @@ def report_lattice(results):
               f"{SET_CHECK_MAX_BONDS} bonds; the hashes compare the sets)")
 
     print()
-    print("targets (issue):")
     by_n = {r["n"]: r for r in results}
     r = by_n.get(TARGET_N)
-    if r is None:
-        print(f"  (N = {fmt_n(TARGET_N)} not run: 1M targets not evaluated)")
-    else:
+    rows = []
+    if r is not None:
         tc, tb_rt = t_of(r["cells"]), t_of(r["rtree"], "builds")
         tb, which = best_scipy(r)
-
-        def verdict(ok_):
-            return "MET" if ok_ else "MISSED"
         if tc is not None:
             gb = r["cells"]["rss"] / 2 ** 30
-            print(f"  family_search 1M <= {TARGET_SECONDS:g} s median: {tc:.3f} s -> "
-                  f"{verdict(tc <= TARGET_SECONDS)}")
-            print(f"  family_search 1M peak memory <= {TARGET_MEMORY_GB:g} GB: {gb:.2f} GB -> "
-                  f"{verdict(gb <= TARGET_MEMORY_GB)}")
+            rows.append((f"family_search 1M <= {TARGET_SECONDS:g} s median", f"{tc:.3f} s",
+                         tc <= TARGET_SECONDS))
+            rows.append((f"family_search 1M peak memory <= {TARGET_MEMORY_GB:g} GB",
+                         f"{gb:.2f} GB", gb <= TARGET_MEMORY_GB))
             if tb is not None:
-                print(f"  family_search 1M >= {TARGET_SPEEDUP:g}x faster than fastest scipy route "
-                      f"({which} {tb:.3f} s): {tb / tc:.1f}x -> "
-                      f"{verdict(tb / tc >= TARGET_SPEEDUP)}")
+                rows.append((f"family_search 1M >= {TARGET_SPEEDUP:g}x faster than fastest "
+                             f"scipy route ({which} {tb:.3f} s)", f"{tb / tc:.1f}x",
+                             tb / tc >= TARGET_SPEEDUP))
         if tb_rt is not None:
-            print(f"  RTree.from_points 1M <= {TARGET_BUILD_SECONDS:g} s: {tb_rt:.3f} s -> "
-                  f"{verdict(tb_rt <= TARGET_BUILD_SECONDS)}")
+            rows.append((f"RTree.from_points 1M <= {TARGET_BUILD_SECONDS:g} s", f"{tb_rt:.3f} s",
+                         tb_rt <= TARGET_BUILD_SECONDS))
+    print_targets(rows)
+    if r is None:
+        print(f"  (N = {fmt_n(TARGET_N)} not run: 1M targets not evaluated)")
     others = [r for r in results if r["n"] != TARGET_N and t_of(r["cells"]) and best_scipy(r)[0]]
     if others:
         print("  (speed-up over the fastest scipy route at other sizes: " + ", ".join(
@@ -809,10 +790,7 @@ def main(argv=None):
     periodic_sizes = sorted({lattice_side(n) ** 3 for n in periodic_sizes})
     graded_n = args.graded_n or (GRADED_QUICK_N if args.quick else GRADED_N)
     avail = mem_available_bytes()
-    if args.mem_limit_gb is not None:
-        mem_limit = args.mem_limit_gb * 2 ** 30
-    else:
-        mem_limit = 0.8 * avail if avail else float("inf")
+    mem_limit = memory_limit(args.mem_limit_gb)
 
     machine = MachineLoad()
     print(f"benchmarks/family_search.py: lattice sizes {[fmt_n(n) for n in sizes]}, "

@@ -68,7 +68,8 @@ import time
 import numpy as np
 
 import _bandwidth as stream
-from _harness import MachineLoad, load_text, mem_available_bytes, median, peak_rss_bytes
+from _harness import (MachineLoad, load_text, median, memory_skip, peak_rss_bytes,
+                      print_targets)
 
 HORIZON_FACTOR = 3.015
 CASES = {"2d-40k": (2, 200), "2d-1M": (2, 1000), "3d-1M": (3, 100)}
@@ -205,10 +206,6 @@ def projection(r1, r2, d, n2):
     return rows, beta
 
 
-def verdict(ok):
-    return "MET" if ok else "MISSED"
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="2-D 40k only (seconds)")
@@ -233,11 +230,9 @@ def main(argv=None):
         streams[case] = {1: [], 2: []}
         for round_ in range(max(1, args.repeat)):
             for mode, ranks in (("serial", 1), ("dist", 1), ("dist", 2)):
-                need = BYTES_PER_BOND[mode] * MEMBERS[d] * k ** d
-                avail = mem_available_bytes() or float("inf")
-                if need > 0.8 * avail:
-                    print(f"  {case} {mode} {ranks} rank(s) skipped: needs ~{need / 2**30:.1f} GB, "
-                          f"{avail / 2**30:.1f} GB available")
+                skip = memory_skip(BYTES_PER_BOND[mode] * MEMBERS[d] * k ** d)
+                if skip:
+                    print(f"  {case} {mode} {ranks} rank(s) skipped: {skip}")
                     continue
                 during = MachineLoad()
                 r = launch(case, mode, ranks)
@@ -300,20 +295,21 @@ def report(results):
             print(f"{case:<7} {name:<10} {r['bonds']:>10d} {r['setup']:8.2f} {r['step']:8.4f} "
                   f"{r['peak'] / 2**30:8.2f}{extra}")
     print()
-    print("targets (issue):")
+    rows = []
     for case, runs in results.items():
         s, r1, r2 = runs.get(("serial", 1)), runs.get(("dist", 1)), runs.get(("dist", 2))
         if r1 and r2:
             x = r1["step"] / r2["step"]
-            print(f"  {case}: 2 ranks vs 1 rank {x:.2f}x (>= {TARGET_SPEEDUP}) -> "
-                  f"{verdict(x >= TARGET_SPEEDUP)}")
+            rows.append((case, f"2 ranks vs 1 rank {x:.2f}x (>= {TARGET_SPEEDUP})",
+                         x >= TARGET_SPEEDUP))
         if s and r2:
             x = s["step"] / r2["step"]
-            print(f"  {case}: 2 ranks vs serial at 2 threads {x:.2f}x (>= {TARGET_VS_THREADS})"
-                  f" -> {verdict(x >= TARGET_VS_THREADS)}")
+            rows.append((case, f"2 ranks vs serial at 2 threads {x:.2f}x (>= {TARGET_VS_THREADS})",
+                         x >= TARGET_VS_THREADS))
             x = r2["peak"] / s["peak"]
-            print(f"  {case}: peak memory per rank / serial peak {x:.2f} (<= {TARGET_MEMORY})"
-                  f" -> {verdict(x <= TARGET_MEMORY)}")
+            rows.append((case, f"peak memory per rank / serial peak {x:.2f} (<= {TARGET_MEMORY})",
+                         x <= TARGET_MEMORY))
+    print_targets(rows)
     for case, runs in results.items():
         r1, r2 = runs.get(("dist", 1)), runs.get(("dist", 2))
         if not (r1 and r2):

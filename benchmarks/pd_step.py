@@ -76,8 +76,8 @@ import time
 import numpy as np
 
 import _bandwidth as stream
-from _harness import (MachineLoad, load_text, median, mem_available_bytes, peak_rss_bytes,
-                      reset_peak_rss, warm_median)
+from _harness import (MachineLoad, load_text, median, mem_available_bytes, memory_limit,
+                      memory_skip, peak_rss_bytes, print_targets, reset_peak_rss, warm_median)
 
 HORIZON_FACTOR = 3.015                  # horizon / h (delta = 3h)
 DISPLACEMENT = 1e-4                     # |u| ~ DISPLACEMENT * h
@@ -230,8 +230,7 @@ class Guard:
 
     def current_limit(self):
         """The user's limit or 80 % of the MemAvailable of the moment, whichever is lower."""
-        avail = mem_available_bytes()
-        return self.limit if avail is None else min(self.limit, 0.8 * avail)
+        return min(self.limit, memory_limit())
 
     def describe(self):
         avail = mem_available_bytes()
@@ -242,11 +241,9 @@ class Guard:
     def check(self, stage, d, bonds):
         """None if the stage fits, else the reason to skip it."""
         need = MEMORY_MARGIN * self.per_bond[stage][d] * bonds
-        limit = self.current_limit()
-        if need <= limit:
-            return None
-        return (f"needs ~{need / 2**30:.3g} GB ({self.per_bond[stage][d]:.0f} B/bond x "
-                f"{bonds / 1e6:.3g}M bonds x{MEMORY_MARGIN:g}) > limit {limit / 2**30:.3g} GB")
+        return memory_skip(need, self.current_limit(), digits=".3g",
+                           detail=f" ({self.per_bond[stage][d]:.0f} B/bond x "
+                                  f"{bonds / 1e6:.3g}M bonds x{MEMORY_MARGIN:g})")
 
     def learn(self, stage, d, growth, bonds):
         if bonds:
@@ -346,10 +343,6 @@ def run_case(name, args, guard, problem_class):
 
 def cell(x, fmt="{:8.4f}", width=8):
     return fmt.format(x) if x is not None else f"{'-':>{width}}"
-
-
-def verdict(good):
-    return "MET" if good else "MISSED"
 
 
 def rate(r, t):
@@ -457,21 +450,22 @@ def report(results, warm, layer):
               f"{missing} not run)")
 
     print()
-    print("targets (issue):")
+    rows = []
     for r in results:
         r2 = None if "skipped" in r else rate(r, TARGET_THREADS)
-        print(f"  >= {TARGET_RATE / 1e6:.0f} M bond updates per second with two threads "
-              f"(bond-based), {r['name']}: " +
-              ("not run" if r2 is None else f"{r2 / 1e6:.1f} M/s -> {verdict(r2 >= TARGET_RATE)}"))
+        label = (f">= {TARGET_RATE / 1e6:.0f} M bond updates per second with two threads "
+                 f"(bond-based), {r['name']}")
+        rows.append((label, "not run", None) if r2 is None else
+                    (label, f"{r2 / 1e6:.1f} M/s", r2 >= TARGET_RATE))
     by_name = {r["name"]: r for r in results}
     r = by_name.get(TARGET_SETUP_CASE)
-    label = (f"  family search + corrections for 1M points (2-D) under "
-             f"{TARGET_SETUP_SECONDS:g} s: ")
+    label = f"family search + corrections for 1M points (2-D) under {TARGET_SETUP_SECONDS:g} s"
     if r is None or r.get("setup") is None:
-        print(label + f"not evaluated ({TARGET_SETUP_CASE} " +
-              ("not run)" if r is None else "setup incomplete)"))
+        rows.append((label, f"not evaluated ({TARGET_SETUP_CASE} "
+                     + ("not run)" if r is None else "setup incomplete)"), None))
     else:
-        print(label + f"{r['setup']:.3f} s -> {verdict(r['setup'] < TARGET_SETUP_SECONDS)}")
+        rows.append((label, f"{r['setup']:.3f} s", r["setup"] < TARGET_SETUP_SECONDS))
+    print_targets(rows)
 
 
 # --------------------------------------------------------------------------- main

@@ -58,9 +58,9 @@ table's ``rep`` column gives the runs done.
 
 **CGAL** (the compiled anchor, square domain only) -- when g++ and CGAL's headers are found
 (Debian: ``apt-get install libcgal-dev``; a benchmark-time tool, not a cnem dependency), the
-driver ``benchmarks/cgal_sibson.cpp`` is compiled once into a cache folder
-(``~/.cache/cnem-benchmarks``, see ``_cgal.py``) and run as its own process on the cnem
-model's nodes and the same query points (raw float64 files).  It builds a
+driver ``tests/cgal_sibson.cpp`` is compiled once into a cache folder
+(``~/.cache/cnem-benchmarks``, see ``tests/cgal_sibson.py``) and run as its own process on the
+cnem model's nodes and the same query points (raw float64 files).  It builds a
 ``Delaunay_triangulation_2`` (timed apart, not counted), then ``--repeat`` times, single
 threaded: ``CGAL::hilbert_sort`` of the query indices (counted), ``locate`` from the
 previous query's face and ``natural_neighbor_coordinates_2`` there (Sibson coordinates,
@@ -107,19 +107,19 @@ How to run
 """
 import argparse
 import gc
-import multiprocessing as mp
 import os
 import sys
 import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
 
 import numpy as np
 
-import _cgal
-from _harness import (MachineLoad, fmt_n, load_text, median, peak_rss_bytes, reset_peak_rss,
-                      warm_both)
+from _harness import (MachineLoad, fmt_n, in_child, load_text, median, peak_rss_bytes,
+                      reset_peak_rss, verdict, warm_both)
+
+# the CGAL driver lives with the test that checks cnem's Sibson values against it
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "tests"))
+import cgal_sibson  # noqa: E402
 
 DOMAINS = {
     "square": dict(),
@@ -159,10 +159,6 @@ def query_points(q):
 
 def cell(x, fmt="{:8.3f}", width=8):
     return fmt.format(x) if x is not None else f"{'-':>{width}}"
-
-
-def verdict(good):
-    return "MET" if good else "MISSED"
 
 
 # --------------------------------------------------------------------------- children
@@ -282,20 +278,6 @@ def _scipy_child(task):
                 rep_err=float(np.abs(rep - pts[inside]).max()) if inside.any() else None)
 
 
-CHILDREN = {"cnem": _cnem_child, "scipy": _scipy_child}
-
-
-def in_child(kind, task):
-    """Run one measurement in a fresh spawned interpreter; a dead child becomes an error."""
-    try:
-        with ProcessPoolExecutor(max_workers=1, mp_context=mp.get_context("spawn")) as ex:
-            return ex.submit(CHILDREN[kind], task).result()
-    except BrokenProcessPool:
-        return dict(error="child process died (killed -- out of memory?)")
-    except Exception as exc:          # noqa: BLE001 - report, keep the other measurements
-        return dict(error=f"{type(exc).__name__}: {exc}")
-
-
 def ok(r):
     return r is not None and "error" not in r and "skipped" not in r
 
@@ -306,7 +288,7 @@ def cgal_vs_cnem(exe, nodes_file, phi_file, queries, repeat, tmp):
     import scipy.sparse
 
     pts = query_points(queries)
-    out = _cgal.run(exe, np.load(nodes_file), pts, repeat, tmp)
+    out = cgal_sibson.run(exe, np.load(nodes_file), pts, repeat, tmp)
     if "error" in out:
         return out
     phi = out.pop("phi")
@@ -334,16 +316,16 @@ def run(domains, sizes, queries, repeat, budget, tmp, cgal):
             r = dict(domain=domain, n=n, queries=queries, repeat=repeat, smallest=i == 0)
             base = dict(domain=domain, n=n, queries=queries, repeat=repeat)
             print(" cnem 1T", end="", flush=True)
-            r["1T"] = in_child("cnem", dict(base, threads=1, save=nodes_file, check=i == 0,
+            r["1T"] = in_child(_cnem_child, dict(base, threads=1, save=nodes_file, check=i == 0,
                                             save_phi=phi_file if with_cgal else None))
             if two:
                 print(f" cnem {TARGET_THREADS}T", end="", flush=True)
-                r["2T"] = in_child("cnem", dict(base, threads=TARGET_THREADS, gradient=True))
+                r["2T"] = in_child(_cnem_child, dict(base, threads=TARGET_THREADS, gradient=True))
             else:
                 r["2T"] = dict(skipped=f"{os.cpu_count()} CPU(s)")
             if os.path.exists(nodes_file):
                 print(" scipy", end="", flush=True)
-                r["scipy"] = in_child("scipy", dict(nodes=nodes_file, queries=queries,
+                r["scipy"] = in_child(_scipy_child, dict(nodes=nodes_file, queries=queries,
                                                     repeat=repeat, budget=budget))
             else:
                 r["scipy"] = dict(error="no nodes (the cnem 1T child failed)")
@@ -650,7 +632,7 @@ def main(argv=None):
           f"{[fmt_n(n) for n in sizes]}, {fmt_n(queries)} queries, repeat {repeat}; "
           f"python {sys.version.split()[0]}, numpy {np.__version__}, scipy {scipy.__version__}, "
           f"{os.cpu_count()} CPUs")
-    cgal = _cgal.build() if "square" in domains and not args.no_cgal else \
+    cgal = cgal_sibson.build() if "square" in domains and not args.no_cgal else \
         dict(skipped="CGAL column not requested (--no-cgal or no square domain)")
     if "exe" in cgal:
         print(f"CGAL {cgal['cgal']} driver: {cgal['exe']} ("

@@ -13,9 +13,11 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from skfem import condense
 
 import cnem
 from cnem import geometry, nodes
+from cnem.solvers import linsolve
 
 #: Edge crack of the square (ends on the boundary at x = 0, tip at (0.5, 0.5)).
 EDGE_CRACK = [[0.0, 0.5], [0.5, 0.5]]
@@ -126,3 +128,36 @@ def model(name):
     """``(domain, cloud, model)`` of a case, discretised once."""
     dom, cloud = case(name)
     return dom, cloud, cnem.discretize(cloud, progress=False)
+
+
+def enriched_centre_crack_system(h, radius=0.1):
+    """The condensed system of the centre-cracked square ``[-0.5, 0.5]^2`` (crack from
+    (-0.1, 0) to (0.1, 0)), branch-enriched within ``radius`` of the tips, E = 1, nu = 0.3,
+    clamped at the bottom and pulled to v = 1e-3 at the top, on a regular cloud of spacing
+    ``h`` (used by ``tests/test_errors_solve.py`` and ``benchmarks/enriched_solve.py``).
+
+    Returns
+    -------
+    A : (k, k) scipy.sparse.csr_matrix
+        The stiffness on the free dofs.
+    b : (k,) ndarray
+    nodal : (k,) bool ndarray
+        Which free dofs are nodal (not enriched).
+    modes : (k, 3) ndarray
+        The rigid-body modes on the free dofs.
+    """
+    dom = cnem.Domain([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]],
+                      cracks=[[[-0.1, 0.0], [0.1, 0.0]]])
+    model = cnem.discretize(cnem.nodes.regular(dom, h))
+    prob = cnem.Elasticity(model, (1.0, 0.3), enrich=dict(radius=radius, functions="branch"))
+    prob.add_dirichlet(lambda p: p[:, 1] < -0.5 + 1e-9, None)
+    prob.add_dirichlet(lambda p: p[:, 1] > 0.5 - 1e-9, 1, 1e-3)
+    K, f = prob.stiffness(), prob.load()
+    D, values = prob.prescribed()
+    x = np.zeros(K.shape[0])
+    x[D] = values
+    A, b, _, interior = condense(K, f, x=x, D=D)
+    n2 = 2 * len(model.nodes)
+    modes = np.zeros((K.shape[0], 3))
+    modes[:n2] = linsolve.rigid_modes(model.nodes)
+    return A.tocsr(), b, prob.solver_options(interior)["nodal"], modes[interior]

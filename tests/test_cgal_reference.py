@@ -1,32 +1,27 @@
 """Sibson values against CGAL's, an independent implementation (when CGAL is installed).
 
-The shape-function benchmark's CGAL driver (``benchmarks/cgal_sibson.cpp``, built by
-``benchmarks/_cgal.py``) evaluates ``natural_neighbor_coordinates_2`` on a Delaunay
-triangulation of the same nodes; without a crack cnem's triangulation is Delaunay, so the
+The CGAL driver (``tests/cgal_sibson.cpp``, built by ``tests/cgal_sibson.py``; the
+shape-function benchmark times it too) evaluates ``natural_neighbor_coordinates_2`` on a
+Delaunay triangulation of the same nodes; without a crack cnem's triangulation is Delaunay, so the
 two must give the same values.  Skipped when g++ or CGAL's headers are missing
 (``apt-get install libcgal-dev``); CGAL is never a dependency of cnem.
 """
-import pathlib
-import sys
-
 import numpy as np
 import pytest
 
+import cgal_sibson
 import cnem
-
-sys.path.insert(0, str(pathlib.Path(__file__).parent.parent / "benchmarks"))
-import _cgal  # noqa: E402
 
 
 def test_missing_compiler_is_a_skip_with_the_reason():
-    out = _cgal.build(cxx="no-such-c++-compiler")
+    out = cgal_sibson.build(cxx="no-such-c++-compiler")
     assert "exe" not in out
     assert "no-such-c++-compiler" in out["skipped"] and "skipped" in out["skipped"]
 
 
 @pytest.mark.slow
 def test_sibson_values_equal_cgal_on_the_square(tmp_path):
-    built = _cgal.build()
+    built = cgal_sibson.build()
     if "exe" not in built:
         pytest.skip(built["skipped"])
     model = cnem.discretize(cnem.nodes.irregular(cnem.geometry.rectangle(), h=0.03, seed=3),
@@ -34,7 +29,7 @@ def test_sibson_values_equal_cgal_on_the_square(tmp_path):
     rng = np.random.default_rng(7)
     points = np.vstack([rng.random((3000, 2)), model.nodes[:50],
                         [[0.5, 0.0], [1.0, 0.37], [0.0, 1.0]]])   # nodes, boundary, corner
-    out = _cgal.run(built["exe"], model.nodes, points, 1, str(tmp_path))
+    out = cgal_sibson.run(built["exe"], model.nodes, points, 1, str(tmp_path))
     assert "error" not in out, out.get("error")
     assert out["outside"] == 0 and out["n_vertices"] == len(model.nodes)
     ours = model.shape_functions(points, kind="sibson")

@@ -1,14 +1,18 @@
 """The demo pages print what the code prints: every page's text comes from
 ``docs/demos/regenerate.py`` (its command on the page and in the text), and the pages whose
-demos are short are rerun here and compared number by number (times left out)."""
+demos are short are compared number by number (times left out) with the run of their
+command that the test session makes once (``demo_runs.py``; ``test_demos.py`` checks the
+numbers of the same runs)."""
 
 from __future__ import annotations
 
 import pathlib
+import re
 import runpy
-import shutil
 
 import pytest
+
+import demo_runs
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PAGES = runpy.run_path(str(ROOT / "docs" / "demos" / "regenerate.py"))
@@ -28,6 +32,15 @@ def test_every_printed_output_has_its_command():
         assert f"docs/demos/output/{name}.txt" in page, name
         for png in PAGES["pictures"](name):
             assert (ROOT / "docs" / "images" / "demos" / png).stat().st_size > 1000, png
+
+
+def test_the_index_names_the_pages_without_a_run():
+    """docs/demos/index.md says which pages show no run of their own: exactly those that
+    `regenerate.py` does not make."""
+    index = (ROOT / "docs" / "demos" / "index.md").read_text()
+    promise = next(p for p in index.split("\n\n") if "show the pictures and the numbers" in p)
+    pages = {p.stem for p in (ROOT / "docs" / "demos").glob("*.md")} - {"index"}
+    assert set(re.findall(r"\[(\w+)\]\(\w+\.md\)", promise)) == pages - set(PAGES["PAGES"])
 
 
 BASE = """$ cnem demo x
@@ -62,16 +75,14 @@ def test_compare_finds_a_changed_number(fresh):
 @pytest.mark.slow
 @pytest.mark.parametrize("name", PAGES["CHEAP"])
 def test_page_prints_what_the_demo_prints(name):
-    """A fresh run of the page's command prints the page's numbers and writes its pictures
+    """The run of the page's command prints the page's numbers and writes its pictures
     (`regenerate.py NAME` rewrites the page when this fails after a deliberate change)."""
     pytest.importorskip("pyvista")
-    text, out = PAGES["run"](name)
-    try:
-        page = (ROOT / "docs" / "demos" / "output" / f"{name}.txt").read_text()
-        assert PAGES["compare"](page, text) == [], (
-            f"docs/demos/output/{name}.txt is stale; if the change is meant, run "
-            f"python docs/demos/regenerate.py {name}")
-        for png in PAGES["pictures"](name):
-            assert (out / png).stat().st_size > 1000, png
-    finally:
-        shutil.rmtree(out, ignore_errors=True)
+    run = demo_runs.run_command(PAGES["PAGES"][name])
+    text = PAGES["page_text"](name, run.stdout, run.outdir, 0.0)
+    page = (ROOT / "docs" / "demos" / "output" / f"{name}.txt").read_text()
+    assert PAGES["compare"](page, text) == [], (
+        f"docs/demos/output/{name}.txt is stale; if the change is meant, run "
+        f"python docs/demos/regenerate.py {name}")
+    for png in PAGES["pictures"](name):
+        assert (run.outdir / png).stat().st_size > 1000, png

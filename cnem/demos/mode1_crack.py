@@ -143,8 +143,12 @@ def study(spacings: tuple = SPACINGS, methods: tuple = ("cnem", "enriched", "fem
 def table(rows):
     lines = [f"{'method':>9} {'h':>8} {'nodes':>6} {'pointwise':>11} {'smoothed':>11} {'K_I':>7}"]
     for r in rows:
+        k = f"{r['KI']:>7.4f}" if np.isfinite(r["KI"]) else f"{'-':>7}"
         lines.append(f"{r['method']:>9} {r['h']:>8.4f} {r['nodes']:>6d} {r['error']:>11.4e} "
-                     f"{r['smoothed']:>11.4e} {r['KI']:>7.4f}")
+                     f"{r['smoothed']:>11.4e} {k}")
+    if any(not np.isfinite(r["KI"]) for r in rows):
+        lines.append("K_I -: not computed for fem (the interaction integral runs on the C-NEM "
+                     "solutions here)")
     rates, smoothed = {}, {}
     for m in dict.fromkeys(r["method"] for r in rows):
         sel = [r for r in rows if r["method"] == m]

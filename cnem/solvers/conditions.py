@@ -1,7 +1,7 @@
 """Boundary conditions written once for every solver (C-NEM, FEM P1, peridynamics).
 
 `Conditions` is the base of every problem class: it stores the Dirichlet,
-traction and body-force conditions with the meanings of ``API.md`` and turns
+traction and body-force conditions with the meanings of ``docs/api-contract.md`` and turns
 them into prescribed dof values; each solver only integrates the loads in its
 own way (`body_forces`, `traction_at`).
 

@@ -8,7 +8,8 @@ show: the printed text (``docs/demos/output/<page>.txt``) and the pictures the p
 Each demo runs in a fresh process (``python -m cnem ...``) with ``NUMBA_NUM_THREADS=1`` and its
 files in a temporary folder; the text keeps the demo's standard output (not the progress bars)
 with that folder written as the demo's default one, and ends with the wall time.
-``tests/test_demo_pages.py`` reruns the pages of `CHEAP` and compares their numbers (`compare`).
+``tests/test_demo_pages.py`` compares the pages of `CHEAP` with the runs of their commands
+that the test session makes once (``tests/demo_runs.py``), number by number (`compare`).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ PAGES = {
     "pd_vs_cnem_crack": ("pd", "pd-vs-cnem-crack", "--n", "16", "32"),
     "pd_crack_branching": ("pd", "pd-crack-branching", "--quick"),
     "cpd_examples": ("pd", "cpd-examples", "--quick"),
+    "kalthoff_winkler": ("pd", "kalthoff-winkler", "--quick"),
     "growth_sent": ("demo", "growth-sent"),
     "growth_kink": ("demo", "growth-kink", "--angles", "30", "60"),
     "growth_two_holes": ("demo", "growth-two-holes", "--h", "0.5", "--steps", "4"),
@@ -47,9 +49,10 @@ CHEAP = tuple(name for name in PAGES if name != "growth_sent")
 #: a fresh run must print one as small, not the same digits.
 ROUND_OFF = 1e-9
 NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
-#: Times: a number of seconds ("4.79 s", "1.5s", "3.76 s per increment") or the last line.
+#: Times: a number of seconds ("4.79 s", "1.5s", "3.76 s per increment"), a column headed
+#: "time", "time s" or "wall (s)", or the last line.
 SECONDS = re.compile(r"[-+]?\d+(?:\.\d+)?\s?s\b")
-TIME_HEADER = re.compile(r"\btime(?: s)?\b")
+TIME_HEADER = re.compile(r"\btime(?: s)?\b|\bwall \(s\)")
 
 
 def command(name: str) -> str:
@@ -68,10 +71,16 @@ def run(name: str) -> tuple[str, pathlib.Path]:
     wall = time.perf_counter() - start
     if done.returncode != 0:
         raise RuntimeError(f"{command(name)} failed ({done.returncode}):\n{done.stderr[-3000:]}")
+    return page_text(name, done.stdout, out, wall), out
+
+
+def page_text(name: str, stdout: str, out: pathlib.Path, wall: float) -> str:
+    """The text page ``name`` shows for a run that printed ``stdout`` with its files in
+    ``out`` (written as the demo's default folder) in ``wall`` seconds."""
     default = f"results/{name}"
-    lines = [line.rstrip() for line in done.stdout.replace(str(out), default).splitlines()]
+    lines = [line.rstrip() for line in stdout.replace(str(out), default).splitlines()]
     text = "\n".join([f"$ {command(name)}", *lines, f"({wall:.0f} s wall, one numba thread)"])
-    return text + "\n", out
+    return text + "\n"
 
 
 def pictures(name: str) -> list[str]:

@@ -1,4 +1,4 @@
-"""Solves that do not give up (issue 19, item 8): branch-enriched systems converge with
+"""Solves that do not give up: branch-enriched systems converge with
 the nodal-block AMG + enriched-block LU preconditioner, a stalled CG falls back to the
 direct solve when its factor fits in memory and otherwise says what to change."""
 
@@ -9,36 +9,16 @@ import logging
 import numpy as np
 import pytest
 import scipy.sparse.linalg as spla
-from skfem import condense
 
+import cases
 import cnem
 from cnem import config
 from cnem.solvers import linsolve
 
 
-def _centre_cracked(h, radius=0.1):
-    """The condensed system of a centre-cracked square plate, branch-enriched, pulled on
-    its top edge: ``A, b``, the nodal mask and the rigid modes of the free dofs."""
-    dom = cnem.Domain([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]],
-                      cracks=[[[-0.1, 0.0], [0.1, 0.0]]])
-    model = cnem.discretize(cnem.nodes.regular(dom, h))
-    prob = cnem.Elasticity(model, (1.0, 0.3), enrich=dict(radius=radius, functions="branch"))
-    prob.add_dirichlet(lambda p: p[:, 1] < -0.5 + 1e-9, None)
-    prob.add_dirichlet(lambda p: p[:, 1] > 0.5 - 1e-9, 1, 1e-3)
-    K, f = prob.stiffness(), prob.load()
-    D, values = prob.prescribed()
-    x = np.zeros(K.shape[0])
-    x[D] = values
-    A, b, _, interior = condense(K, f, x=x, D=D)
-    n2 = 2 * len(model.nodes)
-    modes = np.zeros((K.shape[0], 3))
-    modes[:n2] = linsolve.rigid_modes(model.nodes)
-    return A.tocsr(), b, prob.solver_options(interior)["nodal"], modes[interior]
-
-
 @pytest.fixture(scope="module")
 def small():
-    return _centre_cracked(0.02)          # 2.6k nodes, 6.3k unknowns, 1.3k of them enriched
+    return cases.enriched_centre_crack_system(0.02)          # 2.6k nodes, 6.3k unknowns, 1.3k of them enriched
 
 
 def _relative_residual(A, x, b):
@@ -98,7 +78,7 @@ def test_nodal_mask_of_the_wrong_length_is_named(small):
 def test_enriched_plate_of_16k_nodes_solves_on_the_automatic_path():
     # 15.9k nodes, 39.7k unknowns (8.2k enriched), 3.3M non-zeros: above DIRECT_NNZ, so
     # "auto" takes CG; it stalled before (residual 5.5e-6 after 2000 iterations)
-    A, b, nodal, modes = _centre_cracked(0.008)
+    A, b, nodal, modes = cases.enriched_centre_crack_system(0.008)
     assert A.nnz > config.DIRECT_NNZ and 15_000 < len(nodal) // 2
     x = linsolve.solve_spd(A, b, modes=modes, nodal=nodal, tol=1e-10)
     assert _relative_residual(A, x, b) <= 1e-9

@@ -1,4 +1,4 @@
-"""Guards of the long PD computations (issue 19, item 4): explicit dynamics refuses or
+"""Guards of the long PD computations: explicit dynamics refuses or
 flags a time step above the stable one and stops, naming the step, when its state goes
 non-finite; dynamic relaxation and Newton report non-convergence with their residual
 history."""

@@ -1,4 +1,4 @@
-"""Array arguments checked at the public boundary (issue 19, item 3): wrong lengths,
+"""Array arguments checked at the public boundary: wrong lengths,
 NaN and inf, coordinates whose squares overflow, and moduli whose stiffness overflows
 raise a `cnem.CNEMError` naming the argument and the received shape or value, instead
 of NumPy broadcast errors, scipy overflows or "form ... is not bilinear"."""

@@ -1,8 +1,10 @@
-"""Optional CGAL anchor for the shape-function benchmark: build and run ``cgal_sibson.cpp``.
+"""CGAL's Sibson coordinates: an independent reference for cnem's
+(``tests/test_cgal_reference.py``) and the compiled anchor of
+``benchmarks/shape_functions.py``. `build` compiles ``cgal_sibson.cpp``, `run` runs it.
 
-CGAL is a benchmark-time tool only, never a dependency of cnem: where g++ or CGAL's headers
-(Debian: ``apt-get install libcgal-dev``) are missing, `build` says why and the benchmark
-skips the CGAL column.  The executable is compiled once per source / compiler / flags into a
+CGAL is a test- and benchmark-time tool only, never a dependency of cnem: where g++ or CGAL's
+headers (Debian: ``apt-get install libcgal-dev``) are missing, `build` says why, the test
+skips and the benchmark leaves out the CGAL column.  The executable is compiled once per source / compiler / flags into a
 cache folder (``$XDG_CACHE_HOME/cnem-benchmarks`` or ``~/.cache/cnem-benchmarks``) and
 reused; nothing is written into the repository.
 """
