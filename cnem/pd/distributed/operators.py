@@ -176,6 +176,7 @@ class BondOperators(LocalOperators):
         np.add.at(diag, b.bond_i, w[:, None, None] * n[:, :, None] * n[:, None, :])
         return np.abs(diag).sum(axis=2) + _rows(b.bond_i, off, o)
 
+
 class StateOperators(LocalOperators):
     """The linear peridynamic solid on one rank's owned points.
 
