@@ -65,11 +65,13 @@ class Elasticity(Conditions):
         cells are then split into fan sub-cells (`cnem.assembly.subdivide`).
     stabilization : float
         Weight ``a`` of the sub-cell stabilisation of SCNI (Puso et al. 2008):
-        ``K += a sum_s A_s (B~_s - B~_k)^T C (B~_s - B~_k)`` over the fan
-        sub-cells ``s`` of every cell ``k``. It vanishes for linear fields (the
-        patch test still holds) and stiffens the low-energy oscillating modes
-        that plain SCNI (``a = 0``, the paper's method) leaves almost free, which
-        otherwise show as node-to-node oscillations along free crack faces.
+        ``K += a sum_s A_s (B~_s - B~_k)^T C_mu (B~_s - B~_k)`` over the fan
+        sub-cells ``s`` of every cell ``k``, ``C_mu`` the elasticity of the shear
+        modulus alone (``lam = 0``), so that it does not lock as ``nu -> 1/2``. It
+        vanishes for linear fields (the patch test still holds) and stiffens the
+        low-energy oscillating modes that plain SCNI (``a = 0``, the paper's
+        method) leaves almost free, which otherwise show as node-to-node
+        oscillations along free crack faces.
     gradients : GradientCache, optional
         The model's smoothed gradients at ``gauss``, to share with other
         problems on the model (what it has computed is not computed again); by
@@ -196,53 +198,75 @@ class Elasticity(Conditions):
         return self.materials[self.cells.region]
 
     def stiffness(self) -> sp.csr_matrix:
-        """Global stiffness ``K`` (eq. 33), ``(dim n, dim n)`` CSR."""
+        """Global stiffness ``K`` (eq. 33), ``(dim n, dim n)`` CSR.
+
+        With stabilisation ``a`` it is ``K_cells + a S``, where ``S`` penalises the
+        difference between each sub-cell's smoothed strain and its cell's with the
+        shear modulus alone, ``2 mu (e_s - e_k) : (e_s - e_k)``: bounded as
+        ``nu -> 1/2``, so that it never locks, while it still controls every strain
+        component of the modes one smoothed strain per cell does not see.
+        """
         if self._K is None:
-            a = self.stabilization
-            sub_cells = self._sub_cells()
-            # with sub-cells K = (1 - a) K_cells + a K_sub (see _sub_cell_stiffness)
-            weight = 1.0 - a if sub_cells else 1.0
-            # the weights scale the Lamé parameters: no pass over the matrices
+            (lam, mu), stabilization = self.stiffness_moduli()
             K = None
-            if weight != 0.0:
-                lam, mu = self._lame(weight)
+            if np.any(lam != 0.0) or np.any(mu != 0.0):
                 K = elasticity_form.assemble(self.basis, groups=self.cells.region, lam=lam, mu=mu)
-            if a > 0:
-                extra = (self._sub_cell_stiffness(a) if sub_cells
-                         else self._pointwise_stabilization_stiffness(a))
+            if stabilization is not None:
+                extra = (self._sub_cell_stiffness(*stabilization) if self._sub_cells()
+                         else self._pointwise_stabilization_stiffness(*stabilization))
                 K = extra if K is None else K + extra
             check_stiffness(K.data, self.materials, "the assembled stiffness")
             self._K = K
         return self._K
 
-    def _lame(self, weight=1.0):
-        """Lamé parameters of every material (region), times ``weight``: ``(r,)`` each."""
+    def stiffness_moduli(self) -> tuple[tuple[np.ndarray, np.ndarray],
+                                        tuple[np.ndarray, np.ndarray] | None]:
+        """Lamé parameters per region of the cells' term of `stiffness` and of its
+        stabilisation term (None without stabilisation).
+
+        The stabilisation of weight ``a`` takes the shear modulus alone
+        (``lam = 0``, ``a mu``). With sub-cells, whose strains average to their
+        cell's, ``K_cells(lam, mu) + a sum_s A_s (B~_s - B~_k)^T C_mu (B~_s - B~_k)``
+        is ``K_cells(lam, (1 - a) mu) + a sum_s K_s(0, mu)`` (`_sub_cell_stiffness`).
+
+        Returns
+        -------
+        cells : ((r,) ndarray, (r,) ndarray)
+        stabilization : ((r,) ndarray, (r,) ndarray) or None
+        """
+        a = self.stabilization
         lam, mu = lame(*self.materials.T, self.plane)
-        return weight * lam, weight * mu
+        if a == 0:
+            return (lam, mu), None
+        stabilization = (np.zeros_like(mu), a * mu)
+        if self._sub_cells():
+            mu = (1.0 - a) * mu
+        return (lam, mu), stabilization
 
     def _sub_cells(self):
         """Whether the stabilisation uses the fan sub-cells of the model's cells
         (stabilised, not enriched)."""
         return self.enrichment is None and self.stabilization > 0
 
-    def _sub_cell_stiffness(self, weight):
-        """``weight sum_s A_s B~_s^T C B~_s`` over the fan sub-cells ``s``.
+    def _sub_cell_stiffness(self, lam, mu):
+        """``sum_s A_s B~_s^T C B~_s`` over the fan sub-cells ``s``, ``C`` of the Lamé
+        parameters given per region (the stabilisation's, `stiffness_moduli`).
 
         The sub-cells of a cell ``k`` share its boundary integrals and their
-        spokes cancel, so ``sum_s A_s B~_s = A_k B~_k`` and the stabilised
-        stiffness ``K_k + a sum_s A_s (B~_s - B~_k)^T C (B~_s - B~_k)`` equals
-        ``(1 - a) K_k + a sum_s A_s B~_s^T C B~_s``: no difference operators
-        (whose rows would carry both patterns) are formed. The identity needs a
+        spokes cancel, so ``sum_s A_s B~_s = A_k B~_k`` and the stabilisation
+        ``a sum_s A_s (B~_s - B~_k)^T C (B~_s - B~_k)`` equals
+        ``a sum_s A_s B~_s^T C B~_s - a A_k B~_k^T C B~_k``: no difference operators
+        (whose rows would carry both patterns) are formed, and the cells' own term
+        is taken off their stiffness (`stiffness_moduli`). The identity needs a
         constant ``C`` per cell (a linear law); a state-dependent tangent needs the
         difference form.
         """
         sub, grad = self.gradients.fan(release=True)
         fine = CellBasis(self.model, vector=True, cells=sub, gradient=grad)
-        lam, mu = self._lame(weight)
         return elasticity_form.assemble(fine, groups=sub.region, lam=lam, mu=mu)
 
-    def _pointwise_stabilization_stiffness(self, weight, order=4):
-        """``weight sum_q w_q (B(x_q) - B~_k)^T C (B(x_q) - B~_k)`` over quadrature points of
+    def _pointwise_stabilization_stiffness(self, lam, mu, order=4):
+        """``sum_q w_q (B(x_q) - B~_k)^T C (B(x_q) - B~_k)`` over quadrature points of
         the cells where enrichment functions live, ``B(x)`` the gradients of the
         displacement field itself (Sibson and enrichment gradients).
 
@@ -267,7 +291,6 @@ class Elasticity(Conditions):
         diff = [p - to_cell @ b for p, b in zip(pointwise, ops[d:])]
         at_points = basis.at_points([to_cell @ op for op in ops[:d]] + diff,
                                     weights[keep], points)
-        lam, mu = self._lame(weight)
         return elasticity_form.assemble(at_points, groups=cells.region[owner], lam=lam, mu=mu)
 
     def load(self) -> np.ndarray:
@@ -361,7 +384,7 @@ class Elasticity(Conditions):
         except ValueError as err:
             log.warning("no P1 preconditioner matrix (%s): smoothed aggregation on K", err)
             return None
-        lam, mu = self._lame()
+        lam, mu = lame(*self.materials.T, self.plane)
         P = elasticity_form.assemble(basis, groups=self.model.triangle_region, lam=lam, mu=mu)
         return P if dofs is None else principal_submatrix(P, dofs)
 

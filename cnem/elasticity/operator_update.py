@@ -55,22 +55,19 @@ def cells_stiffness(prob: Any, index: np.ndarray, gradient: SmoothedGradient,
     """
     model = prob.model
     cells = model.cells.subset(index)
-    a = prob.stabilization
+    (lam, mu), stabilization = prob.stiffness_moduli()
     n2 = 2 * len(model.nodes)
     K = sp.csr_matrix((n2, n2))
     if len(cells) == 0:
         return K
-    weight = 1.0 - a if a > 0 else 1.0
-    if weight != 0.0:
-        lam, mu = prob._lame(weight)
+    if np.any(lam != 0.0) or np.any(mu != 0.0):
         basis = CellBasis(model, vector=True, cells=cells, gradient=gradient)
         K = K + form.assemble(basis, groups=cells.region, lam=lam, mu=mu)
-    if a > 0:
+    if stabilization is not None:
         sub, _ = subdivide(cells, model.nodes, node_apex=tip_cells(model)[index], mark_spokes=True)
         grad = smoothed_gradient(model, gauss=prob.gauss, cells=sub)
         fine = CellBasis(model, vector=True, cells=sub, gradient=grad)
-        lam, mu = prob._lame(a)
-        K = K + form.assemble(fine, groups=sub.region, lam=lam, mu=mu)
+        K = K + form.assemble(fine, groups=sub.region, lam=stabilization[0], mu=stabilization[1])
     return K.tocsr()
 
 
