@@ -139,18 +139,24 @@ def kernel_forces(u, body, stiffness, alive, out):
     return out
 
 
-def make_problem_class():
-    """``cnem.pd.Problem`` whose ``_correction`` records its own wall time (nothing else changes)."""
-    from cnem.pd import Problem
+def make_material_class():
+    """``cnem.pd.BondBased`` whose behaviour records the wall time of the surface correction
+    on its problem (``problem.correction_seconds``; nothing else changes)."""
+    from cnem.pd import BondBased
+    from cnem.pd.behaviour import BondBehaviour
 
-    class TimedProblem(Problem):
-        def _correction(self):
+    class TimedBehaviour(BondBehaviour):
+        def correction(self):
             t0 = time.perf_counter()
-            out = super()._correction()
-            self.correction_seconds = time.perf_counter() - t0
+            out = super().correction()
+            self.problem.correction_seconds = time.perf_counter() - t0
             return out
 
-    return TimedProblem
+    class TimedBondBased(BondBased):
+        def behaviour(self, problem):
+            return TimedBehaviour(problem)
+
+    return TimedBondBased
 
 
 # --------------------------------------------------------------------------- measuring
@@ -180,7 +186,7 @@ def timed_calls(fn, repeat):
     return seconds, out, st.growth
 
 
-def setup(points, volumes, horizon, problem_class, with_problem):
+def setup(points, volumes, horizon, material_class, with_problem):
     """Body (+ Problem) once: times, peak growths and the objects."""
     import cnem.pd as pd
     with Stage() as sb:
@@ -189,13 +195,13 @@ def setup(points, volumes, horizon, problem_class, with_problem):
     prob = None
     if with_problem:
         with Stage() as sp_:
-            prob = problem_class(body, pd.BondBased(1.0))
+            prob = pd.Problem(body, material_class(1.0))
         run.update(problem=sp_.seconds, problem_growth=sp_.growth,
                    correction=prob.correction_seconds, peak=max(sb.peak, sp_.peak))
     return run, body, prob
 
 
-def warm_up(problem_class):
+def warm_up(material_class):
     """Every stage once on tiny 2-D and 3-D lattices; seconds."""
     import numba
 
@@ -204,7 +210,7 @@ def warm_up(problem_class):
     for d, k in WARMUP_SIDE.items():
         pts, h = square_lattice(k, d)
         family_search(pts, HORIZON_FACTOR * h)
-        _, body, prob = setup(pts, h ** d, HORIZON_FACTOR * h, problem_class, True)
+        _, body, prob = setup(pts, h ** d, HORIZON_FACTOR * h, material_class, True)
         stiffness = np.ascontiguousarray(prob.bond_stiffness * prob.factor * body.beta)
         u = np.zeros_like(pts)
         alive = np.ones(len(body.bond_j), dtype=np.uint8)
@@ -250,7 +256,7 @@ class Guard:
             self.per_bond[stage][d] = max(self.per_bond[stage][d], growth / bonds)
 
 
-def run_case(name, args, guard, problem_class):
+def run_case(name, args, guard, material_class):
     import numba
 
     import cnem.pd as pd
@@ -285,7 +291,7 @@ def run_case(name, args, guard, problem_class):
     runs, body, prob = [], None, None
     for _ in range(setup_repeat):
         body = prob = None
-        run, body, prob = setup(points, h ** d, horizon, problem_class, not problem_skip)
+        run, body, prob = setup(points, h ** d, horizon, material_class, not problem_skip)
         runs.append(run)
     bonds = len(body.bond_j)
     r["bonds"] = bonds
@@ -497,12 +503,12 @@ def main(argv=None):
           f"threads max); memory guard: {guard.describe()}; load "
           f"average {load_text(machine.before.load)} (other processes on the machine slow the "
           "multi-threaded kernel)")
-    problem_class = make_problem_class()
+    material_class = make_material_class()
     print("  warm-up", flush=True)
-    warm = warm_up(problem_class)
+    warm = warm_up(material_class)
     results = []
     for name in cases:
-        results.append(run_case(name, args, guard, problem_class))
+        results.append(run_case(name, args, guard, material_class))
         gc.collect()
     report(results, warm, numba.threading_layer())
     print("\n" + machine.stop().report())
