@@ -224,10 +224,12 @@ class Elasticity(Conditions):
         """Lamé parameters per region of the cells' term of `stiffness` and of its
         stabilisation term (None without stabilisation).
 
-        The stabilisation of weight ``a`` takes the shear modulus alone
-        (``lam = 0``, ``a mu``). With sub-cells, whose strains average to their
-        cell's, ``K_cells(lam, mu) + a sum_s A_s (B~_s - B~_k)^T C_mu (B~_s - B~_k)``
-        is ``K_cells(lam, (1 - a) mu) + a sum_s K_s(0, mu)`` (`_sub_cell_stiffness`).
+        The sub-cell stabilisation of weight ``a`` takes the shear modulus alone
+        (``lam = 0``, ``a mu``): with sub-cells, whose strains average to their cell's,
+        ``K_cells(lam, mu) + a sum_s A_s (B~_s - B~_k)^T C_mu (B~_s - B~_k)`` is
+        ``K_cells(lam, (1 - a) mu) + a sum_s K_s(0, mu)`` (`_sub_cell_stiffness`). The
+        pointwise term of enriched problems (`_pointwise_stabilization_stiffness`)
+        keeps the full law ``a lam, a mu``.
 
         Returns
         -------
@@ -238,10 +240,11 @@ class Elasticity(Conditions):
         lam, mu = lame(*self.materials.T, self.plane)
         if a == 0:
             return (lam, mu), None
-        stabilization = (np.zeros_like(mu), a * mu)
-        if self._sub_cells():
-            mu = (1.0 - a) * mu
-        return (lam, mu), stabilization
+        if not self._sub_cells():
+            # with enrichment the pointwise term completes the smoothed stiffness towards
+            # the Galerkin one on the few cells near the tips: it keeps the full law
+            return (lam, mu), (a * lam, a * mu)
+        return (lam, (1.0 - a) * mu), (np.zeros_like(mu), a * mu)
 
     def _sub_cells(self):
         """Whether the stabilisation uses the fan sub-cells of the model's cells
