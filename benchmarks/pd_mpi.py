@@ -150,7 +150,8 @@ def worker(case, mode):
     if comm is not None:
         comm.Barrier()
         before, spent[0] = halo.bytes, 0.0
-    with StepClock(sys.modules[type(prob).run_dynamic.__module__]) as clock:
+    import cnem.solvers.stepping as stepping           # the one time stepper's loop
+    with StepClock(stepping) as clock:
         prob.run_dynamic(dt, steps, velocity=vel, every=steps, progress=False)
     step = median(clock.steps)
     out = dict(case=case, mode=mode, setup=setup, step=step, peak=peak_rss_bytes(),
@@ -223,7 +224,7 @@ def main(argv=None):
     machine = MachineLoad()
     print(f"benchmarks/pd_mpi.py: cases {cases}; load average {load_text(machine.before.load)} "
           "(other processes slow every configuration)")
-    results, streams = {}, {}
+    results, streams, failures = {}, {}, 0
     for case in cases:
         d, k = CASES[case]
         rounds = {}
@@ -239,7 +240,9 @@ def main(argv=None):
                 print(f"  round {round_ + 1}: {case} {mode} {ranks} rank(s): "
                       + ("failed" if r is None else f"{r['step']:.4f} s/step") +
                       f" ({during.stop().short()})", flush=True)
-                if r is not None:
+                if r is None:
+                    failures += 1
+                else:
                     rounds.setdefault((mode, ranks), []).append(r)
             during = MachineLoad()
             for procs in streams[case]:
@@ -253,6 +256,8 @@ def main(argv=None):
     report(results)
     report_bandwidth(results, streams)
     print("\n" + machine.stop().report())
+    if failures:
+        raise SystemExit(f"pd_mpi: {failures} run(s) failed (see above)")
     return results
 
 
