@@ -20,6 +20,7 @@ writes its files to ``--out``, by default ``results/<module>/`` (`output_folder`
 from __future__ import annotations
 
 import argparse
+import math
 import importlib
 import logging
 import pathlib
@@ -27,13 +28,14 @@ import sys
 from typing import TYPE_CHECKING
 
 from ._aliases import RENAMED_DEMOS
+from .errors import CNEMError
 
 if TYPE_CHECKING:
-    from typing import Sequence
+    from typing import Callable, Sequence
 
-__all__ = ["main", "DEMOS", "PD_DEMOS", "current_name", "HelpFormatter", "demo_parser",
-           "dynamic_run_options",
-           "output_folder", "show_compile_notice", "warmup", "build_parser"]
+__all__ = ["main", "positive_int", "positive_float", "DEMOS", "PD_DEMOS", "current_name",
+           "HelpFormatter", "demo_parser", "dynamic_run_options", "output_folder",
+           "show_compile_notice", "warmup", "build_parser"]
 
 def _named(*modules: str) -> dict[str, str]:
     """Command-line name -> module of `cnem.demos`: each demo is called by its module's
@@ -90,6 +92,29 @@ def demo_command(module_file: str) -> str | None:
     return None
 
 
+def _positive(kind: type) -> Callable[[str], float]:
+    """An argparse ``type`` that takes only positive, finite numbers of ``kind``: a bad value
+    is one line naming the option (``error: argument --h: ...``), exit status 2."""
+    noun = "whole number" if kind is int else "number"
+
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a positive {noun}, received {text!r}") \
+                from None
+        if not (math.isfinite(value) and value > 0):
+            raise argparse.ArgumentTypeError(f"expected a positive {noun}, received {text}")
+        return value
+
+    parse.__name__ = f"positive {noun}"
+    return parse
+
+
+#: argparse types of the demos' sizes, spacings, counts and times.
+positive_int, positive_float = _positive(int), _positive(float)
+
+
 def demo_parser(module_file: str, doc: str, prog: str | None = None) -> argparse.ArgumentParser:
     """The command line every demo starts from (the one place of the demos' output rule).
 
@@ -135,7 +160,7 @@ def dynamic_run_options(parser: argparse.ArgumentParser, frames: float, quick_h:
         The small run of ``--quick``: grid spacing in m, horizon / spacing and simulated time
         in s (shown in the help in mm and µs).
     """
-    parser.add_argument("--frames", type=float, default=frames, help="µs between damage frames")
+    parser.add_argument("--frames", type=positive_float, default=frames, help="µs between damage frames")
     parser.add_argument("--quick", action="store_true",
                         help=f"a small run: h = {quick_h * 1e3:g} mm, m = {quick_m:g}, "
                              f"{quick_t_end * 1e6:g} µs (overrides --h, --m, --time)")
@@ -289,6 +314,8 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
     parser = argparse.ArgumentParser(prog="cnem", description=__doc__.split("\n")[0],
                                      formatter_class=HelpFormatter,
                                      epilog=__doc__.split("\n\n", 1)[1])
+    from . import __version__
+    parser.add_argument("--version", action="version", version=f"cnem {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     commands = {}
     for command, what in (("demo", "a demo"), ("pd", "a peridynamics demo")):
@@ -337,7 +364,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         _list(args.command)
         return 0
     name = current_name(args.name, args.command)
-    load_demo(name, args.command).cli(rest, prog=f"cnem {args.command} {name}")
+    prog = f"cnem {args.command} {name}"
+    try:
+        load_demo(name, args.command).cli(rest, prog=prog)
+    except (CNEMError, OSError) as err:
+        # a value the options' types cannot judge (a window the picture refuses, an output
+        # folder that cannot be written): one line, as argparse reports its own errors
+        sys.stderr.write(f"{prog}: error: {err}\n")
+        return 2
     return 0
 
 

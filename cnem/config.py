@@ -22,7 +22,7 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "ROU
            "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER",
            "DT_LIMIT", "COORDINATE_LIMIT", "DIRECT_MEMORY", "DIRECT_FILL",
            "CG_MAXITER", "SIF_DISCS", "SIF_REACH", "SIF_INNER", "SIF_STRAIGHTNESS",
-           "SIF_BEND_SPACINGS", "SIF_SPREAD", "SIF_SPACINGS", "PARALLEL_MIN"]
+           "SIF_BEND_SPACINGS", "SIF_SPREAD", "SIF_SPACINGS", "PARALLEL_MIN", "PLOT_MAX_PIXELS"]
 
 # ---------------------------------------------------------------- geometry tolerances
 #: Coordinates (and their extent) must stay below this in magnitude: squared distances
@@ -249,3 +249,8 @@ SIF_SPREAD = 0.01
 #: Fewer local node spacings than this in the largest disc that fits: `sif` warns
 #: (the discs cannot resolve the near-tip field; refine the nodes at the tip).
 SIF_SPACINGS = 3.0
+
+# ---------------------------------------------------------------- pictures
+#: The largest side of a picture in pixels that `cnem.plot` accepts (larger windows make
+#: VTK allocate more than any machine has and abort the interpreter).
+PLOT_MAX_PIXELS = 16384

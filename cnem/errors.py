@@ -58,7 +58,7 @@ __all__ = ["CNEMError", "InputError", "OptionError", "GeometryError", "MaterialE
            "FormatError", "HyperDualError", "LimitError", "UnsupportedError", "SolveError",
            "PlotError", "PlotDependencyError", "PlotInputError", "MissingExtraError", "GrowthWarning",
            "ConvergenceError", "DivergenceError", "StabilityWarning", "SIFWarning",
-           "check_choice"]
+           "check_choice", "check_real"]
 
 
 class CNEMError(Exception):
@@ -214,6 +214,37 @@ def check_choice(name: str, value: _Value, choices: Iterable[object], *,
     return value
 
 
+#: NumPy dtype kinds that are no real numbers, and how a message names them (complex
+#: numbers would lose their imaginary part, booleans and strings would become numbers).
+_NOT_REAL = {"c": "complex numbers (their imaginary part would be dropped)",
+             "b": "booleans", "U": "strings", "S": "bytes", "M": "dates", "m": "time spans",
+             "V": "raw records"}
+
+
+def check_real(name: str, value: object, *, error: type[InputError] = InputError,
+               fix: str = "") -> object:
+    """``value`` unchanged once it is known to hold real numbers: complex numbers (whose
+    imaginary part a float conversion drops), booleans, strings, dates and ``None`` are
+    refused by name, before a conversion to float could take them silently.
+
+    >>> try:
+    ...     check_real("points", [[0.0, 1j]])
+    ... except InputError as exc:
+    ...     print(str(exc)[:62])
+    points: expected real numbers, received complex numbers (their
+    """
+    import numpy as np
+
+    tail = f"; {fix}" if fix else ""
+    if value is None:
+        raise error(f"{name}: expected real numbers, received None{tail}")
+    kind = value.dtype.kind if isinstance(value, np.ndarray) else np.asarray(value).dtype.kind
+    if kind in _NOT_REAL:
+        raise error(f"{name}: expected real numbers, received {_NOT_REAL[kind]} (dtype kind "
+                    f"{kind!r}){tail}")
+    return value
+
+
 def check_array(name: str, value: object, *, shape: tuple | None = None, broadcast: bool = False,
                 finite: bool = True, positive: bool = False, nonnegative: bool = False,
                 error: type[InputError] = InputError, fix: str = "") -> np.ndarray:
@@ -253,6 +284,7 @@ def check_array(name: str, value: object, *, shape: tuple | None = None, broadca
     import numpy as np
 
     tail = f"; {fix}" if fix else ""
+    check_real(name, value, error=error, fix=fix)
     try:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -301,8 +333,6 @@ def check_points(name: str, value: object, *, dims: tuple = (2, 3),
     ...     print(str(exc)[:76])
     points: expected coordinates below 1e+150 in magnitude (their squared distan
     """
-    import numpy as np
-
     from . import config
 
     arr = check_array(name, value, error=error, fix="drop or repair those rows")

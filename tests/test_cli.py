@@ -286,3 +286,40 @@ def test_dynamic_demos_describe_their_quick_run(command, name, monkeypatch, caps
     h = np.atleast_1d(quick["h"])[0]
     assert options["--quick"].help.startswith(
         f"a small run: h = {h * 1e3:g} mm, m = {quick['m']:g}, {quick['t_end'] * 1e6:g} µs")
+
+
+@pytest.mark.parametrize("argv, option", [
+    (["demo", "bimaterial-cylinder", "--nodes", "-5"], "--nodes"),
+    (["demo", "mode1-crack", "--n", "0"], "--n"),
+    (["demo", "growth-sent", "--h", "-0.1"], "--h"),
+    (["demo", "cracked-plate-geometry", "--size", "-5"], "--size"),
+    (["demo", "cracked-plate-geometry", "--h", "nan"], "--h"),
+    (["pd", "pd-crack-branching", "--time", "inf"], "--time"),
+])
+def test_a_bad_value_is_one_line_naming_the_option(argv, option, capsys):
+    """A negative, zero or non-finite size is refused before the demo runs: argparse's one
+    line naming the option and exit status 2 (it was a traceback, or a ZeroDivisionError)."""
+    with pytest.raises(SystemExit) as done:
+        cli.main(argv)
+    assert done.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert f"error: argument {option}: expected a positive" in err
+
+
+def test_an_unwritable_output_folder_is_one_line(tmp_path, capsys):
+    """A library error inside a demo (here the output folder is a file) is one line with
+    the command's name and exit status 2, not a traceback."""
+    blocked = tmp_path / "file"
+    blocked.write_text("")
+    code = cli.main(["demo", "cracked-plate-geometry", "--h", "0.5", "--h-min", "0.1",
+                     "--no-plot", "--out", str(blocked / "sub")])
+    assert code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("cnem demo cracked-plate-geometry: error:")
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as done:
+        cli.main(["--version"])
+    assert done.value.code == 0
+    assert capsys.readouterr().out.strip() == f"cnem {cnem.__version__}"

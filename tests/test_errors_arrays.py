@@ -122,3 +122,30 @@ def test_plane_stress_lambda_is_unchanged():
     lam, mu = lame(E, nu, "stress")
     strain_lam = E * nu / ((1 + nu) * (1 - 2 * nu))
     np.testing.assert_allclose(lam, 2 * strain_lam * mu / (strain_lam + 2 * mu), rtol=1e-15)
+
+
+def _entry_points():
+    """Public calls that take coordinates or a spacing, each as ``call(bad)``."""
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    dom = cnem.Domain(square)
+    model = cnem.discretize(cnem.nodes.regular(dom, 0.25))
+    inside = np.array([[0.3, 0.4], [0.6, 0.7]])
+    return {
+        "Domain": lambda kind: cnem.Domain(square.astype(kind)),
+        "from_points": lambda kind: cnem.nodes.from_points(dom, inside.astype(kind)),
+        "shape_functions": lambda kind: model.shape_functions(inside.astype(kind)),
+        "family_search": lambda kind: cnem.spatial.family_search(inside.astype(kind), 0.5),
+        "regular h": lambda kind: cnem.nodes.regular(dom, np.asarray(0.25).astype(kind)),
+    }
+
+
+@pytest.mark.parametrize("kind", [complex, bool, str])
+@pytest.mark.parametrize("call", sorted(_entry_points()))
+def test_coordinates_that_are_not_real_numbers_are_refused(call, kind):
+    """Complex coordinates lost their imaginary part, booleans became 0 and 1 and the
+    string "0.1" a spacing, silently: each is refused by name."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                # no ComplexWarning on the way
+        with pytest.raises(cnem.CNEMError, match="expected real numbers"):
+            _entry_points()[call](kind)

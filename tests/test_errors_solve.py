@@ -82,3 +82,29 @@ def test_enriched_plate_of_16k_nodes_solves_on_the_automatic_path():
     assert A.nnz > config.DIRECT_NNZ and 15_000 < len(nodal) // 2
     x = linsolve.solve_spd(A, b, modes=modes, nodal=nodal, tol=1e-10)
     assert _relative_residual(A, x, b) <= 1e-9
+
+
+def _problems():
+    """One small problem of each class that takes loads: C-NEM, P1 and PD."""
+    import cnem.fem
+    import cnem.pd as pd
+    dom = cnem.geometry.rectangle()
+    model = cnem.discretize(cnem.nodes.regular(dom, 0.25))
+    g = np.linspace(0.0, 1.0, 6)
+    body = pd.Body(np.array([(x, y) for x in g for y in g]), 0.04, 0.6)
+    return {"cnem": cnem.Elasticity(model, (1.0, 0.3)),
+            "p1": cnem.fem.P1Elasticity(dom, (1.0, 0.3), max_area=0.05),
+            "pd": pd.Problem(body, pd.StateBased(1.0, 0.3))}
+
+
+@pytest.mark.parametrize("kind", ["cnem", "p1", "pd"])
+@pytest.mark.parametrize("bad", [5.0, [1.0, 2.0, 3.0], [[1.0, 2.0]]])
+def test_an_ambiguous_constant_load_is_refused(kind, bad):
+    """A bare number where a vector is meant (t = 5 became (5, 5)) and a constant of the
+    wrong shape are refused, with the fix named; tractions and body forces alike."""
+    prob = _problems()[kind]
+    with pytest.raises(cnem.ConditionError, match="vector of 2 components"):
+        prob.add_body_force(bad)
+    if kind != "pd":                       # PD takes no tractions at all
+        with pytest.raises(cnem.ConditionError, match="pressure p along the outward normal"):
+            prob.add_traction(lambda x, nrm: x[:, 0] > 1.0 - 1e-9, bad)

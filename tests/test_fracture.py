@@ -68,6 +68,19 @@ def test_path_independence():
     assert np.ptp(values[:, 0]) < 0.02 and np.ptp(values[:, 1]) < 0.02 * 0.5, values
 
 
+def test_a_disc_below_a_few_spacings_warns():
+    """A user's disc that holds less than ``SIF_SPACINGS`` node spacings cannot resolve
+    the field (K_I about half the exact 1 on an edge-crack model): it warns, naming the
+    smallest radius to use; a disc of several spacings gives K_I and does not warn."""
+    sol = _solve(_model(0.0, 0.05, True), 1.0, 0.0, "strain")
+    with pytest.warns(cnem.SIFWarning, match="local node spacings"):
+        sif(sol, (0.0, 0.0), radius=0.02)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", cnem.SIFWarning)
+        assert abs(sif(sol, (0.0, 0.0), radius=0.4).KI - 1.0) < 0.03
+
+
 def test_default_radius_is_a_few_spacings():
     sol = _solve(_model(0.0, 0.1, False), 1.0, 0.0, "strain")
     out = sif(sol, (0.05, 0.02))               # the nearest tip is taken

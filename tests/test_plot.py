@@ -118,3 +118,22 @@ def test_field_symbols_are_mathtext_that_vtk_draws():
         parser.parse(label)                       # raises on TeX that mathtext cannot draw
     cnem.plot.fields._pyvista().Plotter(off_screen=True).close()
     assert vtkMathTextUtilities.GetInstance() is not None
+
+
+@pytest.mark.parametrize("size", [(-5, -5), (100000, 100000), (0, 0), (1200.5, 900), 800,
+                                  (True, 10), (10, 10, 10)])
+def test_a_window_vtk_cannot_make_is_refused(size, tmp_path):
+    """Negative or huge windows made VTK abort the interpreter and (0, 0) divided by zero:
+    they are refused before VTK sees them, with what to give instead."""
+    with pytest.raises(cnem.PlotInputError, match="window_size"):
+        cnem.plot.model(model("annulus_sector_regular")[2], tmp_path / "m.png", window_size=size)
+
+
+def test_a_non_finite_scale_is_refused(tmp_path):
+    mdl = model("annulus_sector_regular")[2]
+    prob = cnem.Elasticity(mdl, (1.0, 0.3))
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+    prob.add_body_force([1.0, 0.0])
+    sol = prob.solve(progress=False)
+    with pytest.raises(cnem.PlotInputError, match="scale"):
+        cnem.plot.solution(sol, tmp_path / "s.png", scale=float("nan"))

@@ -48,7 +48,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import cnem
-from cnem.cli import demo_parser
+from cnem.cli import demo_parser, positive_int
 from cnem.errors import InputError
 from cnem.exact import LayeredCylinder
 
@@ -337,7 +337,7 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/bimaterial_cylinder.py --help`` or
     ``cnem demo bimaterial-cylinder``."""
     parser = demo_parser(__file__, __doc__, prog)
-    parser.add_argument("--nodes", type=int, nargs="+",
+    parser.add_argument("--nodes", type=positive_int, nargs="+",
                         help="node counts (default the paper's 147 315 687 1863)")
     kind = parser.add_mutually_exclusive_group()
     kind.add_argument("--irregular", action="store_true", help="irregular clouds only")

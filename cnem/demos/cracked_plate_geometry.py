@@ -40,7 +40,7 @@ import numpy as np
 import cnem
 import cnem.io
 import cnem.plot
-from cnem.cli import demo_parser
+from cnem.cli import demo_parser, positive_float, positive_int
 from cnem.geometry import SegmentKind, rectangle
 
 if TYPE_CHECKING:
@@ -142,11 +142,11 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/cracked_plate_geometry.py --help`` or
     ``cnem demo cracked-plate-geometry``."""
     parser = demo_parser(__file__, __doc__, prog)
-    parser.add_argument("--h", type=float, default=0.1, help="spacing away from the crack")
-    parser.add_argument("--h-min", type=float, default=0.01, help="spacing at the tips")
+    parser.add_argument("--h", type=positive_float, default=0.1, help="spacing away from the crack")
+    parser.add_argument("--h-min", type=positive_float, default=0.01, help="spacing at the tips")
     parser.add_argument("--gamma", type=float, default=30.0, help="crack angle in degrees")
-    parser.add_argument("--growth", type=float, default=0.1, help="spacing grading rate")
-    parser.add_argument("--size", type=int, default=1200, help="picture size in pixels")
+    parser.add_argument("--growth", type=positive_float, default=0.1, help="spacing grading rate")
+    parser.add_argument("--size", type=positive_int, default=1200, help="picture size in pixels")
     args = parser.parse_args(argv)
     res = main(h=args.h, h_min=args.h_min, gamma_deg=args.gamma, growth=args.growth,
                outdir=args.out, plot=not args.no_plot, window_size=(args.size, args.size))

@@ -73,7 +73,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cnem
-from cnem.cli import demo_parser
+from cnem.cli import demo_parser, positive_float, positive_int
 
 if TYPE_CHECKING:
     from typing import Sequence
@@ -291,12 +291,12 @@ def main(h: float = 0.05, *, increment: float = 0.1, steps: int = 30, angles: tu
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_dcb --help`` or ``cnem demo growth-dcb``."""
     parser = demo_parser(__file__, __doc__, prog)
-    parser.add_argument("--h", type=float, default=0.05, help="node spacing (units of H)")
-    parser.add_argument("--increment", type=float, default=0.1, help="crack increment (units of H)")
-    parser.add_argument("--steps", type=int, default=30, help="growth increments")
+    parser.add_argument("--h", type=positive_float, default=0.05, help="node spacing (units of H)")
+    parser.add_argument("--increment", type=positive_float, default=0.1, help="crack increment (units of H)")
+    parser.add_argument("--steps", type=positive_int, default=30, help="growth increments")
     parser.add_argument("--angles", type=float, nargs="+", default=list(ANGLES),
                         help="initial kink angles (degrees)")
-    parser.add_argument("--converge", type=float, default=None,
+    parser.add_argument("--converge", type=positive_float, default=None,
                         help="an angle (the nearest one is taken): run it again with h / 2 and increment / 2")
     args = parser.parse_args(argv)
     return main(args.h, increment=args.increment, steps=args.steps, angles=tuple(args.angles),

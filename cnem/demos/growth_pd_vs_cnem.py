@@ -99,7 +99,7 @@ import shapely
 import cnem
 import cnem.pd as pd
 from cnem._parallel import one_thread
-from cnem.cli import demo_parser
+from cnem.cli import demo_parser, positive_float, positive_int
 from cnem.errors import GeometryError
 from cnem.demos import growth_two_holes as plate
 from cnem.demos.damage.ridge import ridge_bands, ridge_path
@@ -512,17 +512,17 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> dict:
     """Command line: ``python -m cnem.demos.growth_pd_vs_cnem --help`` or
     ``cnem demo growth-pd-vs-cnem``."""
     parser = demo_parser(__file__, __doc__, prog)
-    parser.add_argument("--h", type=float, nargs="+", default=[0.25], help="node spacings (mm)")
+    parser.add_argument("--h", type=positive_float, nargs="+", default=[0.25], help="node spacings (mm)")
     parser.add_argument("--model", choices=("bond", "state"), default="bond",
                         help="the PD material model")
-    parser.add_argument("--steps", type=int, default=12, help="C-NEM increments")
-    parser.add_argument("--factor-step", type=float, default=0.02,
+    parser.add_argument("--steps", type=positive_int, default=12, help="C-NEM increments")
+    parser.add_argument("--factor-step", type=positive_float, default=0.02,
                         help="PD load step, a fraction of the first-breaking factor")
-    parser.add_argument("--factor-max", type=float, default=1.5, help="largest PD load factor")
+    parser.add_argument("--factor-max", type=positive_float, default=1.5, help="largest PD load factor")
     parser.add_argument("--solver", choices=("adr", "sequential"), default="adr",
                         help="PD load stepping: ADR load steps, or event by event with linear "
                              "solves (cnem.pd.sequential)")
-    parser.add_argument("--max-solves", type=int, default=100_000,
+    parser.add_argument("--max-solves", type=positive_int, default=100_000,
                         help="most linear solves of --solver sequential")
     parser.add_argument("--scaling", action="store_true",
                         help="only the first-break load factors at holes and notches against "

@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cnem
-from cnem.cli import demo_parser
+from cnem.cli import demo_parser, positive_float
 
 if TYPE_CHECKING:
     from typing import Sequence
@@ -126,8 +126,8 @@ def main(h: float = 0.01, *, a0: float = 0.2, a1: float = 0.6, increment: float 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_sent --help`` or ``cnem demo growth-sent``."""
     parser = demo_parser(__file__, __doc__, prog)
-    parser.add_argument("--h", type=float, default=0.01, help="node spacing (fraction of W)")
-    parser.add_argument("--increment", type=float, default=0.02, help="crack increment / W")
+    parser.add_argument("--h", type=positive_float, default=0.01, help="node spacing (fraction of W)")
+    parser.add_argument("--increment", type=positive_float, default=0.02, help="crack increment / W")
     parser.add_argument("--full", action="store_true",
                         help="rebuild the model and operators at every increment (no local update)")
     args = parser.parse_args(argv)

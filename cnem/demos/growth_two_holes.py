@@ -85,7 +85,7 @@ import numpy as np
 import shapely
 
 import cnem
-from cnem.cli import demo_parser
+from cnem.cli import demo_parser, positive_float, positive_int
 from cnem.geometry import arc
 
 if TYPE_CHECKING:
@@ -323,9 +323,9 @@ def study(runs: Sequence[tuple] = STUDY, outdir: str = "results/growth_two_holes
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_two_holes --help`` or ``cnem demo growth-two-holes``."""
     parser = demo_parser(__file__, __doc__, prog)
-    parser.add_argument("--h", type=float, default=0.25, help="background node spacing (mm)")
-    parser.add_argument("--increment", type=float, default=1.0, help="crack increment (mm)")
-    parser.add_argument("--steps", type=int, default=12, help="growth increments")
+    parser.add_argument("--h", type=positive_float, default=0.25, help="background node spacing (mm)")
+    parser.add_argument("--increment", type=positive_float, default=1.0, help="crack increment (mm)")
+    parser.add_argument("--steps", type=positive_int, default=12, help="growth increments")
     parser.add_argument("--no-rings", action="store_true", help="no refinement following the tips")
     parser.add_argument("--study", action="store_true",
                         help="also the convergence study: spacing/2, increment/2 and /4, the "

@@ -43,7 +43,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import cnem
-from cnem.cli import demo_parser
+from cnem.cli import demo_parser, positive_float
 from cnem.exact import CentralCrack
 from cnem.fracture import sif
 
@@ -219,7 +219,7 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     parser = demo_parser(__file__, __doc__, prog)
     parser.add_argument("--angles", type=float, nargs="+", default=list(ANGLES),
                         help="crack angles in degrees")
-    parser.add_argument("--h-min", type=float, default=SIF_CLOUD[2], help="spacing at the tips")
+    parser.add_argument("--h-min", type=positive_float, default=SIF_CLOUD[2], help="spacing at the tips")
     args = parser.parse_args(argv)
     cloud = (SIF_CLOUD[0], SIF_CLOUD[1], args.h_min, SIF_CLOUD[3])
     return main(tuple(args.angles), sif_cloud=cloud, outdir=args.out, plot=not args.no_plot)

@@ -86,7 +86,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cnem.pd as pd
-from cnem.cli import demo_parser, dynamic_run_options
+from cnem.cli import demo_parser, dynamic_run_options, positive_float
 from cnem.errors import InputError, MissingExtraError
 from cnem.pd.critical_stretch import bond_based
 from cnem.pd.guards import checked_schedule
@@ -406,10 +406,10 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> dict:
     parser = demo_parser(__file__, __doc__, prog)
     parser.epilog = ("Distributed: mpiexec -n 2 python -m cnem.demos.kalthoff_winkler [options] "
                      "(the same run on 2 MPI ranks; needs cnem[mpi]).")
-    parser.add_argument("--h", type=float, nargs="+", default=[1.0, 0.5],
+    parser.add_argument("--h", type=positive_float, nargs="+", default=[1.0, 0.5],
                         help="grid spacings in mm (each dividing 25 mm), one run each")
-    parser.add_argument("--m", type=float, default=4.0, help="horizon / spacing")
-    parser.add_argument("--time", type=float, default=50.0, help="simulated time in µs")
+    parser.add_argument("--m", type=positive_float, default=4.0, help="horizon / spacing")
+    parser.add_argument("--time", type=positive_float, default=50.0, help="simulated time in µs")
     dynamic_run_options(parser, frames=5.0, quick_h=QUICK["h"][0], quick_m=QUICK["m"],
                         quick_t_end=QUICK["t_end"])
     args = parser.parse_args(argv)

@@ -48,7 +48,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import cnem
-from cnem.cli import demo_parser
+from cnem.cli import demo_parser, positive_int
 from cnem.fracture import polar, sif, williams
 
 if TYPE_CHECKING:
@@ -211,7 +211,7 @@ def main(spacings: tuple = SPACINGS, *, methods: tuple = ("cnem", "enriched", "f
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/mode1_crack.py --help`` or ``cnem demo mode1-crack``."""
     parser = demo_parser(__file__, __doc__, prog)
-    parser.add_argument("--n", type=int, nargs="+", default=[8, 16, 32, 64],
+    parser.add_argument("--n", type=positive_int, nargs="+", default=[8, 16, 32, 64],
                         help="nodes per side of the regular clouds (h = 1 / n)")
     parser.add_argument("--no-fem", action="store_true", help="skip the scikit-fem P1 anchor")
     args = parser.parse_args(argv)

@@ -78,7 +78,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cnem.pd as pd
-from cnem.cli import demo_parser, dynamic_run_options
+from cnem.cli import demo_parser, dynamic_run_options, positive_float
 from cnem.errors import InputError
 from cnem.exact import rayleigh_speed
 from cnem.pd import cracks
@@ -403,9 +403,9 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/pd_crack_branching.py --help`` or
     ``cnem pd pd-crack-branching``."""
     parser = demo_parser(__file__, __doc__, prog)
-    parser.add_argument("--h", type=float, default=0.25, help="grid spacing in mm")
-    parser.add_argument("--m", type=float, default=4.0, help="horizon / spacing")
-    parser.add_argument("--time", type=float, default=46.0, help="simulated time in µs")
+    parser.add_argument("--h", type=positive_float, default=0.25, help="grid spacing in mm")
+    parser.add_argument("--m", type=positive_float, default=4.0, help="horizon / spacing")
+    parser.add_argument("--time", type=positive_float, default=46.0, help="simulated time in µs")
     parser.add_argument("--material", choices=sorted(MATERIALS), default="soda-lime",
                         help="the glass (see the module docstring)")
     parser.add_argument("--stress", type=float, help="edge traction in MPa (default: 2 for "

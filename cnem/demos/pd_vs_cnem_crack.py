@@ -42,7 +42,7 @@ from tqdm.auto import tqdm
 
 import cnem
 import cnem.pd as pd
-from cnem.cli import demo_parser
+from cnem.cli import demo_parser, positive_int
 from cnem.exact import CentralCrack
 from cnem.fracture import sif
 from cnem.fracture.opening import crack_opening, k_from_opening
@@ -204,7 +204,7 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/pd_vs_cnem_crack.py --help`` or
     ``cnem demo pd-vs-cnem-crack``."""
     parser = demo_parser(__file__, __doc__, prog)
-    parser.add_argument("--n", type=int, nargs="+", default=[16, 32, 64],
+    parser.add_argument("--n", type=positive_int, nargs="+", default=[16, 32, 64],
                         help="nodes per unit length (h = 1 / n)")
     args = parser.parse_args(argv)
     return main(tuple(1.0 / n for n in args.n), outdir=args.out, plot=not args.no_plot)

@@ -29,7 +29,7 @@ from .. import config
 from ..assembly.quadrature import cell_quadrature
 from ..errors import FractureError, SIFWarning
 from ..material import effective_modulus
-from .discs import clearance, default_radii
+from .discs import clearance, default_radii, local_spacing
 from .williams import williams
 
 if TYPE_CHECKING:
@@ -134,8 +134,8 @@ def _spread(values):
 
 
 def _check(res, spacing, limited_by, user):
-    """Warn (`SIFWarning`) when the discs disagree, hold too few spacings, or a user's disc
-    reaches past an obstacle."""
+    """Warn (`SIFWarning`) when the discs disagree, hold too few node spacings (the
+    default discs or a user's), or a user's disc reaches past an obstacle."""
     lim, at = res.clearance, res.tip.tolist()
     best = config.SIF_REACH * lim.distance
     if user and res.radius >= lim.distance:
@@ -144,6 +144,13 @@ def _check(res, spacing, limited_by, user):
                       f"tip): the interaction integral does not hold across it; use a radius "
                       f"below {lim.distance:.4g}, e.g. {best:.4g} (leave radius=None to check "
                       "nested discs up to it)", SIFWarning, stacklevel=3)
+        return
+    if user and res.radius < config.SIF_SPACINGS * spacing:
+        warnings.warn(f"the disc of radius {res.radius:.4g} about the tip {at} holds only "
+                      f"{res.radius / spacing:.2g} local node spacings ({spacing:.4g}): K is not "
+                      f"resolved on such a disc; use a radius of at least "
+                      f"{config.SIF_SPACINGS * spacing:.4g} (leave radius=None for nested discs "
+                      f"up to {lim.obstacle})", SIFWarning, stacklevel=3)
         return
     if not user and res.radius < config.SIF_SPACINGS * spacing:
         warnings.warn(f"only {res.radius / spacing:.2g} local node spacings ({spacing:.4g}) fit "
@@ -209,7 +216,7 @@ def sif(sol: Any, tip: np.ndarray, *, radius: float | None = None, order: int = 
         if not np.isfinite(radius) or radius <= 0:
             raise FractureError(f"radius: expected a positive number, received {radius}; leave "
                                 f"it None for nested discs up to {limit.obstacle}")
-        radii, spacing, limited_by = np.array([radius]), float("nan"), limit.obstacle
+        radii, spacing, limited_by = np.array([radius]), local_spacing(model, at), limit.obstacle
     else:
         radii, spacing, limited_by = default_radii(model, at, limit)
     values, region = _disc_integrals(sol, at, d, radii, order)

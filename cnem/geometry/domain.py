@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 
 from .. import config
 from .._predicates import Frame, local_frame
-from ..errors import GeometryError
+from ..errors import GeometryError, check_real
 from .pslg import CRACK, PSLG, build_pslg, ring_coordinates
 
 __all__ = ["Domain"]
@@ -30,7 +30,7 @@ def _fmt(p):
 
 
 def _check_ring(coords, what):
-    arr = np.asarray(coords, dtype=float)
+    arr = np.asarray(check_real(what, coords, error=GeometryError), dtype=float)
     if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 3:
         raise GeometryError(f"{what}: expected a (k, 2) array of at least 3 vertices, "
                             f"received shape {arr.shape}")
@@ -121,7 +121,10 @@ def _is_single_polygon(obj):
             and np.ndim(obj[0]) == 2:
         return True                          # (shell, [hole, ...])
     try:
-        arr = np.asarray(obj, dtype=float)
+        arr = np.asarray(obj)
+        if arr.dtype.kind not in "biuf":        # complex, strings: a ring, refused by name
+            return arr.ndim == 2 and arr.shape[1] == 2
+        arr = arr.astype(float)
     except (ValueError, TypeError):
         return False
     return arr.ndim == 2 and arr.shape[1] == 2

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from .. import config
-from ..errors import GeometryError, LimitError
+from ..errors import GeometryError, LimitError, check_array, check_real
 from .cloud import NodeCloud
 from .pslg import SegmentKind, segment_projection
 
@@ -32,7 +32,11 @@ if TYPE_CHECKING:
 __all__ = ["regular", "irregular", "graded", "from_points", "NodeCloud"]
 
 def _check_spacing(dom, h, name="h"):
-    h = float(h)
+    if np.ndim(h) != 0:
+        raise GeometryError(f"{name}: expected one spacing (a number), received an array of "
+                            f"shape {np.shape(h)}; for spacings that vary use graded(...)")
+    h = float(check_array(name, h, error=GeometryError, finite=False,
+                          fix="pass the node spacing as a number, e.g. 0.1"))
     if not np.isfinite(h) or h <= 0:
         raise GeometryError(f"{name} must be a positive spacing, received {h!r}")
     if h >= dom.diameter:
@@ -419,7 +423,7 @@ def from_points(domain: Domain, points: ArrayLike, *, fill: bool = True) -> Node
         with ``fill=False``, an edge gap longer than `cnem.config.FILL_SPACINGS`
         local spacings.
     """
-    pts = np.array(points, dtype=float)
+    pts = np.array(check_real("points", points, error=GeometryError), dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise GeometryError(f"points: expected a (p, 2) array, received shape {pts.shape}")
     if not np.isfinite(pts).all():

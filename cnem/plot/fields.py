@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .. import config
 from ..errors import PlotDependencyError, PlotError, PlotInputError
 from ..geometry.pslg import SegmentKind
 from ..io import cell_topology
@@ -166,7 +167,7 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
     if not (bx1 > bx0 and by1 > by0):
         raise PlotInputError(f"bounds must be (xmin, ymin, xmax, ymax) with xmin < xmax and "
                              f"ymin < ymax, received {tuple(bounds)}; give a non-empty view")
-    width, height = map(int, window_size)
+    width, height = window_pixels(window_size)
     lift = 1e-4 * dom.diameter        # draw lines above the cells (parallel view: no shift)
     pl = _plotter(pv, width, height)
     # pixels per unit length in the final view
@@ -202,6 +203,34 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
     _top_view(pl, view, width, height, dom.diameter)
     _scale_bar(pl, pv, view, length_unit, 4 * lift)
     return _save(pl, path, "model")
+
+
+def window_pixels(window_size: Any) -> tuple[int, int]:
+    """``(width, height)`` of a picture, checked before VTK sees them.
+
+    Parameters
+    ----------
+    window_size : (2,) int array_like
+
+    Returns
+    -------
+    (int, int)
+
+    Raises
+    ------
+    PlotInputError
+        Not two whole numbers from 1 to `cnem.config.PLOT_MAX_PIXELS` (VTK aborts the
+        interpreter on a negative or huge window, and divides by zero on an empty one).
+    """
+    size = np.asarray(window_size, dtype=object).reshape(-1) if np.ndim(window_size) else None
+    limit = config.PLOT_MAX_PIXELS
+    ok = size is not None and len(size) == 2 and all(
+        isinstance(v, (int, np.integer)) and not isinstance(v, bool) and 1 <= v <= limit
+        for v in size)
+    if not ok:
+        raise PlotInputError(f"window_size: expected (width, height) in whole pixels from 1 to "
+                             f"{limit}, received {window_size!r}; give e.g. (1200, 1000)")
+    return int(size[0]), int(size[1])
 
 
 def _plotter(pv, width, height):
@@ -437,11 +466,14 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *,
         nodes, triangles, diameter = model.nodes, None, model.domain.diameter
     else:
         nodes, triangles, diameter = sol.plot_mesh()
+    width, height = window_pixels(window_size)
     umax = float(np.abs(sol.u).max())
     if scale is None:
         scale = 0.05 * diameter / umax if umax > 0 else 0.0
+    elif not (np.ndim(scale) == 0 and np.isfinite(scale)):
+        raise PlotInputError(f"scale: expected a finite number (the displacement magnification), "
+                             f"received {scale!r}; give e.g. 10.0, or None for 5 % of the body")
     moved = nodes + scale * sol.u
-    width, height = map(int, window_size)
     pl = _plotter(pv, width, height)
     if per_cell is not None:
         mesh = cells_polydata(model)

@@ -9,7 +9,7 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
 from .. import config
-from ..errors import CNEMError, GeometryError, UnsupportedError, check_choice
+from ..errors import CNEMError, GeometryError, UnsupportedError, check_choice, check_real
 from .._parallel import work_chunks
 from . import _kernels as K
 
@@ -151,7 +151,8 @@ def shape_functions(model: Any, points: ArrayLike, *, kind: Literal["sibson", "l
     if gradient and kind != "sibson":
         raise UnsupportedError("gradient=True: gradients are available for kind='sibson' "
                                "only; pass kind='sibson' or gradient=False")
-    pts = np.ascontiguousarray(points, dtype=np.float64)
+    pts = np.ascontiguousarray(check_real("points", points, error=GeometryError),
+                               dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise GeometryError(f"points: expected a (p, 2) array, received shape {pts.shape}")
     if not np.isfinite(pts).all():

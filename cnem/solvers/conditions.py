@@ -31,7 +31,7 @@ from ..errors import ConditionError, UnsupportedError
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-__all__ = ["Conditions", "select_nodes", "Traction", "per_point", "traction_at", "dirichlet_dofs", "last_wins"]
+__all__ = ["Conditions", "select_nodes", "vector_constant", "Traction", "per_point", "traction_at", "dirichlet_dofs", "last_wins"]
 
 #: What `where` may be: a predicate over points, a boolean mask or indices.
 Where = Union[Callable[[np.ndarray], np.ndarray], np.ndarray, list]
@@ -95,6 +95,38 @@ def per_point(value: ArrayLike | Callable[..., np.ndarray], points: np.ndarray, 
         raise ConditionError(f"{what}: expected finite values, received NaN or inf; check "
                              f"the value or function given")
     return arr
+
+
+def vector_constant(value: Any, dim: int, what: str, fix: str) -> Any:
+    """``value`` as given, once it is known not to be an ambiguous constant: a vector
+    quantity (a traction, a body force) given as a constant must have ``dim`` components.
+
+    Parameters
+    ----------
+    value : callable or array_like
+        A callable is returned as it is (its values are checked where it is called).
+    dim : int
+    what : str
+        The argument, named in the error.
+    fix : str
+        What to pass instead, named in the error.
+
+    Raises
+    ------
+    ConditionError
+        A bare number (which component would it be?) or a constant of another shape.
+    """
+    if callable(value):
+        return value
+    shape = np.shape(value)
+    if shape == ():
+        raise ConditionError(f"{what}: expected a vector of {dim} components or a callable, "
+                             f"received the single number {value!r}, which is ambiguous (the "
+                             f"same value on every component is rarely meant); {fix}")
+    if shape != (dim,):
+        raise ConditionError(f"{what}: expected a vector of {dim} components or a callable, "
+                             f"received an array of shape {shape}; {fix}")
+    return value
 
 
 def traction_at(t: ArrayLike | Callable[..., np.ndarray], points: np.ndarray, normal: np.ndarray,
@@ -236,8 +268,13 @@ class Conditions:
             ``nrm (q, 2)``; each solver integrates them exactly up to quadratic
             tractions along an edge.
         """
-        edges, normal = self.boundary_edges()
         x = self.condition_points
+        d = x.shape[1]
+        example = ", ".join(["0.0"] * (d - 1) + ["-1.0"])
+        t = vector_constant(t, d, "add_traction: t",
+                            f"give the traction vector, e.g. [{example}], or a pressure p "
+                            f"along the outward normal as lambda x, nrm: -p * nrm")
+        edges, normal = self.boundary_edges()
         mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
         pick = np.asarray(where(mid, normal)) if callable(where) else np.asarray(where)
         if pick.shape != (len(edges),) or pick.dtype != bool:
@@ -251,8 +288,17 @@ class Conditions:
         self.tractions.append(Traction(index, edges[index], normal[index], t))
 
     def add_body_force(self, b: Any) -> None:
-        """Body force per unit area (2-D) or volume: ``b(x) -> (p, d)`` or a constant ``(d,)``."""
-        self.body_forces.append(b)
+        """Body force per unit area (2-D) or volume: ``b(x) -> (p, d)`` or a constant ``(d,)``.
+
+        Raises
+        ------
+        ConditionError
+            A bare number or a constant that is not ``(d,)``.
+        """
+        d = self.condition_points.shape[1]
+        example = ", ".join(["0.0"] * (d - 1) + ["-9.81"])
+        self.body_forces.append(vector_constant(b, d, "add_body_force: b",
+                                                f"give the force vector, e.g. [{example}]"))
 
     def body_forces_at(self, points: np.ndarray) -> list:
         """The body forces at points, one ``(p, d)`` array per condition.

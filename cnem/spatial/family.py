@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from .. import config
-from ..errors import LimitError, SpatialError, check_array, check_choice
+from ..errors import LimitError, SpatialError, check_array, check_choice, check_real
 from . import _family_kernels as K
 from . import _pair_kernels as P
 from .._parallel import work_chunks
@@ -217,7 +217,7 @@ def family_search(points: ArrayLike, horizon: float | ArrayLike, *,
         ``"brute"`` on more than `cnem.config.BRUTE_LIMIT` points.
     """
     check_choice("method", method, METHODS)
-    arr = np.asarray(points, dtype=np.float64)
+    arr = np.asarray(check_real("points", points, error=SpatialError), dtype=np.float64)
     pts = as_points(arr if arr.size else arr.reshape(0, arr.shape[-1] if arr.ndim == 2 else 2))
     n, d = pts.shape
     per = check_period(period, d, pts)
