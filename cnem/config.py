@@ -13,6 +13,7 @@ True
 """
 
 __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "ROUNDOFF_ULPS",
+           "HORIZON_RTOL",
            "BOUNDARY_FINER", "SHALLOW_END", "CLEARANCE", "MIN_SPACING", "MAX_NODES", "FILL_SPACINGS",
            "SPACING_NEIGHBOURS", "SPACING_COUNT_TOL", "SPACING_BISECTIONS", "FANOUT",
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
@@ -62,6 +63,13 @@ BOUNDARY_FINER = 0.25
 #: round-off (``Frame.resolution``: ``eps`` times their magnitude): the shape
 #: functions' node and edge tolerances are at least this many times it.
 ROUNDOFF_ULPS = 16
+
+#: A peridynamic bond whose length is within this fraction of the horizon above it is in
+#: the family (its partial volume is then about 1/2): a horizon of a whole number of
+#: lattice spacings, the usual choice, then takes the bonds at the horizon whatever the
+#: round-off of their lengths, and the bonds do not jump as the horizon moves by
+#: round-off; `cnem.pd.Body`.
+HORIZON_RTOL = 1e-9
 
 # ---------------------------------------------------------------- node generation
 #: Interior nodes closer than this fraction of the local spacing to a boundary,

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import cnem
+import cnem.pd as pd
 from cnem.pd import Body
 
 H = 2.0 ** -5
@@ -64,3 +65,30 @@ def test_body_from_a_cracked_cloud_is_invariant(scale, shift):
     np.testing.assert_allclose((moved.points - np.asarray(shift)) / scale, ref.points, atol=1e-9)
     np.testing.assert_array_equal(moved.family.offsets, ref.family.offsets)
     np.testing.assert_array_equal(moved.family.indices, ref.family.indices)
+
+
+def _clamped_plate(material, horizon, shift=0.0):
+    """A 0.1 lattice of the unit square, left edge clamped, body force (1, 0.5): the
+    number of bonds and max |u|."""
+    g = np.arange(0.0, 1.0 + 1e-9, 0.1)
+    pts = np.array([(x, y) for x in g for y in g]) + shift
+    body = pd.Body(pts, 0.01, horizon)
+    prob = pd.Problem(body, material)
+    prob.add_dirichlet(lambda p: p[:, 0] < shift + 0.05, None)
+    prob.add_body_force([1.0, 0.5])
+    return len(body.bond_j), float(np.abs(prob.solve().u).max())
+
+
+@pytest.mark.parametrize("material", [pd.StateBased(1.0, 0.3), pd.BondBased(1.0)],
+                         ids=["state", "bond"])
+def test_bonds_at_a_horizon_of_whole_spacings_do_not_turn_on_round_off(material):
+    """Horizon 3h on an h lattice: the bonds of length 3h (partial volume 1/2) are in the
+    family wherever the body lies and however the horizon is rounded. Before, the body
+    moved by 1e6 lost or gained such bonds (u changed by 0.3-2.4 %), and the horizons
+    0.3 - 1e-12, 0.3 and 0.3 + 1e-12 gave max |u| 1.568, 1.581 and 1.615."""
+    bonds, u = _clamped_plate(material, 0.3)
+    for horizon, shift in ((0.3, 1e6), (0.3 - 1e-12, 0.0), (0.3 + 1e-12, 0.0),
+                           (0.1 + 0.2, 0.0)):
+        moved_bonds, moved_u = _clamped_plate(material, horizon, shift)
+        assert moved_bonds == bonds, (horizon, shift)
+        assert abs(moved_u - u) <= 1e-9 * u, (horizon, shift, moved_u, u)

@@ -6,6 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .. import config
 from ..errors import InputError, check_array, check_points
 from ..spatial import family_search, remove_crossing
 from ._kernels import bond_geometry, image_factors
@@ -17,7 +18,7 @@ if TYPE_CHECKING:
     from typing import Sequence
     from numpy.typing import ArrayLike
 
-__all__ = ["Body", "checked_input", "crack_segments"]
+__all__ = ["Body", "bond_reach", "checked_input", "crack_segments"]
 
 
 def _past_the_mouths(crack, tips, reach, tol):
@@ -73,6 +74,30 @@ def crack_segments(cracks: Sequence[ArrayLike]) -> np.ndarray | None:
     return np.concatenate(segs) if segs else None
 
 
+def bond_reach(points: np.ndarray, horizon: float) -> float:
+    """The radius within which a body's bonds are searched: the horizon, a relative
+    `cnem.config.HORIZON_RTOL` above it, plus the round-off of the coordinates
+    (`cnem.config.ROUNDOFF_ULPS` units in the last place of the largest one).
+
+    The partial volume of a bond is 1/2 at the horizon, so a bond of length equal to it
+    belongs to the family; without the margin the round-off of its length decided
+    (and a body moved far from the origin, or a horizon moved by 1e-12, lost or gained
+    such bonds).
+
+    Parameters
+    ----------
+    points : (n, d) ndarray
+    horizon : float
+
+    Returns
+    -------
+    float
+    """
+    scale = max(float(np.abs(points).max(initial=0.0)), horizon)
+    return horizon * (1.0 + config.HORIZON_RTOL) + \
+        config.ROUNDOFF_ULPS * float(np.finfo(float).eps) * scale
+
+
 class Body:
     """Material points with volumes and a horizon; bonds from `cnem.spatial.family_search`.
 
@@ -116,7 +141,7 @@ class Body:
         pts, vol, horizon, self.thickness = checked_input(points, volumes, horizon, thickness)
         n, d = pts.shape
         self.points, self.volumes, self.horizon, self.dim = pts, vol, horizon, d
-        fam = family_search(pts, horizon, period=period)
+        fam = family_search(pts, bond_reach(pts, horizon), period=period)
         segments = crack_segments(cracks)
         if segments is not None:
             test = pts if crossing_points is None else np.asarray(crossing_points, dtype=float)

@@ -8,7 +8,7 @@ import numpy as np
 
 from ...spatial import family_search, remove_crossing
 from .._kernels import bond_geometry, image_factors
-from ..body import checked_input, crack_segments
+from ..body import bond_reach, checked_input, crack_segments
 from . import _kernels as K
 from .comm import Halo, world
 from .partition import bisect, ghost_candidates
@@ -73,6 +73,7 @@ class Body:
             np.broadcast_to(np.asarray(period, dtype=float), (d,)).copy()
         self.image = image_factors(self.period)
         self._period_arg = period
+        self.reach = bond_reach(pts, horizon)
         rank, size = self.comm.rank, self.comm.size
         weights = np.ones(n)
         if size > 1:        # a first cut by point count gives the family sizes to weigh by
@@ -109,11 +110,11 @@ class Body:
         """Families of the points of ``part == rank``: CSR offsets and global member ids,
         each row sorted by id."""
         owned = np.flatnonzero(part == rank)
-        candidates = ghost_candidates(self.global_points, part, rank, self.horizon,
+        candidates = ghost_candidates(self.global_points, part, rank, self.reach,
                                       self._period_arg)
         local = np.concatenate([owned, candidates])
         pts = self.global_points[local]
-        fam = family_search(pts, self.horizon, period=self._period_arg)
+        fam = family_search(pts, self.reach, period=self._period_arg)
         if self._cracks is not None:
             fam = remove_crossing(fam, self._crossing[local], self._cracks)
         offsets = np.ascontiguousarray(fam.offsets[:len(owned) + 1])
