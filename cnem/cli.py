@@ -92,12 +92,12 @@ def demo_command(module_file: str) -> str | None:
     return None
 
 
-def _positive(kind: type) -> Callable[[str], float]:
+def _positive(kind: type) -> Callable[[str], int | float]:
     """An argparse ``type`` that takes only positive, finite numbers of ``kind``: a bad value
     is one line naming the option (``error: argument --h: ...``), exit status 2."""
     noun = "whole number" if kind is int else "number"
 
-    def parse(text: str):
+    def parse(text: str) -> int | float:
         try:
             value = kind(text)
         except ValueError:

@@ -238,7 +238,10 @@ def check_real(name: str, value: object, *, error: type[InputError] = InputError
     tail = f"; {fix}" if fix else ""
     if value is None:
         raise error(f"{name}: expected real numbers, received None{tail}")
-    kind = value.dtype.kind if isinstance(value, np.ndarray) else np.asarray(value).dtype.kind
+    try:
+        kind = value.dtype.kind if isinstance(value, np.ndarray) else np.asarray(value).dtype.kind
+    except (TypeError, ValueError):          # ragged: the float conversion names it
+        return value
     if kind in _NOT_REAL:
         raise error(f"{name}: expected real numbers, received {_NOT_REAL[kind]} (dtype kind "
                     f"{kind!r}){tail}")

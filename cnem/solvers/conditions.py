@@ -97,9 +97,11 @@ def per_point(value: ArrayLike | Callable[..., np.ndarray], points: np.ndarray, 
     return arr
 
 
-def vector_constant(value: Any, dim: int, what: str, fix: str) -> Any:
+def vector_constant(value: Any, dim: int, what: str, fix: str, *,
+                    points: int | None = None) -> Any:
     """``value`` as given, once it is known not to be an ambiguous constant: a vector
-    quantity (a traction, a body force) given as a constant must have ``dim`` components.
+    quantity (a traction, a body force) given as a constant must have ``dim`` components
+    (or one row of them per point, when ``points`` is given).
 
     Parameters
     ----------
@@ -110,6 +112,8 @@ def vector_constant(value: Any, dim: int, what: str, fix: str) -> Any:
         The argument, named in the error.
     fix : str
         What to pass instead, named in the error.
+    points : int, optional
+        How many points a ``(points, dim)`` array of values would have.
 
     Raises
     ------
@@ -119,13 +123,15 @@ def vector_constant(value: Any, dim: int, what: str, fix: str) -> Any:
     if callable(value):
         return value
     shape = np.shape(value)
+    rows = "" if points is None else f" (or {points} rows of them, one per point)"
     if shape == ():
-        raise ConditionError(f"{what}: expected a vector of {dim} components or a callable, "
-                             f"received the single number {value!r}, which is ambiguous (the "
-                             f"same value on every component is rarely meant); {fix}")
-    if shape != (dim,):
-        raise ConditionError(f"{what}: expected a vector of {dim} components or a callable, "
-                             f"received an array of shape {shape}; {fix}")
+        raise ConditionError(f"{what}: expected a vector of {dim} components{rows} or a "
+                             f"callable, received the single number {value!r}, which is "
+                             f"ambiguous (the same value on every component is rarely meant); "
+                             f"{fix}")
+    if shape != (dim,) and shape != (points, dim):
+        raise ConditionError(f"{what}: expected a vector of {dim} components{rows} or a "
+                             f"callable, received an array of shape {shape}; {fix}")
     return value
 
 
@@ -288,7 +294,8 @@ class Conditions:
         self.tractions.append(Traction(index, edges[index], normal[index], t))
 
     def add_body_force(self, b: Any) -> None:
-        """Body force per unit area (2-D) or volume: ``b(x) -> (p, d)`` or a constant ``(d,)``.
+        """Body force per unit area (2-D) or volume: ``b(x) -> (p, d)``, a constant ``(d,)``,
+        or one ``(d,)`` row per condition point (node).
 
         Raises
         ------
@@ -298,7 +305,8 @@ class Conditions:
         d = self.condition_points.shape[1]
         example = ", ".join(["0.0"] * (d - 1) + ["-9.81"])
         self.body_forces.append(vector_constant(b, d, "add_body_force: b",
-                                                f"give the force vector, e.g. [{example}]"))
+                                                f"give the force vector, e.g. [{example}]",
+                                                points=len(self.condition_points)))
 
     def body_forces_at(self, points: np.ndarray) -> list:
         """The body forces at points, one ``(p, d)`` array per condition.
