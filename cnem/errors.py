@@ -58,7 +58,7 @@ __all__ = ["CNEMError", "InputError", "OptionError", "GeometryError", "MaterialE
            "FormatError", "HyperDualError", "LimitError", "UnsupportedError", "SolveError",
            "PlotError", "PlotDependencyError", "PlotInputError", "MissingExtraError", "GrowthWarning",
            "ConvergenceError", "DivergenceError", "StabilityWarning", "SIFWarning",
-           "check_choice", "check_real"]
+           "check_choice", "check_real", "check_count"]
 
 
 class CNEMError(Exception):
@@ -219,6 +219,33 @@ def check_choice(name: str, value: _Value, choices: Iterable[object], *,
 _NOT_REAL = {"c": "complex numbers (their imaginary part would be dropped)",
              "b": "booleans", "U": "strings", "S": "bytes", "M": "dates", "m": "time spans",
              "V": "raw records"}
+
+
+def check_count(name: str, value: object, *, minimum: int = 1,
+                error: type[InputError] = InputError) -> int:
+    """``value`` as an ``int`` of at least ``minimum``: a count (load steps, time steps,
+    iterations). A float is refused even when whole (``steps=2.5`` used to run 2 steps).
+
+    >>> check_count("steps", 3)
+    3
+    >>> try:
+    ...     check_count("steps", 2.5)
+    ... except InputError as exc:
+    ...     print(exc)
+    steps: expected a whole number >= 1, received 2.5 (float); pass e.g. 3
+    """
+    import operator
+
+    try:
+        count = None if isinstance(value, bool) else operator.index(value)
+    except TypeError:
+        count = None
+    if count is None:
+        raise error(f"{name}: expected a whole number >= {minimum}, received {value!r} "
+                    f"({type(value).__name__}); pass e.g. {max(minimum, 3)}")
+    if count < minimum:
+        raise error(f"{name}: expected a whole number >= {minimum}, received {count}")
+    return count
 
 
 def check_real(name: str, value: object, *, error: type[InputError] = InputError,

@@ -108,3 +108,38 @@ def test_an_ambiguous_constant_load_is_refused(kind, bad):
     if kind != "pd":                       # PD takes no tractions at all
         with pytest.raises(cnem.ConditionError, match="pressure p along the outward normal"):
             prob.add_traction(lambda x, nrm: x[:, 0] > 1.0 - 1e-9, bad)
+
+
+@pytest.mark.parametrize("kind", ["cnem", "p1", "pd"])
+@pytest.mark.parametrize("tol", [-1.0, 0.0, float("nan")])
+def test_a_tolerance_that_is_no_relative_residual_is_refused(kind, tol):
+    """solve(tol=-1) ran (and PD advised more load steps): refused, with a value to use."""
+    prob = _problems()[kind]
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+    prob.add_body_force([1.0, 0.0])
+    with pytest.raises(cnem.InputError, match="tol: expected a positive relative residual"):
+        prob.solve(tol=tol)
+
+
+@pytest.mark.parametrize("steps", [2.5, 2.0, True, "3"])
+def test_counts_that_are_not_whole_numbers_are_refused(steps):
+    """Float load steps and time steps were truncated silently (2.5 ran 2 steps)."""
+    prob = _problems()["pd"]
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+    prob.add_body_force([1.0, 0.0])
+    with pytest.raises(cnem.InputError, match="steps: expected a whole number"):
+        prob.solve(steps=steps)
+    with pytest.raises(cnem.InputError, match="steps: expected a whole number"):
+        prob.run_dynamic(1e-3, steps, progress=False)
+
+
+@pytest.mark.parametrize("order", [0, -1, 2.5, 30])
+def test_a_quadrature_order_that_does_not_exist_is_refused(order):
+    """energy_error(order=0 or -1) integrated with some rule silently; 2.5 and 30 failed
+    deep in scikit-fem: each is named."""
+    prob = _problems()["cnem"]
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+    prob.add_body_force([1.0, 0.0])
+    sol = prob.solve(progress=False)
+    with pytest.raises(cnem.InputError, match="order: expected"):
+        sol.energy_error(lambda x: np.zeros((len(x), 3)), order=order)

@@ -129,5 +129,5 @@ def test_free_rigid_motions_are_refused_up_front():
 
 
 def test_bad_counts_are_refused():
-    with pytest.raises(cnem.InputError, match="steps >= 1"):
+    with pytest.raises(cnem.InputError, match="steps: expected a whole number >= 1"):
         newton(chain(2), np.zeros(3), [0], [0.0], points=None, steps=0)

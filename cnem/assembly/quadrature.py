@@ -9,6 +9,7 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
 from .._aliases import renamed_attributes
+from ..errors import InputError, check_count
 from .subdivision import cell_triangles
 
 if TYPE_CHECKING:
@@ -20,6 +21,10 @@ __all__ = ["triangle_quadrature", "cell_quadrature"]
 __getattr__ = renamed_attributes(__name__, {
     "subdivide": ("cnem.assembly.subdivision", "subdivide"),
     "tip_cells": ("cnem.assembly.subdivision", "tip_cells")})
+
+
+#: The highest polynomial degree of scikit-fem's triangle rules.
+MAX_TRIANGLE_ORDER = 19
 
 
 def _triangle_rule(corners, order):
@@ -118,6 +123,10 @@ def triangle_quadrature(corners: np.ndarray, order: int = 4, *,
     weights : (q,) ndarray
         Summing to each triangle's signed area.
     """
+    order = check_count("order", order)
+    if order > MAX_TRIANGLE_ORDER:
+        raise InputError(f"order: expected a polynomial degree from 1 to {MAX_TRIANGLE_ORDER} "
+                         f"(the triangle rules scikit-fem has), received {order}")
     singular = np.zeros((0, 2)) if singular is None else np.asarray(singular, float).reshape(-1, 2)
     hit, source, apex, b, c = _split_at_singular(corners, singular)
     regular = np.flatnonzero(~hit)

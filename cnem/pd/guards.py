@@ -22,7 +22,7 @@ import warnings
 import numpy as np
 
 from .. import config
-from ..errors import DivergenceError, InputError, StabilityWarning
+from ..errors import DivergenceError, InputError, StabilityWarning, check_count
 
 __all__ = ["check_time_step", "checked_run", "checked_schedule", "first_non_finite",
            "diverged"]
@@ -66,7 +66,7 @@ def checked_run(dt: float, steps: int, stable: float) -> tuple[float, int]:
     InputError
         ``dt <= 0``, ``steps < 1``, or ``dt`` above `cnem.config.DT_LIMIT` times ``stable``.
     """
-    dt, steps = float(dt), int(steps)
+    dt, steps = float(dt), check_count("steps", steps)
     if not dt > 0 or steps < 1:
         raise InputError(f"expected dt > 0 and steps >= 1, received dt={dt}, steps={steps}")
     check_time_step(dt, stable, stacklevel=4)

@@ -43,7 +43,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from ..solvers.linsolve import free_rigid_motions
-from ..errors import ConvergenceError, InputError, SolveError
+from ..errors import ConvergenceError, InputError, SolveError, check_count
 from .solution import Relaxation
 
 if TYPE_CHECKING:
@@ -285,8 +285,9 @@ def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: i
         residual went non-finite (the residual reached is given, the residual
         history is the error's ``history``).
     """
-    tol, max_steps, steps = float(tol), int(max_steps), int(steps)
-    every = 10 if every is None else int(every)
+    tol, max_steps = float(tol), check_count("max_steps", max_steps)
+    steps = check_count("steps", steps)
+    every = 10 if every is None else check_count("every", every)
     if not tol > 0 or max_steps < 1 or steps < 1 or every < 1:
         raise InputError(f"expected tol > 0 and max_steps, steps, every >= 1, received tol={tol}, "
                          f"max_steps={max_steps}, steps={steps}, every={every}")

@@ -99,6 +99,10 @@ def solve_constrained(K: sp.spmatrix, f: np.ndarray, fixed: ArrayLike, values: A
         Free rigid motions (named), or a linear solve that fails.
     """
     N = K.shape[0]
+    tol = float(tol)
+    if not (np.isfinite(tol) and tol > 0):
+        raise InputError(f"tol: expected a positive relative residual, received {tol}; pass "
+                         f"e.g. 1e-10")
     fixed = np.asarray(fixed, dtype=np.int64).reshape(-1)
     values = np.asarray(values, dtype=float).reshape(-1)
     if fixed.shape != values.shape:

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .. import config
-from ..errors import ConvergenceError, InputError, SolveError
+from ..errors import ConvergenceError, InputError, SolveError, check_count
 from .condensation import free_dofs
 from .constrained import check_supports, solve_constrained
 
@@ -104,10 +104,12 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
         A load step that does not converge, or whose residual goes non-finite (named,
         with its residuals; the error's ``history`` holds those of every load step so far).
     """
-    steps, max_iterations = int(steps), int(max_iterations)
-    if steps < 1 or max_iterations < 1:
-        raise InputError(f"expected steps >= 1 and max_iterations >= 1, received "
-                         f"steps={steps}, max_iterations={max_iterations}")
+    steps = check_count("steps", steps)
+    max_iterations = check_count("max_iterations", max_iterations)
+    tol = float(tol)
+    if not (np.isfinite(tol) and tol > 0):
+        raise InputError(f"tol: expected a positive relative residual, received {tol}; "
+                         f"pass e.g. 1e-10")
     load = np.asarray(load, dtype=float).reshape(-1)
     fixed = np.asarray(fixed, dtype=np.int64).reshape(-1)
     values = np.asarray(values, dtype=float).reshape(-1)

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from tqdm.auto import tqdm
 
-from ..errors import InputError
+from ..errors import InputError, check_count
 
 if TYPE_CHECKING:
     from typing import Callable
@@ -154,8 +154,9 @@ def velocity_verlet(u: np.ndarray, v: np.ndarray, dt: float, steps: int, *,
         ``dt <= 0``, ``steps < start`` or ``every < 1``, or ``u`` and ``v`` not
         C-contiguous arrays of one shape.
     """
-    dt, steps, start = float(dt), int(steps), int(start)
-    every = max(1, steps // 10) if every is None else int(every)
+    dt, start = float(dt), check_count("start", start, minimum=0)
+    steps = check_count("steps", steps, minimum=0)
+    every = max(1, steps // 10) if every is None else check_count("every", every)
     if not dt > 0 or steps < start or every < 1:
         raise InputError(f"expected dt > 0, steps >= start and every >= 1, received "
                          f"dt={dt}, steps={steps}, start={start}, every={every}")

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..relaxation import force_round_off, load_steps
-from ...errors import InputError
+from ...errors import InputError, check_count
 from ..solution import Relaxation
 
 if TYPE_CHECKING:
@@ -45,8 +45,9 @@ def relax(problem: Any, *, tol: float = 1e-8, max_steps: int = 100_000, steps: i
         history is the error's ``history``). Unlike the serial solver, free rigid motions are
         not detected beforehand: they show as a load step that does not settle.
     """
-    tol, max_steps, steps = float(tol), int(max_steps), int(steps)
-    every = 10 if every is None else int(every)
+    tol, max_steps = float(tol), check_count("max_steps", max_steps)
+    steps = check_count("steps", steps)
+    every = 10 if every is None else check_count("every", every)
     if not tol > 0 or max_steps < 1 or steps < 1 or every < 1:
         raise InputError(f"expected tol > 0 and max_steps, steps, every >= 1, received tol={tol}, "
                          f"max_steps={max_steps}, steps={steps}, every={every}")
