@@ -10,7 +10,7 @@ from ...spatial import family_search, remove_crossing
 from .._kernels import bond_geometry, image_factors
 from ..body import bond_reach, checked_input, crack_segments
 from . import _kernels as K
-from .comm import Halo, world
+from .comm import Halo, collectively, same_on_every_rank, world
 from .partition import bisect, ghost_candidates
 
 if TYPE_CHECKING:
@@ -62,7 +62,11 @@ class Body:
                  thickness: float = 1.0, period: ArrayLike | None = None, cracks: tuple = (),
                  crossing_points: int | None = None, comm: Any = None):
         self.comm = world(comm)
-        pts, vol, horizon, self.thickness = checked_input(points, volumes, horizon, thickness)
+        pts, vol, horizon, self.thickness = collectively(
+            self.comm, lambda: checked_input(points, volumes, horizon, thickness))
+        for name, value in (("points", pts), ("volumes", vol),
+                            ("horizon and thickness", np.array([horizon, self.thickness]))):
+            same_on_every_rank(self.comm, name, value)
         n, d = pts.shape
         self.global_points, self.horizon, self.dim = pts, horizon, d
         self.global_size = n

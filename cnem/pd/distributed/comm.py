@@ -7,16 +7,17 @@ True
 
 from __future__ import annotations
 
+import hashlib
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...errors import MissingExtraError
+from ...errors import CNEMError, InputError, MissingExtraError
 
 if TYPE_CHECKING:
-    from typing import Any
+    from typing import Any, Callable
 
-__all__ = ["mpi", "world", "Halo", "INSTALL_HINT"]
+__all__ = ["mpi", "world", "collectively", "same_on_every_rank", "Halo", "INSTALL_HINT"]
 
 INSTALL_HINT = 'pip install "cnem[mpi]"  (the mpi4py and mpich wheels)'
 
@@ -42,6 +43,69 @@ def mpi() -> Any:
 def world(comm: Any = None) -> Any:
     """``comm``, or ``MPI.COMM_WORLD`` when it is None (one rank under plain ``python``)."""
     return mpi().COMM_WORLD if comm is None else comm
+
+
+def collectively(comm: Any, compute: Callable[[], Any]) -> Any:
+    """``compute()`` on every rank, raising the same error on every rank when it fails on
+    any: a `CNEMError` on one rank alone would leave the others waiting in their next
+    collective call for ever (on a cluster, until the allocation runs out).
+
+    Parameters
+    ----------
+    comm : mpi4py communicator
+    compute : callable ``() -> value``
+        The rank's own work (validating its arguments, ...).
+
+    Returns
+    -------
+    The rank's value.
+
+    Raises
+    ------
+    CNEMError
+        Of the first rank that failed (its type and message, naming the rank when more
+        than one rank runs).
+    """
+    value, failure = None, None
+    try:
+        value = compute()
+    except CNEMError as err:
+        failure = (type(err), str(err))
+    failures = comm.allgather(failure)
+    for rank, failed in enumerate(failures):
+        if failed is not None:
+            kind, message = failed
+            where = f" (on rank {rank} of {comm.size})" if comm.size > 1 else ""
+            raise kind(message + where)
+    return value
+
+
+def same_on_every_rank(comm: Any, name: str, value: np.ndarray) -> None:
+    """Check that every rank was given the same ``value``: each rank of a distributed
+    body must be handed the whole body, the same on all of them.
+
+    Parameters
+    ----------
+    comm : mpi4py communicator
+    name : str
+        The argument, for the message.
+    value : ndarray
+
+    Raises
+    ------
+    InputError
+        On every rank, naming the ranks whose ``value`` differs from rank 0's (shape or
+        contents).
+    """
+    arr = np.ascontiguousarray(value)
+    mine = (arr.shape, hashlib.sha256(arr.tobytes()).hexdigest())
+    every = comm.allgather(mine)
+    differ = [rank for rank, seen in enumerate(every) if seen != every[0]]
+    if differ:
+        shapes = ", ".join(f"rank {r}: {every[r][0]}" for r in [0] + differ)
+        raise InputError(f"{name}: every rank must be given the same {name} (the whole body), "
+                         f"but ranks {differ} differ from rank 0 ({shapes}); build them from "
+                         f"the same data on every rank (the same file or seed)")
 
 
 class Halo:

@@ -236,6 +236,8 @@ class Problem(Conditions, VelocityConditions):
         owned_u = u[:o]
         v = np.zeros((o, d))
         if velocity is not None:
+            if not callable(velocity) and np.shape(velocity) == (len(b), d):
+                velocity = np.asarray(velocity)[b.owned]      # the whole body's, as serial
             v[:] = per_point(velocity, b.points[:o], d, "velocity")
         prescribed.start(owned_u, v)
         first, earlier, broken_here = 0, 0, 0      # earlier: broken before a restart
