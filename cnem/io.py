@@ -343,6 +343,18 @@ class CellMesh:
                 + (f", data: {', '.join(extra)}" if extra else "") + ">")
 
 
+def _meshio_read(path: str, fmt: str) -> meshio.Mesh:
+    """``meshio.read``, with its failures as `FormatError`: on a file it cannot parse
+    meshio raises ``SystemExit`` (which would end the interpreter) or its own errors."""
+    try:
+        return meshio.read(path, file_format=fmt)
+    except FileNotFoundError:
+        raise
+    except (SystemExit, Exception) as err:          # meshio's ReadError, XML, struct errors
+        raise FormatError(f"{str(path)!r} could not be read as {fmt} ({type(err).__name__}: "
+                          f"{err}); is it a file that cnem.io.write produced, complete?") from None
+
+
 def read(path: str | os.PathLike) -> CellMesh:
     """Read nodes and integration cells from a file written by `write`.
 
@@ -364,7 +376,7 @@ def read(path: str | os.PathLike) -> CellMesh:
         Unsupported suffix, or a file that `write` did not produce.
     """
     path, fmt = _format(path)
-    mesh = meshio.read(path, file_format=fmt)
+    mesh = _meshio_read(path, fmt)
     missing = [k for k in RESERVED if k not in mesh.cell_data]
     if missing:
         raise FormatError(f"{str(path)!r} lacks the cell data {missing} that cnem.io.write "

@@ -143,3 +143,25 @@ def test_a_quadrature_order_that_does_not_exist_is_refused(order):
     sol = prob.solve(progress=False)
     with pytest.raises(cnem.InputError, match="order: expected"):
         sol.energy_error(lambda x: np.zeros((len(x), 3)), order=order)
+
+
+def test_the_wrong_object_is_named_with_the_call_that_makes_the_right_one():
+    """A NodeCloud, a Model or None where something else is expected, and a misleading
+    message on a NaN Poisson ratio, gave AttributeErrors or wrong names before."""
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.5, 0.5]]])
+    cloud = cnem.nodes.regular(dom, 0.1)
+    model = cnem.discretize(cloud)
+    prob = cnem.Elasticity(model, (1.0, 0.3))
+    prob.add_dirichlet(lambda x: x[:, 1] < 1e-9, None)
+    prob.add_traction(lambda x, n: x[:, 1] > 1 - 1e-9, [0.0, 1.0])
+    sol = prob.solve(progress=False)
+    with pytest.raises(cnem.InputError, match="expects a Model, received NodeCloud; discretize"):
+        cnem.Elasticity(cloud, (1.0, 0.3))
+    with pytest.raises(cnem.MaterialError, match=r"Poisson ratios .* received \[nan\]"):
+        cnem.Elasticity(model, (1.0, float("nan")))
+    with pytest.raises(cnem.FractureError, match="received Model; solve the problem first"):
+        cnem.fracture.sif(model, (0.5, 0.5))
+    with pytest.raises(cnem.FractureError, match="received 'auto'"):
+        cnem.fracture.sif(sol, (0.5, 0.5), radius="auto")
+    with pytest.raises(cnem.FractureError, match=r"one point \(x, y\), received shape \(2, 2\)"):
+        cnem.fracture.sif(sol, [[0.5, 0.5], [0.0, 0.5]])

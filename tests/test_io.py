@@ -93,3 +93,12 @@ def test_read_rejects_foreign_file(tmp_path):
     path = cnem.io.write_nodes(m, tmp_path / "tri.vtu")
     with pytest.raises(cnem.io.FormatError, match="not written by cnem.io.write"):
         cnem.io.read(path)
+
+
+def test_a_file_meshio_cannot_parse_is_a_format_error(tmp_path):
+    """meshio ends the interpreter (SystemExit) on a file it cannot parse: cnem.io.read
+    names the file instead."""
+    bad = tmp_path / "garbage.vtu"
+    bad.write_text("not a VTU file")
+    with pytest.raises(cnem.FormatError, match="could not be read as vtu"):
+        cnem.io.read(bad)

@@ -137,3 +137,10 @@ def test_a_non_finite_scale_is_refused(tmp_path):
     sol = prob.solve(progress=False)
     with pytest.raises(cnem.PlotInputError, match="scale"):
         cnem.plot.solution(sol, tmp_path / "s.png", scale=float("nan"))
+
+
+def test_a_model_that_is_none_and_a_path_that_is_no_picture_are_named(tmp_path):
+    with pytest.raises(cnem.InputError, match="expects a Model, received NoneType"):
+        cnem.plot.model(None, tmp_path / "m.png")
+    with pytest.raises(cnem.PlotInputError, match="picture file ending in one of"):
+        cnem.plot.model(model("annulus_sector_regular")[2], tmp_path / "m.bogus")

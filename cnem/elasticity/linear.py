@@ -23,6 +23,7 @@ from ..assembly.gradients import GradientCache
 from ..assembly.triangles import triangle_basis
 from ..solvers.constrained import solve_constrained
 from ..errors import GeometryError, InputError
+from ..geometry.model import check_model
 from ..geometry.topology import constraint_edges
 from ..material import check_plane, check_stiffness, lame, moduli, parse_materials, stiffness_matrix
 from .solution import ElasticSolution
@@ -103,7 +104,7 @@ class Elasticity(Conditions):
                  *, plane: str | None = None, gauss: int = 2, enrich: Enrichment | None = None,
                  stabilization: float = 1.0, gradients: GradientCache | None = None):
         from ..fracture.enrichment import Enrichment
-        self.model = model
+        self.model = check_model(model, "Elasticity")
         self.enrichment = Enrichment.from_spec(model, enrich)
         #: the integration cells: the model's, or their fan sub-cells with enrichment (one
         #: smoothed strain per cell cannot control the extra dofs)

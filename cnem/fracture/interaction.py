@@ -204,17 +204,26 @@ def sif(sol: Any, tip: np.ndarray, *, radius: float | None = None, order: int = 
         No tip; a disc that reaches into another material (the interaction
         integral needs one material), leaves no cell, or is not a positive number.
     """
+    if not (hasattr(sol, "model") and hasattr(sol, "stress") and hasattr(sol, "u")):
+        raise FractureError(f"sif expects the solution of an elasticity problem "
+                            f"(prob.solve()), received {type(sol).__name__}; solve the problem "
+                            f"first and pass what solve() returns")
+    tip_arr = np.asarray(tip, dtype=float)
+    if tip_arr.shape != (2,):
+        raise FractureError(f"tip: expected one point (x, y), received shape {tip_arr.shape}; "
+                            f"call sif once per tip")
     model = sol.model
     at, d = model.domain.tip_frame(tip)
     limit = clearance(model.domain, at, d)
     user = radius is not None
     if user:
+        given = radius
         try:
             radius = float(radius)
         except (TypeError, ValueError):
             radius = float("nan")
         if not np.isfinite(radius) or radius <= 0:
-            raise FractureError(f"radius: expected a positive number, received {radius}; leave "
+            raise FractureError(f"radius: expected a positive number, received {given!r}; leave "
                                 f"it None for nested discs up to {limit.obstacle}")
         radii, spacing, limited_by = np.array([radius]), local_spacing(model, at), limit.obstacle
     else:

@@ -90,6 +90,11 @@ def _as_polygon(obj, index, tol):
     poly = Polygon(shell, holes)
     if tol is not None and holes and poly.is_valid:
         _check_rings_apart(shell, holes, what, tol)
+    spread = np.linalg.svd(shell - shell.mean(axis=0), compute_uv=False)
+    if spread[-1] <= config.SHAPE_TOL * spread[0]:
+        raise GeometryError(f"{what} encloses no area: the {len(shell)} vertices of its shell "
+                            f"lie on one line (from {_fmt(shell[0])}); give the corners of a "
+                            f"region")
     if not poly.is_valid:
         raise GeometryError(f"{what} is not a valid polygon: {explain_validity(poly)}; "
                             "a ring must not cross or touch itself (bow-tie) and holes must lie "

@@ -12,7 +12,7 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
 from .._predicates import Frame
-from ..errors import GeometryError
+from ..errors import GeometryError, InputError
 from ._kernels import polygon_moments
 from .cells import voronoi_cells
 from .cloud import NodeCloud
@@ -27,7 +27,7 @@ from .triangulation import constrained_delaunay
 if TYPE_CHECKING:
     from .domain import Domain
 
-__all__ = ["Cells", "Model", "discretize"]
+__all__ = ["Cells", "Model", "discretize", "check_model"]
 
 log = logging.getLogger(__name__)
 
@@ -235,6 +235,22 @@ class Model:
         return (f"<Model {len(self.nodes)} nodes, {len(self.cells)} cells, {nreg} "
                 f"region{'s' * (nreg != 1)}, {ncr} crack{'s' * (ncr != 1)} "
                 f"({len(dom.tips)} tip{'s' * (len(dom.tips) != 1)})>")
+
+
+def check_model(model: object, caller: str) -> Model:
+    """``model`` once it is known to be a `Model`: a node cloud, a domain or None given
+    where a model is expected is named, with the call that makes a model.
+
+    Raises
+    ------
+    InputError
+        Anything but a `Model`.
+    """
+    if not isinstance(model, Model):
+        hint = ("discretize it first: cnem.discretize(cloud)" if isinstance(model, NodeCloud)
+                else "make one with cnem.discretize(cnem.nodes.regular(domain, h))")
+        raise InputError(f"{caller} expects a Model, received {type(model).__name__}; {hint}")
+    return model
 
 
 def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 
 from .. import config
 from ..errors import PlotDependencyError, PlotError, PlotInputError
+from ..geometry.model import check_model
 from ..geometry.pslg import SegmentKind
 from ..io import cell_topology
 
@@ -158,7 +159,7 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
         empty ``bounds`` (a `ValueError`).
     """
     pv = _pyvista()
-    mdl = model
+    mdl = check_model(model, "cnem.plot.model")
     dom = mdl.domain
     xmin, ymin, xmax, ymax = dom.bounds
     if bounds is None:
@@ -331,10 +332,19 @@ def _legend(pl, entries):
     use_font(legend.GetEntryTextProperty())
 
 
+#: The picture formats VTK writes.
+PICTURE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
+
+
 def _save(pl, path, what):
     """Write a PNG if ``path`` is given; return the plotter."""
     if path is not None:
         path = pathlib.Path(path)
+        if path.suffix.lower() not in PICTURE_SUFFIXES:
+            pl.close()
+            raise PlotInputError(f"path: expected a picture file ending in one of "
+                                 f"{', '.join(PICTURE_SUFFIXES)}, received {str(path)!r}; "
+                                 f"e.g. {path.with_suffix('.png').name!r}")
         path.parent.mkdir(parents=True, exist_ok=True)
         try:
             pl.screenshot(str(path))
