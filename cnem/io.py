@@ -42,7 +42,7 @@ import meshio
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import FormatError
+from .errors import FormatError, check_points
 from .geometry.model import Cells
 
 if TYPE_CHECKING:
@@ -275,13 +275,20 @@ def write_points(points: ArrayLike, path: str | os.PathLike, *, triangles: Array
         Unsupported suffix or arrays of the wrong length.
     """
     path, fmt = _format(path)
-    pts = np.asarray(points, dtype=np.float64)
+    pts = check_points("points", points, error=FormatError)
     full = np.zeros((len(pts), 3))
     full[:, :pts.shape[1]] = pts
     if triangles is None:
         block = meshio.CellBlock("vertex", np.arange(len(pts), dtype=np.int64)[:, None])
     else:
-        block = meshio.CellBlock("triangle", np.asarray(triangles, dtype=np.int64))
+        tri = np.asarray(triangles)
+        if tri.ndim != 2 or tri.shape[1] != 3 or tri.dtype.kind not in "iu" or \
+                (tri.size and (tri.min() < 0 or tri.max() >= len(pts))):
+            raise FormatError(f"triangles: expected a (t, 3) array of point indices in "
+                              f"[0, {len(pts)}), received shape {tri.shape}, dtype {tri.dtype}"
+                              + (f", indices {tri.min()}..{tri.max()}" if tri.size else "")
+                              + "; index the points given")
+        block = meshio.CellBlock("triangle", tri.astype(np.int64))
     pdata = {name: _checked(value, len(pts), f"point_data[{name!r}]")[0]
              for name, value in (point_data or {}).items()}
     cdata = {name: [_checked(value, len(block.data), f"cell_data[{name!r}]")[0]]

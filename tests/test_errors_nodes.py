@@ -208,3 +208,18 @@ def test_from_points_without_fill_names_the_bare_crack_face():
         cnem.nodes.from_points(dom, lattice_with_tip_rings(dom, 0.1), fill=False)
 
 
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda dom: cnem.nodes.irregular(dom, 0.1, seed="a"), "seed: expected a whole number"),
+    (lambda dom: cnem.nodes.irregular(dom, 0.1, seed=-1), "seed: expected a whole number >= 0"),
+    (lambda dom: cnem.nodes.irregular(dom, 0.1, seed=1.5), "seed: expected a whole number"),
+    (lambda dom: cnem.nodes.graded(dom, 0.1, near=[[np.nan, 0.5]], h_min=0.02),
+     "near: expected finite values"),
+    (lambda dom: cnem.nodes.graded(dom, 0.1, near=[[0.5, 0.5, 0.0]], h_min=0.02),
+     r"near: expected refinement points \(q, 2\)"),
+], ids=["seed str", "seed negative", "seed float", "near NaN", "near 3 columns"])
+def test_seeds_and_refinement_points_are_checked(call, match):
+    """numpy's SeedSequence and shapely's messages came through before."""
+    with pytest.raises(cnem.GeometryError, match=match):
+        call(cnem.geometry.rectangle())

@@ -102,3 +102,11 @@ def test_a_file_meshio_cannot_parse_is_a_format_error(tmp_path):
     bad.write_text("not a VTU file")
     with pytest.raises(cnem.FormatError, match="could not be read as vtu"):
         cnem.io.read(bad)
+
+
+def test_triangles_that_index_past_the_points_are_refused(tmp_path):
+    pts = np.random.default_rng(0).random((5, 2))
+    with pytest.raises(cnem.FormatError, match=r"indices in \[0, 5\), .* indices 0..9"):
+        cnem.io.write_points(pts, tmp_path / "p.vtu", triangles=[[0, 1, 9]])
+    with pytest.raises(cnem.FormatError, match="received shape"):
+        cnem.io.write_points(pts, tmp_path / "p.vtu", triangles=[[0.0, 1.0, 2.0]])

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from .. import config
-from ..errors import GeometryError, LimitError, check_array, check_real
+from ..errors import GeometryError, LimitError, check_array, check_count, check_real
 from .cloud import NodeCloud
 from .pslg import SegmentKind, segment_projection
 
@@ -30,6 +30,13 @@ if TYPE_CHECKING:
     from .domain import Domain
 
 __all__ = ["regular", "irregular", "graded", "from_points", "NodeCloud"]
+
+def _check_seed(seed):
+    """``seed`` for `numpy.random.default_rng` once it is a whole number >= 0 (or None)."""
+    if seed is None:
+        return None
+    return check_count("seed", seed, minimum=0, error=GeometryError)
+
 
 def _check_spacing(dom, h, name="h"):
     if np.ndim(h) != 0:
@@ -243,7 +250,7 @@ def irregular(domain: Domain, h: float, *, seed: int = 0) -> NodeCloud:
     """
     h = _check_spacing(domain, h)
     _check_uniform_count(domain, h, "irregular")
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(_check_seed(seed))
     spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
     lattice = _lattice(domain, h, offset=0.5 * h)
     lattice = lattice + rng.uniform(-0.35 * h, 0.35 * h, lattice.shape)
@@ -298,7 +305,12 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
         raise GeometryError(f"h_min ({h_min:g}) must not exceed h ({h:g})")
     if not 0 < growth <= 1:
         raise GeometryError(f"growth must lie in (0, 1], received {growth!r}")
-    centres = np.asarray(near, dtype=float).reshape(-1, 2)
+    centres = check_array("near", near, finite=True, error=GeometryError,
+                          fix="give the refinement points as a (q, 2) array, e.g. dom.tips")
+    if centres.size and (centres.ndim not in (1, 2) or centres.shape[-1] != 2):
+        raise GeometryError(f"near: expected refinement points (q, 2) or one point (2,), received "
+                            f"shape {centres.shape}; give e.g. dom.tips")
+    centres = centres.reshape(-1, 2)
     if len(centres) == 0:
         raise GeometryError("graded: `near` is empty; give at least one refinement point")
     _check_graded_count(domain, h, h_min, growth, centres)
@@ -321,7 +333,7 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
         interior.append(pts[level == k])
     interior = np.concatenate(interior)
     if seed is not None:
-        rng = np.random.default_rng(seed)
+        rng = np.random.default_rng(_check_seed(seed))
         interior = interior + rng.uniform(-0.25, 0.25, interior.shape) * spacing_of(interior)[:, None]
     interior = _keep_interior(domain, interior, config.CLEARANCE * spacing_of(interior))
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
