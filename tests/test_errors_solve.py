@@ -165,3 +165,20 @@ def test_the_wrong_object_is_named_with_the_call_that_makes_the_right_one():
         cnem.fracture.sif(sol, (0.5, 0.5), radius="auto")
     with pytest.raises(cnem.FractureError, match=r"one point \(x, y\), received shape \(2, 2\)"):
         cnem.fracture.sif(sol, [[0.5, 0.5], [0.0, 0.5]])
+
+
+def test_a_predicate_of_the_wrong_arity_and_a_setup_without_return_are_named():
+    """A `where` taking the wrong arguments failed with a bare TypeError from inside it, and
+    a grow setup that forgot `return prob` with an AttributeError on None."""
+    prob = _problems()["cnem"]
+    with pytest.raises(cnem.ConditionError, match=r"predicate where\(x\) of 1 argument"):
+        prob.add_dirichlet(lambda x, nrm: x[:, 0] < 1e-9, None)
+    with pytest.raises(cnem.ConditionError, match=r"predicate where\(x, nrm\) of 2 arguments"):
+        prob.add_traction(lambda x: x[:, 0] > 1.0 - 1e-9, [1.0, 0.0])
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.3, 0.5]]])
+
+    def setup(model):
+        cnem.Elasticity(model, (1.0, 0.3))          # no return
+
+    with pytest.raises(cnem.GrowthError, match="must return the problem it builds"):
+        cnem.fracture.grow(dom, 0.1, setup, increment=0.05, steps=1, progress=False)

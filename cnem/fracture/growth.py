@@ -49,7 +49,7 @@ from .history import GrowthHistory, GrowthEvent, Step
 from .interaction import sif
 
 if TYPE_CHECKING:
-    from typing import Callable, Literal
+    from typing import Any, Callable, Literal
     from ..geometry.domain import Domain
 
 __all__ = ["grow"]
@@ -87,12 +87,31 @@ def _crack_length(crack):
     return float(np.hypot(*np.diff(crack, axis=0).T).sum())
 
 
+
+def _checked_setup(setup: Callable[[Any], Any]) -> Callable[[Any], Any]:
+    """``setup`` with its result checked: the problem to solve (what has ``solve``), named
+    when it is missing (a ``setup`` without ``return prob`` gave None to the solve)."""
+    if not callable(setup):
+        raise GrowthError(f"setup: expected a function setup(model) -> problem, received "
+                          f"{type(setup).__name__}")
+
+    def checked(model):
+        prob = setup(model)
+        if not callable(getattr(prob, "solve", None)):
+            raise GrowthError(f"setup(model) must return the problem it builds (e.g. the "
+                              f"cnem.Elasticity with its supports and loads), received "
+                              f"{type(prob).__name__}; end setup with `return prob`")
+        return prob
+
+    return checked
+
 class _Run:
     """The mutable state of one `grow` call."""
 
     def __init__(self, domain, cloud, setup, criterion, K_Ic, max_kink, measure, radius, keep,
                  local, continue_with=None, refine=None):
-        self.domain, self.cloud, self.setup, self.local = domain, cloud, setup, local
+        self.domain, self.cloud, self.local = domain, cloud, local
+        self.setup = _checked_setup(setup)
         self.refine = refine          # the cloud that is discretized: `nodes()`
         self.continue_with = continue_with
         self.retired = {}                     # row -> (tip, crack length) of a crack gone

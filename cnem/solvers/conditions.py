@@ -37,6 +37,24 @@ __all__ = ["Conditions", "select_nodes", "vector_constant", "Traction", "per_poi
 Where = Union[Callable[[np.ndarray], np.ndarray], np.ndarray, list]
 
 
+def _call_where(where: Callable[..., np.ndarray], *args: np.ndarray) -> np.ndarray:
+    """``where(*args)``; a predicate that takes another number of arguments is named with
+    the signature expected (it failed with a bare TypeError from inside it)."""
+    import inspect
+    try:
+        inspect.signature(where).bind(*args)
+    except TypeError:
+        expected = "where(x, nrm)" if len(args) == 2 else "where(x)"
+        raise ConditionError(f"where: expected a predicate {expected} of {len(args)} argument"
+                             f"{'s' if len(args) > 1 else ''} (points (p, d)"
+                             f"{' and outward unit normals (p, d)' if len(args) == 2 else ''}), "
+                             f"received one that does not take them; e.g. lambda x"
+                             f"{', nrm' if len(args) == 2 else ''}: x[:, 0] < 1e-9") from None
+    except ValueError:                        # no signature to read (a builtin): just call
+        pass
+    return where(*args)
+
+
 def select_nodes(nodes: np.ndarray, where: Callable[..., np.ndarray] | ArrayLike) -> np.ndarray:
     """Indices of the nodes picked by a predicate, a boolean mask or an index array.
 
@@ -51,7 +69,7 @@ def select_nodes(nodes: np.ndarray, where: Callable[..., np.ndarray] | ArrayLike
     """
     n = len(nodes)
     if callable(where):
-        mask = np.asarray(where(nodes))
+        mask = np.asarray(_call_where(where, nodes))
         if mask.shape != (n,) or mask.dtype != bool:
             raise ConditionError(f"where(nodes) must return a (n,) bool array for the {n} nodes, "
                                  f"received dtype {mask.dtype} shape {mask.shape}; return a "
@@ -282,7 +300,8 @@ class Conditions:
                             f"along the outward normal as lambda x, nrm: -p * nrm")
         edges, normal = self.boundary_edges()
         mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
-        pick = np.asarray(where(mid, normal)) if callable(where) else np.asarray(where)
+        pick = np.asarray(_call_where(where, mid, normal)) if callable(where) else \
+            np.asarray(where)
         if pick.shape != (len(edges),) or pick.dtype != bool:
             raise ConditionError(f"add_traction: where(x, nrm) must return a ({len(edges)},) bool "
                                  f"array, received dtype {pick.dtype} shape {pick.shape}")
