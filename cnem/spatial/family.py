@@ -28,7 +28,7 @@ from ..errors import LimitError, SpatialError, check_array, check_choice, check_
 from . import _family_kernels as K
 from . import _pair_kernels as P
 from .._parallel import work_chunks
-from .rtree import RTree, as_points, check_period
+from .rtree import RTree, as_points, check_period, unit_scale
 
 __all__ = ["Family", "family_search", "METHODS"]
 
@@ -148,18 +148,6 @@ def _rtree(pts, horizon, period):
     return tree.query_ball(pts, horizon, strict=True, exclude_self=True)
 
 
-def _unit_scale(horizon):
-    """Power of two that brings the largest horizon to about 1.
-
-    Scaling coordinates, horizons and periods by a power of two is exact, so the
-    families are unchanged wherever the squared distances were representable; it
-    keeps them representable (neither subnormal nor overflowing) for bodies of
-    any size, e.g. coordinates of order 1e-300, whose squared distances would
-    underflow to zero.
-    """
-    return float(np.ldexp(1.0, -int(np.frexp(horizon.max())[1])))
-
-
 def _search_horizons(horizon, points, period):
     """The horizons the kernels search with: each capped at a bound above every distance
     in the body.
@@ -168,7 +156,7 @@ def _search_horizons(horizon, points, period):
     of a periodic one: at most half its period) exceeds twice the body's diameter,
     so every pair within the original horizon is within the capped one and the
     families do not change; but a horizon far larger than the body (1e200 on a
-    unit square) no longer sets `_unit_scale`, which would push the scaled
+    unit square) no longer sets `unit_scale`, which would push the scaled
     coordinate differences into underflow and lose every pair.
     """
     span = np.ptp(points, axis=0)
@@ -233,7 +221,7 @@ def family_search(points: ArrayLike, horizon: float | ArrayLike, *,
     if method == "auto":
         method = choose_method(h)
     searched = _search_horizons(h, pts, per)
-    scale = _unit_scale(searched)
+    scale = unit_scale(searched)
     xs, hs, ps = pts * scale, searched * scale, per * scale     # exact: a power of two
     if method == "brute":
         if n > config.BRUTE_LIMIT:

@@ -48,6 +48,18 @@ def check_period(period: ArrayLike | None, dim: int, *points: np.ndarray) -> np.
     return per
 
 
+def unit_scale(lengths: np.ndarray) -> float:
+    """Power of two that brings the largest of ``lengths`` (horizons, radii) to about 1.
+
+    Scaling coordinates, horizons and periods by a power of two is exact, so the
+    families are unchanged wherever the squared distances were representable; it
+    keeps them representable (neither subnormal nor overflowing) for bodies of
+    any size, e.g. coordinates of order 1e-300, whose squared distances would
+    underflow to zero.
+    """
+    return float(np.ldexp(1.0, -int(np.frexp(lengths.max())[1])))
+
+
 def _str_order(centres, fanout):
     """Sort-Tile-Recursive order of box centres ``(b, d)``."""
     b, d = centres.shape
@@ -178,14 +190,24 @@ class RTree:
         self.centre, self.half, self.first, self.count = cen, hw, first, cnt
 
     # ----------------------------------------------------------------- queries
-    def _query(self, qcen, qhalf, radius, kind, exclude_zero=False, qlo=None, qhi=None):
+    def _query(self, qcen, qhalf, radius, kind, exclude_zero=False, qlo=None, qhi=None,
+               scale=1.0):
+        """The kernel's bulk query; with ``scale`` (a power of two) on copies of the tree
+        and the queries scaled by it (exact), for radii whose squares would leave the
+        float range."""
         if self.size == 0 or len(qcen) == 0:
             return np.zeros(len(qcen) + 1, dtype=np.int64), np.zeros(0, dtype=np.int64)
         qlo = qcen if qlo is None else qlo
         qhi = qcen if qhi is None else qhi
-        return K.query(self.centre, self.half, self.first, self.count, self.size, self.depth,
-                       self.fanout, self.order, qcen, qhalf, radius, kind, self.period, exclude_zero,
-                       work_chunks(), self.lo, self.hi, qlo, qhi)
+        tree = (self.centre, self.half, self.period, self.lo, self.hi)
+        query = (qcen, qhalf, radius, qlo, qhi)
+        if scale != 1.0:
+            tree, query = ([a * scale for a in arrays] for arrays in (tree, query))
+        cen, half, period, lo, hi = tree
+        qcen, qhalf, radius, qlo, qhi = query
+        return K.query(cen, half, self.first, self.count, self.size, self.depth, self.fanout,
+                       self.order, qcen, qhalf, radius, kind, period, exclude_zero,
+                       work_chunks(), lo, hi, qlo, qhi)
 
     def _points(self, points, name, *, in_cell=True):
         arr = np.asarray(points, dtype=np.float64)
@@ -253,18 +275,13 @@ class RTree:
         radius = check_array("r", r, shape=(len(pts),), broadcast=True, nonnegative=True,
                              error=SpatialError, fix="pass one distance >= 0, or one per point")
         kind = K.BALL_OPEN if strict else K.BALL_CLOSED
-        if self.size == 0 or len(pts) == 0 or radius.max() == 0.0:
-            return self._query(pts, np.zeros_like(pts), radius, kind, exclude_self)
         # the ball test squares distances: at radii near the ends of the float range
-        # (1e-300, 1e300) they would underflow or overflow, so the test runs on a copy
-        # scaled by the power of two that brings the largest radius to about 1 (exact)
-        scale = float(np.ldexp(1.0, -int(np.frexp(radius.max())[1])))
+        # (1e-300, 1e300) they would underflow or overflow, so the test then runs on
+        # copies scaled by the power of two that brings the largest radius to about 1
+        scale = unit_scale(radius) if len(radius) and radius.max() > 0.0 else 1.0
         if 2.0 ** -400 <= scale <= 2.0 ** 400:
-            return self._query(pts, np.zeros_like(pts), radius, kind, exclude_self)
-        return K.query(self.centre * scale, self.half * scale, self.first, self.count, self.size,
-                       self.depth, self.fanout, self.order, pts * scale, np.zeros_like(pts),
-                       radius * scale, kind, self.period * scale, exclude_self, work_chunks(),
-                       self.lo * scale, self.hi * scale, pts * scale, pts * scale)
+            scale = 1.0
+        return self._query(pts, np.zeros_like(pts), radius, kind, exclude_self, scale=scale)
 
     def nearest(self, points: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Nearest box to each point.
