@@ -126,13 +126,10 @@ def _is_single_polygon(obj):
             and np.ndim(obj[0]) == 2:
         return True                          # (shell, [hole, ...])
     try:
-        arr = np.asarray(obj)
-        if arr.dtype.kind not in "biuf":        # complex, strings: a ring, refused by name
-            return arr.ndim == 2 and arr.shape[1] == 2
-        arr = arr.astype(float)
+        arr = np.asarray(obj)            # no float conversion: complex rings are named later
     except (ValueError, TypeError):
         return False
-    return arr.ndim == 2 and arr.shape[1] == 2
+    return arr.ndim == 2 and arr.shape[1] == 2 and arr.dtype.kind != "O"
 
 
 class Domain:

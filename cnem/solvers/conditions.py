@@ -20,6 +20,7 @@ own way (`body_forces`, `traction_at`).
 
 from __future__ import annotations
 
+import inspect
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable, Union
 
@@ -40,7 +41,6 @@ Where = Union[Callable[[np.ndarray], np.ndarray], np.ndarray, list]
 def _call_where(where: Callable[..., np.ndarray], *args: np.ndarray) -> np.ndarray:
     """``where(*args)``; a predicate that takes another number of arguments is named with
     the signature expected (it failed with a bare TypeError from inside it)."""
-    import inspect
     try:
         inspect.signature(where).bind(*args)
     except TypeError:
