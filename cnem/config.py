@@ -13,7 +13,7 @@ True
 """
 
 __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "ROUNDOFF_ULPS",
-           "HORIZON_RTOL",
+           "HORIZON_RTOL", "CONDITION_RTOL",
            "BOUNDARY_FINER", "SHALLOW_END", "CLEARANCE", "MIN_SPACING", "MAX_NODES", "FILL_SPACINGS",
            "SPACING_NEIGHBOURS", "SPACING_COUNT_TOL", "SPACING_BISECTIONS", "FANOUT",
            "BRUTE_LIMIT", "CELLS_PER_HORIZON", "COLUMNS_PER_HORIZON", "MESH_NODES_STOP",
@@ -70,6 +70,12 @@ ROUNDOFF_ULPS = 16
 #: round-off of their lengths, and the bonds do not jump as the horizon moves by
 #: round-off; `cnem.pd.Body`.
 HORIZON_RTOL = 1e-9
+
+#: Two Dirichlet (or PD velocity) conditions on one dof agree when their values differ by
+#: at most this fraction of the largest prescribed value (round-off of the same formula
+#: evaluated twice); a larger difference is a conflict, refused by
+#: `cnem.solvers.conditions.merged_conditions`.
+CONDITION_RTOL = 1e-12
 
 # ---------------------------------------------------------------- node generation
 #: Interior nodes closer than this fraction of the local spacing to a boundary,

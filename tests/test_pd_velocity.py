@@ -75,6 +75,18 @@ def test_a_velocity_condition_that_selects_nothing_is_named():
         problem().add_velocity(lambda p: p[:, 0] < 0, 0, 1.0)
 
 
+def test_velocities_that_disagree_on_a_point_are_refused_and_agreeing_ones_merge():
+    prob = problem()
+    left = lambda p: p[:, 0] < 1.5 * H
+    prob.add_velocity(left, None, V)
+    prob.add_velocity(lambda p: left(p) & (p[:, 1] < 1.5 * H), 0, V[0])     # agrees
+    dofs, values = prob.prescribed_velocity()
+    assert dofs.size == 2 * 6 and np.all(values.reshape(-1, 2) == V)
+    prob.add_velocity(lambda p: left(p) & (p[:, 1] < 1.5 * H), 1, 0.0)     # disagrees
+    with pytest.raises(ConditionError, match=r"add_velocity: .*conflicting values on 1 dof"):
+        prob.prescribed_velocity()
+
+
 @pytest.mark.skipif(importlib.util.find_spec("mpi4py") is None, reason="needs cnem[mpi]")
 def test_one_rank_gives_the_serial_run_with_a_velocity_condition():
     import cnem.pd.distributed as dpd

@@ -14,6 +14,7 @@ import pytest
 import cnem
 import cnem.fem as fem
 import cnem.pd as pd
+from cnem.errors import ConditionError
 from cnem.solvers.conditions import Conditions
 from cnem.solvers.solution import Solution
 from cnem.material import stiffness_matrix
@@ -78,14 +79,20 @@ def test_every_problem_offers_the_conditions_and_solve(name):
     points = prob.condition_points
     assert points.shape[1] == 2
     prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, 0, 0.5)
-    prob.add_dirichlet(lambda p: (p[:, 0] < 1e-9) & (p[:, 1] < 1e-9), None, lambda p: 2 * p + 1)
+    # the corner again, agreeing on component 0: one dof, one value
+    prob.add_dirichlet(lambda p: (p[:, 0] < 1e-9) & (p[:, 1] < 1e-9), None,
+                       lambda p: np.column_stack([np.full(len(p), 0.5), 2 * p[:, 1] + 1]))
     dofs, values = prob.prescribed()
     left = np.flatnonzero(points[:, 0] < 1e-9)
     corner = np.flatnonzero((points[:, 0] < 1e-9) & (points[:, 1] < 1e-9))
     expected = {2 * i: 0.5 for i in left}
-    expected.update({2 * i + c: 2 * points[i, c] + 1 for i in corner for c in (0, 1)})
-    assert dofs.tolist() == sorted(expected)               # the last condition wins
+    expected.update({2 * i + 1: 2 * points[i, 1] + 1 for i in corner})
+    assert dofs.tolist() == sorted(expected)
     np.testing.assert_array_equal(values, [expected[k] for k in sorted(expected)])
+    # the corner with another value on component 0: a conflict, named
+    prob.add_dirichlet(lambda p: (p[:, 0] < 1e-9) & (p[:, 1] < 1e-9), 0, 1.0)
+    with pytest.raises(ConditionError, match=r"conflicting values on 1 dof.*0\.5 and 1"):
+        prob.prescribed()
     if name == "PD":
         with pytest.raises(NotImplementedError, match="add_body_force"):
             prob.add_traction(lambda x, n: n[:, 0] > 0.5, [1.0, 0.0])

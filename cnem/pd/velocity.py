@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..solvers.conditions import dirichlet_dofs, last_wins
+from ..solvers.conditions import dirichlet_dofs, merged_conditions
 from ..errors import ConditionError
 
 if TYPE_CHECKING:
@@ -55,8 +55,8 @@ class VelocityConditions:
 
     def prescribed_velocity(self) -> tuple[np.ndarray, np.ndarray]:
         """The dofs (``d * point + component``, sorted) with a prescribed velocity and
-        its values (the last condition winning)."""
-        return last_wins(self.velocities)
+        its values (conditions on one dof must agree: `merged_conditions`)."""
+        return merged_conditions(self.velocities, self.condition_points.shape[1], "add_velocity")
 
     def static_only(self, what: str) -> None:
         """Refuse a static solve (``what``) of a problem with velocity conditions.

@@ -13,9 +13,9 @@ own way (`body_forces`, `traction_at`).
 ...         self.condition_points = points
 >>> prob = Points(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]))
 >>> prob.add_dirichlet(lambda p: p[:, 0] > 0.5, 0, 1.0)
->>> prob.add_dirichlet([2], None, 2.0)                        # later conditions win
+>>> prob.add_dirichlet([2], 1, 2.0)                # a second condition on other dofs
 >>> prob.prescribed()
-(array([2, 4, 5]), array([1., 2., 2.]))
+(array([2, 4, 5]), array([1., 1., 2.]))
 """
 
 from __future__ import annotations
@@ -26,13 +26,14 @@ from typing import TYPE_CHECKING, Any, Callable, Union
 
 import numpy as np
 
+from .. import config
 from ..errors import ConditionError, UnsupportedError
 
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
-__all__ = ["Conditions", "select_nodes", "vector_constant", "Traction", "per_point", "traction_at", "dirichlet_dofs", "last_wins"]
+__all__ = ["Conditions", "select_nodes", "vector_constant", "Traction", "per_point", "traction_at", "dirichlet_dofs", "merged_conditions"]
 
 #: What `where` may be: a predicate over points, a boolean mask or indices.
 Where = Union[Callable[[np.ndarray], np.ndarray], np.ndarray, list]
@@ -253,7 +254,10 @@ class Conditions:
                 f"{len(self.body_forces)} body-force conditions")
 
     def add_dirichlet(self, where: Where, component: int | None, value: Any = 0.0) -> None:
-        """Prescribe displacements at nodes (later conditions win on shared dofs).
+        """Prescribe displacements at nodes.
+
+        Several conditions may prescribe one dof if they agree on its value;
+        `prescribed` refuses conflicting values.
 
         Parameters
         ----------
@@ -341,31 +345,62 @@ class Conditions:
         return [per_point(b, points, points.shape[1], "body force") for b in self.body_forces]
 
     def prescribed(self) -> tuple[np.ndarray, np.ndarray]:
-        """The prescribed dofs (interleaved ``d * node + component``) and their values,
-        the last condition winning where several prescribe one dof.
+        """The prescribed dofs (interleaved ``d * node + component``) and their values.
 
         Returns
         -------
         dofs : (k,) int64 ndarray
             Sorted, distinct.
         values : (k,) ndarray
+
+        Raises
+        ------
+        ConditionError
+            If two conditions prescribe different values on one dof.
         """
-        return last_wins(self.dirichlet)
+        return merged_conditions(self.dirichlet, self.condition_points.shape[1], "add_dirichlet")
 
 
-def last_wins(conditions: list) -> tuple[np.ndarray, np.ndarray]:
+def merged_conditions(conditions: list, dim: int, what: str) -> tuple[np.ndarray, np.ndarray]:
     """The dofs of a list of ``(dofs, values)`` conditions (`dirichlet_dofs`) and their
-    values, the last condition winning where several prescribe one dof.
+    values; a dof prescribed by several conditions must get one value from all of them.
+
+    Parameters
+    ----------
+    conditions : list of (dofs (k,), values (k,))
+    dim : int
+        Components per node (the dofs are ``dim * node + component``).
+    what : str
+        The method that added the conditions, named in the error.
 
     Returns
     -------
     dofs : (k,) int64 ndarray
         Sorted, distinct.
     values : (k,) ndarray
+
+    Raises
+    ------
+    ConditionError
+        If two conditions give one dof values that differ by more than
+        `config.CONDITION_RTOL` of the largest prescribed value (a corner node
+        selected by two predicates with different values, say).
     """
-    dofs = np.zeros(0, dtype=np.int64)
-    values = np.zeros(0)
-    for d, v in conditions:
-        dofs, values = np.concatenate([dofs, d]), np.concatenate([values, v])
-    last = len(dofs) - 1 - np.unique(dofs[::-1], return_index=True)[1]
-    return dofs[last], values[last]
+    dofs = np.concatenate([np.zeros(0, dtype=np.int64)] + [d for d, _ in conditions])
+    values = np.concatenate([np.zeros(0)] + [np.asarray(v, dtype=float) for _, v in conditions])
+    unique, first, group = np.unique(dofs, return_index=True, return_inverse=True)
+    low = np.full(unique.size, np.inf)
+    high = np.full(unique.size, -np.inf)
+    np.minimum.at(low, group, values)
+    np.maximum.at(high, group, values)
+    scale = np.max(np.abs(values), initial=0.0)
+    conflict = np.flatnonzero(high - low > config.CONDITION_RTOL * scale)
+    if conflict.size:
+        shown = ", ".join(f"node {unique[k] // dim} component {unique[k] % dim}: "
+                          f"{low[k]:.6g} and {high[k]:.6g}" for k in conflict[:3])
+        raise ConditionError(
+            f"{what}: expected one value for every prescribed dof, received conflicting values "
+            f"on {conflict.size} dof(s) ({shown}{', ...' if conflict.size > 3 else ''}); "
+            "two conditions select the same node with different values: narrow one `where` "
+            "(e.g. leave out the corner) or give both the same value")
+    return unique, values[first]
