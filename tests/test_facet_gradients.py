@@ -1,0 +1,120 @@
+"""3-D smoothed gradients from facet quadratures (`cnem.assembly.facet_gradients`).
+
+On synthetic cells — the Delaunay tetrahedra of a jittered cube lattice — with the
+P1 interpolant as the shape functions, the smoothed gradient of every cell must be
+the P1 gradient of its tetrahedron (the field is linear there, and the facet rule
+integrates linear functions exactly), and so must the gradient of every pyramid
+sub-cell from an apex inside (or on a face of) the cell.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from scipy.spatial import Delaunay
+
+from cnem.assembly.facet_gradients import facet_gradient, facet_rule, pyramid_sub_cells
+from cnem.errors import GeometryError
+
+
+def _lattice(k=4, seed=0, scale=1.0):
+    rng = np.random.default_rng(seed)
+    axis = np.linspace(0.0, 1.0, k)
+    nodes = np.array(list(itertools.product(axis, axis, axis)))
+    free = (nodes > 0.0) & (nodes < 1.0)        # jitter along the faces too: no cocircular
+    nodes += free * rng.uniform(-0.15, 0.15, nodes.shape) / (k - 1)    # squares, no flat tets
+    nodes = nodes * scale
+    dt = Delaunay(nodes)
+    tets = dt.simplices
+    six_v = np.linalg.det(nodes[tets[:, 1:]] - nodes[tets[:, :1]])
+    keep = np.abs(six_v) > 1e-9 * scale ** 3
+    return nodes, dt, tets[keep]
+
+
+def _p1(nodes, dt):
+    """The P1 interpolant's values at points, ``csr (q, n)``."""
+    def evaluate(points):
+        simplex = dt.find_simplex(points, tol=1e-9)
+        assert np.all(simplex >= 0)
+        T = dt.transform[simplex]
+        bary = np.einsum("qij,qj->qi", T[:, :3], points - T[:, 3])
+        bary = np.column_stack([bary, 1.0 - bary.sum(axis=1)])
+        q = len(points)
+        return sp.csr_matrix((bary.ravel(), (np.repeat(np.arange(q), 4),
+                                             dt.simplices[simplex].ravel())),
+                             shape=(q, len(nodes)))
+    return evaluate
+
+
+def _facets(nodes, tets):
+    """The four faces of every tetrahedron, oriented outward, their cells and normals."""
+    corners = nodes[tets]
+    six_v = np.linalg.det(corners[:, 1:] - corners[:, :1])
+    tets = np.where((six_v > 0)[:, None], tets, tets[:, [1, 0, 2, 3]])
+    faces = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
+    tri = nodes[tets[:, faces]].reshape(-1, 3, 3)
+    cell = np.repeat(np.arange(len(tets)), 4)
+    nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    return tets, tri, cell, nrm, np.abs(six_v) / 6.0
+
+
+def _p1_gradients(nodes, tets):
+    corners = nodes[tets]
+    inv = np.linalg.inv(corners[:, 1:] - corners[:, :1])
+    return np.concatenate([-inv.sum(axis=2)[:, None, :], np.transpose(inv, (0, 2, 1))], axis=1)
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e-3, 1e3])
+def test_cell_gradients_are_the_p1_gradients(scale):
+    nodes, dt, tets = _lattice(scale=scale)
+    tets, tri, cell, nrm, vol = _facets(nodes, tets)
+    grad = facet_gradient(tri, cell, nrm, vol, _p1(nodes, dt))
+    exact = _p1_gradients(nodes, tets)                     # (t, 4, 3)
+    for i in range(3):
+        dense = grad.components[i].toarray()
+        expected = np.zeros_like(dense)
+        np.put_along_axis(expected, tets, exact[:, :, i], axis=1)
+        np.testing.assert_allclose(dense, expected, atol=1e-10 / scale)
+
+
+@pytest.mark.parametrize("apex", ["centroid", "face"])
+def test_sub_cell_gradients_are_the_p1_gradients_and_fill_the_cell(apex):
+    nodes, dt, tets = _lattice(k=3)
+    tets, tri, cell, nrm, vol = _facets(nodes, tets)
+    corners = nodes[tets]
+    node_xyz = corners.mean(axis=1) if apex == "centroid" else corners[:, 1:].mean(axis=1)
+    parent, kept, sub_vol, spokes = pyramid_sub_cells(node_xyz, tri, cell)
+    np.testing.assert_allclose(np.bincount(parent, weights=sub_vol, minlength=len(tets)), vol,
+                               rtol=1e-12)
+    assert len(kept) == (4 if apex == "centroid" else 3) * len(tets)
+    grad = facet_gradient(tri[kept], np.arange(len(kept)), nrm[kept], sub_vol, _p1(nodes, dt),
+                          spokes=spokes)
+    exact = _p1_gradients(nodes, tets)[parent]
+    for i in range(3):
+        dense = grad.components[i].toarray()
+        expected = np.zeros_like(dense)
+        np.put_along_axis(expected, tets[parent], exact[:, :, i], axis=1)
+        np.testing.assert_allclose(dense, expected, atol=1e-10)
+
+
+def test_facet_rule_integrates_quadratics_on_a_3d_triangle():
+    tri = np.array([[[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 3.0]]])
+    _, pts, w = facet_rule(tri, 2)
+    area = 0.5 * np.linalg.norm(np.cross(tri[0, 1] - tri[0, 0], tri[0, 2] - tri[0, 0]))
+    assert np.isclose(w.sum(), area)
+    # int x^2 over the triangle = area / 6 (sum of squares + sum of pairwise products)
+    x = tri[0, :, 0]
+    exact = area / 6.0 * (np.sum(x ** 2) + x[0] * x[1] + x[1] * x[2] + x[0] * x[2])
+    assert np.isclose(np.sum(w * pts[:, 0] ** 2), exact)
+
+
+def test_cells_without_volume_are_refused():
+    nodes, dt, tets = _lattice(k=3)
+    tets, tri, cell, nrm, vol = _facets(nodes, tets)
+    vol[2] = 0.0
+    with pytest.raises(GeometryError, match="positive volume"):
+        facet_gradient(tri, cell, nrm, vol, _p1(nodes, dt))
