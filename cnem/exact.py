@@ -13,7 +13,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import MaterialError
+from .errors import InputError, MaterialError, check_array
 from .material import effective_modulus, lame
 
 __all__ = ["LayeredCylinder", "CentralCrack", "rayleigh_speed"]
@@ -41,14 +41,21 @@ class LayeredCylinder:
 
     def __init__(self, radii: ArrayLike, materials: ArrayLike, *, pressure: float = 1.0,
                  plane: Literal["stress", "strain"] = "stress", center: ArrayLike = (0.0, 0.0)) -> None:
-        self.radii = np.asarray(radii, dtype=float)
-        mats = np.asarray(materials, dtype=float).reshape(-1, 2)
+        self.radii = check_array("radii", radii, shape=(None,),
+                                 fix="pass increasing radii: inner, interfaces, outer")
+        mats = check_array("materials", materials, error=MaterialError,
+                           fix="pass one (E, nu) pair per layer, inner layer first")
+        if mats.shape == (2,):
+            mats = mats[None, :]                    # one layer, one pair
+        if mats.ndim != 2 or mats.shape[1] != 2:
+            raise MaterialError(f"materials: expected (E, nu) pairs, shape (k, 2), received "
+                                f"shape {mats.shape}; pass one pair per layer")
         if len(mats) != len(self.radii) - 1 or not (np.diff(self.radii) > 0).all():
             raise MaterialError(f"expected increasing radii and one material per layer, received "
                                 f"{len(self.radii)} radii and {len(mats)} materials; give "
                                 f"len(radii) - 1 (E, nu) pairs")
         self.lam, self.mu = lame(mats[:, 0], mats[:, 1], plane)
-        self.center = np.asarray(center, dtype=float)
+        self.center = check_array("center", center, shape=(2,), fix="pass one point (x, y)")
         k = len(mats)
         A = np.zeros((2 * k, 2 * k))
         rhs = np.zeros(2 * k)

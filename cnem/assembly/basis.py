@@ -17,7 +17,9 @@ from .gradients import smoothed_gradient
 if TYPE_CHECKING:
     from typing import Callable, Literal, Sequence
     from numpy.typing import ArrayLike
+    from ..geometry.cells import Cells
     from ..geometry.model import Model
+    from .gradients import SmoothedGradient
 
 __all__ = ["CellBasis", "spread_component"]
 
@@ -74,8 +76,8 @@ class CellBasis:
     """
 
     def __init__(self, model: Model, *, vector: bool = False, gauss: int = 2,
-                 extra: dict[str, np.ndarray] | None = None, cells: np.ndarray | None = None,
-                 gradient: np.ndarray | None = None):
+                 extra: tuple[sp.spmatrix, ...] | None = None, cells: Cells | None = None,
+                 gradient: SmoothedGradient | None = None):
         cells = model.cells if cells is None else cells
         self.cells = cells
         self.grad = gradient if gradient is not None else \

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any, Callable, Union
 
 import numpy as np
 
-from ..errors import ConditionError, UnsupportedError
+from ..errors import ConditionError, UnsupportedError, check_points, check_real
 
 
 if TYPE_CHECKING:
@@ -67,6 +67,7 @@ def select_nodes(nodes: np.ndarray, where: Callable[..., np.ndarray] | ArrayLike
     -------
     (k,) int64 ndarray, sorted
     """
+    nodes = check_points("nodes", nodes, error=ConditionError)
     n = len(nodes)
     if callable(where):
         mask = np.asarray(_call_where(where, nodes))
@@ -84,6 +85,9 @@ def select_nodes(nodes: np.ndarray, where: Callable[..., np.ndarray] | ArrayLike
     if arr.size and not np.issubdtype(arr.dtype, np.integer):
         raise ConditionError(f"where: expected a callable, a boolean mask or node indices, "
                              f"received an array of dtype {arr.dtype}")
+    if arr.ndim > 1:
+        raise ConditionError(f"where: expected a flat array of node indices, received shape "
+                             f"{arr.shape}; pass e.g. np.array([0, 4, 7])")
     idx = np.unique(arr.astype(np.int64).reshape(-1))
     if idx.size and (idx[0] < 0 or idx[-1] >= n):
         raise ConditionError(f"where: node indices must lie in [0, {n}), received "
@@ -100,7 +104,8 @@ def per_point(value: ArrayLike | Callable[..., np.ndarray], points: np.ndarray, 
     ConditionError
         Values of the wrong shape, or not finite (``what`` names them).
     """
-    arr = np.asarray(value(points) if callable(value) else value, dtype=float)
+    arr = np.asarray(check_real(what, value(points) if callable(value) else value,
+                                error=ConditionError), dtype=float)
     if width == 1 and arr.shape == (len(points),):
         arr = arr[:, None]
     try:
