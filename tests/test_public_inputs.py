@@ -63,6 +63,20 @@ NOT_ENTRY_POINTS = {
     "cnem.material.Material": "an abstract base class",
     "cnem.material.check_plane": "a validator (takes a dimension and a plane name)",
     "cnem.material.check_stiffness": "a validator called on checked moduli",
+    # methods that are plumbing: the library calls them with arrays it built and checked
+    **{name: "plumbing: called by the library with the arrays it built" for name in (
+        "cnem.Elasticity.body_forces_at", "cnem.Elasticity.preconditioner_matrix",
+        "cnem.Elasticity.solver_options", "cnem.ElasticSolution.from_dofs",
+        "cnem.ElasticSolution.write_fields", "cnem.fem.P1Solution.from_dofs",
+        "cnem.fem.P1Solution.write_fields", "cnem.pd.StaticSolution.write_fields",
+        "cnem.geometry.Cells.subset", "cnem.assembly.CellBasis.at_points",
+        "cnem.assembly.CellBasis.from_operators", "cnem.assembly.BilinearForm.assemble",
+        "cnem.fracture.Enrichment.edge_loads", "cnem.fracture.Enrichment.evaluate",
+        "cnem.fracture.Enrichment.in_support", "cnem.fracture.Enrichment.smoothed_gradient",
+        "cnem.fracture.Enrichment.values", "cnem.spatial.RTree.from_points_in",
+        "cnem.pd.CPD.measure_derivatives", "cnem.pd.Problem.energy_density",
+        "cnem.pd.Problem.displacement_gradient", "cnem.pd.Problem.stress_tensor")},
+    "cnem.pd.Problem.add_traction": "refuses every call (a PD body has no boundary edges)",
     # hyper-dual arithmetic: elementwise NumPy semantics on any shape (NaN in, NaN out),
     # inside the energies of the PD and finite-strain materials
     **{f"cnem.hyperdual.{name}": "elementwise hyper-dual math (NumPy semantics)"
@@ -98,6 +112,27 @@ def _public_callables():
     return found
 
 
+def _public_methods(classes):
+    """``{"<class name>.<method>": (class, method name)}``: the public methods (and class
+    methods) of the public classes that take arrays, each function once, those already
+    public as functions (``cnem.fracture.tip_frame`` is ``Domain.tip_frame``) left out."""
+    seen = {id(obj) for obj in classes.values()}
+    found = {}
+    for name, cls in classes.items():
+        if not inspect.isclass(cls):
+            continue
+        for method in dir(cls):
+            attr = inspect.getattr_static(cls, method)
+            func = attr.__func__ if isinstance(attr, (classmethod, staticmethod)) else attr
+            if method.startswith("_") or not inspect.isfunction(func) \
+                    or not func.__module__.startswith("cnem") or id(func) in seen:
+                continue
+            seen.add(id(func))
+            if _array_parameters(func):
+                found[f"{name}.{method}"] = (cls, method)
+    return found
+
+
 PUBLIC = _public_callables()
 
 _ARRAY_WORDS = re.compile(r"ArrayLike|ndarray|Sequence\[float|tuple\[float")
@@ -117,6 +152,20 @@ def _array_parameters(obj):
         if _ARRAY_WORDS.search(text):
             names.append(name)
     return names
+
+
+METHODS = _public_methods(PUBLIC)
+
+#: What the test calls: public functions and classes, and the methods that take arrays.
+ENTRY_POINTS = [name for name in [*PUBLIC, *METHODS] if name not in NOT_ENTRY_POINTS]
+
+
+def _function(name):
+    """The function behind an entry point (a method's, unbound)."""
+    if name in METHODS:
+        cls, method = METHODS[name]
+        return getattr(cls, method)
+    return PUBLIC[name]
 
 
 # --------------------------------------------------------------------------- fixtures
@@ -139,10 +188,20 @@ def fx():
     pd_prob.add_body_force([1.0, 0.0])
     pd_sol = pd_prob.solve_static()
     inside = np.array([[0.3, 0.3], [0.7, 0.8]])
-    return types.SimpleNamespace(square=square, crack=crack, dom=dom, cloud=cloud, model=model,
+    p1 = cnem.fem.P1Elasticity(cnem.Domain(square), (1.0, 0.3), nodes=20)
+    p1.add_dirichlet(lambda p: p[:, 1] < 1e-9, None)
+    p1.add_traction(lambda x, n: x[:, 1] > 1 - 1e-9, [0.0, 1.0])
+    return types.SimpleNamespace(p1_sol=p1.solve(), square=square, crack=crack, dom=dom, cloud=cloud, model=model,
                                  prob=prob, sol=sol, lattice=lattice, body=body,
                                  pd_prob=pd_prob, pd_sol=pd_sol, inside=inside,
                                  tip=np.array([0.5, 0.5]))
+
+
+def _pd_problem(f):
+    """A fresh PD problem on the lattice of `fx` (for calls that add conditions)."""
+    prob = cnem.pd.Problem(f.body, cnem.pd.BondBased(1.0))
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+    return prob
 
 
 def _setup(model):
@@ -303,6 +362,81 @@ EXAMPLES = {
         lambda f: dict(materials=np.array([[1.0, 0.3]]), nregions=1, plane="stress")),
     "cnem.material.moduli": Example(
         lambda f: dict(materials=(cnem.material.LinearElastic(1.0, 0.3),))),
+    # methods ("self" is the object called)
+    "cnem.Domain.contains": Example(lambda f: dict(self=f.dom, points=f.inside)),
+    "cnem.Domain.region_of": Example(lambda f: dict(self=f.dom, points=f.inside)),
+    "cnem.Model.shape_functions": Example(
+        lambda f: dict(self=f.model, points=f.inside, triangles=np.array([-1, -1]))),
+    "cnem.Elasticity.add_body_force": Example(
+        lambda f: dict(self=_setup(f.model), b=np.array([0.0, -1.0]))),
+    "cnem.Elasticity.add_dirichlet": Example(
+        lambda f: dict(self=_setup(f.model), where=np.array([0]), component=None,
+                       value=np.array([0.1, 0.2])),
+        skip={("value", "scalar"): "a number is valid: the same value on every component"}),
+    "cnem.Elasticity.add_traction": Example(
+        lambda f: dict(self=_setup(f.model), where=lambda x, n: x[:, 1] > 1 - 1e-9,
+                       t=np.array([0.0, 1.0]))),
+    "cnem.ElasticSolution.displacement": Example(lambda f: dict(self=f.sol, points=f.inside)),
+    "cnem.ElasticSolution.displacement_gradient": Example(
+        lambda f: dict(self=f.sol, points=f.inside)),
+    "cnem.ElasticSolution.nodal_average": Example(
+        lambda f: dict(self=f.sol, values=f.sol.stress),
+        skip={("values", "shape"): "cell values of any trailing shape",
+              ("values", "nan"): _NAN_IN_NAN_OUT}),
+    "cnem.assembly.CellBasis.get_dofs": Example(
+        lambda f: dict(self=cnem.assembly.CellBasis(f.model), where=np.array([0, 1])),
+        skip={("where", "bool"): _MASK}),
+    "cnem.assembly.CellBasis.interpolate": Example(
+        lambda f: dict(self=cnem.assembly.CellBasis(f.model), u=np.zeros(len(f.model.nodes)))),
+    **{f"cnem.exact.LayeredCylinder.{method}": Example(
+        lambda f: dict(self=cnem.exact.LayeredCylinder([1.0, 2.0], [[1.0, 0.3]]),
+                       r=np.array([1.2, 1.5])),
+        skip={"shape": _ELEMENTWISE, "scalar": _ELEMENTWISE})
+       for method in ("hoop_stress", "layer", "radial_displacement", "radial_stress")},
+    "cnem.exact.LayeredCylinder.displacement": Example(
+        lambda f: dict(self=cnem.exact.LayeredCylinder([1.0, 2.0], [[1.0, 0.3]]),
+                       points=np.array([[1.2, 0.0], [0.0, 1.5]]))),
+    "cnem.exact.LayeredCylinder.stress": Example(
+        lambda f: dict(self=cnem.exact.LayeredCylinder([1.0, 2.0], [[1.0, 0.3]]),
+                       points=np.array([[1.2, 0.0], [0.0, 1.5]]), layer=np.array([0, 0]))),
+    "cnem.exact.CentralCrack.opening": Example(
+        lambda f: dict(self=cnem.exact.CentralCrack(1.0), x=np.array([0.2, 0.5]), E=1.0),
+        skip={"shape": _ELEMENTWISE, "scalar": _ELEMENTWISE}),
+    "cnem.exact.CentralCrack.normal_stress_ahead": Example(
+        lambda f: dict(self=cnem.exact.CentralCrack(1.0), r=np.array([0.2, 0.5])),
+        skip={"shape": _ELEMENTWISE, "scalar": _ELEMENTWISE}),
+    "cnem.spatial.RTree.from_points": Example(
+        lambda f: dict(points=f.lattice, period=np.array([2.0, 2.0])),
+        skip={("points", "shape"): _THREE_D, ("period", "scalar"): _ONE_PERIOD}),
+    "cnem.spatial.RTree.nearest": Example(
+        lambda f: dict(self=cnem.spatial.RTree.from_points(f.lattice), points=f.inside)),
+    "cnem.spatial.RTree.query": Example(
+        lambda f: dict(self=cnem.spatial.RTree.from_points(f.lattice), qlo=f.inside,
+                       qhi=f.inside + 0.1)),
+    "cnem.spatial.RTree.query_ball": Example(
+        lambda f: dict(self=cnem.spatial.RTree.from_points(f.lattice), points=f.inside,
+                       r=0.3)),
+    "cnem.pd.Problem.add_velocity": Example(
+        lambda f: dict(self=_pd_problem(f), where=np.array([24]), component=0, value=1.0)),
+    "cnem.pd.Problem.run_dynamic": Example(
+        lambda f: dict(self=_pd_problem(f), dt=1e-3, steps=2,
+                       velocity=np.zeros((len(f.lattice), 2)), progress=False)),
+    "cnem.pd.Problem.solve": Example(
+        lambda f: dict(self=f.pd_prob, initial=np.zeros((len(f.lattice), 2)))),
+    "cnem.pd.Problem.solve_static": Example(
+        lambda f: dict(self=f.pd_prob, initial=np.zeros((len(f.lattice), 2)))),
+    "cnem.pd.StaticSolution.displacement": Example(
+        lambda f: dict(self=f.pd_sol, points=f.inside)),
+    "cnem.pd.StaticSolution.nodal_average": Example(
+        lambda f: dict(self=f.pd_sol, values=np.ones(len(f.lattice))),
+        skip={("values", "shape"): "point values of any trailing shape",
+              ("values", "nan"): _NAN_IN_NAN_OUT}),
+    "cnem.fem.P1Solution.displacement": Example(
+        lambda f: dict(self=f.p1_sol, points=f.inside)),
+    "cnem.fem.P1Solution.nodal_average": Example(
+        lambda f: dict(self=f.p1_sol, values=f.p1_sol.stress),
+        skip={("values", "shape"): "triangle values of any trailing shape",
+              ("values", "nan"): _NAN_IN_NAN_OUT}),
 }
 
 
@@ -310,13 +444,11 @@ def _cases():
     """``(entry point, parameter, bad kind)`` for every array parameter of every entry point;
     an entry point without an example gives one case that fails."""
     cases = []
-    for name, obj in PUBLIC.items():
-        if name in NOT_ENTRY_POINTS:
-            continue
+    for name in ENTRY_POINTS:
         if name not in EXAMPLES:
             cases.append(pytest.param(name, None, None, id=f"{name}-missing-example"))
             continue
-        for param in _array_parameters(obj):
+        for param in _array_parameters(_function(name)):
             for kind in BAD_KINDS:
                 cases.append(pytest.param(name, param, kind, id=f"{name}-{param}-{kind}"))
     return cases
@@ -367,8 +499,14 @@ def _arguments(name, fixtures):
     return EXAMPLES[name].arguments(fixtures)
 
 
-def _call(obj, kwargs):
-    """``obj(**kwargs)`` with positional-only parameters passed by position."""
+def _call(name, kwargs):
+    """The entry point ``name`` called with ``kwargs`` (a method on ``kwargs["self"]``, or
+    on its class for a class method), positional-only parameters passed by position."""
+    if name in METHODS:
+        cls, method = METHODS[name]
+        obj = getattr(kwargs.pop("self"), method) if "self" in kwargs else getattr(cls, method)
+    else:
+        obj = PUBLIC[name]
     signature = inspect.signature(obj)
     args = [kwargs.pop(n) for n, p in signature.parameters.items()
             if p.kind is p.POSITIONAL_ONLY and n in kwargs]
@@ -377,15 +515,15 @@ def _call(obj, kwargs):
         return obj(*args, **kwargs)
 
 
-@pytest.mark.parametrize("name", [n for n in PUBLIC if n not in NOT_ENTRY_POINTS])
+@pytest.mark.parametrize("name", ENTRY_POINTS)
 def test_example_call_is_valid(name, fixtures):
     """The table's call runs: a bad value refused below is refused for itself, not because
     the example was wrong."""
-    _call(PUBLIC[name], _arguments(name, fixtures))
+    _call(name, _arguments(name, fixtures))
 
 
 def test_table_names_only_public_callables():
-    stale = sorted((set(EXAMPLES) | set(NOT_ENTRY_POINTS)) - set(PUBLIC))
+    stale = sorted((set(EXAMPLES) | set(NOT_ENTRY_POINTS)) - set(PUBLIC) - set(METHODS))
     assert not stale, f"the table names callables that are not public (any more): {stale}"
 
 
@@ -393,11 +531,10 @@ def test_table_names_only_public_callables():
 def test_bad_array_is_refused_by_name(name, param, kind, fixtures):
     kwargs = _arguments(name, fixtures)
     example = EXAMPLES[name]
-    obj = PUBLIC[name]
     if example.skipped(param, kind):
         pytest.skip(example.skipped(param, kind))
     if param not in kwargs:
-        default = inspect.signature(obj).parameters[param].default
+        default = inspect.signature(_function(name)).parameters[param].default
         if default is inspect.Parameter.empty or default is None:
             pytest.fail(f"add a valid value of {param!r} to the example call of {name} in "
                         f"EXAMPLES (tests/test_public_inputs.py), so that its bad values "
@@ -408,7 +545,7 @@ def test_bad_array_is_refused_by_name(name, param, kind, fixtures):
         pytest.skip(f"{param} is a number: no {kind} form")
     kwargs[param] = bad
     try:
-        result = _call(obj, kwargs)
+        result = _call(name, kwargs)
     except cnem.CNEMError as exc:
         singular = param[:-1] if param.endswith("s") else param      # "crack 0" for cracks
         assert singular in str(exc), (f"{name}({param}=<{kind}>) raised {type(exc).__name__} "

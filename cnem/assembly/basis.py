@@ -10,7 +10,7 @@ import numpy as np
 import scipy.sparse as sp
 from skfem.element import DiscreteField
 
-from ..errors import ConditionError, InputError
+from ..errors import ConditionError, InputError, check_array
 from ..solvers.conditions import select_nodes
 from .gradients import smoothed_gradient
 
@@ -224,7 +224,7 @@ class CellBasis:
         DiscreteField
             Value ``(m,)`` or ``(dim, m)``, ``grad`` ``(dim, m)`` or ``(dim, dim, m)``.
         """
-        u = np.asarray(u, dtype=float)
+        u = check_array("u", u, fix="pass one value per dof (e.g. from solve)")
         if u.shape != (self.N,):
             raise InputError(f"u: expected {self.N} dof values, received shape {u.shape}; "
                              f"pass one value per dof of this basis")

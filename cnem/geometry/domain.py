@@ -387,14 +387,13 @@ class Domain:
         (p,) int64 ndarray
             The lowest region index for points on an interface.
         """
-        pts = np.asarray(points, dtype=float)
+        pts = check_array("points", points, error=GeometryError,
+                          fix="pass finite real coordinates, one row (x, y) per point")
         if pts.shape == (2,):
             pts = pts[None]
         if pts.ndim != 2 or pts.shape[1] != 2:
             raise GeometryError(f"points: expected a (2,) or (p, 2) array, received shape "
                                 f"{pts.shape}")
-        if not np.isfinite(pts).all():
-            raise GeometryError("points: coordinates must be finite, received NaN or inf")
         out = np.full(len(pts), -1, dtype=np.int64)
         for i in reversed(range(len(self._regions))):
             box = _axis_box(self._regions[i])

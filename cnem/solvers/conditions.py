@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any, Callable, Union
 
 import numpy as np
 
-from ..errors import ConditionError, UnsupportedError, check_points, check_real
+from ..errors import ConditionError, UnsupportedError, check_array, check_points, check_real
 
 
 if TYPE_CHECKING:
@@ -141,11 +141,12 @@ def vector_constant(value: Any, dim: int, what: str, fix: str, *,
     Raises
     ------
     ConditionError
-        A bare number (which component would it be?) or a constant of another shape.
+        A bare number (which component would it be?), a constant of another shape, or
+        one that is not real and finite numbers.
     """
     if callable(value):
         return value
-    shape = np.shape(value)
+    shape = check_array(what, value, error=ConditionError, fix=fix).shape
     rows = "" if points is None else f" (or {points} rows of them, one per point)"
     if shape == ():
         raise ConditionError(f"{what}: expected a vector of {dim} components{rows} or a "
@@ -257,7 +258,8 @@ class Conditions:
         return (f"{len(self.dirichlet)} Dirichlet, {len(self.tractions)} traction, "
                 f"{len(self.body_forces)} body-force conditions")
 
-    def add_dirichlet(self, where: Where, component: int | None, value: Any = 0.0) -> None:
+    def add_dirichlet(self, where: Where, component: int | None,
+                      value: ArrayLike | Callable[..., np.ndarray] = 0.0) -> None:
         """Prescribe displacements at nodes (later conditions win on shared dofs).
 
         Parameters
@@ -284,7 +286,7 @@ class Conditions:
         raise UnsupportedError(f"{type(self).__name__} has no boundary edges; give loads as "
                                f"body forces (add_body_force)")
 
-    def add_traction(self, where: Where, t: Any) -> None:
+    def add_traction(self, where: Where, t: ArrayLike | Callable[..., np.ndarray]) -> None:
         """Tractions on the boundary edges (outer boundary, holes, crack faces).
 
         Parameters
@@ -317,7 +319,7 @@ class Conditions:
         index = np.flatnonzero(pick)
         self.tractions.append(Traction(index, edges[index], normal[index], t))
 
-    def add_body_force(self, b: Any) -> None:
+    def add_body_force(self, b: ArrayLike | Callable[..., np.ndarray]) -> None:
         """Body force per unit area (2-D) or volume: ``b(x) -> (p, d)``, a constant ``(d,)``,
         or one ``(d,)`` row per condition point (node).
 

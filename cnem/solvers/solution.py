@@ -162,6 +162,18 @@ class Solution:
         """Values ``(k, ...)`` at the places of ``stress`` as ``(n, ...)`` at the nodes."""
         raise NotImplementedError
 
+    def _place_values(self, values: np.ndarray) -> np.ndarray:
+        """``values`` ``(k, ...)``, one row per place of ``stress``, as float64: refused
+        with an `InputError` when complex, boolean, not numbers or of another row count
+        (NaN entries stay: they average to NaN)."""
+        count = len(self.u) if self.stress_at == "points" else len(self.stress)
+        arr = check_array("values", values, finite=False,
+                          fix=f"pass one value (or row) per {self.stress_at[:-1]}")
+        if arr.ndim == 0 or len(arr) != count:
+            raise InputError(f"values: expected one row per {self.stress_at[:-1]} ({count} "
+                             f"rows), received shape {arr.shape}")
+        return arr
+
     def plot_mesh(self) -> None:
         """What a picture draws: ``nodes (n, d)``, ``triangles (t, 3)`` (or None: the
         points alone) and the body's diameter."""

@@ -210,7 +210,7 @@ class RTree:
                        work_chunks(), lo, hi, qlo, qhi)
 
     def _points(self, points, name, *, in_cell=True):
-        arr = np.asarray(points, dtype=np.float64)
+        arr = np.asarray(check_real(name, points, error=SpatialError), dtype=np.float64)
         if arr.size == 0:
             return np.zeros((0, self.dim))
         pts = as_points(arr, name)
