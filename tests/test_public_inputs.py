@@ -228,6 +228,9 @@ class Example:
 _ELEMENTWISE = "elementwise: any shape is valid"
 _SCALAR_OK = "a number is valid (one value for every point)"
 _MASK = "a boolean mask is a valid selection"
+#: The solution classes and the fixture holding one of each.
+_SOLUTIONS = {"cnem.ElasticSolution": "sol", "cnem.pd.StaticSolution": "pd_sol",
+              "cnem.fem.P1Solution": "p1_sol"}
 _THREE_D = "(n, 3) points are valid: a 3-D body"
 _ONE_PERIOD = "one number is a valid period (the same length along every axis)"
 _NAN_IN_NAN_OUT = "elementwise formula: NaN entries give NaN, as in NumPy"
@@ -376,13 +379,16 @@ EXAMPLES = {
     "cnem.Elasticity.add_traction": Example(
         lambda f: dict(self=_setup(f.model), where=lambda x, n: x[:, 1] > 1 - 1e-9,
                        t=np.array([0.0, 1.0]))),
-    "cnem.ElasticSolution.displacement": Example(lambda f: dict(self=f.sol, points=f.inside)),
+    **{f"{cls}.displacement": Example(lambda f, a=attr: dict(self=getattr(f, a),
+                                                             points=f.inside))
+       for cls, attr in _SOLUTIONS.items()},
+    **{f"{cls}.nodal_average": Example(
+        lambda f, a=attr: dict(self=getattr(f, a), values=getattr(f, a).stress),
+        skip={("values", "shape"): "values of any trailing shape, one row per place",
+              ("values", "nan"): _NAN_IN_NAN_OUT})
+       for cls, attr in _SOLUTIONS.items()},
     "cnem.ElasticSolution.displacement_gradient": Example(
         lambda f: dict(self=f.sol, points=f.inside)),
-    "cnem.ElasticSolution.nodal_average": Example(
-        lambda f: dict(self=f.sol, values=f.sol.stress),
-        skip={("values", "shape"): "cell values of any trailing shape",
-              ("values", "nan"): _NAN_IN_NAN_OUT}),
     "cnem.assembly.CellBasis.get_dofs": Example(
         lambda f: dict(self=cnem.assembly.CellBasis(f.model), where=np.array([0, 1])),
         skip={("where", "bool"): _MASK}),
@@ -425,18 +431,6 @@ EXAMPLES = {
         lambda f: dict(self=f.pd_prob, initial=np.zeros((len(f.lattice), 2)))),
     "cnem.pd.Problem.solve_static": Example(
         lambda f: dict(self=f.pd_prob, initial=np.zeros((len(f.lattice), 2)))),
-    "cnem.pd.StaticSolution.displacement": Example(
-        lambda f: dict(self=f.pd_sol, points=f.inside)),
-    "cnem.pd.StaticSolution.nodal_average": Example(
-        lambda f: dict(self=f.pd_sol, values=np.ones(len(f.lattice))),
-        skip={("values", "shape"): "point values of any trailing shape",
-              ("values", "nan"): _NAN_IN_NAN_OUT}),
-    "cnem.fem.P1Solution.displacement": Example(
-        lambda f: dict(self=f.p1_sol, points=f.inside)),
-    "cnem.fem.P1Solution.nodal_average": Example(
-        lambda f: dict(self=f.p1_sol, values=f.p1_sol.stress),
-        skip={("values", "shape"): "triangle values of any trailing shape",
-              ("values", "nan"): _NAN_IN_NAN_OUT}),
 }
 
 
