@@ -346,8 +346,9 @@ def check_array(name: str, value: object, *, shape: tuple | None = None, broadca
                                                                  "non-negative")):
         if flag and bad.any():
             first = np.flatnonzero(bad.reshape(-1))[0]
-            raise error(f"{name}: expected {text} values, received {float(arr.reshape(-1)[first])!r} "
-                        f"at index {int(first)} (shape {arr.shape}){tail}")
+            at = f" at index {int(first)} (shape {arr.shape})" if arr.ndim else ""
+            raise error(f"{name}: expected {text} values, received "
+                        f"{float(arr.reshape(-1)[first])!r}{at}{tail}")
     return arr
 
 

@@ -13,7 +13,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import MaterialError
+from .errors import InputError, MaterialError, check_array, check_points
 from .material import effective_modulus, lame
 
 __all__ = ["LayeredCylinder", "CentralCrack", "rayleigh_speed"]
@@ -41,14 +41,21 @@ class LayeredCylinder:
 
     def __init__(self, radii: ArrayLike, materials: ArrayLike, *, pressure: float = 1.0,
                  plane: Literal["stress", "strain"] = "stress", center: ArrayLike = (0.0, 0.0)) -> None:
-        self.radii = np.asarray(radii, dtype=float)
-        mats = np.asarray(materials, dtype=float).reshape(-1, 2)
+        self.radii = check_array("radii", radii, shape=(None,),
+                                 fix="pass increasing radii: inner, interfaces, outer")
+        mats = check_array("materials", materials, error=MaterialError,
+                           fix="pass one (E, nu) pair per layer, inner layer first")
+        if mats.shape == (2,):
+            mats = mats[None, :]                    # one layer, one pair
+        if mats.ndim != 2 or mats.shape[1] != 2:
+            raise MaterialError(f"materials: expected (E, nu) pairs, shape (k, 2), received "
+                                f"shape {mats.shape}; pass one pair per layer")
         if len(mats) != len(self.radii) - 1 or not (np.diff(self.radii) > 0).all():
             raise MaterialError(f"expected increasing radii and one material per layer, received "
                                 f"{len(self.radii)} radii and {len(mats)} materials; give "
                                 f"len(radii) - 1 (E, nu) pairs")
         self.lam, self.mu = lame(mats[:, 0], mats[:, 1], plane)
-        self.center = np.asarray(center, dtype=float)
+        self.center = check_array("center", center, shape=(2,), fix="pass one point (x, y)")
         k = len(mats)
         A = np.zeros((2 * k, 2 * k))
         rhs = np.zeros(2 * k)
@@ -70,24 +77,38 @@ class LayeredCylinder:
 
     def layer(self, r: ArrayLike) -> np.ndarray:
         """Layer index of radii (the inner layer at an interface)."""
+        r = _distances("r", r)
         return np.clip(np.searchsorted(self.radii, r, side="left") - 1, 0, len(self.a) - 1)
 
     def radial_displacement(self, r: ArrayLike) -> np.ndarray:
+        r = _distances("r", r)
         i = self.layer(r)
         return self.a[i] * r + self.b[i] / r
 
     def radial_stress(self, r: ArrayLike) -> np.ndarray:
+        r = _distances("r", r)
         i = self.layer(r)
         return 2.0 * (self.lam[i] + self.mu[i]) * self.a[i] - 2.0 * self.mu[i] * self.b[i] / r ** 2
 
     def hoop_stress(self, r: ArrayLike) -> np.ndarray:
+        r = _distances("r", r)
         i = self.layer(r)
         return 2.0 * (self.lam[i] + self.mu[i]) * self.a[i] + 2.0 * self.mu[i] * self.b[i] / r ** 2
 
     def _polar(self, points):
-        rel = np.asarray(points, dtype=float) - self.center
+        rel = check_points("points", points, dims=(2,)) - self.center
         r = np.hypot(rel[:, 0], rel[:, 1])
         return r, rel[:, 0] / r, rel[:, 1] / r
+
+    def _layers(self, layer, count):
+        """``layer`` as ``count`` whole layer indices, checked."""
+        values = check_array("layer", layer, shape=(count,),
+                             fix="pass one layer index per point (0 = inner layer)")
+        index = values.astype(np.int64)
+        if (index != values).any() or (index < 0).any() or (index >= len(self.a)).any():
+            raise InputError(f"layer: expected whole layer indices in [0, {len(self.a)}), "
+                             f"received {values.tolist()[:5]}")
+        return index
 
     def displacement(self, points: ArrayLike) -> np.ndarray:
         """``(p, 2)`` Cartesian displacements."""
@@ -98,12 +119,17 @@ class LayeredCylinder:
     def stress(self, points: ArrayLike, *, layer: ArrayLike | None = None) -> np.ndarray:
         """``(p, 3)`` ``[sxx, syy, sxy]``; ``layer`` forces the layer (for cells on an interface)."""
         r, c, s = self._polar(points)
-        i = self.layer(r) if layer is None else np.asarray(layer)
+        i = self.layer(r) if layer is None else self._layers(layer, len(r))
         lm = 2.0 * (self.lam[i] + self.mu[i]) * self.a[i]
         dev = 2.0 * self.mu[i] * self.b[i] / r ** 2
         srr, stt = lm - dev, lm + dev
         return np.column_stack([srr * c * c + stt * s * s, srr * s * s + stt * c * c,
                                 (srr - stt) * s * c])
+
+
+def _distances(name: str, value: ArrayLike) -> np.ndarray:
+    """``value`` (coordinates or distances, any shape) as a float64 array: real, finite."""
+    return check_array(name, value, fix="pass real, finite distances")
 
 
 def rayleigh_speed(E: float, nu: float, density: float, plane: Literal["stress", "strain"] = "stress") -> float:
@@ -170,11 +196,11 @@ class CentralCrack:
     def opening(self, x: ArrayLike, E: float, nu: float = 0.0,
                 plane: Literal["stress", "strain"] = "stress") -> np.ndarray:
         """Normal opening ``(p,)`` of the faces at ``x`` (crack axes; 0 outside the crack)."""
-        x = np.asarray(x, dtype=float)
+        x = _distances("x", x)
         return 4 * self.normal / effective_modulus(E, nu, plane) * \
             np.sqrt(np.clip(self.a * self.a - x * x, 0.0, None))
 
     def normal_stress_ahead(self, r: ArrayLike) -> np.ndarray:
         """Normal stress ``(p,)`` on the crack line at distance ``r > 0`` ahead of a tip."""
-        r = np.asarray(r, dtype=float)
+        r = _distances("r", r)
         return self.normal * (self.a + r) / np.sqrt(r * (2 * self.a + r))

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import config
-from .errors import HyperDualError
+from .errors import HyperDualError, check_array, check_real
 
 __all__ = ["HyperDual", "HyperDualError", "sqrt", "exp", "log", "sin", "cos", "tan", "arcsin",
            "arccos", "arctan", "sinh", "cosh", "tanh", "power", "dot", "cross", "norm", "stack",
@@ -68,7 +68,11 @@ class HyperDual:
 
     def __init__(self, re: ArrayLike, e1: ArrayLike = 0.0, e2: ArrayLike = 0.0,
                  e12: ArrayLike = 0.0) -> None:
-        parts = [np.asarray(p, dtype=np.float64) for p in (re, e1, e2, e12)]
+        parts = [np.asarray(p) for p in (re, e1, e2, e12)]
+        for name, part in zip(_PARTS, parts):
+            if part.dtype.kind not in "fiu":      # complex, boolean, text: named, not cast
+                check_real(f"HyperDual {name}", part, error=HyperDualError)
+        parts = [p.astype(np.float64, copy=False) for p in parts]
         shape = _broadcast([p.shape for p in parts], "HyperDual(re, e1, e2, e12)")
         for name, p in zip(_PARTS, parts):
             object.__setattr__(self, name, p if p.shape == shape else np.broadcast_to(p, shape))
@@ -366,7 +370,7 @@ def derivatives(f: Callable[[HyperDual], HyperDual], x: ArrayLike, *,
             f"hd.derivatives: expected real x of shape (m, k) (m points, k >= 1 variables), got "
             f"{'a HyperDual' if isinstance(x, HyperDual) else 'shape'} {np.shape(x)}; pass "
             f"x[:, None] for one variable or x.reshape(m, -1) for several")
-    x = np.asarray(x, dtype=np.float64)
+    x = check_array("x", x, finite=False, error=HyperDualError)
     m, k = x.shape
     first, second = np.triu_indices(k)
     eye = np.eye(k)
@@ -406,7 +410,7 @@ def derivative(f: Callable[[HyperDual], HyperDual],
     -------
     value, first, second : (m,) ndarrays
     """
-    x = np.asarray(x, dtype=np.float64)
+    x = check_array("x", x, finite=False, error=HyperDualError)
     out = f(HyperDual(x, 1.0, 1.0))
     _check_output(out, x.shape, "hd.derivative")
     return np.array(out.re), np.array(out.e1), np.array(out.e12)

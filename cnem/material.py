@@ -23,7 +23,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import MaterialError, OptionError, check_choice
+from .errors import MaterialError, OptionError, check_array, check_choice, check_real
 
 __all__ = ["PLANES", "Material", "LinearElastic", "parse_materials", "moduli", "check_plane", "check_stiffness",
            "lame", "stiffness_matrix", "kappa", "effective_modulus"]
@@ -168,7 +168,7 @@ def parse_materials(materials: Material | ArrayLike | list, nregions: int,
 def _pairs(materials, nregions):
     """``(r, 2)`` array of ``(E, nu)`` from one pair or a list of pairs, checked."""
     try:
-        arr = np.asarray(materials, dtype=float)
+        arr = np.asarray(check_real("materials", materials, error=MaterialError), dtype=float)
     except (TypeError, ValueError):
         raise MaterialError(f"materials: expected an (E, nu) pair, a Material or a list of "
                             f"{nregions} of either, received {materials!r}") from None
@@ -208,6 +208,14 @@ def check_stiffness(values: np.ndarray, materials: np.ndarray, what: str) -> Non
             f"units (e.g. MPa or GPa instead of Pa)")
 
 
+def _real_moduli(name: str, value: ArrayLike) -> float | np.ndarray:
+    """``value`` (a modulus or an array of them) as a float or a float64 array, refused
+    with a `MaterialError` when it is complex, boolean, not numbers or not finite."""
+    arr = check_array(name, value, error=MaterialError,
+                      fix="pass real, finite elastic constants")
+    return float(arr) if arr.ndim == 0 else arr
+
+
 def lame(E: ArrayLike, nu: ArrayLike,
          plane: Literal["stress", "strain"] | None) -> tuple[np.ndarray, np.ndarray]:
     """Lamé parameters of the law: ``sigma = 2 mu eps + lam tr(eps) I``.
@@ -221,7 +229,7 @@ def lame(E: ArrayLike, nu: ArrayLike,
     """
     if plane is not None:
         check_choice("plane", plane, PLANES)
-    E, nu = np.asarray(E, dtype=float), np.asarray(nu, dtype=float)
+    E, nu = np.asarray(_real_moduli("E", E)), np.asarray(_real_moduli("nu", nu))
     mu = E / (2.0 * (1.0 + nu))
     if plane == "stress":        # 2 lambda mu / (lambda + 2 mu), without the product
         lam = E * nu / ((1.0 + nu) * (1.0 - nu))
@@ -255,6 +263,7 @@ def stiffness_matrix(E: ArrayLike, nu: ArrayLike,
 def kappa(nu: float | np.ndarray, plane: Literal["stress", "strain"]) -> float | np.ndarray:
     """Kolosov's constant: ``3 - 4 nu`` (plane strain) or ``(3 - nu) / (1 + nu)`` (plane stress)."""
     check_choice("plane", plane, PLANES)
+    nu = _real_moduli("nu", nu)
     return 3.0 - 4.0 * nu if plane == "strain" else (3.0 - nu) / (1.0 + nu)
 
 
@@ -262,4 +271,5 @@ def effective_modulus(E: float | np.ndarray, nu: float | np.ndarray,
                       plane: Literal["stress", "strain"]) -> float | np.ndarray:
     """``E' = E`` (plane stress) or ``E / (1 - nu^2)`` (plane strain): ``G = K^2 / E'``."""
     kappa(nu, plane)
+    E, nu = _real_moduli("E", E), _real_moduli("nu", nu)
     return E if plane == "stress" else E / (1.0 - nu * nu)

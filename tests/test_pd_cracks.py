@@ -4,7 +4,7 @@ point, half-angle and speed are measured back; `cnem.exact.rayleigh_speed`."""
 import numpy as np
 import pytest
 
-from cnem.errors import GeometryError
+from cnem.errors import GeometryError, InputError
 from cnem.exact import rayleigh_speed
 from cnem.pd import cracks
 
@@ -94,6 +94,34 @@ def test_bad_images_are_named():
         cracks.crack_region(np.zeros(10), (0, 0), 1.0, (0, 0), 1.0)
     with pytest.raises(GeometryError, match="expected a positive grid spacing"):
         cracks.bands(np.zeros((4, 4), bool), (0, 0), -1.0, 0.0)
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), float("inf"), [1.0, 2.0], 1j])
+@pytest.mark.parametrize("measure", ["local_speeds window", "branching window",
+                                     "branching persistence", "crack_region reach"])
+def test_a_window_that_measures_nothing_is_named(measure, bad):
+    """A window of zero fitted no sample and gave NaN speeds (or three columns of branches)
+    without a word: a window, a persistence or a reach must be a positive length."""
+    function, name = measure.split()
+    t = np.arange(6.0)
+    image = np.zeros((12, 9))
+    image[4:10, 4] = 1.0
+    calls = {"local_speeds": lambda v: cracks.local_speeds(t, 2.0 * t, v),
+             "branching": lambda v: cracks.branching(
+                 image > 0, (0.0, -4.0), 1.0, 4.0,
+                 **{"persistence": 2.0, "window": 4.0, name: v}),
+             "crack_region": lambda v: cracks.crack_region(image, (0.0, -4.0), 1.0,
+                                                           (4.0, 0.0), v)}
+    with pytest.raises(InputError, match=rf"^{name}: expected"):
+        calls[function](bad)
+
+
+def test_a_positive_window_still_measures():
+    """The checks keep the measures: a tip moving at speed 2 has speed 2 in every window of
+    three samples or more (a window of 4 holds three at the ends)."""
+    t = np.arange(6.0)
+    speeds = cracks.local_speeds(t, 2.0 * t, 4.0)
+    np.testing.assert_allclose(speeds, 2.0)
 
 
 @pytest.mark.parametrize("nu", [0.0, 0.25, 1 / 3, 0.45])

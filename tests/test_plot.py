@@ -139,6 +139,22 @@ def test_a_non_finite_scale_is_refused(tmp_path):
         cnem.plot.solution(sol, tmp_path / "s.png", scale=float("nan"))
 
 
+@pytest.mark.parametrize("scale", [float("nan"), float("inf"), [1.0, 2.0]])
+@pytest.mark.parametrize("run", ["static", "dynamic"])
+def test_a_non_finite_scale_is_refused_for_peridynamic_results(run, scale, tmp_path):
+    """A PD result's picture (points moved by scale * u) refuses a scale that is not one
+    finite number, by name, as the C-NEM one does."""
+    h = 0.25
+    lattice = np.array([(x, y) for x in np.arange(5) * h for y in np.arange(5) * h])
+    prob = cnem.pd.Problem(cnem.pd.Body(lattice, h * h, 3.04 * h), cnem.pd.BondBased(1.0))
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+    prob.add_body_force([1.0, 0.0])
+    sol = prob.solve_static() if run == "static" else \
+        prob.run_dynamic(1e-3, 2, velocity=np.ones((len(lattice), 2)), progress=False)
+    with pytest.raises(cnem.PlotInputError, match="scale: expected a finite number"):
+        sol.plot(tmp_path / "s.png", scale=scale)
+
+
 def test_a_model_that_is_none_and_a_path_that_is_no_picture_are_named(tmp_path):
     with pytest.raises(cnem.InputError, match="expects a Model, received NoneType"):
         cnem.plot.model(None, tmp_path / "m.png")

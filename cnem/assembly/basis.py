@@ -10,14 +10,16 @@ import numpy as np
 import scipy.sparse as sp
 from skfem.element import DiscreteField
 
-from ..errors import ConditionError, InputError
+from ..errors import ConditionError, InputError, check_array
 from ..solvers.conditions import select_nodes
 from .gradients import smoothed_gradient
 
 if TYPE_CHECKING:
     from typing import Callable, Literal, Sequence
     from numpy.typing import ArrayLike
+    from ..geometry.cells import Cells
     from ..geometry.model import Model
+    from .gradients import SmoothedGradient
 
 __all__ = ["CellBasis", "spread_component"]
 
@@ -74,8 +76,8 @@ class CellBasis:
     """
 
     def __init__(self, model: Model, *, vector: bool = False, gauss: int = 2,
-                 extra: dict[str, np.ndarray] | None = None, cells: np.ndarray | None = None,
-                 gradient: np.ndarray | None = None):
+                 extra: tuple[sp.spmatrix, ...] | None = None, cells: Cells | None = None,
+                 gradient: SmoothedGradient | None = None):
         cells = model.cells if cells is None else cells
         self.cells = cells
         self.grad = gradient if gradient is not None else \
@@ -222,7 +224,7 @@ class CellBasis:
         DiscreteField
             Value ``(m,)`` or ``(dim, m)``, ``grad`` ``(dim, m)`` or ``(dim, dim, m)``.
         """
-        u = np.asarray(u, dtype=float)
+        u = check_array("u", u, fix="pass one value per dof (e.g. from solve)")
         if u.shape != (self.N,):
             raise InputError(f"u: expected {self.N} dof values, received shape {u.shape}; "
                              f"pass one value per dof of this basis")

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..assembly.quadrature import cell_quadrature
 from ..solvers.solution import Solution, energy_error_density, engineering_strain, von_mises
-from ..errors import check_choice
+from ..errors import GeometryError, check_choice, check_points
 
 __all__ = ["ElasticSolution", "von_mises", "energy_error_density"]
 
@@ -97,7 +97,7 @@ class ElasticSolution(Solution):
         (p, d, d) ndarray
             ``[q, i, j] = du_i/dx_j``.
         """
-        pts = np.asarray(points, dtype=float)
+        pts = check_points("points", points, dims=(self.u.shape[1],), error=GeometryError)
         shape = self.model.shape_functions(pts, gradient=True)
         out = np.stack([g @ self.u for g in shape.gradient], axis=2)
         enrichment = self.problem.enrichment
@@ -152,7 +152,7 @@ class ElasticSolution(Solution):
         """Cell values ``(m, ...)`` at the nodes: each node's cell (area-weighted over the
         cells of a node on an interface), ``(n, ...)``."""
         cells, n = self.cells, len(self.model.nodes)
-        values = np.asarray(values, dtype=float)
+        values = self._place_values(values)
         weight = np.bincount(cells.node, weights=cells.area, minlength=n)
         flat = values.reshape(len(values), -1)
         out = np.stack([np.bincount(cells.node, weights=cells.area * col, minlength=n) / weight

@@ -67,7 +67,7 @@ class P1Elasticity(Conditions):
 
     def __init__(self, domain: Domain,
                  materials: tuple[float, float] | Sequence[tuple[float, float]], *,
-                 plane: str = "stress", nodes: np.ndarray | None = None,
+                 plane: str = "stress", nodes: int | None = None,
                  max_area: float | None = None, quality: float = 30.0):
         self.domain = domain
         check_plane(2, plane)

@@ -10,6 +10,7 @@ from skfem.helpers import sym_grad
 
 from ..assembly.quadrature import triangle_quadrature
 from ..material import stiffness_matrix
+from ..errors import GeometryError, check_points
 from ..solvers.solution import Solution, energy_error_density
 
 __all__ = ["P1Solution"]
@@ -65,7 +66,7 @@ class P1Solution(Solution):
     def displacement(self, points: np.ndarray) -> np.ndarray:
         """Displacements ``(p, 2)`` at points ``(p, 2)`` inside the mesh, through the P1
         shape functions."""
-        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        pts = check_points("points", points, dims=(2,), error=GeometryError)
         values = self.basis.probes(np.ascontiguousarray(pts.T)) @ self.u.reshape(-1)
         return values.reshape(2, -1).T                      # probes give x values, then y
 
@@ -107,7 +108,7 @@ class P1Solution(Solution):
     def nodal_average(self, values: np.ndarray) -> np.ndarray:
         """Triangle values ``(t, ...)`` at the nodes: the area-weighted mean over the
         triangles around each node, ``(n, ...)``."""
-        values = np.asarray(values, dtype=float)
+        values = self._place_values(values)
         n, tri = self.mesh.p.shape[1], self.mesh.t.T
         area = np.repeat(self.basis.dx.sum(axis=1), 3)
         flat = values.reshape(len(values), -1)

@@ -25,7 +25,7 @@ import scipy.sparse as sp
 
 from .. import config
 from ..assembly.edge_quadrature import boundary_quadrature
-from ..errors import FractureError, InputError, check_choice
+from ..errors import FractureError, InputError, check_choice, check_real
 from ..geometry.topology import circumcenters
 from .williams import sided_polar
 
@@ -69,7 +69,8 @@ class Enrichment:
     def __init__(self, model: Model, tips: np.ndarray, radius: float, *, functions: str = "sqrt"):
         check_choice("enrich functions", functions, FUNCTIONS)
         self.functions, self.size = functions, FUNCTIONS[functions]
-        pts = np.atleast_2d(np.asarray(tips, dtype=float))
+        pts = np.atleast_2d(np.asarray(check_real("enrich tips", tips, error=FractureError),
+                                       dtype=float))
         if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) == 0:
             raise FractureError(f"enrich tips: expected points (t, 2), received shape {pts.shape}")
         frames = [model.domain.tip_frame(p) for p in pts]

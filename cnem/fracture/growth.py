@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from tqdm.auto import tqdm
 
-from ..errors import CNEMError, GeometryError, GrowthError, GrowthWarning
+from ..errors import CNEMError, GeometryError, GrowthError, GrowthWarning, check_real
 from ..geometry.cloud import NodeCloud
 from ..geometry.model import discretize
 from ..geometry.model_update import update
@@ -63,6 +63,7 @@ _WARN = {"crack", "closed", "sharp_kink", "left_domain"}
 def _positive(value, name, allow_none=False):
     if value is None and allow_none:
         return None
+    check_real(name, value, error=GrowthError, fix="pass a positive number")
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -472,7 +473,7 @@ def grow(domain: Domain, cloud: NodeCloud | float, setup: Callable[..., np.ndarr
         raise GrowthError(f"steps: expected a non-negative integer, received {steps!r}")
     K_Ic = _positive(K_Ic, "K_Ic", allow_none=True)
     if paris is not None:
-        if np.shape(paris) != (2,):
+        if np.shape(check_real("paris", paris, error=GrowthError)) != (2,):
             raise GrowthError(f"paris: expected (C, m), received {paris!r}")
         paris = (_positive(paris[0], "paris C"), _positive(paris[1], "paris m"))
     if exponent is None:

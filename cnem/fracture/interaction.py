@@ -27,7 +27,7 @@ import numpy as np
 
 from .. import config
 from ..assembly.quadrature import cell_quadrature
-from ..errors import FractureError, SIFWarning
+from ..errors import FractureError, SIFWarning, check_array, check_real
 from ..material import effective_modulus
 from .discs import clearance, default_radii, local_spacing
 from .williams import williams
@@ -208,10 +208,11 @@ def sif(sol: Any, tip: np.ndarray, *, radius: float | None = None, order: int = 
         raise FractureError(f"sif expects the solution of an elasticity problem "
                             f"(prob.solve()), received {type(sol).__name__}; solve the problem "
                             f"first and pass what solve() returns")
-    tip_arr = np.asarray(tip, dtype=float)
+    tip_arr = np.asarray(check_real("tip", tip, error=FractureError), dtype=float)
     if tip_arr.shape != (2,):
         raise FractureError(f"tip: expected one point (x, y), received shape {tip_arr.shape}; "
                             f"call sif once per tip")
+    tip = check_array("tip", tip_arr, error=FractureError, fix="pass a point near the tip")
     model = sol.model
     at, d = model.domain.tip_frame(tip)
     limit = clearance(model.domain, at, d)

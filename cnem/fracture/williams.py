@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..errors import FractureError, check_array
 from ..material import kappa
 
 if TYPE_CHECKING:
@@ -43,8 +44,8 @@ def williams(r: np.ndarray, theta: np.ndarray, KI: float, KII: float, E: float, 
     du_dx1 : (p, 2) ndarray
         ``[du1/dx1, du2/dx1]``.
     """
-    r = np.asarray(r, dtype=float)
-    theta = np.asarray(theta, dtype=float)
+    r = check_array("r", r, error=FractureError, fix="pass real distances from the tip")
+    theta = check_array("theta", theta, error=FractureError, fix="pass real angles in radians")
     k = kappa(nu, plane)
     mu = E / (2.0 * (1.0 + nu))
     s, c = np.sin(theta / 2), np.cos(theta / 2)
@@ -78,7 +79,12 @@ def polar(points: np.ndarray, tip: np.ndarray, direction: np.ndarray) -> tuple:
     tip, direction : (2,) ndarray
         The tip and the unit crack direction (out of the crack).
     """
-    rel = np.asarray(points, dtype=float) - tip
+    points = check_array("points", points, shape=(None, 2), error=FractureError,
+                         fix="pass one row (x, y) per point")
+    tip = check_array("tip", tip, shape=(2,), error=FractureError, fix="pass one point (x, y)")
+    direction = check_array("direction", direction, shape=(2,), error=FractureError,
+                            fix="pass the crack's unit direction (dx, dy)")
+    rel = points - tip
     x1 = rel @ direction
     x2 = rel @ np.array([-direction[1], direction[0]])
     return np.hypot(x1, x2), np.arctan2(x2, x1)

@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 
 from .. import config
 from .._predicates import Frame, local_frame
-from ..errors import GeometryError, check_real
+from ..errors import GeometryError, check_array, check_real
 from .pslg import CRACK, PSLG, build_pslg, ring_coordinates
 
 __all__ = ["Domain"]
@@ -184,6 +184,10 @@ class Domain:
         self._regions = tuple(_as_polygon(r, i, self._tol) for i, r in enumerate(regions))
         self._union = shapely.union_all(self._regions)
         self._check_overlaps()
+        if isinstance(cracks, (str, bytes)) or not isinstance(cracks, (list, tuple, np.ndarray)):
+            raise GeometryError(f"cracks: expected a list of (k, 2) polylines, received "
+                                f"{type(cracks).__name__}; pass e.g. cracks=[[[0, 0.5], "
+                                f"[0.5, 0.5]]]")
         self._cracks = tuple(self._check_crack(c, i) for i, c in enumerate(cracks))
         self._check_crack_crossings()
         polylines = [(r, True) for p in self._regions for r in ring_coordinates(p)]
@@ -211,7 +215,7 @@ class Domain:
 
     def _check_crack(self, crack, index):
         what = f"crack {index}"
-        arr = np.asarray(crack, dtype=float)
+        arr = np.asarray(check_real(what, crack, error=GeometryError), dtype=float)
         if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 2:
             raise GeometryError(f"{what}: expected a (k, 2) polyline with k >= 2, "
                                 f"received shape {arr.shape}")
@@ -348,12 +352,8 @@ class Domain:
         if len(tips) == 0:
             raise GeometryError("the domain has no crack tip (a crack end inside the body): its "
                                 "cracks, if any, end on the boundary; give a crack that ends inside")
-        tip = np.asarray(tip, dtype=float).reshape(-1)
-        if tip.shape != (2,):
-            raise GeometryError(f"tip: expected a point (2,), received shape {tip.shape}")
-        if not np.isfinite(tip).all():
-            raise GeometryError(f"tip: expected finite coordinates, received {tip.tolist()}; "
-                                f"pass a point near the crack tip")
+        tip = check_array("tip", tip, shape=(2,), error=GeometryError,
+                          fix="pass one point (x, y) near the crack tip")
         at = tips[np.argmin(np.hypot(*(tips - tip).T))]
         for crack in self.cracks:
             for end, before in ((crack[-1], crack[-2]), (crack[0], crack[1])):
@@ -387,14 +387,13 @@ class Domain:
         (p,) int64 ndarray
             The lowest region index for points on an interface.
         """
-        pts = np.asarray(points, dtype=float)
+        pts = check_array("points", points, error=GeometryError,
+                          fix="pass finite real coordinates, one row (x, y) per point")
         if pts.shape == (2,):
             pts = pts[None]
         if pts.ndim != 2 or pts.shape[1] != 2:
             raise GeometryError(f"points: expected a (2,) or (p, 2) array, received shape "
                                 f"{pts.shape}")
-        if not np.isfinite(pts).all():
-            raise GeometryError("points: coordinates must be finite, received NaN or inf")
         out = np.full(len(pts), -1, dtype=np.int64)
         for i in reversed(range(len(self._regions))):
             box = _axis_box(self._regions[i])

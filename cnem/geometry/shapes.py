@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import GeometryError
+from ..errors import GeometryError, check_array
 from .domain import Domain
 
 __all__ = ["rectangle", "plate_with_hole", "annulus", "l_shape", "arc"]
@@ -50,7 +50,9 @@ def arc(center: ArrayLike, radius: float, start: float, stop: float, spacing: fl
     elif int(pieces) < 2:
         raise GeometryError(f"pieces must be an integer >= 2, received {pieces!r}")
     t = np.linspace(start, stop, pieces + 1)
-    return np.asarray(center, float) + radius * np.column_stack([np.cos(t), np.sin(t)])
+    center = check_array("center", center, shape=(2,), error=GeometryError,
+                         fix="pass one point (x, y)")
+    return center + radius * np.column_stack([np.cos(t), np.sin(t)])
 
 
 def rectangle(width: float = 1.0, height: float = 1.0, *, origin: ArrayLike = (0.0, 0.0),
@@ -62,7 +64,8 @@ def rectangle(width: float = 1.0, height: float = 1.0, *, origin: ArrayLike = (0
     Domain
     """
     w, h = _positive("width", width), _positive("height", height)
-    x0, y0 = map(float, origin)
+    x0, y0 = check_array("origin", origin, shape=(2,), error=GeometryError,
+                         fix="pass one point (x, y)")
     shell = [[x0, y0], [x0 + w, y0], [x0 + w, y0 + h], [x0, y0 + h]]
     return Domain([shell], cracks=cracks)
 
@@ -80,7 +83,8 @@ def plate_with_hole(width: float = 1.0, height: float = 1.0, radius: float = 0.2
         Length of the chords of the hole, default ``radius / 8``.
     """
     w, h, r = _positive("width", width), _positive("height", height), _positive("radius", radius)
-    c = np.array([w / 2, h / 2] if center is None else center, dtype=float)
+    c = check_array("center", [w / 2, h / 2] if center is None else center, shape=(2,),
+                    error=GeometryError, fix="pass one point (x, y)")
     if (c - r < 0).any() or c[0] + r > w or c[1] + r > h:
         raise GeometryError(f"the hole (centre {c.tolist()}, radius {r}) does not fit inside "
                             f"the plate [0, {w}] x [0, {h}]; make it smaller or move it")
@@ -106,7 +110,10 @@ def annulus(radii: Sequence[float], *, angles: Sequence[float] | None = None,
     segments : int, optional
         The same number of chords on every arc instead (polar node lattices).
     """
-    radii = np.asarray(radii, dtype=float)
+    radii = check_array("radii", radii, shape=(None,), error=GeometryError,
+                        fix="pass increasing radii (r_0, r_1, ...)")
+    center = check_array("center", center, shape=(2,), error=GeometryError,
+                         fix="pass one point (x, y)")
     if radii.ndim != 1 or len(radii) < 2 or radii[0] <= 0 or (np.diff(radii) <= 0).any():
         raise GeometryError(f"radii must be >= 2 positive increasing numbers, received {radii}")
     spacing = spacing or (radii[-1] - radii[0]) / 10
@@ -117,7 +124,8 @@ def annulus(radii: Sequence[float], *, angles: Sequence[float] | None = None,
             inner = arc(center, r_in, 0, 2 * np.pi, spacing, pieces=segments)[:-1]
             regions.append((outer, [inner[::-1]]))
         else:
-            a0, a1 = map(float, angles)
+            a0, a1 = check_array("angles", angles, shape=(2,), error=GeometryError,
+                                 fix="pass (start, stop) in radians")
             if not 0 < a1 - a0 < 2 * np.pi:
                 raise GeometryError(f"angles must satisfy 0 < stop - start < 2 pi, received {angles}")
             outer = arc(center, r_out, a0, a1, spacing, pieces=segments)

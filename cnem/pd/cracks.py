@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import ndimage
 
-from ..errors import GeometryError
+from ..errors import GeometryError, check_array
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -49,6 +49,12 @@ def _grid(image, origin, spacing):
         raise GeometryError(f"spacing: expected a positive grid spacing, received {spacing}")
     x0, y0 = (float(c) for c in origin)
     return (x0, y0), h
+
+
+def _length(name, value, what):
+    """``value`` as a positive finite float (a window, a persistence, a reach), or an
+    `InputError` naming it: zero would fit nothing and measure nothing."""
+    return float(check_array(name, value, shape=(), positive=True, fix=f"pass a positive {what}"))
 
 
 def _index_at(coordinate, lowest, h):
@@ -85,7 +91,7 @@ def crack_region(image: np.ndarray, origin: np.ndarray, spacing: float, start: n
     """
     (x0, y0), h = _grid(image, origin, spacing)
     labels, _ = ndimage.label(np.asarray(image) > threshold, structure=np.ones((3, 3)))
-    r = int(np.ceil(reach / h))
+    r = int(np.ceil(_length("reach", reach, "distance (typically the horizon)") / h))
     col, row = _index_at(start[0], x0, h), _index_at(start[1], y0, h)
     near = labels[max(col - r, 0):col + r, max(row - r, 0):row + r]
     return np.isin(labels, np.unique(near[near > 0]))
@@ -167,6 +173,8 @@ def branching(mask: np.ndarray, origin: ArrayLike, spacing: float, start_x: floa
         crack has not branched.
     """
     h = _grid(mask, origin, spacing)[1]
+    persistence = _length("persistence", persistence, "length along x (e.g. two horizons)")
+    window = _length("window", window, "length along x of the branches fitted")
     xs, centres = bands(mask, origin, spacing, start_x)
     two = np.array([len(c) >= 2 for c in centres])
     run = max(2, int(np.ceil(persistence / h)))
@@ -241,6 +249,7 @@ def local_speeds(times: np.ndarray, position: np.ndarray, window: float, *,
     (k,) ndarray
         ``nan`` outside ``where`` and where a fit has fewer than 3 samples.
     """
+    window = _length("window", window, "duration (a few sampling intervals)")
     times, position = np.asarray(times, dtype=float), np.asarray(position, dtype=float)
     where = np.ones(len(times), bool) if where is None else np.asarray(where, dtype=bool)
     out = np.full(len(times), np.nan)

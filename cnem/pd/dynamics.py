@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..solvers.conditions import per_point
+from ..solvers.conditions import per_point, vector_constant
 from ..solvers.stepping import Prescribed, velocity_verlet
 from ..errors import InputError
 from .frames import FrameWriter
@@ -100,6 +100,9 @@ class Dynamics:
         u = np.zeros((n, d))
         v = np.zeros((n, d))
         if velocity is not None:
+            velocity = vector_constant(velocity, d, "velocity", "give one velocity vector for "
+                                       "every point, (n, d), a constant (d,), or a callable",
+                                       points=len(b.points))
             v[:] = per_point(velocity, b.points, d, "velocity")
         prescribed.start(u, v)
         fext = self.load().reshape(n, d) / b.volumes[:, None]

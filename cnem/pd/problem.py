@@ -13,7 +13,7 @@ import scipy.sparse as sp
 
 from ..solvers.conditions import Conditions
 from ..solvers.newton import LINE_SEARCH_HALVINGS, newton
-from ..errors import InputError, MaterialError, UnsupportedError, check_choice
+from ..errors import InputError, MaterialError, UnsupportedError, check_array, check_choice
 from .dynamics import Dynamics
 from .moments import moment_tensors, live_inverse
 from ..material import PLANES
@@ -354,6 +354,10 @@ class Problem(Conditions, VelocityConditions, Dynamics):
             load step so far).
         """
         self.static_only("solve")
+        if initial is not None:
+            initial = check_array("initial", initial, shape=(len(self.body), self.dim),
+                                  fix="pass a displacement of every point, e.g. a previous "
+                                      "solution's u")
         evaluate, pattern = self.behaviour.static_system()
         D, values = self.prescribed()
         u, history = newton(evaluate, self.load(), D, values, points=self.body.points,

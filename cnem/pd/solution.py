@@ -12,7 +12,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..errors import GeometryError
+from ..errors import GeometryError, check_points
 from ..solvers.solution import Solution, engineering_strain, voigt
 
 __all__ = ["PointSolution", "StaticSolution", "DynamicRun", "Relaxation"]
@@ -82,7 +82,7 @@ class PointSolution(Solution):
         ValueError
             Points outside the convex hull of the body's points.
         """
-        pts = np.asarray(points, dtype=float).reshape(-1, self.u.shape[1])
+        pts = check_points("points", points, dims=(self.u.shape[1],), error=GeometryError)
         body = self.problem.body
         model = getattr(body, "model", None)
         if model is not None:
@@ -97,8 +97,8 @@ class PointSolution(Solution):
         return out
 
     def nodal_average(self, values: np.ndarray) -> np.ndarray:
-        """Point values are the nodal values: ``values`` itself."""
-        return np.asarray(values, dtype=float)
+        """Point values are the nodal values: ``values`` itself (checked)."""
+        return self._place_values(values)
 
     def plot_mesh(self) -> tuple:
         """The points, the C-NEM model's triangles for a body made from a node cloud

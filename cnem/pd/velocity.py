@@ -26,7 +26,9 @@ from ..solvers.conditions import dirichlet_dofs, merged_conditions
 from ..errors import ConditionError
 
 if TYPE_CHECKING:
-    from typing import Any
+    from typing import Any, Callable
+
+    from numpy.typing import ArrayLike
 
 __all__ = ["VelocityConditions"]
 
@@ -37,7 +39,8 @@ class VelocityConditions:
     #: ``(dofs, values)`` of each velocity condition, in the order given.
     velocities: tuple = ()
 
-    def add_velocity(self, where: Any, component: int | None, value: Any = 0.0) -> None:
+    def add_velocity(self, where: Any, component: int | None,
+                     value: ArrayLike | Callable[..., np.ndarray] = 0.0) -> None:
         """Prescribe velocities at points for the dynamic runs: ``u = value t``.
 
         Parameters

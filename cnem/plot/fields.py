@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import config
-from ..errors import PlotDependencyError, PlotError, PlotInputError
+from ..errors import PlotDependencyError, PlotError, PlotInputError, check_array
 from ..geometry.model import check_model
 from ..geometry.pslg import SegmentKind
 from ..io import cell_topology
@@ -63,7 +63,12 @@ def _pyvista():
 
 def region_color(region: ArrayLike) -> np.ndarray:
     """RGB colour (0-255) of each region, ``(r, 3)`` uint8 for ``(r,)`` region indices."""
-    return REGION_COLORS[np.asarray(region, dtype=np.int64) % len(REGION_COLORS)]
+    index = check_array("region", region, shape=(None,), error=PlotInputError,
+                        fix="pass the region index of each cell (model.cells.region)")
+    if (index != np.round(index)).any():
+        raise PlotInputError(f"region: expected whole region indices, received "
+                             f"{index[index != np.round(index)][0]!r}")
+    return REGION_COLORS[index.astype(np.int64) % len(REGION_COLORS)]
 
 
 def _lift(points2d, z):
@@ -164,7 +169,8 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
     xmin, ymin, xmax, ymax = dom.bounds
     if bounds is None:
         bounds = (xmin, ymin, xmax, ymax)
-    bx0, by0, bx1, by1 = map(float, bounds)
+    bx0, by0, bx1, by1 = check_array("bounds", bounds, shape=(4,), error=PlotInputError,
+                                     fix="pass (xmin, ymin, xmax, ymax)")
     if not (bx1 > bx0 and by1 > by0):
         raise PlotInputError(f"bounds must be (xmin, ymin, xmax, ymax) with xmin < xmax and "
                              f"ymin < ymax, received {tuple(bounds)}; give a non-empty view")
@@ -398,7 +404,7 @@ def nodal_field(sol, field):
     """
     n, k = len(sol.u), len(sol.stress)
     if not isinstance(field, str):
-        values = np.asarray(field, dtype=float)
+        values = _field_values(field)
         if values.shape == (n,):
             return values
         if values.shape != (k,):
@@ -528,6 +534,13 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *,
     return _save(pl, path, "solution")
 
 
+def _field_values(field):
+    """The values of a field given as numbers (at the nodes or the cells), refused when
+    complex or boolean; NaN is drawn in the colour map's NaN colour."""
+    return check_array("field", field, finite=False, error=PlotInputError,
+                       fix="pass real values, one per node or per cell, or a field name")
+
+
 def _cell_values(sol, field):
     """``field`` as one value per integration cell of a C-NEM solution, or None (a
     displacement, another kind of solution, or values at the nodes)."""
@@ -540,5 +553,5 @@ def _cell_values(sol, field):
         if field in ("ux", "uy", "|u|") or field not in SOLUTION_FIELDS:
             return None
         return _per_place(sol, field)
-    values = np.asarray(field, dtype=float)
+    values = _field_values(field)
     return values if values.shape == (len(model.cells),) and len(sol.u) != len(values) else None

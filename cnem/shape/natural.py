@@ -9,7 +9,8 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
 from .. import config
-from ..errors import CNEMError, GeometryError, UnsupportedError, check_choice, check_real
+from ..errors import (CNEMError, GeometryError, UnsupportedError, check_array, check_choice,
+                      check_real)
 from .._parallel import work_chunks
 from . import _kernels as K
 
@@ -233,8 +234,10 @@ def _coordinates(model, pts, kind, triangles, gradient):
     if triangles is None:
         tri_of = _locate_sorted(model, nodes, spts, tol)
     else:
-        hint = np.asarray(triangles, dtype=np.int64).reshape(-1)
-        if hint.shape != (len(pts),) or (hint < -1).any() or (hint >= len(model.triangles)).any():
+        values = check_array("triangles", triangles, shape=(len(pts),), error=GeometryError,
+                             fix="pass one triangle index per point, or -1 to locate it")
+        hint = values.astype(np.int64)
+        if (hint != values).any() or (hint < -1).any() or (hint >= len(model.triangles)).any():
             raise GeometryError(f"triangles: expected {len(pts)} indices into the "
                                 f"{len(model.triangles)} triangles (or -1), received "
                                 f"shape {hint.shape}, range [{hint.min()}, {hint.max()}]")

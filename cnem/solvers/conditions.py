@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any, Callable, Union
 import numpy as np
 
 from .. import config
-from ..errors import ConditionError, UnsupportedError
+from ..errors import ConditionError, UnsupportedError, check_array, check_points, check_real
 
 
 if TYPE_CHECKING:
@@ -68,6 +68,7 @@ def select_nodes(nodes: np.ndarray, where: Callable[..., np.ndarray] | ArrayLike
     -------
     (k,) int64 ndarray, sorted
     """
+    nodes = check_points("nodes", nodes, error=ConditionError)
     n = len(nodes)
     if callable(where):
         mask = np.asarray(_call_where(where, nodes))
@@ -85,6 +86,9 @@ def select_nodes(nodes: np.ndarray, where: Callable[..., np.ndarray] | ArrayLike
     if arr.size and not np.issubdtype(arr.dtype, np.integer):
         raise ConditionError(f"where: expected a callable, a boolean mask or node indices, "
                              f"received an array of dtype {arr.dtype}")
+    if arr.ndim > 1:
+        raise ConditionError(f"where: expected a flat array of node indices, received shape "
+                             f"{arr.shape}; pass e.g. np.array([0, 4, 7])")
     idx = np.unique(arr.astype(np.int64).reshape(-1))
     if idx.size and (idx[0] < 0 or idx[-1] >= n):
         raise ConditionError(f"where: node indices must lie in [0, {n}), received "
@@ -101,7 +105,8 @@ def per_point(value: ArrayLike | Callable[..., np.ndarray], points: np.ndarray, 
     ConditionError
         Values of the wrong shape, or not finite (``what`` names them).
     """
-    arr = np.asarray(value(points) if callable(value) else value, dtype=float)
+    arr = np.asarray(check_real(what, value(points) if callable(value) else value,
+                                error=ConditionError), dtype=float)
     if width == 1 and arr.shape == (len(points),):
         arr = arr[:, None]
     try:
@@ -137,11 +142,12 @@ def vector_constant(value: Any, dim: int, what: str, fix: str, *,
     Raises
     ------
     ConditionError
-        A bare number (which component would it be?) or a constant of another shape.
+        A bare number (which component would it be?), a constant of another shape, or
+        one that is not real and finite numbers.
     """
     if callable(value):
         return value
-    shape = np.shape(value)
+    shape = check_array(what, value, error=ConditionError, fix=fix).shape
     rows = "" if points is None else f" (or {points} rows of them, one per point)"
     if shape == ():
         raise ConditionError(f"{what}: expected a vector of {dim} components{rows} or a "
@@ -253,7 +259,8 @@ class Conditions:
         return (f"{len(self.dirichlet)} Dirichlet, {len(self.tractions)} traction, "
                 f"{len(self.body_forces)} body-force conditions")
 
-    def add_dirichlet(self, where: Where, component: int | None, value: Any = 0.0) -> None:
+    def add_dirichlet(self, where: Where, component: int | None,
+                      value: ArrayLike | Callable[..., np.ndarray] = 0.0) -> None:
         """Prescribe displacements at nodes.
 
         Several conditions may prescribe one dof if they agree on its value;
@@ -283,7 +290,7 @@ class Conditions:
         raise UnsupportedError(f"{type(self).__name__} has no boundary edges; give loads as "
                                f"body forces (add_body_force)")
 
-    def add_traction(self, where: Where, t: Any) -> None:
+    def add_traction(self, where: Where, t: ArrayLike | Callable[..., np.ndarray]) -> None:
         """Tractions on the boundary edges (outer boundary, holes, crack faces).
 
         Parameters
@@ -316,7 +323,7 @@ class Conditions:
         index = np.flatnonzero(pick)
         self.tractions.append(Traction(index, edges[index], normal[index], t))
 
-    def add_body_force(self, b: Any) -> None:
+    def add_body_force(self, b: ArrayLike | Callable[..., np.ndarray]) -> None:
         """Body force per unit area (2-D) or volume: ``b(x) -> (p, d)``, a constant ``(d,)``,
         or one ``(d,)`` row per condition point (node).
 

@@ -26,7 +26,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, check_array
 
 __all__ = ["Solution", "von_mises", "engineering_strain", "voigt", "energy_error_density"]
 
@@ -51,7 +51,12 @@ def engineering_strain(gradient: np.ndarray) -> np.ndarray:
 
 def von_mises(stress: np.ndarray) -> np.ndarray:
     """Von Mises stress of Voigt stresses: plane ``(..., 3)`` ``[sxx, syy, sxy]`` (the
-    in-plane components), or ``(..., 6)`` in 3-D. Returns ``(...)``."""
+    in-plane components), or ``(..., 6)`` in 3-D. Returns ``(...)``; NaN entries give NaN."""
+    stress = check_array("stress", stress, finite=False, fix="pass Voigt stresses, (..., 3) in "
+                         "2-D or (..., 6) in 3-D")
+    if stress.ndim == 0 or stress.shape[-1] not in (3, 6):
+        raise InputError(f"stress: expected Voigt stresses of shape (..., 3) or (..., 6), "
+                         f"received shape {stress.shape}")
     if stress.shape[-1] == 6:
         sxx, syy, szz, syz, sxz, sxy = np.moveaxis(stress, -1, 0)
         return np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2)
@@ -156,6 +161,18 @@ class Solution:
     def nodal_average(self, values: np.ndarray) -> np.ndarray:
         """Values ``(k, ...)`` at the places of ``stress`` as ``(n, ...)`` at the nodes."""
         raise NotImplementedError
+
+    def _place_values(self, values: np.ndarray) -> np.ndarray:
+        """``values`` ``(k, ...)``, one row per place of ``stress``, as float64: refused
+        with an `InputError` when complex, boolean, not numbers or of another row count
+        (NaN entries stay: they average to NaN)."""
+        count = len(self.u) if self.stress_at == "points" else len(self.stress)
+        arr = check_array("values", values, finite=False,
+                          fix=f"pass one value (or row) per {self.stress_at[:-1]}")
+        if arr.ndim == 0 or len(arr) != count:
+            raise InputError(f"values: expected one row per {self.stress_at[:-1]} ({count} "
+                             f"rows), received shape {arr.shape}")
+        return arr
 
     def plot_mesh(self) -> None:
         """What a picture draws: ``nodes (n, d)``, ``triangles (t, 3)`` (or None: the

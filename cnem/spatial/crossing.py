@@ -6,7 +6,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import config
-from ..errors import SpatialError
+from ..errors import SpatialError, check_array
 from . import _family_kernels as K
 from .family import Family
 from .rtree import RTree
@@ -53,8 +53,10 @@ def remove_crossing(family: Family, points: ArrayLike, segments: ArrayLike) -> F
     Family
         Same points and horizon, fewer bonds.
     """
-    pts = np.ascontiguousarray(points, dtype=np.float64)
-    seg = np.asarray(segments, dtype=np.float64)
+    pts = check_array("points", points, error=SpatialError,
+                      fix="pass the points the family was searched on")
+    seg = check_array("segments", segments, error=SpatialError,
+                      fix="pass one pair of end points per segment")
     if seg.ndim == 2 and seg.shape[1] == 4:
         seg = seg.reshape(-1, 2, 2)
     if seg.ndim != 3 or seg.shape[1:] != (2, 2):

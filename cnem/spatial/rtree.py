@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike
 
 from .. import config
 from .._parallel import work_chunks
-from ..errors import SpatialError, check_array, check_points
+from ..errors import SpatialError, check_array, check_points, check_real
 from . import _rtree_kernels as K
 
 __all__ = ["RTree", "check_period", "as_points"]
@@ -31,7 +31,7 @@ def check_period(period: ArrayLike | None, dim: int, *points: np.ndarray) -> np.
     """Period as a ``(d,)`` array (``inf`` where not periodic); points must lie in ``[0, L)``."""
     if period is None:
         return np.full(dim, np.inf)
-    per = np.asarray(period, dtype=np.float64)
+    per = np.asarray(check_real("period", period, error=SpatialError), dtype=np.float64)
     if per.ndim > 1 or per.size not in (1, dim):
         raise SpatialError(f"period: expected None, a number or {dim} lengths, received "
                            f"{period!r}")
@@ -210,7 +210,7 @@ class RTree:
                        work_chunks(), lo, hi, qlo, qhi)
 
     def _points(self, points, name, *, in_cell=True):
-        arr = np.asarray(points, dtype=np.float64)
+        arr = np.asarray(check_real(name, points, error=SpatialError), dtype=np.float64)
         if arr.size == 0:
             return np.zeros((0, self.dim))
         pts = as_points(arr, name)
