@@ -123,7 +123,7 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
 
 
 def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_cell: np.ndarray,
-                      rtol: float = 1e-12):
+                      rtol: float = 1e-12) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple]:
     """The tetrahedra from each cell's node to its facet triangles, as sub-cells.
 
     Parameters
