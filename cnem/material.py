@@ -235,16 +235,21 @@ class NeoHookean(Hyperelastic):
         object.__setattr__(self, "mu", mu)
         object.__setattr__(self, "lam", lam)
 
-    def lame(self, dim=2, plane=None):
+    def lame(self, dim: int = 2, plane: Literal["strain"] | None = None
+             ) -> tuple[float, float]:
+        """``(lam, mu)`` as given (see `Hyperelastic.lame`)."""
         return _hyper_lame(dim, plane, self.lam, self.mu)
 
-    def energy(self, F):
+    def energy(self, F: np.ndarray | hd.HyperDual) -> np.ndarray | hd.HyperDual:
+        """``W (q,)`` at ``F (q, d, d)`` (see `Hyperelastic.energy`)."""
         d = F.shape[-1]
         log_j = hd.log(hd.det(F))
         return 0.5 * self.mu * ((F * F).sum(axis=(-2, -1)) - d) - self.mu * log_j \
             + 0.5 * self.lam * log_j * log_j
 
-    def evaluate(self, F, *, tangent=True):
+    def evaluate(self, F: np.ndarray, *, tangent: bool = True
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """``W``, ``P`` and ``A`` at ``F (q, d, d)`` (see `Hyperelastic.evaluate`)."""
         F = _deformation_gradients(F)
         mu, lam = self.mu, self.lam
         with np.errstate(invalid="ignore", divide="ignore"):    # J <= 0: NaN, for Newton
@@ -289,17 +294,22 @@ class SaintVenantKirchhoff(Hyperelastic):
         object.__setattr__(self, "E", float(self.E))
         object.__setattr__(self, "nu", float(self.nu))
 
-    def lame(self, dim=2, plane=None):
+    def lame(self, dim: int = 2, plane: Literal["strain"] | None = None
+             ) -> tuple[float, float]:
+        """``(lam, mu)`` of ``E``, ``nu`` (the 3-D law's, also plane strain's)."""
         lam, mu = lame(self.E, self.nu, None)
         return _hyper_lame(dim, plane, float(lam), float(mu))
 
-    def energy(self, F):
+    def energy(self, F: np.ndarray | hd.HyperDual) -> np.ndarray | hd.HyperDual:
+        """``W (q,)`` at ``F (q, d, d)`` (see `Hyperelastic.energy`)."""
         lam, mu = self.lame(3, None)
         strain = 0.5 * (hd.matmul(hd.transpose(F), F) - np.eye(F.shape[-1]))
         tr = hd.trace(strain)
         return 0.5 * lam * tr * tr + mu * (strain * strain).sum(axis=(-2, -1))
 
-    def evaluate(self, F, *, tangent=True):
+    def evaluate(self, F: np.ndarray, *, tangent: bool = True
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """``W``, ``P`` and ``A`` at ``F (q, d, d)`` (see `Hyperelastic.evaluate`)."""
         F = _deformation_gradients(F)
         lam, mu = self.lame(3, None)
         d = F.shape[1]
