@@ -74,13 +74,14 @@ def test_patch_test_whole_boundary(holed, mat):
     assert len(sol.residual_history) == 1 and len(sol.residual_history[0]) <= 3
 
 
+@pytest.mark.parametrize("stabilization", [0.0, 1.0])
 @pytest.mark.parametrize("mat", MATERIALS, ids=repr)
-def test_patch_test_with_dead_tractions_converges_quadratically(holed, mat):
+def test_patch_test_with_dead_tractions_converges_quadratically(holed, mat, stabilization):
     """F on the outer boundary and its dead traction ``P N`` on the hole: Newton has to
     work (the predictor is the linear answer) and converges quadratically to the
-    homogeneous state, reproduced to 1e-10."""
+    homogeneous state, reproduced to 1e-10; the sub-cell stabilisation vanishes there."""
     _, P, _ = mat.evaluate(F2[None])
-    prob = cnem.Hyperelasticity(holed, mat)
+    prob = cnem.Hyperelasticity(holed, mat, stabilization=stabilization)
     prob.add_dirichlet(_outer, None, _homogeneous(F2))
     prob.add_traction(lambda x, n: np.linalg.norm(x - 0.5, axis=1) < 0.3, lambda x, n: n @ P[0].T)
     sol = prob.solve(steps=2, tol=1e-12)
@@ -143,14 +144,15 @@ def test_patch_test_3d_on_synthetic_cells(mat):
 
 
 # -- consistency -------------------------------------------------------------------------
+@pytest.mark.parametrize("stabilization", [0.0, 0.7])
 @pytest.mark.parametrize("mat", MATERIALS, ids=repr)
-def test_tangent_is_the_derivative_of_the_internal_forces(holed, mat):
-    op = cnem.Hyperelasticity(holed, mat).operator
+def test_tangent_is_the_derivative_of_the_internal_forces(holed, mat, stabilization):
+    op = cnem.Hyperelasticity(holed, mat, stabilization=stabilization).system
     rng = np.random.default_rng(5)
-    u = 0.002 * rng.normal(size=op.basis.N) + _homogeneous(F2 * 0.3 + 0.7 * np.eye(2))(
+    u = 0.002 * rng.normal(size=holed.nodes.size) + _homogeneous(F2 * 0.3 + 0.7 * np.eye(2))(
         holed.nodes).reshape(-1)
     f, K = op.evaluate(u)
-    v = rng.normal(size=op.basis.N)
+    v = rng.normal(size=holed.nodes.size)
     h = 1e-6
     fd = (op.evaluate(u + h * v, False)[0] - op.evaluate(u - h * v, False)[0]) / (2 * h)
     np.testing.assert_allclose(K @ v, fd, atol=1e-7 * np.abs(K @ v).max())
@@ -159,13 +161,15 @@ def test_tangent_is_the_derivative_of_the_internal_forces(holed, mat):
     assert abs(K - K.T).max() <= 1e-12 * abs(K).max()
 
 
-def test_small_strain_limit_is_linear_elasticity(holed):
-    """A tiny load in one step: the linear `Elasticity` answer (plane strain, plain SCNI,
-    the linearised moduli) to 1e-6."""
+@pytest.mark.parametrize("stabilization", [0.0, 1.0])
+def test_small_strain_limit_is_linear_elasticity(holed, stabilization):
+    """A tiny load in one step: the linear `Elasticity` answer (plane strain, the
+    linearised moduli, the same stabilisation weight: plain SCNI or the sub-cell term
+    of the shear modulus alone) to 1e-6."""
     mat = NeoHookean(1.0, 1.5)
     E, nu = mat.linearized()
-    nonlinear = cnem.Hyperelasticity(holed, mat)
-    linear = cnem.Elasticity(holed, (E, nu), plane="strain", stabilization=0.0,
+    nonlinear = cnem.Hyperelasticity(holed, mat, stabilization=stabilization)
+    linear = cnem.Elasticity(holed, (E, nu), plane="strain", stabilization=stabilization,
                              gradients=nonlinear.gradients)
     for prob in (nonlinear, linear):
         prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
@@ -236,6 +240,8 @@ def test_bad_inputs_are_named(holed):
         cnem.Hyperelasticity(holed, [mat, mat])
     with pytest.raises(cnem.OptionError, match="plane strain"):
         cnem.Hyperelasticity(holed, mat, plane="stress")
+    with pytest.raises(cnem.InputError, match="stabilization"):
+        cnem.Hyperelasticity(holed, mat, stabilization=-1.0)
     with pytest.raises(cnem.InputError, match="expects a Model"):
         cnem.Hyperelasticity(cnem.nodes.regular(cnem.geometry.rectangle(), 0.5), mat)
     prob = cnem.Hyperelasticity(holed, mat)

@@ -41,7 +41,7 @@ if TYPE_CHECKING:
 
     from ..assembly.basis import CellBasis
 
-__all__ = ["FiniteStrainOperator"]
+__all__ = ["FiniteStrainOperator", "EnergySum"]
 
 
 class FiniteStrainOperator:
@@ -137,3 +137,40 @@ class FiniteStrainOperator:
         # the kernel's coeff[k, a, b] has trial descriptor a and test b: A's transpose
         coeff = np.swapaxes(A.reshape(-1, d * d, d * d), 1, 2)
         return f, gradient_gram(self.basis, coeff)
+
+
+class EnergySum:
+    """A weighted sum of cell energies, ``Pi(u) = sum_t w_t Pi_t(u)``, with their
+    internal forces and tangents summed alike: a physical energy plus a stabilisation
+    (see `cnem.Hyperelasticity`).
+
+    Parameters
+    ----------
+    terms : sequence of (float, FiniteStrainOperator)
+        Weights and operators on the same dofs.
+    """
+
+    def __init__(self, terms: Sequence[tuple[float, FiniteStrainOperator]]):
+        self.terms = tuple((float(w), op) for w, op in terms)
+        sizes = {op.basis.N for _, op in self.terms}
+        if len(sizes) != 1:
+            raise InputError(f"EnergySum: expected operators on the same dofs, received "
+                             f"{sorted(sizes)} dofs")
+
+    def __repr__(self):
+        return f"<EnergySum of {len(self.terms)} terms>"
+
+    def energy(self, u: np.ndarray) -> float:
+        """``sum_t w_t Pi_t(u)``."""
+        return sum(w * op.energy(u) for w, op in self.terms)
+
+    def evaluate(self, u: np.ndarray, tangent: bool = True
+                 ) -> tuple[np.ndarray, sp.csr_matrix | None]:
+        """Summed internal forces ``(N,)`` and tangent (see `FiniteStrainOperator.evaluate`)."""
+        f, K = 0.0, None
+        for w, op in self.terms:
+            f_t, K_t = op.evaluate(u, tangent)
+            f = f + w * f_t
+            if tangent:
+                K = w * K_t if K is None else K + w * K_t
+        return f, K

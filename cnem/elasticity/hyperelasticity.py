@@ -10,10 +10,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..assembly import CellBasis
-from ..errors import MaterialError, OptionError
-from ..material import Hyperelastic, check_plane, parse_materials
+from ..errors import InputError, MaterialError, OptionError
+from ..material import Hyperelastic, NeoHookean, check_plane, parse_materials
 from ..solvers.newton import newton
-from .finite_strain import FiniteStrainOperator
+from .finite_strain import EnergySum, FiniteStrainOperator
 from .hyperelastic_solution import HyperelasticSolution
 from .model_problem import ModelProblem
 
@@ -31,8 +31,8 @@ log = logging.getLogger(__name__)
 class Hyperelasticity(ModelProblem):
     """Finite-strain hyperelasticity on a C-NEM model: plane strain in 2-D (``F33 = 1``)
     or 3-D, total Lagrangian with the smoothed deformation gradient
-    ``F~ = I + grad~ u`` of each integration cell (plain SCNI, no stabilisation:
-    `cnem.elasticity.finite_strain.FiniteStrainOperator`).
+    ``F~ = I + grad~ u`` of each integration cell
+    (`cnem.elasticity.finite_strain.FiniteStrainOperator`).
 
     Conditions are those of `cnem.Elasticity` (`add_dirichlet`, `add_traction`,
     `add_body_force`): the Dirichlet values are reached at the last load step,
@@ -50,6 +50,18 @@ class Hyperelasticity(ModelProblem):
         for a 3-D model.
     gauss : int
         Gauss points per cell-edge piece in the smoothed gradients.
+    stabilization : float
+        Weight ``a`` of an energy-based sub-cell stabilisation (0, the default:
+        plain SCNI). The energy becomes
+        ``sum_k V_k W(F~_k) + a [sum_s V_s W_mu(F~_s) - sum_k V_k W_mu(F~_k)]`` over
+        the fan sub-cells ``s`` of the cells ``k``, ``W_mu`` the neo-Hookean law of the
+        region's shear modulus alone (``lam = 0``). The sub-cells' gradients average
+        to their cell's, so the term vanishes for homogeneous deformations (the patch
+        test holds) and, near the reference state (where ``W_mu`` is convex, by
+        Jensen's inequality), is positive for the oscillating modes one gradient
+        per cell does not see; with ``mu`` alone it does not lock
+        as the material becomes incompressible. At small strain it is the
+        stabilisation of `cnem.Elasticity` with the same weight.
     gradients : GradientCache, optional
         The model's smoothed gradients at ``gauss``, shared with other problems
         on the model (an `Elasticity` on the same model, say).
@@ -78,7 +90,7 @@ class Hyperelasticity(ModelProblem):
 
     def __init__(self, model: Model, materials: Hyperelastic | Sequence[Hyperelastic], *,
                  plane: Literal["strain"] | None = None, gauss: int = 2,
-                 gradients: GradientCache | None = None):
+                 stabilization: float = 0.0, gradients: GradientCache | None = None):
         super().__init__(model, gauss=gauss, gradients=gradients, caller="Hyperelasticity")
         if self.dim == 2 and plane is None:
             plane = "strain"
@@ -95,7 +107,11 @@ class Hyperelasticity(ModelProblem):
             raise MaterialError(f"materials: expected hyperelastic laws (cnem.material."
                                 f"NeoHookean, SaintVenantKirchhoff), received {', '.join(other)}"
                                 f"; for a small-strain law use cnem.Elasticity")
+        self.stabilization = float(stabilization)
+        if not (np.isfinite(self.stabilization) and self.stabilization >= 0):
+            raise InputError(f"stabilization: expected a number >= 0, received {stabilization!r}")
         self._operator = None
+        self._system = None
 
     def __repr__(self):
         idealisation = f"plane {self.plane}" if self.plane else "3-D"
@@ -116,6 +132,25 @@ class Hyperelasticity(ModelProblem):
             self._operator = FiniteStrainOperator(basis, self.region_materials,
                                                   self.cells.region)
         return self._operator
+
+    @property
+    def system(self) -> FiniteStrainOperator | EnergySum:
+        """What Newton solves: `operator`, plus the sub-cell stabilisation when
+        ``stabilization > 0`` (an `cnem.elasticity.finite_strain.EnergySum`)."""
+        if self._system is None:
+            a = self.stabilization
+            if a == 0:
+                self._system = self.operator
+            else:
+                sub, grad = self.gradients.fan(release=True)     # B~ of the cells with it
+                fine = CellBasis(self.model, vector=True, cells=sub, gradient=grad)
+                shear = [NeoHookean(m.lame(self.dim, self.plane)[1], 0.0)
+                         for m in self.region_materials]
+                cells = self.operator
+                self._system = EnergySum([
+                    (1.0, cells), (a, FiniteStrainOperator(fine, shear, sub.region)),
+                    (-a, FiniteStrainOperator(cells.basis, shear, self.cells.region))])
+        return self._system
 
     def load(self) -> np.ndarray:
         """The whole dead load (tractions and body forces), ``(dim n,)``."""
@@ -151,11 +186,10 @@ class Hyperelasticity(ModelProblem):
             Rigid motions not fixed by the Dirichlet conditions (named).
         """
         t0 = time.perf_counter()
-        operator = self.operator
-        operator.basis.operators
+        system = self.system
         t1 = time.perf_counter()
         D, values = self.prescribed()
-        u, history = newton(operator.evaluate, self.load(), D, values, points=self.model.nodes,
+        u, history = newton(system.evaluate, self.load(), D, values, points=self.model.nodes,
                             tol=tol, steps=steps, max_iterations=max_iterations,
                             line_search=line_search)
         t2 = time.perf_counter()
