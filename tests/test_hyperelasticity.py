@@ -271,3 +271,16 @@ def test_solution_writes_and_repr(holed, tmp_path):
     np.testing.assert_allclose(J[np.isfinite(J)], np.linalg.det(F2), rtol=1e-10)
     np.testing.assert_allclose(sol.displacement(np.array([[0.1, 0.1]])),
                                _homogeneous(F2)(np.array([[0.1, 0.1]])), rtol=0, atol=1e-10)
+
+
+@pytest.mark.parametrize("stabilization", [0.0, 0.6])
+def test_tangent_at_the_reference_state_is_the_linear_stiffness(holed, stabilization):
+    """At u = 0 the tangent is `Elasticity`'s stiffness (plane strain, the linearised
+    moduli, the same stabilisation weight), entry by entry."""
+    mat = SaintVenantKirchhoff(3.0, 0.35)
+    prob = cnem.Hyperelasticity(holed, mat, stabilization=stabilization)
+    f, K = prob.system.evaluate(np.zeros(holed.nodes.size))
+    linear = cnem.Elasticity(holed, mat.linearized(), plane="strain",
+                             stabilization=stabilization).stiffness()
+    assert np.abs(f).max() == 0.0
+    assert abs(K - linear).max() <= 1e-12 * abs(linear).max()
