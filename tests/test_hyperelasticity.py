@@ -6,15 +6,13 @@ the closed-form plane-strain neo-Hookean answer, non-convergence and bad inputs.
 
 from __future__ import annotations
 
-import itertools
 from types import SimpleNamespace
 
 import meshio
 import numpy as np
 import pytest
-import scipy.sparse as sp
 from scipy.optimize import brentq
-from scipy.spatial import Delaunay
+from test_dimension import _tetrahedral_patch
 
 import cnem
 from cnem.assembly import CellBasis
@@ -93,32 +91,12 @@ def test_patch_test_with_dead_tractions_converges_quadratically(holed, mat, stab
         assert _order(history) > 1.7
 
 
-def _tetrahedral_patch(k=4, seed=0):
-    """Nodes of a jittered ``k^3`` lattice in the unit cube and the P1 operators of its
-    Delaunay tetrahedra (as in tests/test_dimension.py): a 3-D basis that reproduces
-    linear fields."""
-    rng = np.random.default_rng(seed)
-    axis = np.linspace(0.0, 1.0, k)
-    nodes = np.array(list(itertools.product(axis, axis, axis)))
-    inside = np.all((nodes > 0.0) & (nodes < 1.0), axis=1)
-    nodes[inside] += rng.uniform(-0.15, 0.15, (inside.sum(), 3)) / (k - 1)
-    tets = Delaunay(nodes).simplices
-    corners = nodes[tets]
-    edges = corners[:, 1:] - corners[:, :1]
-    volume = np.abs(np.linalg.det(edges)) / 6.0
-    keep = volume > 1e-12
-    tets, corners, edges, volume = tets[keep], corners[keep], edges[keep], volume[keep]
-    inv = np.linalg.inv(edges)
-    grad = np.concatenate([-inv.sum(axis=2)[:, None, :], np.transpose(inv, (0, 2, 1))], axis=1)
-    t, n = len(tets), len(nodes)
-    indptr = np.arange(0, 4 * t + 1, 4)
-
-    def op(values):
-        return sp.csr_matrix((values.reshape(-1), tets.reshape(-1), indptr), shape=(t, n))
-
-    basis = CellBasis.from_operators(SimpleNamespace(nodes=nodes), op(np.full((t, 4), 0.25)),
-                                     tuple(op(grad[:, :, i]) for i in range(3)), volume,
-                                     corners.mean(axis=1), vector=True)
+def _tetrahedral_basis():
+    """The synthetic 3-D cells of tests/test_dimension.py (P1 tetrahedra of a jittered
+    4^3 lattice, a basis that reproduces linear fields): nodes and vector basis."""
+    nodes, value, gradients, volume, centroids = _tetrahedral_patch()
+    basis = CellBasis.from_operators(SimpleNamespace(nodes=nodes), value, gradients, volume,
+                                     centroids, vector=True)
     return nodes, basis
 
 
@@ -126,7 +104,7 @@ def _tetrahedral_patch(k=4, seed=0):
 def test_patch_test_3d_on_synthetic_cells(mat):
     """F on the cube's faces, the interior started off it (a bubble): Newton converges
     quadratically to (F - I) X at every node, F~ = F in every cell."""
-    nodes, basis = _tetrahedral_patch()
+    nodes, basis = _tetrahedral_basis()
     op = FiniteStrainOperator(basis, [mat], np.zeros(len(basis.dx), dtype=np.int64))
     boundary = np.flatnonzero(np.any((nodes == 0.0) | (nodes == 1.0), axis=1))
     dofs = basis.get_dofs(boundary)
