@@ -53,9 +53,11 @@ _MODULES = frozenset({"assembly", "cli", "config", "elasticity", "errors", "exac
 
 #: The core workflow names -> the module that defines them.
 _NAMES = {"Domain": "geometry", "NodeCloud": "geometry", "Model": "geometry",
-          "discretize": "geometry", "Elasticity": "elasticity", "ElasticSolution": "elasticity"}
+          "discretize": "geometry", "Elasticity": "elasticity", "ElasticSolution": "elasticity",
+          "Hyperelasticity": "elasticity"}
 
 __all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
+           "Hyperelasticity",
            "nodes", "geometry", "assembly", "elasticity", "exact", "fracture", "io", "plot", "shape",
            "spatial", "hyperdual", "pd", "fem", "material",
            "CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError", "FormError",

@@ -30,7 +30,8 @@ from .errors import HyperDualError, check_array, check_real
 
 __all__ = ["HyperDual", "HyperDualError", "sqrt", "exp", "log", "sin", "cos", "tan", "arcsin",
            "arccos", "arctan", "sinh", "cosh", "tanh", "power", "dot", "cross", "norm", "stack",
-           "concatenate", "derivatives", "derivative"]
+           "concatenate", "trace", "transpose", "matmul", "det", "inv", "derivatives",
+           "derivative"]
 
 _PARTS = ("re", "e1", "e2", "e12")
 
@@ -310,6 +311,82 @@ def cross(a: HyperDual | ArrayLike, b: HyperDual | ArrayLike) -> HyperDual | np.
                            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]])
     raise HyperDualError(f"hd.cross: expected vectors of 2 or 3 components on the last axis, got "
                          f"{d} (shapes {a.shape} and {b.shape}); pass 2-D or 3-D vectors")
+
+
+def _matrices(a, what):
+    """``a`` (HyperDual or float ndarray) after checking it holds square matrices
+    ``(..., d, d)``."""
+    a = a if isinstance(a, HyperDual) else np.asarray(a, dtype=np.float64)
+    if a.ndim < 2 or a.shape[-1] != a.shape[-2]:
+        raise HyperDualError(f"{what}: expected square matrices on the last two axes, shape "
+                             f"(..., d, d), got shape {a.shape}; reshape to (..., d, d)")
+    return a
+
+
+def _small(a, what):
+    """``a`` as square matrices of size 2 or 3 (`_matrices`)."""
+    a = _matrices(a, what)
+    if a.shape[-1] not in (2, 3):
+        raise HyperDualError(f"{what}: written for 2 x 2 and 3 x 3 matrices, got shape "
+                             f"{a.shape}; pass (..., 2, 2) or (..., 3, 3)")
+    return a
+
+
+def trace(a: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
+    """Trace of matrices ``(..., d, d) -> (...)``."""
+    a = _matrices(a, "hd.trace")
+    total = a[..., 0, 0]
+    for i in range(1, a.shape[-1]):
+        total = total + a[..., i, i]
+    return total
+
+
+def transpose(a: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
+    """Matrices ``(..., d, e)`` transposed to ``(..., e, d)``."""
+    if isinstance(a, HyperDual):
+        return HyperDual(*(np.swapaxes(getattr(a, p), -1, -2) for p in _PARTS))
+    return np.swapaxes(np.asarray(a, dtype=np.float64), -1, -2)
+
+
+def matmul(a: HyperDual | ArrayLike, b: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
+    """Matrix products ``(..., d, e) @ (..., e, f) -> (..., d, f)``, broadcast over the
+    leading axes; either may be real."""
+    a, b = (v if isinstance(v, HyperDual) else np.asarray(v, dtype=np.float64) for v in (a, b))
+    if a.ndim < 2 or b.ndim < 2 or a.shape[-1] != b.shape[-2]:
+        raise HyperDualError(f"hd.matmul: expected matrices (..., d, e) and (..., e, f), got "
+                             f"shapes {a.shape} and {b.shape}")
+    return (a[..., :, :, None] * b[..., None, :, :]).sum(axis=-2)
+
+
+def det(a: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
+    """Determinants of 2 x 2 or 3 x 3 matrices ``(..., d, d) -> (...)`` (cofactor
+    expansion, so that the derivative parts are exact)."""
+    a = _small(a, "hd.det")
+    if a.shape[-1] == 2:
+        return a[..., 0, 0] * a[..., 1, 1] - a[..., 0, 1] * a[..., 1, 0]
+    return (a[..., 0, 0] * (a[..., 1, 1] * a[..., 2, 2] - a[..., 1, 2] * a[..., 2, 1])
+            - a[..., 0, 1] * (a[..., 1, 0] * a[..., 2, 2] - a[..., 1, 2] * a[..., 2, 0])
+            + a[..., 0, 2] * (a[..., 1, 0] * a[..., 2, 1] - a[..., 1, 1] * a[..., 2, 0]))
+
+
+def inv(a: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
+    """Inverses of 2 x 2 or 3 x 3 matrices ``(..., d, d)``: adjugate over determinant
+    (singular matrices give inf or NaN, as a division by zero does)."""
+    a = _small(a, "hd.inv")
+    d = a.shape[-1]
+    if d == 2:
+        rows = [[a[..., 1, 1], -a[..., 0, 1]], [-a[..., 1, 0], a[..., 0, 0]]]
+    else:
+        def cofactor(i, j):                 # of entry (j, i): the adjugate's (i, j)
+            r, c = [k for k in range(3) if k != j], [k for k in range(3) if k != i]
+            minor = a[..., r[0], c[0]] * a[..., r[1], c[1]] - a[..., r[0], c[1]] * a[..., r[1], c[0]]
+            return minor if (i + j) % 2 == 0 else -minor
+        rows = [[cofactor(i, j) for j in range(3)] for i in range(3)]
+    # both stacks put their items on the last axis: transpose to rows first
+    adjugate = transpose(_stack_any([_stack_any(row) for row in rows]))
+    size = det(a)
+    return adjugate / (size[..., None, None] if isinstance(size, HyperDual)
+                       else np.asarray(size)[..., None, None])
 
 
 def stack(items: Sequence[HyperDual | ArrayLike], axis: int = -1) -> HyperDual:

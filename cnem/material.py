@@ -2,7 +2,10 @@
 eq. 24-25 of the C-NEM paper) and 3-D.
 
 A material is an object that knows its constitutive law in any dimension
-(`Material`); `LinearElastic` is the isotropic Hooke law. The vectorised functions
+(`Material`); `LinearElastic` is the isotropic Hooke law. The hyperelastic laws of
+finite strain (`Hyperelastic`: `NeoHookean`, `SaintVenantKirchhoff`) are energies of
+the deformation gradient ``F`` with their first Piola-Kirchhoff stress and its
+tangent, vectorised over integration points ``(q, d, d)``. The vectorised functions
 below (`lame`, `stiffness_matrix`, `kappa`, `effective_modulus`) are the constitutive
 facts that C-NEM, the P1 anchor, fracture and peridynamics share, over arrays of
 ``(E, nu)``. Voigt order: ``[xx, yy, xy]`` in 2-D, ``[xx, yy, zz, yz, xz, xy]`` in
@@ -13,6 +16,10 @@ facts that C-NEM, the P1 anchor, fracture and peridynamics share, over arrays of
 >>> steel.elasticity_matrix(2, "strain").shape, steel.elasticity_matrix(3).shape
 ((3, 3), (6, 6))
 >>> E, nu = steel                     # unpacks like the (E, nu) pair it replaces
+>>> import numpy as np
+>>> W, P, A = NeoHookean(1.0, 2.0).evaluate(np.eye(3)[None])   # stress-free reference
+>>> float(W[0]), float(abs(P).max()), A.shape
+(0.0, 0.0, (1, 3, 3, 3, 3))
 """
 
 from __future__ import annotations
@@ -23,9 +30,11 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from . import hyperdual as hd
 from .errors import MaterialError, OptionError, check_array, check_choice, check_real
 
-__all__ = ["PLANES", "Material", "LinearElastic", "parse_materials", "moduli", "check_plane", "check_stiffness",
+__all__ = ["PLANES", "Material", "LinearElastic", "Hyperelastic", "NeoHookean",
+           "SaintVenantKirchhoff", "parse_materials", "moduli", "check_plane", "check_stiffness",
            "lame", "stiffness_matrix", "kappa", "effective_modulus"]
 
 #: The 2-D idealisations: plane stress or plane strain.
@@ -109,6 +118,214 @@ class LinearElastic(Material):
     def tangent(self, dim: int = 2, plane: Literal["stress", "strain"] | None = None) -> np.ndarray:
         """The elasticity matrix (`elasticity_matrix`): the tangent of a linear law."""
         return self.elasticity_matrix(dim, plane)
+
+
+class Hyperelastic(Material):
+    """A hyperelastic law: a strain energy per unit reference volume ``W(F)`` of the
+    deformation gradient, its first Piola-Kirchhoff stress ``P = dW/dF`` and the
+    tangent ``A = dP/dF``, for any dimension ``d`` of ``F``.
+
+    In 2-D, ``F`` is the in-plane ``2 x 2`` block of a plane-strain deformation
+    (``F33 = 1``, no out-of-plane shear): the laws below are written so that the
+    2-D energy is exactly the 3-D one of that deformation. Subclasses give
+    `evaluate` and `lame`; ``energy`` is written with `cnem.hyperdual` functions, so
+    that it also takes hyper-dual numbers (the tests differentiate it that way).
+    """
+
+    def evaluate(self, F: np.ndarray, *, tangent: bool = True
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """Energy, stress and tangent at deformation gradients ``F``.
+
+        Parameters
+        ----------
+        F : (q, d, d) ndarray
+            ``F[k, i, J] = dx_i / dX_J``, d = 2 (plane strain) or 3.
+        tangent : bool
+            Also the tangent (else None).
+
+        Returns
+        -------
+        W : (q,) ndarray
+        P : (q, d, d) ndarray
+            ``P[k, i, J] = dW / dF_iJ``.
+        A : (q, d, d, d, d) ndarray or None
+            ``A[k, i, J, k, L] = d P_iJ / d F_kL`` (major symmetry ``A_iJkL = A_kLiJ``).
+        """
+        raise NotImplementedError
+
+    def energy(self, F: np.ndarray | hd.HyperDual) -> np.ndarray | hd.HyperDual:
+        """``W (q,)`` at ``F (q, d, d)`` (an ndarray or `cnem.hyperdual.HyperDual`)."""
+        raise NotImplementedError
+
+    def lame(self, dim: int = 2, plane: Literal["strain"] | None = None
+             ) -> tuple[float, float]:
+        """Lamé parameters ``(lam, mu)`` of the law linearised at ``F = I`` (in 2-D
+        plane strain, the only idealisation: ``plane`` None or "strain")."""
+        raise NotImplementedError
+
+    def linearized(self) -> LinearElastic:
+        """The small-strain law of this material (`LinearElastic` of its `lame`)."""
+        lam, mu = self.lame(3, None)
+        return LinearElastic(mu * (3.0 * lam + 2.0 * mu) / (lam + mu), lam / (2.0 * (lam + mu)))
+
+    def tangent(self, dim: int = 2, plane: Literal["strain"] | None = None) -> np.ndarray:
+        """The Voigt tangent of the law linearised at ``F = I`` (plane strain in 2-D)."""
+        self.lame(dim, plane)
+        return self.linearized().elasticity_matrix(dim, "strain" if dim == 2 else None)
+
+
+def _positive_lame(name, lam, mu):
+    """``(lam, mu)`` as floats, or a MaterialError unless finite with mu > 0 and a
+    positive bulk modulus ``lam + 2 mu / 3``."""
+    try:
+        lam, mu = float(lam), float(mu)
+    except (TypeError, ValueError):
+        raise MaterialError(f"{name}: expected numbers, received lam={lam!r}, mu={mu!r}") from None
+    if not (np.isfinite(mu) and np.isfinite(lam) and mu > 0 and lam + 2.0 * mu / 3.0 > 0):
+        raise MaterialError(f"{name}: expected a finite shear modulus mu > 0 and bulk modulus "
+                            f"lam + 2 mu / 3 > 0, received mu={mu}, lam={lam}")
+    return lam, mu
+
+
+def _hyper_lame(dim, plane, lam, mu):
+    """``(lam, mu)`` after checking the idealisation: plane strain in 2-D, none in 3-D
+    (a hyperelastic plane-stress law needs the out-of-plane stretch solved for); None
+    in 2-D is plane strain."""
+    if dim == 2 and plane is None:
+        plane = "strain"
+    check_plane(dim, plane)
+    if plane == "stress":
+        raise OptionError("plane: the hyperelastic laws are written for plane strain (F33 = 1) "
+                          "in 2-D, received 'stress'; pass plane='strain' or use a 3-D model")
+    return lam, mu
+
+
+def _deformation_gradients(F):
+    """``F`` as a float ``(q, d, d)`` array, d = 2 or 3, or a MaterialError."""
+    F = np.asarray(F, dtype=float)
+    if F.ndim != 3 or F.shape[1] != F.shape[2] or F.shape[1] not in (2, 3):
+        raise MaterialError(f"F: expected deformation gradients of shape (q, d, d), d = 2 or 3, "
+                            f"received shape {F.shape}")
+    return F
+
+
+@dataclass(frozen=True)
+class NeoHookean(Hyperelastic):
+    """Compressible neo-Hookean law
+    ``W = mu/2 (tr C - 3) - mu ln J + lam/2 (ln J)^2``, ``C = F^T F``, ``J = det F``.
+
+    In plane strain ``tr C = C11 + C22 + 1`` (``F33 = 1``), so the 2-D law is
+    ``mu/2 (|F|^2 - 2) - mu ln J + lam/2 (ln J)^2`` with the 2 x 2 ``F``. Its
+    stress is ``P = mu (F - F^-T) + lam ln J F^-T`` and its linearisation at
+    ``F = I`` Hooke's law with Lamé parameters ``lam``, ``mu``.
+
+    Parameters
+    ----------
+    mu : float
+        Shear modulus, positive and finite.
+    lam : float
+        Lamé's first parameter; the bulk modulus ``lam + 2 mu / 3`` must be positive.
+    """
+
+    mu: float
+    lam: float
+
+    def __post_init__(self):
+        lam, mu = _positive_lame("NeoHookean", self.lam, self.mu)
+        object.__setattr__(self, "mu", mu)
+        object.__setattr__(self, "lam", lam)
+
+    def lame(self, dim: int = 2, plane: Literal["strain"] | None = None
+             ) -> tuple[float, float]:
+        """``(lam, mu)`` as given (see `Hyperelastic.lame`)."""
+        return _hyper_lame(dim, plane, self.lam, self.mu)
+
+    def energy(self, F: np.ndarray | hd.HyperDual) -> np.ndarray | hd.HyperDual:
+        """``W (q,)`` at ``F (q, d, d)`` (see `Hyperelastic.energy`)."""
+        d = F.shape[-1]
+        log_j = hd.log(hd.det(F))
+        return 0.5 * self.mu * ((F * F).sum(axis=(-2, -1)) - d) - self.mu * log_j \
+            + 0.5 * self.lam * log_j * log_j
+
+    def evaluate(self, F: np.ndarray, *, tangent: bool = True
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """``W``, ``P`` and ``A`` at ``F (q, d, d)`` (see `Hyperelastic.evaluate`)."""
+        F = _deformation_gradients(F)
+        mu, lam = self.mu, self.lam
+        with np.errstate(invalid="ignore", divide="ignore"):    # J <= 0: NaN, for Newton
+            log_j = np.log(np.linalg.det(F))
+        inv = np.linalg.inv(F)                                  # inv[k, J, i] = F^-1_Ji
+        inv_t = np.swapaxes(inv, 1, 2)                          # F^-T_iJ
+        W = 0.5 * mu * (np.einsum("kij,kij->k", F, F) - F.shape[1]) - mu * log_j \
+            + 0.5 * lam * log_j ** 2
+        P = mu * F + (lam * log_j - mu)[:, None, None] * inv_t
+        if not tangent:
+            return W, P, None
+        d = F.shape[1]
+        # A_iJkL = mu d_ik d_JL + (mu - lam ln J) F^-1_Jk F^-1_Li + lam F^-1_Ji F^-1_Lk
+        A = mu * np.einsum("ik,JL->iJkL", np.eye(d), np.eye(d))[None] \
+            + (mu - lam * log_j)[:, None, None, None, None] * np.einsum("qJk,qLi->qiJkL", inv, inv) \
+            + lam * np.einsum("qJi,qLk->qiJkL", inv, inv)
+        return W, P, A
+
+
+@dataclass(frozen=True)
+class SaintVenantKirchhoff(Hyperelastic):
+    """Saint Venant-Kirchhoff law ``W = lam/2 (tr E)^2 + mu E : E``, ``E = (F^T F - I)/2``.
+
+    In plane strain ``E33 = E13 = E23 = 0``: the 2-D law is the same formula with
+    the 2 x 2 ``F``. ``S = lam tr E I + 2 mu E``, ``P = F S``. It does not resist
+    strong compression (the energy has a maximum along uniaxial compression near
+    a stretch of ``1/sqrt(3)``); use `NeoHookean` there.
+
+    Parameters
+    ----------
+    E : float
+        Young's modulus of the linearised law, positive and finite.
+    nu : float
+        Its Poisson ratio, in (-1, 0.5).
+    """
+
+    E: float
+    nu: float
+
+    def __post_init__(self):
+        LinearElastic(self.E, self.nu)                          # the same checks
+        object.__setattr__(self, "E", float(self.E))
+        object.__setattr__(self, "nu", float(self.nu))
+
+    def lame(self, dim: int = 2, plane: Literal["strain"] | None = None
+             ) -> tuple[float, float]:
+        """``(lam, mu)`` of ``E``, ``nu`` (the 3-D law's, also plane strain's)."""
+        lam, mu = lame(self.E, self.nu, None)
+        return _hyper_lame(dim, plane, float(lam), float(mu))
+
+    def energy(self, F: np.ndarray | hd.HyperDual) -> np.ndarray | hd.HyperDual:
+        """``W (q,)`` at ``F (q, d, d)`` (see `Hyperelastic.energy`)."""
+        lam, mu = self.lame(3, None)
+        strain = 0.5 * (hd.matmul(hd.transpose(F), F) - np.eye(F.shape[-1]))
+        tr = hd.trace(strain)
+        return 0.5 * lam * tr * tr + mu * (strain * strain).sum(axis=(-2, -1))
+
+    def evaluate(self, F: np.ndarray, *, tangent: bool = True
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+        """``W``, ``P`` and ``A`` at ``F (q, d, d)`` (see `Hyperelastic.evaluate`)."""
+        F = _deformation_gradients(F)
+        lam, mu = self.lame(3, None)
+        d = F.shape[1]
+        eye = np.eye(d)
+        strain = 0.5 * (np.einsum("kiJ,kiL->kJL", F, F) - eye)
+        tr = np.trace(strain, axis1=1, axis2=2)
+        S = lam * tr[:, None, None] * eye + 2.0 * mu * strain
+        W = 0.5 * lam * tr ** 2 + mu * np.einsum("kij,kij->k", strain, strain)
+        P = F @ S
+        if not tangent:
+            return W, P, None
+        # A_iJkL = d_ik S_LJ + lam F_iJ F_kL + mu F_iL F_kJ + mu (F F^T)_ik d_JL
+        A = np.einsum("ik,qLJ->qiJkL", eye, S) + lam * np.einsum("qiJ,qkL->qiJkL", F, F) \
+            + mu * np.einsum("qiL,qkJ->qiJkL", F, F) \
+            + mu * np.einsum("qik,JL->qiJkL", F @ np.swapaxes(F, 1, 2), eye)
+        return W, P, A
 
 
 def _check_moduli(E: np.ndarray, nu: np.ndarray) -> None:

@@ -342,3 +342,47 @@ def test_errors_say_what_was_expected():
         hd.concatenate([x, np.ones((2, 2))])
     with pytest.raises(TypeError):
         np.sqrt(x)                                        # numpy ufuncs refuse, use hd.sqrt
+
+
+# -- matrix functions (finite strain) ----------------------------------------------------
+@pytest.mark.parametrize("d", [2, 3])
+def test_matrix_functions_match_numpy_on_real_input(d):
+    a, b = RNG.normal(size=(2, 9, d, d))
+    close(hd.det(a), np.linalg.det(a))
+    close(hd.inv(a), np.linalg.inv(a), rtol=1e-11)
+    close(hd.trace(a), np.trace(a, axis1=1, axis2=2))
+    close(hd.matmul(a, b), a @ b)
+    np.testing.assert_array_equal(hd.transpose(a), np.swapaxes(a, 1, 2))
+    assert not isinstance(hd.inv(a), HyperDual)
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_determinant_and_inverse_derivatives(d):
+    """Jacobi's formula: d det A / dA = det A A^-T; d2 det / dA_ij dA_kl = det (A^-1_ji
+    A^-1_lk - A^-1_li A^-1_jk); the inverse's directional derivative -A^-1 H A^-1."""
+    a = np.eye(d) + 0.4 * RNG.normal(size=(7, d, d))
+    det, inv = np.linalg.det(a), np.linalg.inv(a)
+    value, grad, hess = hd.derivatives(lambda y: hd.det(y.reshape(y.shape[:-1] + (d, d))),
+                                       a.reshape(7, -1))
+    close(value, det)
+    close(grad.reshape(7, d, d), det[:, None, None] * np.swapaxes(inv, 1, 2))
+    second = det[:, None, None, None, None] * (np.einsum("qji,qlk->qijkl", inv, inv)
+                                               - np.einsum("qli,qjk->qijkl", inv, inv))
+    close(hess.reshape(7, d, d, d, d), second, rtol=1e-11)
+    h = RNG.normal(size=(d, d))
+    out = hd.inv(HyperDual(a, h, h))
+    close(out.re, inv, rtol=1e-11)
+    close(out.e1, -inv @ h @ inv, rtol=1e-11)
+    close(out.e12, 2 * inv @ h @ inv @ h @ inv, rtol=1e-10)
+    t = hd.trace(hd.matmul(hd.transpose(HyperDual(a, h)), HyperDual(a, h)))   # |A|^2
+    close(t.re, (a * a).sum(axis=(1, 2)))
+    close(t.e1, 2 * (a * h).sum(axis=(1, 2)))
+
+
+def test_matrix_functions_refuse_wrong_shapes():
+    with pytest.raises(cnem.HyperDualError, match=r"square matrices"):
+        hd.det(np.ones((4, 2, 3)))
+    with pytest.raises(cnem.HyperDualError, match=r"2 x 2 and 3 x 3"):
+        hd.inv(np.ones((4, 4, 4)))
+    with pytest.raises(cnem.HyperDualError, match=r"\(\.\.\., d, e\) and \(\.\.\., e, f\)"):
+        hd.matmul(np.ones((2, 3)), np.ones((2, 3)))

@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from typing import Any
     from .basis import CellBasis
 
-__all__ = ["BilinearForm", "LinearForm", "Functional", "asm"]
+__all__ = ["BilinearForm", "LinearForm", "Functional", "asm", "gradient_gram"]
 
 
 def _extras(basis, kwargs):
@@ -174,12 +174,46 @@ class BilinearForm(_Form):
                     weights[:, i, j] = other[a, b]
                 elif a >= g and b >= g:
                     weights[:, i, j] = basis.dx * grad_coeff[group, a - g, b - g]
-        stack = sp.vstack([ops[d] for d in used], format="csr")
-        t = stack.T.tocsr()
-        indptr, indices, data = SK.weighted_gram(stack.indptr, stack.indices, stack.data,
-                                                 t.indptr, t.indices, t.data, weights, m,
-                                                 basis.N, work_chunks())
-        return sp.csr_matrix((data, indices, indptr), shape=(basis.N, basis.N))
+        return _weighted_gram([ops[d] for d in used], weights, basis.N)
+
+
+def _weighted_gram(ops, weights, N):
+    """``sum_k sum_ab P_b[k]^T weights[k, a, b] P_a[k]`` ``(N, N)`` CSR from descriptor
+    operators ``ops`` (each ``(m, N)``) and ``weights (m, len(ops), len(ops))``."""
+    stack = sp.vstack(ops, format="csr")
+    t = stack.T.tocsr()
+    indptr, indices, data = SK.weighted_gram(stack.indptr, stack.indices, stack.data,
+                                             t.indptr, t.indices, t.data, weights,
+                                             len(weights), N, work_chunks())
+    return sp.csr_matrix((data, indices, indptr), shape=(N, N))
+
+
+def gradient_gram(basis: CellBasis, coeff: np.ndarray) -> sp.csr_matrix:
+    """``sum_k dx_k G_k^T coeff_k G_k`` for a vector basis, ``G_k`` the ``d^2`` gradient
+    descriptors at cell ``k`` (``du_i/dx_j`` at ``d i + j``): the matrix of a form
+    whose coefficients differ from cell to cell (a tangent of finite strain, say).
+
+    Parameters
+    ----------
+    basis : CellBasis
+        A vector basis, ``m`` cells.
+    coeff : (m, d d, d d) ndarray
+        ``coeff[k, a, b]``: trial descriptor ``a``, test descriptor ``b``.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (N, N)
+    """
+    m, d = len(basis.dx), basis.ncomp
+    coeff = np.ascontiguousarray(coeff, dtype=float)
+    if not basis.vector or coeff.shape != (m, d * d, d * d):
+        raise FormError(f"gradient_gram: expected a vector basis and coefficients of shape "
+                        f"({m}, {d * d}, {d * d}), received a {'vector' if basis.vector else 'scalar'} "
+                        f"basis and shape {coeff.shape}")
+    grads = basis.component_gradients()
+    if grads is not None:              # d x d node blocks from the scalar gradients
+        return _gradient_blocks(grads, coeff, np.arange(m), basis.dx, basis.N)
+    return _weighted_gram(basis.operators[d:], basis.dx[:, None, None] * coeff, basis.N)
 
 
 def _gradient_blocks(grads, coeff, group, weight, N):

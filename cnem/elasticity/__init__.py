@@ -1,4 +1,5 @@
-"""Physical models on C-NEM: plane linear elasticity.
+"""Physical models on C-NEM: linear elasticity, and finite-strain hyperelasticity
+(`Hyperelasticity`).
 
 >>> import cnem
 >>> model = cnem.discretize(cnem.nodes.regular(cnem.geometry.rectangle(), 0.2))
@@ -12,10 +13,13 @@ True
 
 from .._aliases import renamed_attributes
 from .linear import Elasticity, elasticity_form
+from .hyperelasticity import Hyperelasticity
+from .hyperelastic_solution import HyperelasticSolution
 from ..material import lame, stiffness_matrix
 from .solution import ElasticSolution, von_mises
 
-__all__ = ["Elasticity", "ElasticSolution", "elasticity_form", "lame", "stiffness_matrix",
+__all__ = ["Elasticity", "ElasticSolution", "Hyperelasticity", "HyperelasticSolution",
+           "elasticity_form", "lame", "stiffness_matrix",
            "von_mises"]
 
 #: Old names (one release): the modules of ``cnem.elasticity`` as attributes

@@ -15,17 +15,15 @@ from tqdm.auto import tqdm
 
 from ..assembly import BilinearForm, CellBasis
 from ..solvers.condensation import principal_submatrix
-from ..solvers.conditions import Conditions, traction_at
 from ..assembly.basis import spread_component
 from ..assembly.quadrature import cell_quadrature
 from ..assembly.subdivision import subdivide, tip_cells
 from ..assembly.gradients import GradientCache
 from ..assembly.triangles import triangle_basis
 from ..solvers.constrained import solve_constrained
-from ..errors import GeometryError, InputError
-from ..geometry.model import check_model
-from ..geometry.topology import constraint_edges
+from ..errors import InputError
 from ..material import check_plane, check_stiffness, lame, moduli, parse_materials, stiffness_matrix
+from .model_problem import ModelProblem
 from .solution import ElasticSolution
 
 if TYPE_CHECKING:
@@ -45,7 +43,7 @@ def elasticity_form(u, v, w):
     return ddot(linear_stress(w.lam, w.mu)(sym_grad(u)), sym_grad(v))
 
 
-class Elasticity(Conditions):
+class Elasticity(ModelProblem):
     """Linear elasticity on a C-NEM model: plane stress or strain in 2-D; the dofs,
     the assembly and the solution carry the model's dimension ``dim``.
 
@@ -104,13 +102,12 @@ class Elasticity(Conditions):
                  *, plane: str | None = None, gauss: int = 2, enrich: Enrichment | None = None,
                  stabilization: float = 1.0, gradients: GradientCache | None = None):
         from ..fracture.enrichment import Enrichment
-        self.model = check_model(model, "Elasticity")
+        super().__init__(model, gauss=gauss, gradients=gradients, caller="Elasticity")
         self.enrichment = Enrichment.from_spec(model, enrich)
         #: the integration cells: the model's, or their fan sub-cells with enrichment (one
         #: smoothed strain per cell cannot control the extra dofs)
-        self.cells = (model.cells if self.enrichment is None
-                      else subdivide(model.cells, model.nodes, node_apex=tip_cells(model))[0])
-        self.dim = model.nodes.shape[1]
+        if self.enrichment is not None:
+            self.cells = subdivide(model.cells, model.nodes, node_apex=tip_cells(model))[0]
         if self.dim == 2 and plane is None:
             plane = "stress"
         check_plane(self.dim, plane)
@@ -121,16 +118,6 @@ class Elasticity(Conditions):
         if not (np.isfinite(self.stabilization) and self.stabilization >= 0):
             raise InputError(f"stabilization: expected a number >= 0, received {stabilization!r}")
         self.plane = plane
-        self.gauss = gauss
-        if gradients is None:
-            gradients = GradientCache(model, gauss=gauss)
-        elif gradients.model is not model or gradients.gauss != gauss:
-            raise GeometryError(f"gradients: expected the GradientCache of this model with "
-                                f"gauss={gauss}, received {gradients!r}; build them with "
-                                f"GradientCache(model, gauss={gauss})")
-        #: the owner of the smoothed gradients this problem uses
-        self.gradients = gradients
-        super().__init__()
         self._basis = None
         self._K = None
 
@@ -138,23 +125,7 @@ class Elasticity(Conditions):
         return (f"<Elasticity plane {self.plane}, {len(self.model.nodes)} nodes, "
                 f"{self.conditions_repr()}>")
 
-    # -- conditions (`Conditions`: add_dirichlet, add_traction, add_body_force) ---------
-    #: Dirichlet predicates see the model's nodes (direct imposition: Kronecker delta).
-    points_name = "model.nodes"
-
-    @property
-    def condition_points(self) -> np.ndarray:
-        """``(n, dim)`` the nodes that conditions refer to (``model.nodes``)."""
-        return self.model.nodes
-
-    def boundary_edges(self) -> tuple:
-        """The model's constraint edges with the body on one side (see
-        `Conditions.boundary_edges`)."""
-        tri = self.model.triangles
-        edges, _ = constraint_edges(tri, self.model.neighbors(across_regions=True))
-        d = self.model.nodes[edges[:, 1]] - self.model.nodes[edges[:, 0]]
-        normal = np.column_stack([d[:, 1], -d[:, 0]]) / np.linalg.norm(d, axis=1)[:, None]
-        return edges, normal
+    # -- conditions (`ModelProblem`: add_dirichlet, add_traction, add_body_force) ------
 
     # -- assembly -----------------------------------------------------------------------
     @property
@@ -299,26 +270,13 @@ class Elasticity(Conditions):
 
     def load(self) -> np.ndarray:
         """Load vector ``f`` (eq. 21), ``(dim n,)`` (then the enriched dofs' loads)."""
-        n, d = self.model.nodes.shape
-        f = np.zeros((n, d))
+        f = self.nodal_load()
+        d = self.dim
         enriched = np.zeros((0 if self.enrichment is None else len(self.enrichment), d))
-        g, w = np.polynomial.legendre.leggauss(3)
-        s, w = 0.5 * (g + 1.0), 0.5 * w
-        x = self.model.nodes
-        for traction in self.tractions:
-            edges, normal, t = traction.edges, traction.normal, traction.value
-            a, b = x[edges[:, 0]], x[edges[:, 1]]
-            length = np.linalg.norm(b - a, axis=1)
-            for sk, wk in zip(s, w):
-                pts = a + sk * (b - a)
-                tr = traction_at(t, pts, normal)
-                np.add.at(f, edges[:, 0], (wk * (1.0 - sk) * length)[:, None] * tr)
-                np.add.at(f, edges[:, 1], (wk * sk * length)[:, None] * tr)
-            if self.enrichment is not None:
-                enriched += self.enrichment.edge_loads(edges, normal, t)
-        cells = self.cells
-        for b in self.body_forces_at(x[cells.node]):
-            np.add.at(f, cells.node, cells.area[:, None] * b)
+        if self.enrichment is not None:
+            for traction in self.tractions:
+                enriched += self.enrichment.edge_loads(traction.edges, traction.normal,
+                                                       traction.value)
         # (the enrichment functions vanish at the nodes: no nodal body-force share)
         return np.concatenate([f.reshape(-1), enriched.reshape(-1)])
 

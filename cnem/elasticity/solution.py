@@ -11,11 +11,52 @@ from ..assembly.quadrature import cell_quadrature
 from ..solvers.solution import Solution, energy_error_density, engineering_strain, von_mises
 from ..errors import GeometryError, check_choice, check_points
 
-__all__ = ["ElasticSolution", "von_mises", "energy_error_density"]
+__all__ = ["CellSolution", "ElasticSolution", "von_mises", "energy_error_density"]
 
 
 @dataclass(eq=False, repr=False)
-class ElasticSolution(Solution):
+class CellSolution(Solution):
+    """What the solutions of the C-NEM problems on a model share: displacements through
+    the shape functions (and the problem's enrichment, if any), cell values at the nodes,
+    pictures and files of the nodes and integration cells. Subclasses hold ``model``,
+    ``cells`` (``stress`` and ``strain`` live there) and their fields."""
+
+    stress_at = "cells"
+
+    def displacement(self, points: np.ndarray) -> np.ndarray:
+        """Displacements ``(p, d)`` at points ``(p, d)`` through the shape functions (and
+        the enrichment functions)."""
+        phi = self.model.shape_functions(points)
+        out = phi @ self.u
+        enrichment = self.problem.enrichment
+        if enrichment is not None:
+            out += enrichment.values(np.asarray(points, dtype=float), phi) @ self.enriched
+        return out
+
+    def nodal_average(self, values: np.ndarray) -> np.ndarray:
+        """Cell values ``(m, ...)`` at the nodes: each node's cell (area-weighted over the
+        cells of a node on an interface), ``(n, ...)``."""
+        cells, n = self.cells, len(self.model.nodes)
+        values = self._place_values(values)
+        weight = np.bincount(cells.node, weights=cells.area, minlength=n)
+        flat = values.reshape(len(values), -1)
+        out = np.stack([np.bincount(cells.node, weights=cells.area * col, minlength=n) / weight
+                        for col in flat.T], axis=1)
+        return out.reshape((n,) + values.shape[1:])
+
+    def plot_mesh(self) -> tuple:
+        """The nodes, the constrained Delaunay triangles and the domain's diameter."""
+        return self.model.nodes, self.model.triangles, self.model.domain.diameter
+
+    def write_fields(self, path: str, point_data: dict[str, np.ndarray],
+                     cell_data: dict[str, np.ndarray]) -> None:
+        """Nodes and integration cells with the fields (`cnem.io.write`)."""
+        from .. import io
+        io.write(self.model, path, point_data=point_data, cell_data=cell_data)
+
+
+@dataclass(eq=False, repr=False)
+class ElasticSolution(CellSolution):
     """The solution of an `Elasticity` problem (the fields of `cnem.solvers.solution`).
 
     Attributes
@@ -57,8 +98,6 @@ class ElasticSolution(Solution):
     model: Any
     plane: str
 
-    stress_at = "cells"
-
     @classmethod
     def from_dofs(cls, problem: Any, dofs: np.ndarray, C: np.ndarray,
                   timings: dict[str, float]) -> ElasticSolution:
@@ -71,16 +110,6 @@ class ElasticSolution(Solution):
                    stress=np.einsum("kij,kj->ki", C, strain), strain=strain, cells=problem.cells,
                    gradient=gradient, dofs=dofs, enriched=dofs[d * n:].reshape(-1, d), C=C,
                    timings=timings, model=problem.model, plane=problem.plane)
-
-    def displacement(self, points: np.ndarray) -> np.ndarray:
-        """Displacements ``(p, d)`` at points ``(p, d)`` through the shape functions (and
-        the enrichment functions)."""
-        phi = self.model.shape_functions(points)
-        out = phi @ self.u
-        enrichment = self.problem.enrichment
-        if enrichment is not None:
-            out += enrichment.values(np.asarray(points, dtype=float), phi) @ self.enriched
-        return out
 
     def displacement_gradient(self, points: np.ndarray) -> np.ndarray:
         """The gradient of the displacement field itself (not smoothed) at points
@@ -147,24 +176,3 @@ class ElasticSolution(Solution):
     def energy(self) -> float:
         """Strain energy ``1/2 sum_k A_k σ_k · ε_k``."""
         return 0.5 * float(self.cells.area @ (self.stress * self.strain).sum(axis=1))
-
-    def nodal_average(self, values: np.ndarray) -> np.ndarray:
-        """Cell values ``(m, ...)`` at the nodes: each node's cell (area-weighted over the
-        cells of a node on an interface), ``(n, ...)``."""
-        cells, n = self.cells, len(self.model.nodes)
-        values = self._place_values(values)
-        weight = np.bincount(cells.node, weights=cells.area, minlength=n)
-        flat = values.reshape(len(values), -1)
-        out = np.stack([np.bincount(cells.node, weights=cells.area * col, minlength=n) / weight
-                        for col in flat.T], axis=1)
-        return out.reshape((n,) + values.shape[1:])
-
-    def plot_mesh(self) -> tuple:
-        """The nodes, the constrained Delaunay triangles and the domain's diameter."""
-        return self.model.nodes, self.model.triangles, self.model.domain.diameter
-
-    def write_fields(self, path: str, point_data: dict[str, np.ndarray],
-                     cell_data: dict[str, np.ndarray]) -> None:
-        """Nodes and integration cells with the fields (`cnem.io.write`)."""
-        from .. import io
-        io.write(self.model, path, point_data=point_data, cell_data=cell_data)

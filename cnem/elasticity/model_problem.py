@@ -1,0 +1,120 @@
+"""`ModelProblem`: what every C-NEM problem on a model shares, linear or finite strain.
+
+The model (checked), its dimension, the owner of its smoothed gradients
+(`cnem.assembly.GradientCache`, one per model and Gauss order), the conditions on its
+nodes (`cnem.solvers.conditions.Conditions` with the model's boundary edges) and the
+nodal loads of the tractions and body forces. `cnem.Elasticity` and
+`cnem.Hyperelasticity` derive from it.
+
+>>> import cnem
+>>> model = cnem.discretize(cnem.nodes.regular(cnem.geometry.rectangle(), 0.5))
+>>> prob = ModelProblem(model, gauss=2, gradients=None, caller="example")
+>>> prob.add_body_force([0.0, -1.0])
+>>> float(prob.nodal_load()[:, 1].sum())               # the body's weight: area 1
+-1.0
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..assembly.gradients import GradientCache
+from ..errors import GeometryError
+from ..geometry.model import check_model
+from ..geometry.topology import constraint_edges
+from ..solvers.conditions import Conditions, traction_at
+
+if TYPE_CHECKING:
+    from ..geometry.model import Model
+
+__all__ = ["ModelProblem"]
+
+
+class ModelProblem(Conditions):
+    """Conditions, loads and smoothed gradients of a problem on a C-NEM model.
+
+    Parameters
+    ----------
+    model : Model
+        ``n`` nodes, ``m`` integration cells.
+    gauss : int
+        Gauss points per cell-edge piece in the smoothed gradients.
+    gradients : GradientCache, optional
+        The model's smoothed gradients at ``gauss``, to share with other problems
+        on the model; by default the problem keeps its own.
+    caller : str
+        The problem class, named in the errors.
+
+    Attributes
+    ----------
+    model : Model
+    dim : int
+        The model's dimension.
+    gauss : int
+    gradients : GradientCache
+        The owner of the smoothed gradients this problem uses.
+    cells : Cells
+        The integration cells (``model.cells`` unless a subclass sets others).
+    """
+
+    #: Dirichlet predicates see the model's nodes (direct imposition: Kronecker delta).
+    points_name = "model.nodes"
+
+    def __init__(self, model: Model, *, gauss: int, gradients: GradientCache | None,
+                 caller: str):
+        self.model = check_model(model, caller)
+        self.dim = model.nodes.shape[1]
+        self.gauss = gauss
+        if gradients is None:
+            gradients = GradientCache(model, gauss=gauss)
+        elif gradients.model is not model or gradients.gauss != gauss:
+            raise GeometryError(f"gradients: expected the GradientCache of this model with "
+                                f"gauss={gauss}, received {gradients!r}; build them with "
+                                f"GradientCache(model, gauss={gauss})")
+        self.gradients = gradients
+        self.cells = model.cells
+        super().__init__()
+
+    @property
+    def condition_points(self) -> np.ndarray:
+        """``(n, dim)`` the nodes that conditions refer to (``model.nodes``)."""
+        return self.model.nodes
+
+    def boundary_edges(self) -> tuple:
+        """The model's constraint edges with the body on one side (see
+        `Conditions.boundary_edges`)."""
+        tri = self.model.triangles
+        edges, _ = constraint_edges(tri, self.model.neighbors(across_regions=True))
+        d = self.model.nodes[edges[:, 1]] - self.model.nodes[edges[:, 0]]
+        normal = np.column_stack([d[:, 1], -d[:, 0]]) / np.linalg.norm(d, axis=1)[:, None]
+        return edges, normal
+
+    def nodal_load(self) -> np.ndarray:
+        """The nodes' share of the tractions (3-point Gauss rule on each edge, exact
+        up to quadratic tractions) and of the body forces (one value per cell, at its
+        node), on the reference configuration.
+
+        Returns
+        -------
+        (n, dim) ndarray
+        """
+        n, d = self.model.nodes.shape
+        f = np.zeros((n, d))
+        g, w = np.polynomial.legendre.leggauss(3)
+        s, w = 0.5 * (g + 1.0), 0.5 * w
+        x = self.model.nodes
+        for traction in self.tractions:
+            edges, normal, t = traction.edges, traction.normal, traction.value
+            a, b = x[edges[:, 0]], x[edges[:, 1]]
+            length = np.linalg.norm(b - a, axis=1)
+            for sk, wk in zip(s, w):
+                pts = a + sk * (b - a)
+                tr = traction_at(t, pts, normal)
+                np.add.at(f, edges[:, 0], (wk * (1.0 - sk) * length)[:, None] * tr)
+                np.add.at(f, edges[:, 1], (wk * sk * length)[:, None] * tr)
+        cells = self.cells
+        for b in self.body_forces_at(x[cells.node]):
+            np.add.at(f, cells.node, cells.area[:, None] * b)
+        return f
