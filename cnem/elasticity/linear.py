@@ -147,6 +147,11 @@ class Elasticity(Conditions):
         """``(n, dim)`` the nodes that conditions refer to (``model.nodes``)."""
         return self.model.nodes
 
+    @property
+    def condition_domain(self):
+        """The model's domain: its named boundaries may be given as ``where``."""
+        return self.model.domain
+
     def boundary_edges(self) -> tuple:
         """The model's constraint edges with the body on one side (see
         `Conditions.boundary_edges`)."""

@@ -276,6 +276,16 @@ class Problem(Conditions, VelocityConditions, Dynamics):
         """``(n, d)`` the points that conditions refer to (``body.points``)."""
         return self.body.points
 
+    names_fix = ("build the body with Body.from_cloud(cloud), which keeps the domain, or "
+                 "select with a predicate, a mask or indices")
+
+    @property
+    def condition_domain(self):
+        """The domain of a body from a node cloud (`Body.from_cloud`), else None: its
+        named boundaries may be given as ``where``."""
+        model = getattr(self.body, "model", None)
+        return None if model is None else model.domain
+
     def add_traction(self, where: Callable[..., np.ndarray] | ArrayLike,
                      t: ArrayLike | Callable[..., np.ndarray]) -> None:
         """Not for peridynamics: a nonlocal body has no boundary edges to load.
