@@ -97,11 +97,11 @@ def _piece(entity, sagitta):
     """``(points (k, 2), closed)`` of one outline entity."""
     kind, dxf = entity.dxftype(), entity.dxf
     if kind == "LINE":
-        return np.array([dxf.start[:2], dxf.end[:2]], dtype=float), False
+        return np.array([(dxf.start.x, dxf.start.y), (dxf.end.x, dxf.end.y)]), False
     if kind in ("ARC", "CIRCLE"):
         start = np.radians(dxf.start_angle) if kind == "ARC" else 0.0
         sweep = (np.radians(dxf.end_angle) - start) % (2 * np.pi) if kind == "ARC" else 2 * np.pi
-        pts = _arc(dxf.center[:2], dxf.radius, start, sweep or 2 * np.pi, sagitta)
+        pts = _arc((dxf.center.x, dxf.center.y), dxf.radius, start, sweep or 2 * np.pi, sagitta)
         return _to_wcs(entity, pts[:-1] if kind == "CIRCLE" else pts), kind == "CIRCLE"
     if kind == "LWPOLYLINE":
         return _polyline(entity, list(entity.get_points("xyb")), entity.closed, sagitta)

@@ -101,9 +101,9 @@ def read_gmsh(path) -> dict:
     GeometryError
         Outlines that do not close, cross or branch.
     """
-    import meshio
+    import meshio.gmsh                      # not meshio.read: it exits Python on a bad file
     try:
-        mesh = meshio.read(path, file_format="gmsh")
+        mesh = meshio.gmsh.read(str(path))
     except Exception as exc:               # meshio raises ReadError, ValueError, IndexError ...
         raise FormatError(f"{path}: cannot read it as a gmsh mesh ({type(exc).__name__}: "
                           f"{exc}); expected a .msh file saved by gmsh (ASCII or binary, "
