@@ -31,6 +31,7 @@ from .solution import ElasticSolution
 if TYPE_CHECKING:
     from typing import Literal, Sequence
     from ..fracture.enrichment import Enrichment
+    from ..geometry.domain import Domain
     from ..geometry.model import Model
     from ..geometry.model_update import ModelUpdate
 
@@ -148,7 +149,7 @@ class Elasticity(Conditions):
         return self.model.nodes
 
     @property
-    def condition_domain(self):
+    def condition_domain(self) -> Domain:
         """The model's domain: its named boundaries may be given as ``where``."""
         return self.model.domain
 

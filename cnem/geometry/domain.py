@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 
 import numpy as np
@@ -210,7 +211,7 @@ class Domain:
         self._region_names = check_region_names(region_names, len(self._regions))
 
     @classmethod
-    def from_file(cls, path, **options) -> Domain:
+    def from_file(cls, path: str | os.PathLike, **options: float) -> Domain:
         """A 2-D domain read from a geometry file, its named groups kept as `boundaries`.
 
         Parameters

@@ -20,6 +20,7 @@ left out (logged).
 from __future__ import annotations
 
 import logging
+import os
 
 import numpy as np
 
@@ -153,7 +154,7 @@ def _pieces(doc, path, chord_tolerance):
     return pieces
 
 
-def read_dxf(path, *, chord_tolerance: float | None = None) -> dict:
+def read_dxf(path: str | os.PathLike, *, chord_tolerance: float | None = None) -> dict:
     """Regions and named boundaries (layers) of a DXF drawing (see the module).
 
     Parameters

@@ -14,6 +14,8 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from ..errors import FormatError, GeometryError
@@ -85,7 +87,7 @@ def _outlines(edges, points, named_vertices, tol, path):
     return polygons_from_rings(rings, path)
 
 
-def read_gmsh(path) -> dict:
+def read_gmsh(path: str | os.PathLike) -> dict:
     """Regions, named boundaries and region names of a 2-D gmsh mesh (see the module).
 
     Returns

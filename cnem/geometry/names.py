@@ -20,6 +20,7 @@ from collections.abc import Mapping
 import numpy as np
 import shapely
 
+from .._predicates import Frame
 from ..errors import ConditionError, GeometryError
 
 __all__ = ["as_named_segments", "check_named_segments", "check_region_names", "points_on_segments",
@@ -91,7 +92,7 @@ def _lines(segments, frame):
     return shapely.linestrings(local)
 
 
-def check_named_segments(named: dict[str, np.ndarray], edges: shapely.Geometry, frame,
+def check_named_segments(named: dict[str, np.ndarray], edges: shapely.Geometry, frame: Frame,
                          tol: float) -> None:
     """Every named segment lies on ``edges`` (the region boundaries) within ``tol``.
 
@@ -125,7 +126,8 @@ def check_named_segments(named: dict[str, np.ndarray], edges: shapely.Geometry, 
                 "them or leave it out")
 
 
-def points_on_segments(points: np.ndarray, segments: np.ndarray, frame, tol: float) -> np.ndarray:
+def points_on_segments(points: np.ndarray, segments: np.ndarray, frame: Frame,
+                       tol: float) -> np.ndarray:
     """Which points lie within ``tol`` of any of the segments.
 
     Parameters

@@ -65,7 +65,7 @@ def _features(data, path):
                       f"received an object of type {kind!r}")
 
 
-def read_geojson(path) -> dict:
+def read_geojson(path: str | os.PathLike) -> dict:
     """Regions (Polygon, MultiPolygon: one region per polygon, named by the feature's
     ``"name"`` property) and named boundaries (LineString, MultiLineString features with
     a ``"name"``) of a GeoJSON file."""
@@ -98,7 +98,7 @@ def read_geojson(path) -> dict:
     return {"regions": regions, "boundaries": boundaries, "region_names": region_names}
 
 
-def read_wkt(path) -> dict:
+def read_wkt(path: str | os.PathLike) -> dict:
     """Regions of a WKT file: one POLYGON, MULTIPOLYGON or GEOMETRYCOLLECTION of them
     (one region per polygon)."""
     try:
@@ -130,7 +130,7 @@ SUFFIXES = {".msh": _gmsh, ".dxf": _dxf, ".geojson": read_geojson, ".json": read
             ".wkt": read_wkt}
 
 
-def read_geometry(path: str | os.PathLike, **options) -> dict:
+def read_geometry(path: str | os.PathLike, **options: float) -> dict:
     """The regions, named boundaries and region names a geometry file gives.
 
     Parameters

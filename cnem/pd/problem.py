@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
     from .behaviour import BondBehaviour, CPDBehaviour, StateBehaviour
+    from ..geometry.domain import Domain
     from .body import Body
     from .cpd import CPD, Interactions
     from .materials import BondBased, StateBased
@@ -280,7 +281,7 @@ class Problem(Conditions, VelocityConditions, Dynamics):
                  "select with a predicate, a mask or indices")
 
     @property
-    def condition_domain(self):
+    def condition_domain(self) -> Domain | None:
         """The domain of a body from a node cloud (`Body.from_cloud`), else None: its
         named boundaries may be given as ``where``."""
         model = getattr(self.body, "model", None)
