@@ -157,3 +157,21 @@ def test_names_survive_crack_growth_rebuild():
     left = model.boundary_nodes("left")
     assert np.array_equal(left, np.flatnonzero(model.nodes[:, 0] < 1e-9))
     assert np.count_nonzero(np.all(model.nodes[left] == [0.0, 0.5], axis=1)) == 2   # the mouth, both faces
+
+
+@pytest.mark.parametrize("suffix", ["msh", "dxf", "geojson"])
+def test_file_names_pick_the_same_nodes_moved_and_scaled(tmp_path, suffix):
+    """The file's coordinates moved by 1e6 and scaled by 1e-3: each name still picks the
+    nodes its predicate picks, and the same ones as at the origin in unit scale."""
+    picked = []
+    for scale, shift in [(1.0, 0.0), (1e-3, 1e6)]:
+        cloud = cnem.nodes.irregular(by_hand(scale, shift), 0.2 * scale, seed=0)
+        read = cnem.Domain.from_file(WRITERS[suffix](tmp_path / f"b{scale}.{suffix}", scale, shift))
+        model = cnem.discretize(cnem.nodes.from_points(read, cloud.points))
+        where = predicates(scale, shift)
+        names = {n: model.boundary_nodes(n) for n in ("clamp", "load", "hole")}
+        for name, nodes in names.items():
+            assert np.array_equal(nodes, np.flatnonzero(where[name](model.nodes))), name
+        picked.append(names)
+    for name in picked[0]:
+        assert np.array_equal(picked[0][name], picked[1][name]), name
