@@ -205,9 +205,7 @@ class Domain:
                                 extra_vertices=self._crack_interface_points())
         self._tips = self._find_tips()
         self._named = as_named_segments(boundaries)
-        edges = shapely.transform(shapely.union_all([p.boundary for p in self._regions]),
-                                  self._frame.to_local)
-        check_named_segments(self._named, edges, self._frame, self._tol)
+        check_named_segments(self._named, self._regions, self._frame, self._tol)
         self._region_names = check_region_names(region_names, len(self._regions))
 
     @classmethod

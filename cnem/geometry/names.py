@@ -15,7 +15,7 @@ placed anywhere along a named segment, not only at its ends, are found.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import shapely
@@ -92,15 +92,14 @@ def _lines(segments, frame):
     return shapely.linestrings(local)
 
 
-def check_named_segments(named: dict[str, np.ndarray], edges: shapely.Geometry, frame: Frame,
-                         tol: float) -> None:
-    """Every named segment lies on ``edges`` (the region boundaries) within ``tol``.
+def check_named_segments(named: dict[str, np.ndarray], regions: Sequence[shapely.Polygon],
+                         frame: Frame, tol: float) -> None:
+    """Every named segment lies on the boundary of a region within ``tol``.
 
     Parameters
     ----------
     named : dict of str to (s, 2, 2) ndarray
-    edges : shapely geometry
-        The region boundaries in the local ``frame``.
+    regions : sequence of shapely.Polygon
     frame : cnem._predicates.Frame
     tol : float
         Absolute tolerance (global units).
@@ -110,7 +109,10 @@ def check_named_segments(named: dict[str, np.ndarray], edges: shapely.Geometry, 
     GeometryError
         Naming the first segment off the boundary and where.
     """
-    band = edges.buffer(tol / frame.scale)
+    if not named:
+        return
+    edges = shapely.union_all([r.boundary for r in regions])
+    band = shapely.transform(edges, frame.to_local).buffer(tol / frame.scale)
     shapely.prepare(band)
     for name, segments in named.items():
         if len(segments) == 0:
