@@ -23,7 +23,8 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "ROU
            "FD_STEP", "HYPERDUAL_CHUNK", "CELLS_PER_PASS", "ROW_SLOTS", "TRIANGLE_TREE_AFTER",
            "DT_LIMIT", "COORDINATE_LIMIT", "DIRECT_MEMORY", "DIRECT_FILL",
            "CG_MAXITER", "SIF_DISCS", "SIF_REACH", "SIF_INNER", "SIF_STRAIGHTNESS",
-           "SIF_BEND_SPACINGS", "SIF_SPREAD", "SIF_SPACINGS", "PARALLEL_MIN", "PLOT_MAX_PIXELS"]
+           "SIF_BEND_SPACINGS", "SIF_SPREAD", "SIF_SPACINGS", "PARALLEL_MIN", "PLOT_MAX_PIXELS",
+           "CHORD_TOLERANCE", "ARC_MIN_PIECES"]
 
 # ---------------------------------------------------------------- geometry tolerances
 #: Coordinates (and their extent) must stay below this in magnitude: squared distances
@@ -34,6 +35,13 @@ COORDINATE_LIMIT = 1e150
 #: Points closer than ``SNAP_TOL * diameter`` to a boundary, interface or crack
 #: are snapped onto it; vertices closer than this are the same vertex.
 SNAP_TOL = 1e-9
+
+#: Arcs, circles and curves read from files (DXF) become chords that stay within this
+#: distance of the curve, relative to the drawing's diagonal; `cnem.geometry.dxf_reader`.
+CHORD_TOLERANCE = 1e-3
+
+#: ... and a full turn of an arc has at least this many chords (small holes stay round).
+ARC_MIN_PIECES = 16
 
 #: Relative area below which an overlap of two regions is considered round-off.
 OVERLAP_TOL = 1e-12

@@ -27,6 +27,7 @@ from ..geometry.topology import constraint_edges
 from ..solvers.conditions import Conditions, traction_at
 
 if TYPE_CHECKING:
+    from ..geometry.domain import Domain
     from ..geometry.model import Model
 
 __all__ = ["ModelProblem"]
@@ -81,6 +82,11 @@ class ModelProblem(Conditions):
     def condition_points(self) -> np.ndarray:
         """``(n, dim)`` the nodes that conditions refer to (``model.nodes``)."""
         return self.model.nodes
+
+    @property
+    def condition_domain(self) -> Domain:
+        """The model's domain: its named boundaries may be given as ``where``."""
+        return self.model.domain
 
     def boundary_edges(self) -> tuple:
         """The model's constraint edges with the body on one side (see

@@ -102,6 +102,11 @@ class P1Elasticity(Conditions):
         """``(n, 2)`` the nodes that conditions refer to (`nodes`)."""
         return self.nodes
 
+    @property
+    def condition_domain(self) -> Domain:
+        """The domain meshed: its named boundaries may be given as ``where``."""
+        return self.domain
+
     def boundary_edges(self) -> tuple:
         """The mesh's boundary facets as node pairs with the body on the left, and their
         outward normals (see `Conditions.boundary_edges`; `boundary_facets` in the

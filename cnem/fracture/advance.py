@@ -304,5 +304,7 @@ def cloud_in(cloud: NodeCloud, domain: Domain) -> NodeCloud:
 
 
 def rebuilt_domain(domain: Domain, cracks: Sequence[np.ndarray]) -> Domain:
-    """The same regions with new crack polylines."""
-    return Domain(list(domain.regions), cracks=[np.asarray(c) for c in cracks])
+    """The same regions (their names and named boundaries kept) with new crack polylines."""
+    return Domain(list(domain.regions), cracks=[np.asarray(c) for c in cracks],
+                  boundaries={name: domain.boundary_segments(name) for name in domain.boundaries},
+                  region_names=domain.region_names)

@@ -8,6 +8,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 
 import numpy as np
@@ -20,6 +21,8 @@ from numpy.typing import ArrayLike
 from .. import config
 from .._predicates import Frame, local_frame
 from ..errors import GeometryError, check_array, check_real
+from .names import (as_named_segments, check_named_segments, check_region_names,
+                    points_on_segments, unknown_name)
 from .pslg import CRACK, PSLG, build_pslg, ring_coordinates
 
 __all__ = ["Domain"]
@@ -144,16 +147,24 @@ class Domain:
     cracks : list of (k, 2) array-like
         Traction-free crack polylines inside the closure of the domain. An end on
         the outer boundary or a hole makes an edge crack; an end inside is a tip.
+    boundaries : mapping of str to polylines, optional
+        Named boundaries (`boundaries`): each name maps to a ``(k, 2)`` polyline or a
+        list of them lying on the outer boundary, a hole or an interface; conditions
+        take the names as ``where`` (``prob.add_dirichlet("clamp", None)``).
+    region_names : sequence of str or None, optional
+        A name for each region (`region_names`), e.g. a gmsh physical surface.
 
     Raises
     ------
     GeometryError
         Invalid or self-intersecting polygons, overlapping regions, cracks leaving
-        the domain or crossing each other, zero-length segments.
+        the domain or crossing each other, zero-length segments, named boundaries
+        off the region boundaries.
     """
 
     def __init__(self, regions: ArrayLike | Polygon | Sequence[ArrayLike | tuple | Polygon],
-                 cracks: Sequence[ArrayLike] = ()) -> None:
+                 cracks: Sequence[ArrayLike] = (), *, boundaries: dict | None = None,
+                 region_names: Sequence[str | None] | None = None) -> None:
         if isinstance(regions, MultiPolygon):
             regions = list(regions.geoms)
         elif _is_single_polygon(regions):
@@ -197,6 +208,37 @@ class Domain:
         self._pslg = build_pslg(polylines, hints, self._tol,
                                 extra_vertices=self._crack_interface_points())
         self._tips = self._find_tips()
+        self._named = as_named_segments(boundaries)
+        check_named_segments(self._named, self._regions, self._frame, self._tol)
+        self._region_names = check_region_names(region_names, len(self._regions))
+
+    @classmethod
+    def from_file(cls, path: str | os.PathLike, **options: float) -> Domain:
+        """A 2-D domain read from a geometry file, its named groups kept as `boundaries`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            gmsh ``.msh``, ``.dxf``, ``.geojson`` / ``.json`` or ``.wkt``
+            (`cnem.geometry.readers.read_geometry` tells what each gives).
+        **options
+            ``chord_tolerance`` (DXF): the largest distance between an arc and its
+            chords, relative to the drawing's diagonal.
+
+        Raises
+        ------
+        FormatError
+            An unknown suffix or a file that cannot be read as its format.
+        GeometryError
+            An open or self-intersecting outline (the file is named).
+        """
+        from .readers import read_geometry
+        geometry = read_geometry(path, **options)
+        try:
+            return cls(geometry["regions"], boundaries=geometry["boundaries"],
+                       region_names=geometry["region_names"])
+        except GeometryError as exc:
+            raise GeometryError(f"{path}: {exc}") from None
 
     # ------------------------------------------------------------------ checks
     def _check_overlaps(self):
@@ -327,6 +369,51 @@ class Domain:
     def frame(self) -> Frame:
         """`cnem._predicates.Frame`: the local frame of the domain's bounding box."""
         return self._frame
+
+    @property
+    def boundaries(self) -> tuple[str, ...]:
+        """tuple of str: the names of the named boundaries (gmsh physical lines, DXF
+        layers, the sides of the built-in shapes, ...), usable as ``where``."""
+        return tuple(self._named)
+
+    @property
+    def region_names(self) -> tuple[str | None, ...]:
+        """tuple of str or None: the name of each region (None where unnamed)."""
+        return self._region_names
+
+    def boundary_segments(self, name: str) -> np.ndarray:
+        """The segments of a named boundary, ``(s, 2, 2)`` (start and end points).
+
+        Raises
+        ------
+        ConditionError
+            An unknown name (the error lists the known ones).
+        """
+        if name not in self._named:
+            raise unknown_name(name, self.boundaries)
+        return self._named[name].copy()
+
+    def on_boundary(self, points: ArrayLike, name: str | None = None) -> np.ndarray:
+        """Whether points lie on a named boundary (within `tolerance`), or with
+        ``name=None`` on the outer boundary or a hole.
+
+        Parameters
+        ----------
+        points : (p, 2) array_like
+        name : str, optional
+
+        Returns
+        -------
+        (p,) bool ndarray
+        """
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        if name is None:
+            ring = shapely.transform(self._union.boundary, self._frame.to_local)
+            return shapely.dwithin(ring, shapely.points(self._frame.to_local(pts)),
+                                   self._tol / self._frame.scale)
+        if name not in self._named:
+            raise unknown_name(name, self.boundaries)
+        return points_on_segments(pts, self._named[name], self._frame, self._tol)
 
     @property
     def tips(self) -> np.ndarray:

@@ -5,18 +5,19 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Callable, Literal
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
 from .._predicates import Frame
-from ..errors import GeometryError, InputError
+from ..errors import ConditionError, GeometryError, InputError
 from ._kernels import polygon_moments
 from .cells import voronoi_cells
 from .cloud import NodeCloud
 from .cracks import split_cracks
+from .pslg import SegmentKind
 from ..shape import shape_functions
 from ..spatial.rtree import RTree
 from .topology import (circumcenters, cut_between_regions, triangle_neighbors,
@@ -198,6 +199,45 @@ class Model:
         if name not in self._derived:
             self._derived[name] = build()
         return self._derived[name]
+
+    def boundary_nodes(self, name_or_predicate: str | Callable | None = None) -> np.ndarray:
+        """Indices of the nodes on the boundary, on a named boundary, or on the boundary
+        where a predicate holds.
+
+        Parameters
+        ----------
+        name_or_predicate : None, str or callable ``(p, 2) -> (p,) bool``
+            None: every node on the outer boundary and the holes (crack faces and
+            interfaces are not the boundary); a str: the nodes on that named boundary
+            (`Domain.boundaries`), between its vertices too; a callable: the boundary
+            nodes at which it is True.
+
+        Returns
+        -------
+        (k,) int64 ndarray
+            Sorted.
+
+        Raises
+        ------
+        ConditionError
+            An unknown name (the error lists the known ones), or a predicate that does
+            not return one bool per point.
+        """
+        if isinstance(name_or_predicate, str):
+            return np.flatnonzero(self.domain.on_boundary(self.nodes, name_or_predicate))
+        on = np.unique(self.segments[self.segment_kind == SegmentKind.BOUNDARY])
+        if name_or_predicate is None:
+            return on
+        if not callable(name_or_predicate):
+            raise ConditionError(f"name_or_predicate: expected None, a boundary name or a "
+                                 f"predicate (p, 2) -> (p,) bool, received "
+                                 f"{type(name_or_predicate).__name__}")
+        mask = np.asarray(name_or_predicate(self.nodes[on]))
+        if mask.shape != on.shape or mask.dtype != bool:
+            raise ConditionError(f"name_or_predicate: expected a predicate returning a "
+                                 f"({len(on)},) bool array for the {len(on)} boundary nodes, "
+                                 f"received dtype {mask.dtype} shape {mask.shape}")
+        return on[mask]
 
     def node_sides(self) -> np.ndarray:
         """A point on the side of each node: the area-weighted centroid of its cells

@@ -1,4 +1,16 @@
-"""Builders for the domains users need most.
+"""Builders for the domains users need most, their boundaries named.
+
+=================  ==============================================================
+shape              named boundaries (`cnem.Domain.boundaries`)
+=================  ==============================================================
+`rectangle`        ``left``, ``right``, ``bottom``, ``top``
+`plate_with_hole`  ``left``, ``right``, ``bottom``, ``top``, ``hole0``
+`annulus`          ``inner``, ``outer`` (the innermost and outermost circles); a
+                   sector also ``start`` and ``stop`` (the straight sides at its
+                   start and stop angles)
+`l_shape`          ``left``, ``bottom``, ``right``, ``top``, ``cut`` (the two sides
+                   of the re-entrant corner)
+=================  ==============================================================
 
 >>> from cnem.geometry import rectangle, annulus
 >>> rectangle(2.0, 1.0).area
@@ -55,9 +67,16 @@ def arc(center: ArrayLike, radius: float, start: float, stop: float, spacing: fl
     return center + radius * np.column_stack([np.cos(t), np.sin(t)])
 
 
+def _sides(x0, y0, x1, y1):
+    """The named sides of the box ``[x0, x1] x [y0, y1]``."""
+    return {"left": [[x0, y0], [x0, y1]], "right": [[x1, y0], [x1, y1]],
+            "bottom": [[x0, y0], [x1, y0]], "top": [[x0, y1], [x1, y1]]}
+
+
 def rectangle(width: float = 1.0, height: float = 1.0, *, origin: ArrayLike = (0.0, 0.0),
               cracks: Sequence[ArrayLike] = ()) -> Domain:
-    """Axis-aligned rectangle ``[x0, x0 + width] x [y0, y0 + height]``.
+    """Axis-aligned rectangle ``[x0, x0 + width] x [y0, y0 + height]``, its sides
+    named ``left``, ``right``, ``bottom``, ``top``.
 
     Returns
     -------
@@ -67,13 +86,14 @@ def rectangle(width: float = 1.0, height: float = 1.0, *, origin: ArrayLike = (0
     x0, y0 = check_array("origin", origin, shape=(2,), error=GeometryError,
                          fix="pass one point (x, y)")
     shell = [[x0, y0], [x0 + w, y0], [x0 + w, y0 + h], [x0, y0 + h]]
-    return Domain([shell], cracks=cracks)
+    return Domain([shell], cracks=cracks, boundaries=_sides(x0, y0, x0 + w, y0 + h))
 
 
 def plate_with_hole(width: float = 1.0, height: float = 1.0, radius: float = 0.2, *,
                     center: ArrayLike | None = None, spacing: float | None = None,
                     cracks: Sequence[ArrayLike] = ()) -> Domain:
-    """Rectangle ``[0, width] x [0, height]`` with a circular hole.
+    """Rectangle ``[0, width] x [0, height]`` with a circular hole; boundaries named
+    ``left``, ``right``, ``bottom``, ``top`` and ``hole0``.
 
     Parameters
     ----------
@@ -90,13 +110,16 @@ def plate_with_hole(width: float = 1.0, height: float = 1.0, radius: float = 0.2
                             f"the plate [0, {w}] x [0, {h}]; make it smaller or move it")
     ring = arc(c, r, 0.0, 2 * np.pi, spacing or r / 8)[:-1]
     shell = [[0, 0], [w, 0], [w, h], [0, h]]
-    return Domain([(shell, [ring[::-1]])], cracks=cracks)
+    names = {**_sides(0.0, 0.0, w, h), "hole0": np.concatenate([ring, ring[:1]])}
+    return Domain([(shell, [ring[::-1]])], cracks=cracks, boundaries=names)
 
 
 def annulus(radii: Sequence[float], *, angles: Sequence[float] | None = None,
             center: ArrayLike = (0.0, 0.0), spacing: float | None = None,
             segments: int | None = None, cracks: Sequence[ArrayLike] = ()) -> Domain:
-    """Concentric annular regions (a multi-material cylinder section).
+    """Concentric annular regions (a multi-material cylinder section); boundaries named
+    ``inner`` and ``outer`` (the first and last radius), for a sector also ``start`` and
+    ``stop`` (its straight sides).
 
     Parameters
     ----------
@@ -117,7 +140,7 @@ def annulus(radii: Sequence[float], *, angles: Sequence[float] | None = None,
     if radii.ndim != 1 or len(radii) < 2 or radii[0] <= 0 or (np.diff(radii) <= 0).any():
         raise GeometryError(f"radii must be >= 2 positive increasing numbers, received {radii}")
     spacing = spacing or (radii[-1] - radii[0]) / 10
-    regions = []
+    regions, names = [], {}
     for r_in, r_out in zip(radii[:-1], radii[1:]):
         if angles is None:
             outer = arc(center, r_out, 0, 2 * np.pi, spacing, pieces=segments)[:-1]
@@ -131,13 +154,22 @@ def annulus(radii: Sequence[float], *, angles: Sequence[float] | None = None,
             outer = arc(center, r_out, a0, a1, spacing, pieces=segments)
             inner = arc(center, r_in, a0, a1, spacing, pieces=segments)[::-1]
             regions.append(np.concatenate([outer, inner]))
-    return Domain(regions, cracks=cracks)
+            names.setdefault("start", []).append(np.array([inner[-1], outer[0]]))
+            names.setdefault("stop", []).append(np.array([outer[-1], inner[0]]))
+        if r_in == radii[0]:
+            names["inner"] = inner if angles is not None else np.concatenate([inner, inner[:1]])
+        if r_out == radii[-1]:
+            names["outer"] = outer if angles is not None else np.concatenate([outer, outer[:1]])
+    return Domain(regions, cracks=cracks, boundaries=names)
 
 
 def l_shape(size: float = 1.0, cut: float = 0.5, *, cracks: Sequence[ArrayLike] = ()) -> Domain:
-    """Square ``[0, size]^2`` without its top-right ``cut x cut`` corner."""
+    """Square ``[0, size]^2`` without its top-right ``cut x cut`` corner; boundaries
+    named ``left``, ``bottom``, ``right``, ``top`` and ``cut`` (the re-entrant sides)."""
     s, c = _positive("size", size), _positive("cut", cut)
     if c >= s:
         raise GeometryError(f"cut ({c}) must be smaller than size ({s})")
     shell = [[0, 0], [s, 0], [s, s - c], [s - c, s - c], [s - c, s], [0, s]]
-    return Domain([shell], cracks=cracks)
+    names = {"left": [[0, 0], [0, s]], "bottom": [[0, 0], [s, 0]], "right": [[s, 0], [s, s - c]],
+             "top": [[0, s], [s - c, s]], "cut": [[s, s - c], [s - c, s - c], [s - c, s]]}
+    return Domain([shell], cracks=cracks, boundaries=names)

@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
     from .behaviour import BondBehaviour, CPDBehaviour, StateBehaviour
+    from ..geometry.domain import Domain
     from .body import Body
     from .cpd import CPD, Interactions
     from .materials import BondBased, StateBased
@@ -275,6 +276,16 @@ class Problem(Conditions, VelocityConditions, Dynamics):
     def condition_points(self) -> np.ndarray:
         """``(n, d)`` the points that conditions refer to (``body.points``)."""
         return self.body.points
+
+    names_fix = ("build the body with Body.from_cloud(cloud), which keeps the domain, or "
+                 "select with a predicate, a mask or indices")
+
+    @property
+    def condition_domain(self) -> Domain | None:
+        """The domain of a body from a node cloud (`Body.from_cloud`), else None: its
+        named boundaries may be given as ``where``."""
+        model = getattr(self.body, "model", None)
+        return None if model is None else model.domain
 
     def add_traction(self, where: Callable[..., np.ndarray] | ArrayLike,
                      t: ArrayLike | Callable[..., np.ndarray]) -> None:

@@ -45,8 +45,9 @@ class VelocityConditions:
 
         Parameters
         ----------
-        where : callable ``(n, d) -> (n,) bool``, or a boolean mask / index array over
-            the points (``condition_points``)
+        where : str, callable ``(n, d) -> (n,) bool``, or a boolean mask / index array
+            over the points (``condition_points``); a str names a boundary of the body's
+            domain (`cnem.solvers.Conditions.named_nodes`)
         component : {0, ..., d - 1, None}
             ``None`` prescribes every component.
         value : float, or callable ``(p, d) -> (p,)`` (``(p, d)`` for every component)
@@ -54,7 +55,8 @@ class VelocityConditions:
         """
         self.velocities = self.velocities + (
             dirichlet_dofs(self.condition_points, where, component, value,
-                           where_to_look=self.points_name, what="add_velocity"),)
+                           where_to_look=self.points_name, what="add_velocity",
+                           named=getattr(self, "named_nodes", None)),)
 
     def prescribed_velocity(self) -> tuple[np.ndarray, np.ndarray]:
         """The dofs (``d * point + component``, sorted) with a prescribed velocity and

@@ -35,8 +35,8 @@ if TYPE_CHECKING:
 
 __all__ = ["Conditions", "select_nodes", "vector_constant", "Traction", "per_point", "traction_at", "dirichlet_dofs", "merged_conditions"]
 
-#: What `where` may be: a predicate over points, a boolean mask or indices.
-Where = Union[Callable[[np.ndarray], np.ndarray], np.ndarray, list]
+#: What `where` may be: a boundary name, a predicate over points, a boolean mask or indices.
+Where = Union[str, Callable[[np.ndarray], np.ndarray], np.ndarray, list]
 
 
 def _call_where(where: Callable[..., np.ndarray], *args: np.ndarray) -> np.ndarray:
@@ -56,13 +56,18 @@ def _call_where(where: Callable[..., np.ndarray], *args: np.ndarray) -> np.ndarr
     return where(*args)
 
 
-def select_nodes(nodes: np.ndarray, where: Callable[..., np.ndarray] | ArrayLike) -> np.ndarray:
-    """Indices of the nodes picked by a predicate, a boolean mask or an index array.
+def select_nodes(nodes: np.ndarray, where: str | Callable[..., np.ndarray] | ArrayLike, *,
+                 named: Callable[[str], np.ndarray] | None = None) -> np.ndarray:
+    """Indices of the nodes picked by a boundary name, a predicate, a boolean mask or an
+    index array.
 
     Parameters
     ----------
     nodes : (n, 2) ndarray
-    where : callable ``(p, 2) -> (p,) bool``, (n,) bool array_like, or int array_like
+    where : str, callable ``(p, 2) -> (p,) bool``, (n,) bool array_like, or int array_like
+    named : callable ``name -> (k,) int ndarray``, optional
+        The nodes on a named boundary (`Conditions.named_nodes`); without it a name is
+        refused.
 
     Returns
     -------
@@ -70,6 +75,11 @@ def select_nodes(nodes: np.ndarray, where: Callable[..., np.ndarray] | ArrayLike
     """
     nodes = check_points("nodes", nodes, error=ConditionError)
     n = len(nodes)
+    if isinstance(where, str):
+        if named is None:
+            raise ConditionError(f"where={where!r}: boundary names need a problem on a domain; "
+                                 "select the nodes with a predicate, a mask or indices")
+        return np.unique(np.asarray(named(where), dtype=np.int64))
     if callable(where):
         mask = np.asarray(_call_where(where, nodes))
         if mask.shape != (n,) or mask.dtype != bool:
@@ -169,14 +179,15 @@ def traction_at(t: ArrayLike | Callable[..., np.ndarray], points: np.ndarray, no
 
 def dirichlet_dofs(points: np.ndarray, where: Where, component: int | None,
                    value: float | Callable[..., np.ndarray], *,
-                   where_to_look: str = "the nodes",
-                   what: str = "add_dirichlet") -> tuple[np.ndarray, np.ndarray]:
+                   where_to_look: str = "the nodes", what: str = "add_dirichlet",
+                   named: Callable[[str], np.ndarray] | None = None
+                   ) -> tuple[np.ndarray, np.ndarray]:
     """Dofs (interleaved: ``d * node + component``) and values of a Dirichlet condition.
 
     Parameters
     ----------
     points : (n, d) ndarray
-    where : callable ``(n, d) -> (n,) bool``, or a boolean mask / index array over points
+    where : str, callable ``(n, d) -> (n,) bool``, or a boolean mask / index array over points
     component : None or 0..d-1
         ``None`` prescribes every component.
     value : float or callable ``(p, d) -> (p,)`` (``(p, d)`` for every component)
@@ -184,6 +195,8 @@ def dirichlet_dofs(points: np.ndarray, where: Where, component: int | None,
         Named in the error when nothing is selected.
     what : str
         The method named in the errors.
+    named : callable ``name -> (k,) int ndarray``, optional
+        The points on a named boundary (see `select_nodes`).
 
     Returns
     -------
@@ -194,7 +207,7 @@ def dirichlet_dofs(points: np.ndarray, where: Where, component: int | None,
     if component is not None and component not in range(d):
         raise ConditionError(f"component: expected None (all) or 0..{d - 1}, received "
                              f"{component!r}")
-    nodes = select_nodes(points, where)
+    nodes = select_nodes(points, where, named=named)
     if nodes.size == 0:
         raise ConditionError(f"{what}: `where` selects no node; check the predicate against "
                          f"{where_to_look} (boundary nodes lie exactly on the boundary)")
@@ -233,7 +246,10 @@ class Conditions:
     * ``condition_points`` : ``(n, d)`` ndarray, the nodes (points) that
       Dirichlet predicates, masks and indices refer to;
     * ``boundary_edges()`` -> ``edges (e, 2)``, ``normal (e, 2)`` (node pairs with
-      the body on the left, outward unit normals) if it takes tractions.
+      the body on the left, outward unit normals) if it takes tractions;
+    * ``condition_domain``: the domain (`cnem.Domain`, or any object with
+      ``on_boundary(points, name)`` and ``boundaries``) whose named boundaries ``where``
+      may name, if it has one.
 
     Attributes
     ----------
@@ -248,6 +264,11 @@ class Conditions:
     points_name = "the nodes"
     #: What the error of a traction predicate that selects nothing calls the edges.
     edges_name = "boundary edge"
+
+    #: The domain whose boundary names `where` may give (None: names are refused).
+    condition_domain = None
+    #: How to do without names, said when a problem has no `condition_domain`.
+    names_fix = "select with a predicate, a mask or indices"
 
     def __init__(self):
         self.dirichlet = []
@@ -268,14 +289,55 @@ class Conditions:
 
         Parameters
         ----------
-        where : callable ``(n, d) -> (n,) bool``, or a boolean mask / index array over
+        where : str, callable ``(n, d) -> (n,) bool``, or a boolean mask / index array over
             the nodes (``condition_points``)
+            A str names a boundary of the domain (``condition_domain.boundaries``): the
+            nodes on it, between its vertices too.
         component : {0, ..., d - 1, None}
             ``None`` prescribes every component.
         value : float, or callable ``(p, d) -> (p,)`` (``(p, d)`` for every component)
         """
         self.dirichlet.append(dirichlet_dofs(self.condition_points, where, component, value,
-                                             where_to_look=self.points_name))
+                                             where_to_look=self.points_name,
+                                             named=self.named_nodes))
+
+    def _named_domain(self, name: str):
+        """The domain whose boundary ``name`` is meant (refused without one)."""
+        if self.condition_domain is None:
+            raise ConditionError(f"where={name!r}: {type(self).__name__} knows no domain, so "
+                                 f"it has no named boundaries; {self.names_fix}")
+        return self.condition_domain
+
+    def named_nodes(self, name: str) -> np.ndarray:
+        """The condition points on the boundary named ``name``.
+
+        Returns
+        -------
+        (k,) int64 ndarray
+
+        Raises
+        ------
+        ConditionError
+            An unknown name (the error lists the known ones), or a problem without a
+            domain.
+        """
+        domain = self._named_domain(name)
+        return np.flatnonzero(domain.on_boundary(self.condition_points, name))
+
+    def named_facets(self, name: str) -> np.ndarray:
+        """Which of ``boundary_edges()`` lie on the boundary named ``name`` (their nodes
+        and their midpoint on it).
+
+        Returns
+        -------
+        (e,) bool ndarray
+        """
+        domain = self._named_domain(name)
+        edges, _ = self.boundary_edges()
+        corners = self.condition_points[edges]                     # (e, k, d)
+        on = domain.on_boundary(corners.reshape(-1, corners.shape[2]), name)
+        return on.reshape(len(edges), -1).all(axis=1) & domain.on_boundary(corners.mean(axis=1),
+                                                                          name)
 
     def boundary_edges(self) -> tuple[np.ndarray, np.ndarray]:
         """Edges of the outer boundary, holes and crack faces.
@@ -295,9 +357,10 @@ class Conditions:
 
         Parameters
         ----------
-        where : callable ``(x, nrm) -> (e,) bool``, or an ``(e,)`` bool mask
-            Midpoints ``(e, 2)`` and outward unit normals ``(e, 2)`` of the edges
-            of ``boundary_edges()``.
+        where : str, callable ``(x, nrm) -> (e,) bool``, or an ``(e,)`` bool mask
+            A boundary name (``condition_domain.boundaries``: the edges on it, see
+            `named_facets`), or a predicate of the midpoints ``(e, 2)`` and outward
+            unit normals ``(e, 2)`` of the edges of ``boundary_edges()``.
         t : (2,) array_like, or callable ``(x, nrm) -> (q, 2)``
             Traction vectors at boundary points ``x (q, 2)`` with normals
             ``nrm (q, 2)``; each solver integrates them exactly up to quadratic
@@ -311,8 +374,11 @@ class Conditions:
                             f"along the outward normal as lambda x, nrm: -p * nrm")
         edges, normal = self.boundary_edges()
         mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
-        pick = np.asarray(_call_where(where, mid, normal)) if callable(where) else \
-            np.asarray(where)
+        if isinstance(where, str):
+            pick = self.named_facets(where)
+        else:
+            pick = np.asarray(_call_where(where, mid, normal)) if callable(where) else \
+                np.asarray(where)
         if pick.shape != (len(edges),) or pick.dtype != bool:
             raise ConditionError(f"add_traction: where(x, nrm) must return a ({len(edges)},) bool "
                                  f"array, received dtype {pick.dtype} shape {pick.shape}")
