@@ -1,5 +1,7 @@
 """Node clouds on a `Domain`: regular, irregular, graded, or the user's own points.
 
+On a `Domain3D` the same functions build 3-D clouds (`cnem.geometry.nodes3d`).
+
 Every polygon corner, interface vertex and crack vertex is a node; the generated
 clouds put nodes about one local spacing apart along every boundary, interface
 and crack edge (and at least one inside a crack edge between two tips, so that
@@ -22,54 +24,20 @@ from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from .. import config
-from ..errors import GeometryError, LimitError, check_array, check_count, check_real
+from ..errors import GeometryError, LimitError, check_array, check_real
+from . import nodes3d
 from .cloud import NodeCloud
+from .domain3d import Domain3D
 from .pslg import SegmentKind, segment_projection
+from .spacing import check_node_count as _check_count
+from .spacing import check_seed as _check_seed
+from .spacing import check_spacing as _check_spacing
+from .spacing import point_spacing as _point_spacing
 
 if TYPE_CHECKING:
     from .domain import Domain
 
 __all__ = ["regular", "irregular", "graded", "from_points", "NodeCloud"]
-
-def _check_seed(seed):
-    """``seed`` for `numpy.random.default_rng` once it is a whole number >= 0 (or None)."""
-    if seed is None:
-        return None
-    return check_count("seed", seed, minimum=0, error=GeometryError)
-
-
-def _check_spacing(dom, h, name="h"):
-    if np.ndim(h) != 0:
-        raise GeometryError(f"{name}: expected one spacing (a number), received an array of "
-                            f"shape {np.shape(h)}; for spacings that vary use graded(...)")
-    h = float(check_array(name, h, error=GeometryError, finite=False,
-                          fix="pass the node spacing as a number, e.g. 0.1"))
-    if not np.isfinite(h) or h <= 0:
-        raise GeometryError(f"{name} must be a positive spacing, received {h!r}")
-    if h >= dom.diameter:
-        raise GeometryError(f"{name} = {h:g} is not smaller than the domain diameter "
-                            f"{dom.diameter:g}; choose a spacing that fits several nodes")
-    # ten snapping tolerances: the tolerance grows with the coordinates' round-off far
-    # from the origin (a body 1 across at 1e8 resolves no spacing below ~4e-6)
-    smallest = max(config.MIN_SPACING * dom.diameter, 10 * dom.tolerance)
-    if h < smallest:
-        raise GeometryError(
-            f"{name} = {h:g} is below the smallest spacing this domain resolves, {smallest:.3g} "
-            f"(cnem.config.MIN_SPACING = {config.MIN_SPACING:g} times the diameter "
-            f"{dom.diameter:.3g}, or ten snapping tolerances {dom.tolerance:.3g}, which far "
-            f"from the origin cover the coordinates' round-off; nodes closer are within a few "
-            f"tolerances of each other); expected {name} >= {smallest:.3g}, or coordinates "
-            f"nearer the origin")
-    return h
-
-
-def _check_count(estimate, what, fix):
-    """Refuse a cloud of more than `cnem.config.MAX_NODES` nodes before building it."""
-    if estimate > config.MAX_NODES:
-        raise LimitError(f"{what} would need ~{estimate:.3g} nodes, more than "
-                         f"cnem.config.MAX_NODES = {config.MAX_NODES:g}; expected {fix} "
-                         "(or raise cnem.config.MAX_NODES)")
-
 
 def _uniform_count(dom, h):
     """Nodes of a cloud of spacing ``h``: the area over h^2 and the PSLG's length over h."""
@@ -222,7 +190,7 @@ def regular(domain: Domain, h: float) -> NodeCloud:
 
     Parameters
     ----------
-    domain : Domain
+    domain : Domain or Domain3D
     h : float
         Node spacing, ``0 < h < domain.diameter``.
 
@@ -230,6 +198,8 @@ def regular(domain: Domain, h: float) -> NodeCloud:
     -------
     NodeCloud
     """
+    if isinstance(domain, Domain3D):
+        return nodes3d.regular(domain, h)
     h = _check_spacing(domain, h)
     _check_uniform_count(domain, h, "regular")
     spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
@@ -248,6 +218,8 @@ def irregular(domain: Domain, h: float, *, seed: int = 0) -> NodeCloud:
     -------
     NodeCloud
     """
+    if isinstance(domain, Domain3D):
+        return nodes3d.irregular(domain, h, seed=seed)
     h = _check_spacing(domain, h)
     _check_uniform_count(domain, h, "irregular")
     rng = np.random.default_rng(_check_seed(seed))
@@ -339,16 +311,6 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
 
 
-def _point_spacing(pts):
-    """(p,) local spacing at each point: the mean distance to its
-    `cnem.config.SPACING_NEIGHBOURS` nearest others (``inf`` for a lone point); a
-    single nearest neighbour is too noisy a measure on irregular clouds."""
-    k = min(config.SPACING_NEIGHBOURS, len(pts) - 1)
-    if k < 1:
-        return np.full(len(pts), np.inf)
-    return cKDTree(pts).query(pts, k=k + 1)[0][:, 1:].mean(axis=1)
-
-
 def _fill_edges(domain, pts, seg_of, user_spacing, fill):
     """Nodes along the gaps of each PSLG edge longer than `cnem.config.FILL_SPACINGS`
     local spacings (at each place, the `_point_spacing` of the user's point nearest
@@ -417,8 +379,8 @@ def from_points(domain: Domain, points: ArrayLike, *, fill: bool = True) -> Node
 
     Parameters
     ----------
-    domain : Domain
-    points : (p, 2) array_like
+    domain : Domain or Domain3D
+    points : (p, 2) array_like (``(p, 3)`` on a `Domain3D`)
     fill : bool
         Fill long gaps along the edges with nodes (else raise).
 
@@ -435,6 +397,8 @@ def from_points(domain: Domain, points: ArrayLike, *, fill: bool = True) -> Node
         with ``fill=False``, an edge gap longer than `cnem.config.FILL_SPACINGS`
         local spacings.
     """
+    if isinstance(domain, Domain3D):
+        return nodes3d.from_points(domain, points, fill=fill)
     pts = np.array(check_real("points", points, error=GeometryError), dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise GeometryError(f"points: expected a (p, 2) array, received shape {pts.shape}")
