@@ -277,7 +277,6 @@ class Domain3D:
         if self.n_regions == 1:
             return
         tol = self.tolerance / self.size
-        check_self_intersections(self._local, self.faces, tol, self._face_names)
         tri = self._local[self.faces]
         centroids = tri.mean(axis=1)
         for r in range(self.n_regions):
@@ -301,6 +300,7 @@ class Domain3D:
                 raise GeometryError(
                     f"regions overlap: {self._face_names[k]} lies inside region {r}; regions "
                     "must only share boundaries: subtract one from the other")
+        check_self_intersections(self._local, self.faces, tol, self._face_names)
 
     # --------------------------------------------------------------- public API
     @classmethod

@@ -147,8 +147,9 @@ def from_points(domain: Domain3D, points: ArrayLike, *, fill: bool = True) -> No
     Points within ``domain.tolerance`` of the surface are snapped onto it (onto a vertex,
     then a feature edge, then a face). Every input vertex is a node; with ``fill=True``
     (the default) the feature edges and the surface patches get nodes at the user's
-    median spacing (the mean distance to the `cnem.config.SPACING_NEIGHBOURS` nearest
-    others) wherever the user's points leave more than half of it free.
+    median spacing ``s`` (the mean distance to the `cnem.config.SPACING_NEIGHBOURS` nearest
+    others) where no user's point lies within ``cnem.config.FILL_SPACINGS / 2 * s`` (gaps
+    wider than `cnem.config.FILL_SPACINGS` spacings are filled, as along the 2-D edges).
 
     Parameters
     ----------
@@ -189,7 +190,8 @@ def from_points(domain: Domain3D, points: ArrayLike, *, fill: bool = True) -> No
     h = float(np.median(finite)) if len(finite) else 0.1 * domain.size
     pin = np.flatnonzero((edge >= 0) | (patch >= 0))
     surface = sample_surface(domain, h / domain.size, None,
-                             (snapped[pin], edge[pin], t[pin], patch[pin]), fill)
+                             (snapped[pin], edge[pin], t[pin], patch[pin]), fill,
+                             0.5 * config.FILL_SPACINGS * h / domain.size)
     nodes, faces, regions, segments, kinds = surface
     k, q = len(domain.vertices), len(pin)
     vertex_node = np.full(k, -1)

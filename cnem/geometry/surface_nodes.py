@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 import triangle
+from scipy.spatial import cKDTree
 
 from .. import config
 from ..errors import GeometryError
@@ -95,9 +96,9 @@ def surface_patches(vertices, faces, face_regions, tol):
     return patch, edges, face_edge, border
 
 
-def _edge_nodes(vertices, edges, h, rng, pinned_t, pinned_edge):
+def _edge_nodes(vertices, edges, h, rng, pinned_t, pinned_edge, pin_clearance):
     """Nodes along the border edges: ``(t, edge)`` of the generated ones (``pinned`` ones
-    are kept, generated ones closer than half a spacing to them dropped)."""
+    are kept, generated ones closer than ``pin_clearance`` to them dropped)."""
     length = np.linalg.norm(vertices[edges[:, 1]] - vertices[edges[:, 0]], axis=1)
     pieces = np.maximum(1, np.rint(length / h)).astype(np.int64)
     edge = np.repeat(np.arange(len(edges)), pieces - 1)
@@ -115,7 +116,7 @@ def _edge_nodes(vertices, edges, h, rng, pinned_t, pinned_edge):
         for k in range(int((hi - lo).max(initial=0))):       # bounded by the pins per edge
             has = lo + k < hi
             idx = np.minimum(lo + k, len(pt) - 1)
-            near |= has & (np.abs(pt[idx] - t) * length[edge] < config.CLEARANCE * h)
+            near |= has & (np.abs(pt[idx] - t) * length[edge] < pin_clearance)
         t, edge = t[~near], edge[~near]
     return t, edge
 
@@ -139,7 +140,7 @@ def _lattice2d(lo, hi, h, rng):
     return grid
 
 
-def _triangulate_patch(points, normal, patch_faces, segs, inner, h, rng, tol):
+def _triangulate_patch(points, normal, patch_faces, segs, inner, h, rng, pin_clearance):
     """Triangles of one planar patch.
 
     Parameters
@@ -153,6 +154,11 @@ def _triangulate_patch(points, normal, patch_faces, segs, inner, h, rng, tol):
         Border pieces (node pairs).
     inner : (q,) int ndarray
         Nodes that lie inside the patch already (the user's points).
+    h : float or None
+        Spacing of the patch's lattice (None: no lattice).
+    rng : numpy.random.Generator or None
+    pin_clearance : float
+        Lattice points closer than this to an inner node are dropped.
 
     Returns
     -------
@@ -162,6 +168,8 @@ def _triangulate_patch(points, normal, patch_faces, segs, inner, h, rng, tol):
         New nodes (lattice points, and any point ``triangle`` had to add).
     """
     origin, u, v = _patch_frame(points, normal, segs)
+    # the patch's own vertices off its border (a fan's centre) are nodes inside it too
+    inner = np.setdiff1d(np.concatenate([inner, patch_faces.ravel()]), segs.ravel())
     ids = np.unique(np.concatenate([segs.ravel(), inner]))
     xy = np.column_stack([(points[ids] - origin) @ u, (points[ids] - origin) @ v])
     tri2d = np.stack([np.column_stack([(points[f] - origin) @ u, (points[f] - origin) @ v])
@@ -176,9 +184,7 @@ def _triangulate_patch(points, normal, patch_faces, segs, inner, h, rng, tol):
         clear = config.CLEARANCE * h * (1 - 1e-9)
         near = shapely.dwithin(region.boundary, shapely.points(lattice), clear)
         if len(inner) and len(lattice):
-            from scipy.spatial import cKDTree
-
-            near |= cKDTree(xy[np.searchsorted(ids, inner)]).query(lattice)[0] < clear
+            near |= cKDTree(xy[np.searchsorted(ids, inner)]).query(lattice)[0] < pin_clearance
         lattice = lattice[~near]
     local = np.full(len(points), -1)
     local[ids] = np.arange(len(ids))
@@ -194,7 +200,7 @@ def _triangulate_patch(points, normal, patch_faces, segs, inner, h, rng, tol):
     return number[tris], new
 
 
-def sample_surface(dom, h, rng=None, pinned=None, fill=True):
+def sample_surface(dom, h, rng=None, pinned=None, fill=True, pin_clearance=None):
     """Surface nodes of a domain about ``h`` apart, and their triangulation.
 
     Parameters
@@ -210,6 +216,9 @@ def sample_surface(dom, h, rng=None, pinned=None, fill=True):
         patch ``patch`` (-1 if not). Generated nodes keep half a spacing from them.
     fill : bool
         Generate nodes (else only the vertices and the pinned points).
+    pin_clearance : float, optional
+        Generated nodes closer than this to a pinned point (or a vertex inside a patch)
+        are dropped; by default `cnem.config.CLEARANCE` times ``h``.
 
     Returns
     -------
@@ -230,10 +239,13 @@ def sample_surface(dom, h, rng=None, pinned=None, fill=True):
     if pinned is None:
         pinned = (np.empty((0, 3)), np.empty(0, np.int64), np.empty(0), np.empty(0, np.int64))
     ppts, pedge, pt, ppatch = pinned
+    if pin_clearance is None:
+        pin_clearance = config.CLEARANCE * h
     on_edge = pedge >= 0
     local_edge = np.full(len(edges), -1)
     local_edge[bedges] = np.arange(len(bedges))
-    t, e = _edge_nodes(vertices, edges[bedges], h, rng, pt[on_edge], local_edge[pedge[on_edge]])
+    t, e = _edge_nodes(vertices, edges[bedges], h, rng, pt[on_edge], local_edge[pedge[on_edge]],
+                       pin_clearance)
     if not fill:
         t, e = t[:0], e[:0]
     a, b = vertices[edges[bedges[e], 0]], vertices[edges[bedges[e], 1]]
@@ -281,7 +293,7 @@ def sample_surface(dom, h, rng=None, pinned=None, fill=True):
         inner = len(vertices) + inner_of[inner_start[p]:inner_start[p + 1]]
         tris, new = _triangulate_patch(np.concatenate([nodes] + new_nodes), n / np.linalg.norm(n),
                                        dom.faces[mine], np.concatenate(pieces), inner,
-                                       h if fill else None, rng, tol)
+                                       h if fill else None, rng, pin_clearance)
         faces_out.append(tris)
         regions_out.append(np.repeat(dom.face_regions[mine[:1]], len(tris), axis=0))
         new_nodes.append(new)
