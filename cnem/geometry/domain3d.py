@@ -136,7 +136,7 @@ class Domain3D:
 
     dim = 3
 
-    def __init__(self, regions) -> None:
+    def __init__(self, regions: object) -> None:
         if isinstance(regions, Domain3D):
             regions = [(regions.vertices, regions.faces[regions.face_regions[:, 0] == r])
                        for r in range(regions.n_regions)]

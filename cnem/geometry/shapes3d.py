@@ -1,7 +1,7 @@
 """Built-in 3-D bodies: box, sphere, hollow sphere, cylinder.
 
 >>> from cnem.geometry import box, cylinder
->>> box((0, 0, 0), (1, 2, 3)).volume
+>>> round(box((0, 0, 0), (1, 2, 3)).volume, 12)
 6.0
 >>> len(cylinder(1.0, 2.0, segments=8).faces)
 32

@@ -18,14 +18,14 @@ from ..errors import GeometryError, LimitError, check_array, check_count
 __all__ = ["check_seed", "check_spacing", "check_node_count", "point_spacing"]
 
 
-def check_seed(seed):
+def check_seed(seed: int | None) -> int | None:
     """``seed`` for `numpy.random.default_rng` once it is a whole number >= 0 (or None)."""
     if seed is None:
         return None
     return check_count("seed", seed, minimum=0, error=GeometryError)
 
 
-def check_spacing(dom, h, name="h"):
+def check_spacing(dom: object, h: float, name: str = "h") -> float:
     """``h`` as a float once it is one positive spacing smaller than ``dom.diameter`` and
     above the smallest spacing the domain resolves (``dom.tolerance``)."""
     if np.ndim(h) != 0:
@@ -52,7 +52,7 @@ def check_spacing(dom, h, name="h"):
     return h
 
 
-def check_node_count(estimate, what, fix):
+def check_node_count(estimate: float, what: str, fix: str) -> None:
     """Refuse a cloud of more than `cnem.config.MAX_NODES` nodes before building it."""
     if estimate > config.MAX_NODES:
         raise LimitError(f"{what} would need ~{estimate:.3g} nodes, more than "
@@ -60,7 +60,7 @@ def check_node_count(estimate, what, fix):
                          "(or raise cnem.config.MAX_NODES)")
 
 
-def point_spacing(pts):
+def point_spacing(pts: np.ndarray) -> np.ndarray:
     """(p,) local spacing at each point: the mean distance to its
     `cnem.config.SPACING_NEIGHBOURS` nearest others (``inf`` for a lone point); a
     single nearest neighbour is too noisy a measure on irregular clouds."""

@@ -17,6 +17,8 @@ so that the triangles tile every input face exactly.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import shapely
 import triangle
@@ -26,6 +28,9 @@ from .. import config
 from ..errors import GeometryError
 from .pslg import SegmentKind
 from .surface_checks import edge_table
+
+if TYPE_CHECKING:
+    from .domain3d import Domain3D
 
 __all__ = ["surface_patches", "sample_surface"]
 
@@ -41,7 +46,8 @@ def _unit_normals(vertices, faces):
     return n / np.linalg.norm(n, axis=1)[:, None], 0.5 * np.linalg.norm(n, axis=1)
 
 
-def surface_patches(vertices, faces, face_regions, tol):
+def surface_patches(vertices: np.ndarray, faces: np.ndarray, face_regions: np.ndarray,
+                    tol: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Planar patches of a surface.
 
     Parameters
@@ -200,7 +206,9 @@ def _triangulate_patch(points, normal, patch_faces, segs, inner, h, rng, pin_cle
     return number[tris], new
 
 
-def sample_surface(dom, h, rng=None, pinned=None, fill=True, pin_clearance=None):
+def sample_surface(dom: Domain3D, h: float, rng: np.random.Generator | None = None,
+                   pinned: tuple | None = None, fill: bool = True,
+                   pin_clearance: float | None = None) -> tuple[np.ndarray, ...]:
     """Surface nodes of a domain about ``h`` apart, and their triangulation.
 
     Parameters

@@ -39,7 +39,7 @@ def _segment_distance(p, a, b):
     return np.linalg.norm(p - a - t[:, None] * ab, axis=1)
 
 
-def triangle_distance(p, a, b, c):
+def triangle_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     """Distance from points to triangles, pairwise.
 
     Parameters
@@ -66,7 +66,9 @@ def triangle_distance(p, a, b, c):
     return np.where(inside, np.abs(height) * np.sqrt(nn), out)
 
 
-def faces_within(points, vertices, faces, radius, tree=None):
+def faces_within(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
+                 radius: float | np.ndarray,
+                 tree: RTree | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Point-face pairs closer than ``radius``.
 
     Parameters
@@ -95,13 +97,13 @@ def faces_within(points, vertices, faces, radius, tree=None):
     return point[keep], cand[keep], dist[keep]
 
 
-def face_tree(vertices, faces, dims=3):
+def face_tree(vertices: np.ndarray, faces: np.ndarray, dims: int = 3) -> RTree:
     """`RTree` over the faces' bounding boxes (the first ``dims`` coordinates)."""
     tri = vertices[faces][:, :, :dims]
     return RTree(tri.min(axis=1), tri.max(axis=1))
 
 
-def region_weights(face_regions, n_regions):
+def region_weights(face_regions: np.ndarray, n_regions: int) -> np.ndarray:
     """(f, r) matrix: +1 for the region a face points out of, -1 for the one on its
     other side (none for the outside, -1)."""
     w = np.zeros((len(face_regions), n_regions))
@@ -112,7 +114,8 @@ def region_weights(face_regions, n_regions):
     return w
 
 
-def solid_angle_winding(points, vertices, faces, weights=None):
+def solid_angle_winding(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
+                        weights: np.ndarray | None = None) -> np.ndarray:
     """Generalised winding numbers: the solid angles of the faces seen from each point
     over 4 pi (van Oosterom and Strackee's formula).
 
@@ -177,7 +180,8 @@ def _edge_signs(pxy, u, w, iu, iw):
     return (np.where(flip, -sign, sign)).astype(np.int8), certain
 
 
-def region_winding(points, vertices, faces, weights, xy_tree=None):
+def region_winding(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
+                   weights: np.ndarray, xy_tree: RTree | None = None) -> np.ndarray:
     """Winding numbers per region by a ray cast upwards (+z) from each point.
 
     Each face that the ray crosses adds its region weights with the sign of its normal's
