@@ -16,7 +16,9 @@ from cnem.geometry.surface_nodes import surface_patches
 from cnem.geometry.surface_queries import faces_within
 
 KINDS = {"regular": lambda d, h: cnem.nodes.regular(d, h),
-         "irregular": lambda d, h: cnem.nodes.irregular(d, h, seed=4)}
+         "irregular": lambda d, h: cnem.nodes.irregular(d, h, seed=4),
+         "graded": lambda d, h: cnem.nodes.graded(d, h, near=d.vertices[:1], h_min=h / 4,
+                                                  growth=0.5, seed=3)}
 
 
 def two_boxes():
@@ -92,7 +94,7 @@ def test_boundary_triangles_close_each_region(case):
         assert volume == pytest.approx(dom.region_volumes[r], rel=1e-12)
 
 
-def test_every_node_of_a_boundary_triangle_and_interior_clearance(case):
+def test_surface_and_interior_nodes(case):
     dom, h, cloud = case
     on_surface = np.zeros(len(cloud.points), dtype=bool)
     on_surface[cloud.boundary_faces.ravel()] = True
@@ -100,16 +102,37 @@ def test_every_node_of_a_boundary_triangle_and_interior_clearance(case):
     assert dom.near_surface(cloud.points[on_surface], 10 * dom.tolerance).all()
     inner = cloud.points[~on_surface]
     assert (dom.region_of(inner) >= 0).all()
-    assert not dom.near_surface(inner, 0.5 * h * (1 - 1e-6)).any()
+    assert not dom.near_surface(inner, 0.5 * cloud.spacing[~on_surface] * (1 - 1e-6)).any()
+    assert (cloud.spacing <= h).all()
 
 
 def test_spacing(case):
     dom, h, cloud = case
     d = cKDTree(cloud.points).query(cloud.points, k=2)[0][:, 1]
-    assert d.min() > 0.1 * h
+    assert (d > 0.1 * cloud.spacing).all()
+    if cloud.spacing.min() < h:                       # graded: see test_graded_spacing
+        return
     assert np.median(d) == pytest.approx(h, rel=0.35)
     # the nodes' count is about volume / h^3 and the surface's nodes about area / h^2
     assert 0.5 < len(cloud.points) / (dom.volume / h**3 + dom.area / h**2) < 2.5
+
+
+def test_graded_spacing():
+    dom = box()
+    centre = np.array([0.5, 0.5, 1.0])
+    cloud = cnem.nodes.graded(dom, 0.2, near=centre, h_min=0.02, growth=0.4)
+    law = np.minimum(0.2, 0.02 + 0.4 * np.linalg.norm(cloud.points - centre, axis=1))
+    assert np.allclose(cloud.spacing, law)
+    d = cKDTree(cloud.points).query(cloud.points, k=2)[0][:, 1]
+    near = np.linalg.norm(cloud.points - centre, axis=1) < 0.1
+    far = np.linalg.norm(cloud.points - centre, axis=1) > 0.6
+    # nodes near the centre are several times closer than far from it, about s(x) apart
+    assert np.median(d[near]) < 0.3 * np.median(d[far])
+    assert 0.4 < np.median(d / law) < 1.5
+    with pytest.raises(GeometryError, match=r"near: expected refinement points \(q, 3\)"):
+        cnem.nodes.graded(dom, 0.2, near=[[0.5, 0.5]], h_min=0.02)
+    with pytest.raises(GeometryError, match="must not exceed"):
+        cnem.nodes.graded(dom, 0.2, near=centre, h_min=0.3)
 
 
 def test_interface_nodes_are_shared():
@@ -120,7 +143,6 @@ def test_interface_nodes_are_shared():
     interface = cloud.boundary_face_regions[:, 1] >= 0
     assert (cloud.boundary_face_regions[interface] == [0, 1]).all()
     assert np.isclose(cloud.points[cloud.boundary_faces[interface]][..., 0], 1.0).all()
-    assert "interface" not in repr(cloud) or True
 
 
 def test_irregular_is_reproducible_and_seeded():

@@ -24,12 +24,14 @@ from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from .. import config
-from ..errors import GeometryError, LimitError, check_array, check_real
+from ..errors import GeometryError, check_real
 from . import nodes3d
 from .cloud import NodeCloud
 from .domain3d import Domain3D
 from .pslg import SegmentKind, segment_projection
+from .spacing import check_grading
 from .spacing import check_node_count as _check_count
+from .spacing import count_along as _count_along
 from .spacing import check_seed as _check_seed
 from .spacing import check_spacing as _check_spacing
 from .spacing import point_spacing as _point_spacing
@@ -66,47 +68,6 @@ def _tip_to_tip(dom):
         return np.zeros(len(edges), dtype=bool)
     is_tip = cKDTree(dom.tips).query(v)[0] <= dom.tolerance
     return (kinds == SegmentKind.CRACK) & is_tip[edges[:, 0]] & is_tip[edges[:, 1]]
-
-
-def _count_along(pa, pb, spacing_of):
-    """Cumulative node count along segment ``pa-pb`` under the spacing law.
-
-    The density ``length / spacing_of(x)`` is integrated by the trapezoid rule
-    on 65 samples, each interval bisected again while its midpoint changes its
-    count by more than `cnem.config.SPACING_COUNT_TOL` nodes: a law that shrinks
-    to a tiny spacing at a tip is followed down to it (a fixed rule gave the
-    first 1/64 of the segment one uniform tiny spacing).
-
-    Returns
-    -------
-    t : (m,) ndarray
-        Increasing parameters in [0, 1].
-    cum : (m,) ndarray
-        Nodes expected between ``pa`` and ``pa + t (pb - pa)``.
-    """
-    length = np.linalg.norm(pb - pa)
-
-    def density(t):
-        return length / spacing_of(pa + t[:, None] * (pb - pa))
-
-    t = np.linspace(0.0, 1.0, 65)
-    dens = density(t)
-    for _ in range(config.SPACING_BISECTIONS):
-        mid = 0.5 * (t[1:] + t[:-1])
-        dmid = density(mid)
-        error = np.abs(dmid - 0.5 * (dens[1:] + dens[:-1])) * np.diff(t)
-        split = error > config.SPACING_COUNT_TOL
-        if not split.any():
-            break
-        t, dens = np.concatenate([t, mid[split]]), np.concatenate([dens, dmid[split]])
-        order = np.argsort(t, kind="stable")
-        t, dens = t[order], dens[order]
-    else:
-        raise LimitError(
-            f"the node spacing along the segment {pa.tolist()} - {pb.tolist()} is not resolved "
-            f"after {config.SPACING_BISECTIONS} bisections of its samples; expected a spacing "
-            "law that is bounded below by a positive h_min")
-    return t, np.concatenate([[0.0], np.cumsum(0.5 * (dens[1:] + dens[:-1]) * np.diff(t))])
 
 
 def _boundary_nodes(dom, spacing_of, jitter=None):
@@ -258,7 +219,10 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
 
     Parameters
     ----------
-    near : (q, 2) array_like
+    domain : Domain or Domain3D
+    h : float
+        Largest spacing.
+    near : (q, 2) array_like (``(q, 3)`` on a `Domain3D`)
         Refinement centres.
     h_min : float
         Spacing at the centres, ``0 < h_min <= h``.
@@ -271,20 +235,9 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
     -------
     NodeCloud
     """
-    h = _check_spacing(domain, h)
-    h_min = _check_spacing(domain, h_min, "h_min")
-    if h_min > h:
-        raise GeometryError(f"h_min ({h_min:g}) must not exceed h ({h:g})")
-    if not 0 < growth <= 1:
-        raise GeometryError(f"growth must lie in (0, 1], received {growth!r}")
-    centres = check_array("near", near, finite=True, error=GeometryError,
-                          fix="give the refinement points as a (q, 2) array, e.g. dom.tips")
-    if centres.size and (centres.ndim not in (1, 2) or centres.shape[-1] != 2):
-        raise GeometryError(f"near: expected refinement points (q, 2) or one point (2,), received "
-                            f"shape {centres.shape}; give e.g. dom.tips")
-    centres = centres.reshape(-1, 2)
-    if len(centres) == 0:
-        raise GeometryError("graded: `near` is empty; give at least one refinement point")
+    if isinstance(domain, Domain3D):
+        return nodes3d.graded(domain, h, near=near, h_min=h_min, growth=growth, seed=seed)
+    h, h_min, centres = check_grading(domain, h, h_min, growth, near, 2)
     _check_graded_count(domain, h, h_min, growth, centres)
     tree = cKDTree(centres)
 

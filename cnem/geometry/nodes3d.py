@@ -1,6 +1,6 @@
 """Node clouds on a `Domain3D`: regular, irregular, or the user's own points.
 
-`cnem.nodes.regular`, `irregular` and `from_points` call these for a 3-D domain.
+`cnem.nodes.regular`, `irregular`, `graded` and `from_points` call these for a 3-D domain.
 Every input vertex is a node; feature edges and planar patches of the surface get
 nodes about ``h`` apart (`cnem.geometry.surface_nodes`), the inside a cubic lattice
 kept half a spacing from the surface. The cloud carries the triangulation of its
@@ -23,11 +23,12 @@ from .. import config
 from ..errors import GeometryError, check_points, check_real
 from .cloud import NodeCloud
 from .domain3d import Domain3D
-from .spacing import check_node_count, check_seed, check_spacing, point_spacing
+from .spacing import (SpacingLaw, check_grading, check_node_count, check_seed, check_spacing,
+                      point_spacing)
 from .surface_nodes import sample_surface, surface_patches
 from .surface_queries import faces_within
 
-__all__ = ["regular", "irregular", "from_points"]
+__all__ = ["regular", "irregular", "graded", "from_points"]
 
 
 def _check_uniform_count(dom, h, caller):
@@ -36,20 +37,19 @@ def _check_uniform_count(dom, h, caller):
                      f"h >= {(dom.volume / config.MAX_NODES) ** (1 / 3):.3g}")
 
 
-def _interior(dom, h, rng):
-    """Lattice points (jittered with ``rng``) inside ``dom``, half a spacing from its
-    surface, in global coordinates."""
+def _interior(dom, law, offset, rng, jitter):
+    """Lattice points of ``law`` (local frame) inside ``dom``, each moved by up to
+    ``jitter`` times its spacing with ``rng``, kept half a spacing from the surface;
+    in global coordinates."""
     lo, hi = dom.local_vertices.min(axis=0), dom.local_vertices.max(axis=0)
-    hl = h / dom.size
-    offset = 0.0 if rng is None else 0.5 * hl
-    axes = [lo[k] + offset + hl * np.arange(int(np.ceil((hi[k] - lo[k]) / hl)) + 1)
-            for k in range(3)]
-    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    grid = law.lattice(lo, hi, offset=offset)
     if rng is not None:
-        grid = grid + rng.uniform(-0.35 * hl, 0.35 * hl, grid.shape)
+        grid = grid + rng.uniform(-jitter, jitter, grid.shape) * law(grid)[:, None]
     points = dom.to_global(grid)
-    points = points[~dom.near_surface(points, config.CLEARANCE * h * (1 - 1e-9))]
-    return points[dom.region_of(points) >= 0]
+    clear = config.CLEARANCE * law(grid) * dom.size * (1 - 1e-9)
+    inside = dom.region_of(points) >= 0
+    inside[inside] = ~dom.near_surface(points[inside], clear[inside])
+    return points[inside]
 
 
 def _assemble(dom, surface, interior, spacing):
@@ -77,8 +77,8 @@ def regular(domain: Domain3D, h: float) -> NodeCloud:
     """
     h = check_spacing(domain, h)
     _check_uniform_count(domain, h, "regular")
-    surface = sample_surface(domain, h / domain.size)
-    return _assemble(domain, surface, _interior(domain, h, None),
+    law = SpacingLaw(h / domain.size)
+    return _assemble(domain, sample_surface(domain, law), _interior(domain, law, 0.0, None, 0.0),
                      lambda x: np.full(len(x), h))
 
 
@@ -96,8 +96,50 @@ def irregular(domain: Domain3D, h: float, *, seed: int = 0) -> NodeCloud:
     h = check_spacing(domain, h)
     _check_uniform_count(domain, h, "irregular")
     rng = np.random.default_rng(check_seed(seed))
-    surface = sample_surface(domain, h / domain.size, rng)
-    return _assemble(domain, surface, _interior(domain, h, rng), lambda x: np.full(len(x), h))
+    law = SpacingLaw(h / domain.size)
+    surface = sample_surface(domain, law, rng)
+    return _assemble(domain, surface, _interior(domain, law, 0.5, rng, 0.35),
+                     lambda x: np.full(len(x), h))
+
+
+def graded(domain: Domain3D, h: float, *, near: ArrayLike, h_min: float, growth: float = 0.3,
+           seed: int | None = None) -> NodeCloud:
+    """Nodes whose spacing shrinks from ``h`` to ``h_min`` towards given points.
+
+    The local spacing is ``s(x) = min(h, h_min + growth * d(x))`` with ``d`` the distance
+    to the nearest point of ``near``: interior lattices of spacing ``h / 2^k`` where
+    ``s`` lies between ``h / 2^(k+1)`` and ``h / 2^k``, the feature edges and patches
+    sampled at ``s`` (as the 2-D `cnem.nodes.graded`).
+
+    Parameters
+    ----------
+    domain : Domain3D
+    h : float
+    near : (q, 3) array_like
+        Refinement centres.
+    h_min : float
+        Spacing at the centres, ``0 < h_min <= h``.
+    growth : float
+        Spacing increase per unit distance (0 < growth <= 1).
+    seed : int, optional
+        When given, interior nodes are perturbed by up to 0.25 s(x).
+
+    Returns
+    -------
+    NodeCloud
+    """
+    h, h_min, centres = check_grading(domain, h, h_min, growth, near, 3)
+    distinct = len(np.unique(centres, axis=0))
+    # the integral of 1 / s^3 over the ball where s < h, per centre
+    per_centre = 4 * np.pi / growth**3 * np.log(h / h_min)
+    check_node_count(domain.volume / h**3 + domain.area / h**2 + distinct * per_centre,
+                     f"graded with h = {h:g}, h_min = {h_min:g}, growth = {growth:g} around "
+                     f"{distinct} centres", "a larger h_min or growth, or fewer centres")
+    law = SpacingLaw(h / domain.size, h_min=h_min / domain.size, growth=growth,
+                     centres=domain.to_local(centres))
+    rng = None if seed is None else np.random.default_rng(check_seed(seed))
+    return _assemble(domain, sample_surface(domain, law), _interior(domain, law, 0.5, rng, 0.25),
+                     lambda x: law(domain.to_local(x)) * domain.size)
 
 
 def _classify(domain, local):
@@ -189,7 +231,7 @@ def from_points(domain: Domain3D, points: ArrayLike, *, fill: bool = True) -> No
     finite = spacing[np.isfinite(spacing)]
     h = float(np.median(finite)) if len(finite) else 0.1 * domain.size
     pin = np.flatnonzero((edge >= 0) | (patch >= 0))
-    surface = sample_surface(domain, h / domain.size, None,
+    surface = sample_surface(domain, SpacingLaw(h / domain.size), None,
                              (snapped[pin], edge[pin], t[pin], patch[pin]), fill,
                              0.5 * config.FILL_SPACINGS * h / domain.size)
     nodes, faces, regions, segments, kinds = surface

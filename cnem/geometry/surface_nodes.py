@@ -8,9 +8,10 @@ border), and each patch is triangulated with ``triangle`` (constrained by its bo
 so that the triangles tile every input face exactly.
 
 >>> from cnem.geometry import box
+>>> from cnem.geometry.spacing import SpacingLaw
 >>> from cnem.geometry.surface_nodes import sample_surface
 >>> dom = box()
->>> nodes, faces, regions, _, _ = sample_surface(dom, 0.5 / dom.size)
+>>> nodes, faces, regions, _, _ = sample_surface(dom, SpacingLaw(0.5 / dom.size))
 >>> len(nodes), len(faces)
 (26, 48)
 """
@@ -27,6 +28,7 @@ from scipy.spatial import cKDTree
 from .. import config
 from ..errors import GeometryError
 from .pslg import SegmentKind
+from .spacing import SpacingLaw, count_along
 from .surface_checks import edge_table
 
 if TYPE_CHECKING:
@@ -102,15 +104,24 @@ def surface_patches(vertices: np.ndarray, faces: np.ndarray, face_regions: np.nd
     return patch, edges, face_edge, border
 
 
-def _edge_nodes(vertices, edges, h, rng, pinned_t, pinned_edge, pin_clearance):
+def _edge_nodes(vertices, edges, law, rng, pinned_t, pinned_edge, pin_clearance):
     """Nodes along the border edges: ``(t, edge)`` of the generated ones (``pinned`` ones
     are kept, generated ones closer than ``pin_clearance`` to them dropped)."""
     length = np.linalg.norm(vertices[edges[:, 1]] - vertices[edges[:, 0]], axis=1)
-    pieces = np.maximum(1, np.rint(length / h)).astype(np.int64)
-    edge = np.repeat(np.arange(len(edges)), pieces - 1)
-    first = np.concatenate([[0], np.cumsum(pieces - 1)])[:-1]
-    j = np.arange(len(edge)) - np.repeat(first, pieces - 1) + 1
-    t = j / pieces[edge]
+    if law.uniform:
+        pieces = np.maximum(1, np.rint(length / law.h)).astype(np.int64)
+        edge = np.repeat(np.arange(len(edges)), pieces - 1)
+        first = np.concatenate([[0], np.cumsum(pieces - 1)])[:-1]
+        j = np.arange(len(edge)) - np.repeat(first, pieces - 1) + 1
+        t = j / pieces[edge]
+    else:
+        t, edge, pieces = [], [], np.ones(len(edges), dtype=np.int64)
+        for k, (a, b) in enumerate(edges):               # bounded by the border edges
+            samples, cum = count_along(vertices[a], vertices[b], law)
+            pieces[k] = max(1, int(round(cum[-1])))
+            t.append(np.interp(np.linspace(0, cum[-1], pieces[k] + 1)[1:-1], cum, samples))
+            edge.append(np.full(pieces[k] - 1, k))
+        t, edge = np.concatenate(t), np.concatenate(edge).astype(np.int64)
     if rng is not None:
         t = t + rng.uniform(-0.2, 0.2, len(t)) / pieces[edge]
     if len(pinned_t):
@@ -136,17 +147,7 @@ def _patch_frame(points, normal, border_pairs):
     return points[border_pairs[0, 0]], u, np.cross(normal, u)
 
 
-def _lattice2d(lo, hi, h, rng):
-    offset = 0.0 if rng is None else 0.5 * h
-    xs = lo[0] + offset + h * np.arange(int(np.ceil((hi[0] - lo[0]) / h)) + 1)
-    ys = lo[1] + offset + h * np.arange(int(np.ceil((hi[1] - lo[1]) / h)) + 1)
-    grid = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
-    if rng is not None:
-        grid = grid + rng.uniform(-0.35 * h, 0.35 * h, grid.shape)
-    return grid
-
-
-def _triangulate_patch(points, normal, patch_faces, segs, inner, h, rng, pin_clearance):
+def _triangulate_patch(points, normal, patch_faces, segs, inner, law, rng, pin_clearance):
     """Triangles of one planar patch.
 
     Parameters
@@ -160,9 +161,10 @@ def _triangulate_patch(points, normal, patch_faces, segs, inner, h, rng, pin_cle
         Border pieces (node pairs).
     inner : (q,) int ndarray
         Nodes that lie inside the patch already (the user's points).
-    h : float or None
+    law : SpacingLaw or None
         Spacing of the patch's lattice (None: no lattice).
     rng : numpy.random.Generator or None
+        Jitter the lattice by up to 0.35 h (uniform laws).
     pin_clearance : float
         Lattice points closer than this to an inner node are dropped.
 
@@ -182,12 +184,20 @@ def _triangulate_patch(points, normal, patch_faces, segs, inner, h, rng, pin_cle
                       for f in patch_faces.T], axis=1)
     region = shapely.union_all(shapely.polygons(tri2d))
     lattice = np.empty((0, 2))
-    if h is not None:
-        lattice = _lattice2d(xy.min(axis=0), xy.max(axis=0), h, rng)
+    if law is not None:
+        def lift(y):
+            return origin + y[:, :1] * u + y[:, 1:] * v
+
+        centres = None if law.uniform else np.column_stack(
+            [(law.centres - origin) @ u, (law.centres - origin) @ v])
+        lattice = law.lattice(xy.min(axis=0), xy.max(axis=0), lift=lift, centres=centres,
+                              offset=0.0 if rng is None and law.uniform else 0.5)
+        if rng is not None:
+            lattice = lattice + rng.uniform(-0.35 * law.h, 0.35 * law.h, lattice.shape)
         shapely.prepare(region)
         keep = shapely.contains_xy(region, lattice[:, 0], lattice[:, 1])
         lattice = lattice[keep]
-        clear = config.CLEARANCE * h * (1 - 1e-9)
+        clear = config.CLEARANCE * law(lift(lattice)) * (1 - 1e-9)
         near = shapely.dwithin(region.boundary, shapely.points(lattice), clear)
         if len(inner) and len(lattice):
             near |= cKDTree(xy[np.searchsorted(ids, inner)]).query(lattice)[0] < pin_clearance
@@ -206,18 +216,19 @@ def _triangulate_patch(points, normal, patch_faces, segs, inner, h, rng, pin_cle
     return number[tris], new
 
 
-def sample_surface(dom: Domain3D, h: float, rng: np.random.Generator | None = None,
+def sample_surface(dom: Domain3D, law: SpacingLaw, rng: np.random.Generator | None = None,
                    pinned: tuple | None = None, fill: bool = True,
                    pin_clearance: float | None = None) -> tuple[np.ndarray, ...]:
-    """Surface nodes of a domain about ``h`` apart, and their triangulation.
+    """Surface nodes of a domain at the spacing of ``law``, and their triangulation.
 
     Parameters
     ----------
     dom : Domain3D
-    h : float
-        Spacing in the domain's local frame (`Domain3D.to_local`: lengths over its size).
+    law : SpacingLaw
+        The spacing in the domain's local frame (`Domain3D.to_local`: lengths over its
+        size).
     rng : numpy.random.Generator, optional
-        Jitter the nodes (irregular clouds); None for a regular lattice.
+        Jitter the nodes (irregular clouds, uniform laws only); None for lattices.
     pinned : tuple, optional
         ``(points (q, 3), edge (q,), t (q,), patch (q,))``: the user's surface points in the
         local frame, on border edge ``edge`` at parameter ``t`` (-1 if not on one) or inside
@@ -226,7 +237,7 @@ def sample_surface(dom: Domain3D, h: float, rng: np.random.Generator | None = No
         Generate nodes (else only the vertices and the pinned points).
     pin_clearance : float, optional
         Generated nodes closer than this to a pinned point (or a vertex inside a patch)
-        are dropped; by default `cnem.config.CLEARANCE` times ``h``.
+        are dropped; by default `cnem.config.CLEARANCE` times ``law.h``.
 
     Returns
     -------
@@ -248,11 +259,11 @@ def sample_surface(dom: Domain3D, h: float, rng: np.random.Generator | None = No
         pinned = (np.empty((0, 3)), np.empty(0, np.int64), np.empty(0), np.empty(0, np.int64))
     ppts, pedge, pt, ppatch = pinned
     if pin_clearance is None:
-        pin_clearance = config.CLEARANCE * h
+        pin_clearance = config.CLEARANCE * law.h
     on_edge = pedge >= 0
     local_edge = np.full(len(edges), -1)
     local_edge[bedges] = np.arange(len(bedges))
-    t, e = _edge_nodes(vertices, edges[bedges], h, rng, pt[on_edge], local_edge[pedge[on_edge]],
+    t, e = _edge_nodes(vertices, edges[bedges], law, rng, pt[on_edge], local_edge[pedge[on_edge]],
                        pin_clearance)
     if not fill:
         t, e = t[:0], e[:0]
@@ -283,7 +294,7 @@ def sample_surface(dom: Domain3D, h: float, rng: np.random.Generator | None = No
     inner_of = np.argsort(ppatch, kind="stable")
     inner_start = np.searchsorted(ppatch[inner_of], np.arange(patch.max() + 2))
     plain = _plain_faces(dom.faces, patch, face_edge, border, seg_start, ppatch, area, edges,
-                         vertices, h if fill else None)
+                         vertices, law if fill else None)
     faces_out.append(dom.faces[plain])
     regions_out.append(dom.face_regions[plain])
     todo = np.unique(patch[~plain])
@@ -301,7 +312,7 @@ def sample_surface(dom: Domain3D, h: float, rng: np.random.Generator | None = No
         inner = len(vertices) + inner_of[inner_start[p]:inner_start[p + 1]]
         tris, new = _triangulate_patch(np.concatenate([nodes] + new_nodes), n / np.linalg.norm(n),
                                        dom.faces[mine], np.concatenate(pieces), inner,
-                                       h if fill else None, rng, pin_clearance)
+                                       law if fill else None, rng, pin_clearance)
         faces_out.append(tris)
         regions_out.append(np.repeat(dom.face_regions[mine[:1]], len(tris), axis=0))
         new_nodes.append(new)
@@ -314,7 +325,7 @@ def sample_surface(dom: Domain3D, h: float, rng: np.random.Generator | None = No
             kind.astype(np.int8))
 
 
-def _plain_faces(faces, patch, face_edge, border, seg_start, ppatch, area, edges, vertices, h):
+def _plain_faces(faces, patch, face_edge, border, seg_start, ppatch, area, edges, vertices, law):
     """(f,) bool: faces that are a patch of their own with no node but their corners
     (no sample on their edges, no pinned point, too small for a lattice point kept half a
     spacing from their edges): they are boundary triangles as they are."""
@@ -326,6 +337,6 @@ def _plain_faces(faces, patch, face_edge, border, seg_start, ppatch, area, edges
     length = np.linalg.norm(vertices[edges[face_edge, 1]] - vertices[edges[face_edge, 0]],
                             axis=2).sum(axis=1)
     inradius = 2 * area / length
-    roomy = np.zeros(len(faces), dtype=bool) if h is None \
-        else inradius > config.CLEARANCE * h * (1 - 1e-9)
+    roomy = np.zeros(len(faces), dtype=bool) if law is None \
+        else inradius > config.CLEARANCE * law(vertices[faces].mean(axis=1)) * (1 - 1e-9)
     return alone & ~split & ~pinned & ~roomy
