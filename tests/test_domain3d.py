@@ -268,6 +268,9 @@ def test_mesh_objects_are_regions():
     ref = Domain3D((v, f))
     _same_domain(Domain3D(trimesh.Trimesh(v, f, process=False)), ref)
     _same_domain(Domain3D(meshio.Mesh(v, [("triangle", f)])), ref)
+    pyvista = pytest.importorskip("pyvista")
+    flat = np.column_stack([np.full(len(f), 3), f]).ravel()
+    _same_domain(Domain3D(pyvista.PolyData(v, flat)), ref)
 
 
 def test_unknown_file(tmp_path):

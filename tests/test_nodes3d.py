@@ -117,6 +117,18 @@ def test_spacing(case):
     assert 0.5 < len(cloud.points) / (dom.volume / h**3 + dom.area / h**2) < 2.5
 
 
+@pytest.mark.parametrize("kind", list(KINDS))
+def test_box_clearance_by_coordinates(kind):
+    """In a box the distance to the surface is the least distance to its six planes."""
+    lo, hi = np.array([0.0, 0.0, 0.0]), np.array([1.0, 0.6, 0.8])
+    cloud = KINDS[kind](box(lo, hi), 0.13)
+    gap = np.minimum(cloud.points - lo, hi - cloud.points).min(axis=1)
+    on = np.zeros(len(gap), dtype=bool)
+    on[cloud.boundary_faces.ravel()] = True
+    assert np.abs(gap[on]).max() < 1e-15
+    assert (gap[~on] >= 0.5 * cloud.spacing[~on] * (1 - 1e-9)).all()
+
+
 def test_graded_spacing():
     dom = box()
     centre = np.array([0.5, 0.5, 1.0])

@@ -137,9 +137,6 @@ class Domain3D:
     dim = 3
 
     def __init__(self, regions: object) -> None:
-        if isinstance(regions, Domain3D):
-            regions = [(regions.vertices, regions.faces[regions.face_regions[:, 0] == r])
-                       for r in range(regions.n_regions)]
         if _is_region(regions):
             regions = [regions]
         if not isinstance(regions, (list, tuple)) or not regions:

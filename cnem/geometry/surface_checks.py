@@ -78,6 +78,9 @@ def check_closed(faces: np.ndarray, names: Sequence[str]) -> None:
         return [f"the edge between vertices {edges[e, 0]} and {edges[e, 1]} of {names[owner[e]]}"
                 for e in ids]
 
+    def faces_at(e):
+        return [names[i] for i in np.flatnonzero((face_edge == e).any(axis=1))]
+
     open_ = np.flatnonzero(uses == 1)
     if open_.size:
         raise GeometryError(
@@ -86,20 +89,18 @@ def check_closed(faces: np.ndarray, names: Sequence[str]) -> None:
     many = np.flatnonzero(uses > 2)
     if many.size:
         e = many[0]
-        users = np.flatnonzero((face_edge == e).any(axis=1))
         raise GeometryError(
             f"the surface is not manifold: {many.size} edges belong to more than two faces, "
             f"first the edge between vertices {edges[e, 0]} and {edges[e, 1]}, shared by "
-            f"{_listed([names[i] for i in users])}; split the surface into closed surfaces "
+            f"{_listed(faces_at(e))}; split the surface into closed surfaces "
             "that share no edge (regions of their own)")
     same = np.flatnonzero(ahead != 1)
     if same.size:
         e = same[0]
-        users = np.flatnonzero((face_edge == e).any(axis=1))
         raise GeometryError(
             f"the surface is not consistently oriented: {same.size} edges are run along in the "
             f"same direction by both of their faces, first the edge between vertices "
-            f"{edges[e, 0]} and {edges[e, 1]} of {' and '.join(names[i] for i in users)}; "
+            f"{edges[e, 0]} and {edges[e, 1]} of {' and '.join(faces_at(e))}; "
             "reverse one of the faces (number every face's vertices counter-clockwise seen from "
             "outside)")
 
