@@ -41,7 +41,7 @@ def _surface_arrays(obj, what):
                                 f"{sorted(obj.cells_dict)}); give its surface triangles")
         vertices, faces = obj.points, tri
     elif hasattr(obj, "faces") and hasattr(obj, "points") and hasattr(obj, "n_cells"):  # pyvista
-        surf = obj.extract_surface().triangulate()
+        surf = obj.triangulate()                        # a PolyData: polygons into triangles
         vertices, faces = surf.points, np.asarray(surf.faces).reshape(-1, 4)[:, 1:]
     elif hasattr(obj, "vertices") and hasattr(obj, "faces"):           # trimesh
         vertices, faces = obj.vertices, obj.faces
