@@ -84,6 +84,14 @@ def test_boundary_triangles_tile_each_patch(case):
     assert np.allclose(out_area, in_area, rtol=1e-12, atol=1e-14 * dom.size**2)
 
 
+def test_boundary_triangles_have_no_slivers(case):
+    _, _, cloud = case
+    tri = cloud.points[cloud.boundary_faces]
+    area = np.linalg.norm(_areas(cloud.points, cloud.boundary_faces), axis=1)
+    longest = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2).max(axis=1)
+    assert (area / longest**2).min() > 0.02          # equilateral: 0.433
+
+
 def test_boundary_triangles_close_each_region(case):
     dom, _, cloud = case
     for r in range(dom.n_regions):
