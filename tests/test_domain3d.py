@@ -220,6 +220,15 @@ def test_bad_coordinates(bad, message):
         Domain3D((v, f))
 
 
+def test_faces_as_whole_floats_and_bad_faces():
+    v, f = box_surface((0, 0, 0), (1, 1, 1))
+    assert Domain3D((v, f.astype(float))).volume == pytest.approx(1.0)
+    with pytest.raises(GeometryError, match="vertex numbers"):
+        Domain3D((v, f + 0.5))
+    with pytest.raises(GeometryError, match=r"must lie in \[0, 8\)"):
+        Domain3D((v, f + 1))
+
+
 def test_bad_query_points():
     dom = box()
     with pytest.raises(GeometryError, match="real numbers"):

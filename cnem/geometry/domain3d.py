@@ -57,7 +57,9 @@ def _surface_arrays(obj, what):
         raise GeometryError(f"{what}: {bad.size} vertices are not finite (NaN or inf), first "
                             f"{bad[:5].tolist()}; repair or remove them")
     faces = np.asarray(check_real(f"{what} faces", faces, error=GeometryError))
-    if faces.ndim != 2 or faces.shape[1] != 3 or faces.dtype.kind not in "iu" and len(faces):
+    whole = faces.dtype.kind in "iu" or (faces.dtype.kind == "f" and np.isfinite(faces).all()
+                                         and (faces == np.round(faces)).all())
+    if faces.ndim != 2 or faces.shape[1] != 3 or not whole:
         raise GeometryError(f"{what}: expected faces as an (f, 3) array of vertex numbers, "
                             f"received shape {faces.shape} of {faces.dtype}")
     faces = faces.astype(np.int64)
@@ -79,8 +81,7 @@ def _is_surface(obj):
         shapes = [np.shape(np.asarray(x)) for x in obj]
     except (ValueError, TypeError):
         return False
-    return all(len(s) == 2 and s[1] == 3 for s in shapes) \
-        and np.asarray(obj[1]).dtype.kind in "iu"
+    return all(len(s) == 2 and s[1] == 3 for s in shapes)
 
 
 def _is_region(obj):
