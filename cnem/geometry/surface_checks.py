@@ -173,17 +173,21 @@ def _segment_hits(p0, p1, a, b, c, tol):
     d0 = np.einsum("ij,ij->i", p0 - a, n) / nlen
     d1 = np.einsum("ij,ij->i", p1 - a, n) / nlen
     flat = (np.abs(d0) <= tol) & (np.abs(d1) <= tol)
-    cross = (d0 * d1 <= 0) & ~flat & (d0 != d1)
-    t = np.where(cross, d0 / np.where(d0 != d1, d0 - d1, 1.0), 0.0)
-    x = p0 + t[:, None] * (p1 - p0)
-    hit = cross & _inside(x, a, b, c, n, tol)
+    hit = np.zeros(len(p0), dtype=bool)
+    cross = np.flatnonzero((d0 * d1 <= 0) & ~flat & (d0 != d1))
+    t = d0[cross] / (d0[cross] - d1[cross])
+    x = p0[cross] + t[:, None] * (p1[cross] - p0[cross])
+    hit[cross] = _inside(x, a[cross], b[cross], c[cross], n[cross], tol)
     # a segment in the triangle's plane: an end inside, or crossing one of its edges
-    coplanar = flat & (_inside(p0, a, b, c, n, tol) | _inside(p1, a, b, c, n, tol))
+    k = np.flatnonzero(flat)
+    p0, p1, a, b, c, n = p0[k], p1[k], a[k], b[k], c[k], n[k]
+    coplanar = _inside(p0, a, b, c, n, tol) | _inside(p1, a, b, c, n, tol)
     for u, w in ((a, b), (b, c), (c, a)):
         s0, s1 = _side(u, w, p0, n), _side(u, w, p1, n)
         s2, s3 = _side(p0, p1, u, n), _side(p0, p1, w, n)
-        coplanar |= flat & (s0 * s1 < 0) & (s2 * s3 < 0)
-    return hit | coplanar
+        coplanar |= (s0 * s1 < 0) & (s2 * s3 < 0)
+    hit[k] |= coplanar
+    return hit
 
 
 def check_self_intersections(vertices: np.ndarray, faces: np.ndarray, tol: float,
@@ -213,12 +217,12 @@ def check_self_intersections(vertices: np.ndarray, faces: np.ndarray, tol: float
     shared = same.sum(axis=(1, 2))
     bad = np.zeros(len(i), dtype=bool)
     a, b = tri[i], tri[j]
-    apart = shared == 0
+    apart = np.flatnonzero(shared == 0)
+    pa, pb = a[apart], b[apart]
     for k in range(3):
-        for s, t, mask in ((a, b, apart), (b, a, apart)):
-            idx = np.flatnonzero(mask)
-            bad[idx] |= _segment_hits(s[idx, k], s[idx, (k + 1) % 3], t[idx, 0], t[idx, 1],
-                                      t[idx, 2], tol)
+        for s, t in ((pa, pb), (pb, pa)):
+            bad[apart] |= _segment_hits(s[:, k], s[:, (k + 1) % 3], t[:, 0], t[:, 1], t[:, 2],
+                                        tol)
     one = np.flatnonzero(shared == 1)
     if one.size:
         ka = np.argmax(same[one].any(axis=2), axis=1)       # shared corner of each face
