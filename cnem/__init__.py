@@ -52,11 +52,11 @@ _MODULES = frozenset({"assembly", "cli", "config", "elasticity", "errors", "exac
                       "plot", "shape", "solvers", "spatial"})
 
 #: The core workflow names -> the module that defines them.
-_NAMES = {"Domain": "geometry", "NodeCloud": "geometry", "Model": "geometry",
-          "discretize": "geometry", "Elasticity": "elasticity", "ElasticSolution": "elasticity",
-          "Hyperelasticity": "elasticity"}
+_NAMES = {"Domain": "geometry", "Domain3D": "geometry", "NodeCloud": "geometry",
+          "Model": "geometry", "discretize": "geometry", "Elasticity": "elasticity",
+          "ElasticSolution": "elasticity", "Hyperelasticity": "elasticity"}
 
-__all__ = ["Domain", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
+__all__ = ["Domain", "Domain3D", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
            "Hyperelasticity",
            "nodes", "geometry", "assembly", "elasticity", "exact", "fracture", "io", "plot", "shape",
            "spatial", "hyperdual", "pd", "fem", "material",

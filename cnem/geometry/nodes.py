@@ -1,5 +1,7 @@
 """Node clouds on a `Domain`: regular, irregular, graded, or the user's own points.
 
+On a `Domain3D` the same functions build 3-D clouds (`cnem.geometry.nodes3d`).
+
 Every polygon corner, interface vertex and crack vertex is a node; the generated
 clouds put nodes about one local spacing apart along every boundary, interface
 and crack edge (and at least one inside a crack edge between two tips, so that
@@ -22,54 +24,22 @@ from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from .. import config
-from ..errors import GeometryError, LimitError, check_array, check_count, check_real
+from ..errors import GeometryError, check_real
+from . import nodes3d
 from .cloud import NodeCloud
+from .domain3d import Domain3D
 from .pslg import SegmentKind, segment_projection
+from .spacing import check_grading
+from .spacing import check_node_count as _check_count
+from .spacing import count_along as _count_along
+from .spacing import check_seed as _check_seed
+from .spacing import check_spacing as _check_spacing
+from .spacing import point_spacing as _point_spacing
 
 if TYPE_CHECKING:
     from .domain import Domain
 
 __all__ = ["regular", "irregular", "graded", "from_points", "NodeCloud"]
-
-def _check_seed(seed):
-    """``seed`` for `numpy.random.default_rng` once it is a whole number >= 0 (or None)."""
-    if seed is None:
-        return None
-    return check_count("seed", seed, minimum=0, error=GeometryError)
-
-
-def _check_spacing(dom, h, name="h"):
-    if np.ndim(h) != 0:
-        raise GeometryError(f"{name}: expected one spacing (a number), received an array of "
-                            f"shape {np.shape(h)}; for spacings that vary use graded(...)")
-    h = float(check_array(name, h, error=GeometryError, finite=False,
-                          fix="pass the node spacing as a number, e.g. 0.1"))
-    if not np.isfinite(h) or h <= 0:
-        raise GeometryError(f"{name} must be a positive spacing, received {h!r}")
-    if h >= dom.diameter:
-        raise GeometryError(f"{name} = {h:g} is not smaller than the domain diameter "
-                            f"{dom.diameter:g}; choose a spacing that fits several nodes")
-    # ten snapping tolerances: the tolerance grows with the coordinates' round-off far
-    # from the origin (a body 1 across at 1e8 resolves no spacing below ~4e-6)
-    smallest = max(config.MIN_SPACING * dom.diameter, 10 * dom.tolerance)
-    if h < smallest:
-        raise GeometryError(
-            f"{name} = {h:g} is below the smallest spacing this domain resolves, {smallest:.3g} "
-            f"(cnem.config.MIN_SPACING = {config.MIN_SPACING:g} times the diameter "
-            f"{dom.diameter:.3g}, or ten snapping tolerances {dom.tolerance:.3g}, which far "
-            f"from the origin cover the coordinates' round-off; nodes closer are within a few "
-            f"tolerances of each other); expected {name} >= {smallest:.3g}, or coordinates "
-            f"nearer the origin")
-    return h
-
-
-def _check_count(estimate, what, fix):
-    """Refuse a cloud of more than `cnem.config.MAX_NODES` nodes before building it."""
-    if estimate > config.MAX_NODES:
-        raise LimitError(f"{what} would need ~{estimate:.3g} nodes, more than "
-                         f"cnem.config.MAX_NODES = {config.MAX_NODES:g}; expected {fix} "
-                         "(or raise cnem.config.MAX_NODES)")
-
 
 def _uniform_count(dom, h):
     """Nodes of a cloud of spacing ``h``: the area over h^2 and the PSLG's length over h."""
@@ -98,47 +68,6 @@ def _tip_to_tip(dom):
         return np.zeros(len(edges), dtype=bool)
     is_tip = cKDTree(dom.tips).query(v)[0] <= dom.tolerance
     return (kinds == SegmentKind.CRACK) & is_tip[edges[:, 0]] & is_tip[edges[:, 1]]
-
-
-def _count_along(pa, pb, spacing_of):
-    """Cumulative node count along segment ``pa-pb`` under the spacing law.
-
-    The density ``length / spacing_of(x)`` is integrated by the trapezoid rule
-    on 65 samples, each interval bisected again while its midpoint changes its
-    count by more than `cnem.config.SPACING_COUNT_TOL` nodes: a law that shrinks
-    to a tiny spacing at a tip is followed down to it (a fixed rule gave the
-    first 1/64 of the segment one uniform tiny spacing).
-
-    Returns
-    -------
-    t : (m,) ndarray
-        Increasing parameters in [0, 1].
-    cum : (m,) ndarray
-        Nodes expected between ``pa`` and ``pa + t (pb - pa)``.
-    """
-    length = np.linalg.norm(pb - pa)
-
-    def density(t):
-        return length / spacing_of(pa + t[:, None] * (pb - pa))
-
-    t = np.linspace(0.0, 1.0, 65)
-    dens = density(t)
-    for _ in range(config.SPACING_BISECTIONS):
-        mid = 0.5 * (t[1:] + t[:-1])
-        dmid = density(mid)
-        error = np.abs(dmid - 0.5 * (dens[1:] + dens[:-1])) * np.diff(t)
-        split = error > config.SPACING_COUNT_TOL
-        if not split.any():
-            break
-        t, dens = np.concatenate([t, mid[split]]), np.concatenate([dens, dmid[split]])
-        order = np.argsort(t, kind="stable")
-        t, dens = t[order], dens[order]
-    else:
-        raise LimitError(
-            f"the node spacing along the segment {pa.tolist()} - {pb.tolist()} is not resolved "
-            f"after {config.SPACING_BISECTIONS} bisections of its samples; expected a spacing "
-            "law that is bounded below by a positive h_min")
-    return t, np.concatenate([[0.0], np.cumsum(0.5 * (dens[1:] + dens[:-1]) * np.diff(t))])
 
 
 def _boundary_nodes(dom, spacing_of, jitter=None):
@@ -222,7 +151,7 @@ def regular(domain: Domain, h: float) -> NodeCloud:
 
     Parameters
     ----------
-    domain : Domain
+    domain : Domain or Domain3D
     h : float
         Node spacing, ``0 < h < domain.diameter``.
 
@@ -230,6 +159,8 @@ def regular(domain: Domain, h: float) -> NodeCloud:
     -------
     NodeCloud
     """
+    if isinstance(domain, Domain3D):
+        return nodes3d.regular(domain, h)
     h = _check_spacing(domain, h)
     _check_uniform_count(domain, h, "regular")
     spacing_of = lambda x: np.full(len(x), h)  # noqa: E731
@@ -248,6 +179,8 @@ def irregular(domain: Domain, h: float, *, seed: int = 0) -> NodeCloud:
     -------
     NodeCloud
     """
+    if isinstance(domain, Domain3D):
+        return nodes3d.irregular(domain, h, seed=seed)
     h = _check_spacing(domain, h)
     _check_uniform_count(domain, h, "irregular")
     rng = np.random.default_rng(_check_seed(seed))
@@ -286,7 +219,10 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
 
     Parameters
     ----------
-    near : (q, 2) array_like
+    domain : Domain or Domain3D
+    h : float
+        Largest spacing.
+    near : (q, 2) array_like (``(q, 3)`` on a `Domain3D`)
         Refinement centres.
     h_min : float
         Spacing at the centres, ``0 < h_min <= h``.
@@ -299,20 +235,9 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
     -------
     NodeCloud
     """
-    h = _check_spacing(domain, h)
-    h_min = _check_spacing(domain, h_min, "h_min")
-    if h_min > h:
-        raise GeometryError(f"h_min ({h_min:g}) must not exceed h ({h:g})")
-    if not 0 < growth <= 1:
-        raise GeometryError(f"growth must lie in (0, 1], received {growth!r}")
-    centres = check_array("near", near, finite=True, error=GeometryError,
-                          fix="give the refinement points as a (q, 2) array, e.g. dom.tips")
-    if centres.size and (centres.ndim not in (1, 2) or centres.shape[-1] != 2):
-        raise GeometryError(f"near: expected refinement points (q, 2) or one point (2,), received "
-                            f"shape {centres.shape}; give e.g. dom.tips")
-    centres = centres.reshape(-1, 2)
-    if len(centres) == 0:
-        raise GeometryError("graded: `near` is empty; give at least one refinement point")
+    if isinstance(domain, Domain3D):
+        return nodes3d.graded(domain, h, near=near, h_min=h_min, growth=growth, seed=seed)
+    h, h_min, centres = check_grading(domain, h, h_min, growth, near, 2)
     _check_graded_count(domain, h, h_min, growth, centres)
     tree = cKDTree(centres)
 
@@ -337,16 +262,6 @@ def graded(domain: Domain, h: float, *, near: ArrayLike, h_min: float, growth: f
         interior = interior + rng.uniform(-0.25, 0.25, interior.shape) * spacing_of(interior)[:, None]
     interior = _keep_interior(domain, interior, config.CLEARANCE * spacing_of(interior))
     return _assemble(domain, _boundary_nodes(domain, spacing_of), interior, spacing_of)
-
-
-def _point_spacing(pts):
-    """(p,) local spacing at each point: the mean distance to its
-    `cnem.config.SPACING_NEIGHBOURS` nearest others (``inf`` for a lone point); a
-    single nearest neighbour is too noisy a measure on irregular clouds."""
-    k = min(config.SPACING_NEIGHBOURS, len(pts) - 1)
-    if k < 1:
-        return np.full(len(pts), np.inf)
-    return cKDTree(pts).query(pts, k=k + 1)[0][:, 1:].mean(axis=1)
 
 
 def _fill_edges(domain, pts, seg_of, user_spacing, fill):
@@ -417,8 +332,8 @@ def from_points(domain: Domain, points: ArrayLike, *, fill: bool = True) -> Node
 
     Parameters
     ----------
-    domain : Domain
-    points : (p, 2) array_like
+    domain : Domain or Domain3D
+    points : (p, 2) array_like (``(p, 3)`` on a `Domain3D`)
     fill : bool
         Fill long gaps along the edges with nodes (else raise).
 
@@ -435,6 +350,8 @@ def from_points(domain: Domain, points: ArrayLike, *, fill: bool = True) -> Node
         with ``fill=False``, an edge gap longer than `cnem.config.FILL_SPACINGS`
         local spacings.
     """
+    if isinstance(domain, Domain3D):
+        return nodes3d.from_points(domain, points, fill=fill)
     pts = np.array(check_real("points", points, error=GeometryError), dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise GeometryError(f"points: expected a (p, 2) array, received shape {pts.shape}")
