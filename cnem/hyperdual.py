@@ -273,6 +273,15 @@ def _vectors(a, b, what):
     return a, b
 
 
+def _real_operand(value, what, name):
+    """``value`` unchanged if a HyperDual, else as a float64 array once it holds real
+    numbers (complex numbers and booleans refused, naming argument ``name`` of ``what``)."""
+    if isinstance(value, HyperDual):
+        return value
+    check_real(f"{what} argument {name}", value, error=HyperDualError)
+    return np.asarray(value, dtype=np.float64)
+
+
 def _stack_any(items):
     if any(isinstance(v, HyperDual) for v in items):
         return stack(items, axis=-1)
@@ -313,13 +322,15 @@ def cross(a: HyperDual | ArrayLike, b: HyperDual | ArrayLike) -> HyperDual | np.
                          f"{d} (shapes {a.shape} and {b.shape}); pass 2-D or 3-D vectors")
 
 
-def _matrices(a, what):
-    """``a`` (HyperDual or float ndarray) after checking it holds square matrices
-    ``(..., d, d)``."""
-    a = a if isinstance(a, HyperDual) else np.asarray(a, dtype=np.float64)
-    if a.ndim < 2 or a.shape[-1] != a.shape[-2]:
-        raise HyperDualError(f"{what}: expected square matrices on the last two axes, shape "
-                             f"(..., d, d), got shape {a.shape}; reshape to (..., d, d)")
+def _matrices(a, what, name="a", *, square=True):
+    """``a`` (HyperDual or real array, `_real_operand`) after checking it holds matrices
+    ``(..., d, e)``, square (``d == e``) unless ``square`` is False."""
+    a = _real_operand(a, what, name)
+    if a.ndim < 2 or (square and a.shape[-1] != a.shape[-2]):
+        form = "square matrices on the last two axes, shape (..., d, d)" if square else \
+            "matrices on the last two axes, shape (..., d, e)"
+        raise HyperDualError(f"{what} argument {name}: expected {form}, got shape {a.shape}; "
+                             f"reshape to {'(..., d, d)' if square else '(..., d, e)'}")
     return a
 
 
@@ -327,8 +338,8 @@ def _small(a, what):
     """``a`` as square matrices of size 2 or 3 (`_matrices`)."""
     a = _matrices(a, what)
     if a.shape[-1] not in (2, 3):
-        raise HyperDualError(f"{what}: written for 2 x 2 and 3 x 3 matrices, got shape "
-                             f"{a.shape}; pass (..., 2, 2) or (..., 3, 3)")
+        raise HyperDualError(f"{what} argument a: written for 2 x 2 and 3 x 3 matrices, got "
+                             f"shape {a.shape}; pass (..., 2, 2) or (..., 3, 3)")
     return a
 
 
@@ -343,18 +354,21 @@ def trace(a: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
 
 def transpose(a: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
     """Matrices ``(..., d, e)`` transposed to ``(..., e, d)``."""
+    a = _matrices(a, "hd.transpose", square=False)
     if isinstance(a, HyperDual):
         return HyperDual(*(np.swapaxes(getattr(a, p), -1, -2) for p in _PARTS))
-    return np.swapaxes(np.asarray(a, dtype=np.float64), -1, -2)
+    return np.swapaxes(a, -1, -2)
 
 
 def matmul(a: HyperDual | ArrayLike, b: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
     """Matrix products ``(..., d, e) @ (..., e, f) -> (..., d, f)``, broadcast over the
     leading axes; either may be real."""
-    a, b = (v if isinstance(v, HyperDual) else np.asarray(v, dtype=np.float64) for v in (a, b))
-    if a.ndim < 2 or b.ndim < 2 or a.shape[-1] != b.shape[-2]:
-        raise HyperDualError(f"hd.matmul: expected matrices (..., d, e) and (..., e, f), got "
-                             f"shapes {a.shape} and {b.shape}")
+    a, b = (_matrices(v, "hd.matmul", name, square=False) for v, name in ((a, "a"), (b, "b")))
+    if a.shape[-1] != b.shape[-2]:
+        raise HyperDualError(f"hd.matmul: expected matrices (..., d, e) and (..., e, f) as "
+                             f"arguments a and b, got a of shape {a.shape} and b of shape "
+                             f"{b.shape}; the columns of a must match the rows of b")
+    _broadcast([a.shape[:-2], b.shape[:-2]], "hd.matmul arguments a and b (leading axes)")
     return (a[..., :, :, None] * b[..., None, :, :]).sum(axis=-2)
 
 

@@ -139,7 +139,8 @@ class Hyperelastic(Material):
         Parameters
         ----------
         F : (q, d, d) ndarray
-            ``F[k, i, J] = dx_i / dX_J``, d = 2 (plane strain) or 3.
+            ``F[k, i, J] = dx_i / dX_J``, d = 2 (plane strain) or 3. A point with
+            NaN entries gets NaN values.
         tangent : bool
             Also the tangent (else None).
 
@@ -154,7 +155,8 @@ class Hyperelastic(Material):
         raise NotImplementedError
 
     def energy(self, F: np.ndarray | hd.HyperDual) -> np.ndarray | hd.HyperDual:
-        """``W (q,)`` at ``F (q, d, d)`` (an ndarray or `cnem.hyperdual.HyperDual`)."""
+        """``W (...)`` at ``F (..., d, d)`` (an ndarray or `cnem.hyperdual.HyperDual`;
+        ``(q, d, d)`` for q points, any leading axes allowed), d = 2 or 3."""
         raise NotImplementedError
 
     def lame(self, dim: int = 2, plane: Literal["strain"] | None = None
@@ -200,12 +202,19 @@ def _hyper_lame(dim, plane, lam, mu):
     return lam, mu
 
 
-def _deformation_gradients(F):
-    """``F`` as a float ``(q, d, d)`` array, d = 2 or 3, or a MaterialError."""
-    F = np.asarray(F, dtype=float)
-    if F.ndim != 3 or F.shape[1] != F.shape[2] or F.shape[1] not in (2, 3):
-        raise MaterialError(f"F: expected deformation gradients of shape (q, d, d), d = 2 or 3, "
-                            f"received shape {F.shape}")
+def _deformation_gradients(F, *, leading=False):
+    """``F`` as a float ``(q, d, d)`` array, d = 2 or 3, or a MaterialError naming ``F``
+    (complex, boolean, not numbers, another shape). With ``leading``, any leading axes
+    ``(..., d, d)`` and a `cnem.hyperdual.HyperDual` (kept as it is) are accepted.
+    NaN entries pass: they give NaN energies and stresses at their points, as inverted
+    gradients do, which Newton reports as a named `ConvergenceError`."""
+    if not (leading and isinstance(F, hd.HyperDual)):
+        F = check_array("F", F, finite=False, error=MaterialError)
+    if (F.ndim < 2 if leading else F.ndim != 3) or F.shape[-1] != F.shape[-2] \
+            or F.shape[-1] not in (2, 3):
+        expected = "(..., d, d)" if leading else "(q, d, d) (F[None] for one gradient)"
+        raise MaterialError(f"F: expected deformation gradients of shape {expected}, d = 2 or "
+                            f"3, received shape {F.shape}")
     return F
 
 
@@ -241,7 +250,8 @@ class NeoHookean(Hyperelastic):
         return _hyper_lame(dim, plane, self.lam, self.mu)
 
     def energy(self, F: np.ndarray | hd.HyperDual) -> np.ndarray | hd.HyperDual:
-        """``W (q,)`` at ``F (q, d, d)`` (see `Hyperelastic.energy`)."""
+        """``W (...)`` at ``F (..., d, d)`` (see `Hyperelastic.energy`)."""
+        F = _deformation_gradients(F, leading=True)
         d = F.shape[-1]
         log_j = hd.log(hd.det(F))
         return 0.5 * self.mu * ((F * F).sum(axis=(-2, -1)) - d) - self.mu * log_j \
@@ -252,20 +262,22 @@ class NeoHookean(Hyperelastic):
         """``W``, ``P`` and ``A`` at ``F (q, d, d)`` (see `Hyperelastic.evaluate`)."""
         F = _deformation_gradients(F)
         mu, lam = self.mu, self.lam
-        with np.errstate(invalid="ignore", divide="ignore"):    # J <= 0: NaN, for Newton
-            log_j = np.log(np.linalg.det(F))
-        inv = np.linalg.inv(F)                                  # inv[k, J, i] = F^-1_Ji
-        inv_t = np.swapaxes(inv, 1, 2)                          # F^-T_iJ
-        W = 0.5 * mu * (np.einsum("kij,kij->k", F, F) - F.shape[1]) - mu * log_j \
-            + 0.5 * lam * log_j ** 2
-        P = mu * F + (lam * log_j - mu)[:, None, None] * inv_t
-        if not tangent:
-            return W, P, None
         d = F.shape[1]
-        # A_iJkL = mu d_ik d_JL + (mu - lam ln J) F^-1_Jk F^-1_Li + lam F^-1_Ji F^-1_Lk
-        A = mu * np.einsum("ik,JL->iJkL", np.eye(d), np.eye(d))[None] \
-            + (mu - lam * log_j)[:, None, None, None, None] * np.einsum("qJk,qLi->qiJkL", inv, inv) \
-            + lam * np.einsum("qJi,qLk->qiJkL", inv, inv)
+        # J <= 0 gives NaN (J = 0: inf and NaN), not an error or a warning: Newton reports it
+        with np.errstate(invalid="ignore", divide="ignore"):
+            log_j = np.log(np.linalg.det(F))
+            inv = hd.inv(F)                                     # inv[k, J, i] = F^-1_Ji
+            inv_t = np.swapaxes(inv, 1, 2)                      # F^-T_iJ
+            W = 0.5 * mu * (np.einsum("kij,kij->k", F, F) - d) - mu * log_j \
+                + 0.5 * lam * log_j ** 2
+            P = mu * F + (lam * log_j - mu)[:, None, None] * inv_t
+            if not tangent:
+                return W, P, None
+            # A_iJkL = mu d_ik d_JL + (mu - lam ln J) F^-1_Jk F^-1_Li + lam F^-1_Ji F^-1_Lk
+            A = mu * np.einsum("ik,JL->iJkL", np.eye(d), np.eye(d))[None] \
+                + (mu - lam * log_j)[:, None, None, None, None] \
+                * np.einsum("qJk,qLi->qiJkL", inv, inv) \
+                + lam * np.einsum("qJi,qLk->qiJkL", inv, inv)
         return W, P, A
 
 
@@ -301,7 +313,8 @@ class SaintVenantKirchhoff(Hyperelastic):
         return _hyper_lame(dim, plane, float(lam), float(mu))
 
     def energy(self, F: np.ndarray | hd.HyperDual) -> np.ndarray | hd.HyperDual:
-        """``W (q,)`` at ``F (q, d, d)`` (see `Hyperelastic.energy`)."""
+        """``W (...)`` at ``F (..., d, d)`` (see `Hyperelastic.energy`)."""
+        F = _deformation_gradients(F, leading=True)
         lam, mu = self.lame(3, None)
         strain = 0.5 * (hd.matmul(hd.transpose(F), F) - np.eye(F.shape[-1]))
         tr = hd.trace(strain)

@@ -118,6 +118,13 @@ def test_inverted_gradients_give_nan_not_a_warning():
     assert np.isnan(W).all() and np.isnan(P).all()
 
 
+def test_collapsed_gradient_gives_infinite_energy_not_an_error():
+    F = np.array([[[1.0, 0.0], [0.0, 0.0]]])              # J = 0: no inverse
+    with np.errstate(all="raise"):
+        W, P, A = NeoHookean(1.0, 1.0).evaluate(F)
+    assert W[0] == np.inf and not np.isfinite(P).all() and not np.isfinite(A).all()
+
+
 def test_bad_inputs_are_named():
     with pytest.raises(cnem.MaterialError, match="shear modulus mu > 0"):
         NeoHookean(0.0, 1.0)

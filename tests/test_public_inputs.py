@@ -37,6 +37,7 @@ NOT_ENTRY_POINTS = {
     "cnem.NodeCloud": "a result of cnem.nodes.*",
     "cnem.Model": "a result of cnem.discretize",
     "cnem.ElasticSolution": "a result of Elasticity.solve",
+    "cnem.elasticity.HyperelasticSolution": "a result of Hyperelasticity.solve",
     "cnem.geometry.Cells": "a result of cnem.discretize (model.cells)",
     "cnem.geometry.PSLG": "built by Domain from checked polygons",
     "cnem.geometry.SegmentKind": "an enumeration",
@@ -61,13 +62,17 @@ NOT_ENTRY_POINTS = {
     "cnem.elasticity.elasticity_form": "a weak form: called by asm with fields",
     "cnem.plot.offscreen_pyplot": "no arguments",
     "cnem.material.Material": "an abstract base class",
+    "cnem.material.Hyperelastic": "an abstract base class",
+    **{f"cnem.material.Hyperelastic.{method}": "abstract (raises NotImplementedError): those "
+       "of NeoHookean and SaintVenantKirchhoff are tried" for method in ("energy", "evaluate")},
     "cnem.material.check_plane": "a validator (takes a dimension and a plane name)",
     "cnem.material.check_stiffness": "a validator called on checked moduli",
     # methods that are plumbing: the library calls them with arrays it built and checked
     **{name: "plumbing: called by the library with the arrays it built" for name in (
         "cnem.Elasticity.body_forces_at", "cnem.Elasticity.preconditioner_matrix",
         "cnem.Elasticity.solver_options", "cnem.ElasticSolution.from_dofs",
-        "cnem.ElasticSolution.write_fields", "cnem.fem.P1Solution.from_dofs",
+        "cnem.ElasticSolution.write_fields", "cnem.elasticity.HyperelasticSolution.from_dofs",
+        "cnem.fem.P1Solution.from_dofs",
         "cnem.fem.P1Solution.write_fields", "cnem.pd.StaticSolution.write_fields",
         "cnem.geometry.Cells.subset", "cnem.assembly.CellBasis.at_points",
         "cnem.assembly.CellBasis.from_operators", "cnem.assembly.BilinearForm.assemble",
@@ -234,6 +239,12 @@ _SOLUTIONS = {"cnem.ElasticSolution": "sol", "cnem.pd.StaticSolution": "pd_sol",
 _THREE_D = "(n, 3) points are valid: a 3-D body"
 _ONE_PERIOD = "one number is a valid period (the same length along every axis)"
 _NAN_IN_NAN_OUT = "elementwise formula: NaN entries give NaN, as in NumPy"
+_NAN_PER_MATRIX = "a formula per matrix: NaN entries give NaN, as in numpy.linalg"
+_NAN_PER_POINT = ("a law per point: a NaN gradient gives NaN energy and stress there, as an "
+                  "inverted one does, and Newton names the non-finite residual")
+#: Deformation gradients ``(q, d, d)`` for the hyperelastic laws and hyper-dual matrices.
+_GRADIENTS = np.array([[[1.1, 0.2], [0.0, 0.9]], [[1.0, 0.0], [0.1, 1.2]]])
+_WIDE = np.array([[[1.0, 0.5, 0.0], [0.0, 1.0, 0.3]]] * 2)     # (2, 2, 3): not square
 _FIELDS = {("point_data", "nan"): "NaN is the VTU fill value of a field",
            ("cell_data", "nan"): "NaN is the VTU fill value of a field",
            ("point_data", "bool"): "a boolean mask is a valid field (written 0 / 1)",
@@ -348,6 +359,17 @@ EXAMPLES = {
     "cnem.hyperdual.derivative": Example(
         lambda f: dict(f=cnem.hyperdual.sin, x=np.array([1.0, 2.0])),
         skip={"shape": _ELEMENTWISE, "scalar": _ELEMENTWISE, "nan": _NAN_IN_NAN_OUT}),
+    **{f"cnem.hyperdual.{name}": Example(lambda f: dict(a=_GRADIENTS),
+                                         skip={("a", "nan"): _NAN_PER_MATRIX})
+       for name in ("trace", "det", "inv")},
+    "cnem.hyperdual.transpose": Example(
+        lambda f: dict(a=_WIDE),
+        skip={("a", "nan"): _NAN_PER_MATRIX,
+              ("a", "shape"): "matrices (..., d, e) of any d and e are valid"}),
+    "cnem.hyperdual.matmul": Example(
+        lambda f: dict(a=_WIDE, b=np.swapaxes(_WIDE, 1, 2)),
+        skip={"nan": _NAN_PER_MATRIX,
+              ("b", "shape"): "b of shape (..., e, f) is valid for any number f of columns"}),
     "cnem.pd.Body": Example(
         lambda f: dict(points=f.lattice, volumes=np.full(len(f.lattice), 0.0625),
                        horizon=0.76, period=np.array([1.25, 1.25])),
@@ -365,11 +387,20 @@ EXAMPLES = {
         lambda f: dict(materials=np.array([[1.0, 0.3]]), nregions=1, plane="stress")),
     "cnem.material.moduli": Example(
         lambda f: dict(materials=(cnem.material.LinearElastic(1.0, 0.3),))),
+    "cnem.material.NeoHookean": Example(lambda f: dict(mu=1.0, lam=1.5)),
+    "cnem.material.SaintVenantKirchhoff": Example(lambda f: dict(E=1.0, nu=0.3)),
+    "cnem.Hyperelasticity": Example(
+        lambda f: dict(model=f.model, materials=cnem.material.NeoHookean(1.0, 1.5))),
     # methods ("self" is the object called)
     "cnem.Domain.contains": Example(lambda f: dict(self=f.dom, points=f.inside)),
     "cnem.Domain.region_of": Example(lambda f: dict(self=f.dom, points=f.inside)),
     "cnem.Model.shape_functions": Example(
         lambda f: dict(self=f.model, points=f.inside, triangles=np.array([-1, -1]))),
+    **{f"cnem.material.{law.__name__}.{method}": Example(
+        lambda f, law=law: dict(self=law(1.0, 0.3), F=_GRADIENTS),
+        skip={("F", "nan"): _NAN_PER_POINT})
+       for law in (cnem.material.NeoHookean, cnem.material.SaintVenantKirchhoff)
+       for method in ("energy", "evaluate")},
     "cnem.Elasticity.add_body_force": Example(
         lambda f: dict(self=_setup(f.model), b=np.array([0.0, -1.0]))),
     "cnem.Elasticity.add_dirichlet": Example(
