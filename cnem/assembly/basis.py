@@ -82,13 +82,13 @@ class CellBasis:
         self.cells = cells
         self.grad = gradient if gradient is not None else \
             smoothed_gradient(model, gauss=gauss, cells=None if cells is model.cells else cells)
-        m, n = len(cells.area), len(model.nodes)
+        m, n = len(cells.measure), len(model.nodes)
         value = sp.csr_matrix((np.ones(m), (np.arange(m), cells.node)), shape=(m, n))
         grads = tuple(self.grad)
         if extra is not None:           # functions that vanish at the nodes (enrichment)
             value = sp.hstack([value, sp.csr_matrix(extra[0].shape)], format="csr")
             grads = tuple(sp.hstack([g, e], format="csr") for g, e in zip(grads, extra, strict=True))
-        self._setup(model, vector, (value,) + grads, cells.area, cells.centroid().T,
+        self._setup(model, vector, (value,) + grads, cells.measure, cells.centroid().T,
                     model.nodes[cells.node].T)
 
     def _setup(self, model, vector, node_ops, dx, x, nodes):

@@ -213,9 +213,9 @@ class GradientCache:
     def __init__(self, model: Model, *, gauss: int = 2, cells: SmoothedGradient | None = None):
         self.model = model
         self.gauss = check_gauss(gauss)
-        if cells is not None and cells.shape != (len(model.cells.area), len(model.nodes)):
+        if cells is not None and cells.shape != (len(model.cells.measure), len(model.nodes)):
             raise GeometryError(f"cells: expected the smoothed gradient of this model's "
-                                f"{len(model.cells.area)} cells and {len(model.nodes)} nodes, "
+                                f"{len(model.cells.measure)} cells and {len(model.nodes)} nodes, "
                                 f"received shape {cells.shape}")
         self._cells = cells
         self._fan = None

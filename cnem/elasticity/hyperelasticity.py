@@ -99,7 +99,7 @@ class Hyperelasticity(ModelProblem):
             raise OptionError("plane: finite-strain C-NEM is written for plane strain (F33 = 1) "
                               "in 2-D, received 'stress'; pass plane='strain' or use a 3-D model")
         self.plane = plane
-        self.region_materials = parse_materials(materials, len(model.domain.regions),
+        self.region_materials = parse_materials(materials, model.domain.n_regions,
                                                 dim=self.dim)
         other = [type(m).__name__ for m in self.region_materials
                  if not isinstance(m, Hyperelastic)]

@@ -111,7 +111,7 @@ class Elasticity(ModelProblem):
         if self.dim == 2 and plane is None:
             plane = "stress"
         check_plane(self.dim, plane)
-        self.region_materials = parse_materials(materials, len(model.domain.regions), plane,
+        self.region_materials = parse_materials(materials, model.domain.n_regions, plane,
                                                 dim=self.dim)
         self.materials = moduli(self.region_materials)
         self.stabilization = float(stabilization)

@@ -20,6 +20,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from skfem.quadrature import get_quadrature
+from skfem.refdom import RefTri
+
 from ..assembly.gradients import GradientCache
 from ..errors import GeometryError
 from ..geometry.model import check_model
@@ -89,8 +92,11 @@ class ModelProblem(Conditions):
         return self.model.domain
 
     def boundary_edges(self) -> tuple:
-        """The model's constraint edges with the body on one side (see
-        `Conditions.boundary_edges`)."""
+        """The model's boundary pieces with the body on one side and their outward unit
+        normals (see `Conditions.boundary_edges`): constraint edges ``(e, 2)`` in 2-D,
+        boundary triangles ``(e, 3)`` in 3-D."""
+        if self.dim == 3:
+            return self.model.boundary_with_normals()
         tri = self.model.triangles
         edges, _ = constraint_edges(tri, self.model.neighbors(across_regions=True))
         d = self.model.nodes[edges[:, 1]] - self.model.nodes[edges[:, 0]]
@@ -98,9 +104,10 @@ class ModelProblem(Conditions):
         return edges, normal
 
     def nodal_load(self) -> np.ndarray:
-        """The nodes' share of the tractions (3-point Gauss rule on each edge, exact
-        up to quadratic tractions) and of the body forces (one value per cell, at its
-        node), on the reference configuration.
+        """The nodes' share of the tractions (3-point Gauss rule on each edge, a
+        degree-4 rule on each 3-D boundary triangle: exact up to quadratic tractions)
+        and of the body forces (one value per cell, at its node), on the reference
+        configuration.
 
         Returns
         -------
@@ -113,6 +120,9 @@ class ModelProblem(Conditions):
         x = self.model.nodes
         for traction in self.tractions:
             edges, normal, t = traction.edges, traction.normal, traction.value
+            if d == 3:
+                f += triangle_loads(x, edges, normal, t)
+                continue
             a, b = x[edges[:, 0]], x[edges[:, 1]]
             length = np.linalg.norm(b - a, axis=1)
             for sk, wk in zip(s, w):
@@ -122,5 +132,33 @@ class ModelProblem(Conditions):
                 np.add.at(f, edges[:, 1], (wk * sk * length)[:, None] * tr)
         cells = self.cells
         for b in self.body_forces_at(x[cells.node]):
-            np.add.at(f, cells.node, cells.area[:, None] * b)
+            np.add.at(f, cells.node, cells.measure[:, None] * b)
         return f
+
+
+def triangle_loads(x: np.ndarray, faces: np.ndarray, normal: np.ndarray, t) -> np.ndarray:
+    """The nodes' share ``int t N_a dA`` of a traction on boundary triangles, where the
+    shape functions are linear between the three nodes of each face.
+
+    Parameters
+    ----------
+    x : (n, 3) ndarray
+    faces : (e, 3) int64 ndarray
+    normal : (e, 3) ndarray
+        Outward unit normals.
+    t : (3,) array_like or callable ``(x, nrm) -> (q, 3)``
+
+    Returns
+    -------
+    (n, 3) ndarray
+    """
+    ref, w = get_quadrature(RefTri, 4)                   # reference triangle, area 1/2
+    corners = x[faces]
+    e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+    twice_area = np.linalg.norm(np.cross(e1, e2), axis=1)
+    f = np.zeros_like(x)
+    for r, s, wk in zip(ref[0], ref[1], w):
+        tr = traction_at(t, corners[:, 0] + r * e1 + s * e2, normal)
+        for a, shape in enumerate((1.0 - r - s, r, s)):
+            np.add.at(f, faces[:, a], (wk * shape * twice_area)[:, None] * tr)
+    return f

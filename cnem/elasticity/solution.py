@@ -38,9 +38,9 @@ class CellSolution(Solution):
         cells of a node on an interface), ``(n, ...)``."""
         cells, n = self.cells, len(self.model.nodes)
         values = self._place_values(values)
-        weight = np.bincount(cells.node, weights=cells.area, minlength=n)
+        weight = np.bincount(cells.node, weights=cells.measure, minlength=n)
         flat = values.reshape(len(values), -1)
-        out = np.stack([np.bincount(cells.node, weights=cells.area * col, minlength=n) / weight
+        out = np.stack([np.bincount(cells.node, weights=cells.measure * col, minlength=n) / weight
                         for col in flat.T], axis=1)
         return out.reshape((n,) + values.shape[1:])
 
@@ -175,4 +175,4 @@ class ElasticSolution(CellSolution):
 
     def energy(self) -> float:
         """Strain energy ``1/2 sum_k A_k σ_k · ε_k``."""
-        return 0.5 * float(self.cells.area @ (self.stress * self.strain).sum(axis=1))
+        return 0.5 * float(self.cells.measure @ (self.stress * self.strain).sum(axis=1))

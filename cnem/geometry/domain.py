@@ -329,6 +329,11 @@ class Domain:
         return self._regions
 
     @property
+    def n_regions(self) -> int:
+        """int: the number of material regions (as `cnem.Domain3D` has it)."""
+        return len(self._regions)
+
+    @property
     def cracks(self) -> tuple[np.ndarray, ...]:
         """tuple of (k, 2) ndarray: the crack polylines."""
         return self._cracks

@@ -81,6 +81,11 @@ class Cells:
     def __len__(self):
         return len(self.node)
 
+    @property
+    def measure(self) -> np.ndarray:
+        """``(m,)`` the cells' areas (the volumes of 3-D cells), for dimension-generic code."""
+        return self.area
+
     def subset(self, index: ArrayLike) -> Cells:
         """The cells ``index`` (in that order) as a `Cells` of their own."""
         index = np.asarray(index, dtype=np.int64)

@@ -340,13 +340,15 @@ class Conditions:
                                                                           name)
 
     def boundary_edges(self) -> tuple[np.ndarray, np.ndarray]:
-        """Edges of the outer boundary, holes and crack faces.
+        """Edges of the outer boundary, holes and crack faces (triangles of the boundary
+        surfaces in 3-D).
 
         Returns
         -------
-        edges : (e, 2) int64 ndarray
-            Node pairs, the body on the left (counter-clockwise).
-        normal : (e, 2) ndarray
+        edges : (e, 2) or (e, 3) int64 ndarray
+            Node pairs, the body on the left (counter-clockwise); in 3-D node
+            triples, counter-clockwise seen from outside.
+        normal : (e, d) ndarray
             Outward unit normals.
         """
         raise UnsupportedError(f"{type(self).__name__} has no boundary edges; give loads as "
@@ -360,8 +362,9 @@ class Conditions:
         where : str, callable ``(x, nrm) -> (e,) bool``, or an ``(e,)`` bool mask
             A boundary name (``condition_domain.boundaries``: the edges on it, see
             `named_facets`), or a predicate of the midpoints ``(e, 2)`` and outward
-            unit normals ``(e, 2)`` of the edges of ``boundary_edges()``.
-        t : (2,) array_like, or callable ``(x, nrm) -> (q, 2)``
+            unit normals ``(e, 2)`` of the edges of ``boundary_edges()`` (in 3-D the
+            centroids and normals ``(e, 3)`` of its triangles).
+        t : (d,) array_like, or callable ``(x, nrm) -> (q, d)``
             Traction vectors at boundary points ``x (q, 2)`` with normals
             ``nrm (q, 2)``; each solver integrates them exactly up to quadratic
             tractions along an edge.
@@ -373,7 +376,7 @@ class Conditions:
                             f"give the traction vector, e.g. [{example}], or a pressure p "
                             f"along the outward normal as lambda x, nrm: -p * nrm")
         edges, normal = self.boundary_edges()
-        mid = 0.5 * (x[edges[:, 0]] + x[edges[:, 1]])
+        mid = x[edges].mean(axis=1)          # edge midpoints; triangle centroids in 3-D
         if isinstance(where, str):
             pick = self.named_facets(where)
         else:
