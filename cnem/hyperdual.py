@@ -262,14 +262,15 @@ def power(x: HyperDual | ArrayLike, p: HyperDual | ArrayLike) -> HyperDual | np.
 
 
 def _vectors(a, b, what):
-    """Check two vector arrays (last axis = components) of equal length; return them."""
-    a, b = (v if isinstance(v, HyperDual) else np.asarray(v, dtype=np.float64) for v in (a, b))
+    """Check two vector arrays (last axis = components) of equal length, each a HyperDual
+    or real (`_real_operand`); return them."""
+    a, b = _real_operand(a, what, "a"), _real_operand(b, what, "b")
     if a.ndim == 0 or b.ndim == 0 or a.shape[-1] != b.shape[-1]:
         raise HyperDualError(
-            f"{what}: expected two arrays of vectors with the components on the last axis and the "
-            f"same number of components, got shapes {a.shape} and {b.shape}; put the components "
-            f"last (shape (..., d)) in both")
-    _broadcast([a.shape[:-1], b.shape[:-1]], what)
+            f"{what} arguments a and b: expected two arrays of vectors with the components on "
+            f"the last axis and the same number of components, got shapes {a.shape} and "
+            f"{b.shape}; put the components last (shape (..., d)) in both")
+    _broadcast([a.shape[:-1], b.shape[:-1]], f"{what} arguments a and b")
     return a, b
 
 
@@ -296,6 +297,10 @@ def dot(a: HyperDual | ArrayLike, b: HyperDual | ArrayLike) -> HyperDual | np.nd
 
 def norm(a: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
     """Euclidean norm over the last axis: ``(..., d) -> (...)``."""
+    a = _real_operand(a, "hd.norm", "a")
+    if a.ndim == 0:
+        raise HyperDualError("hd.norm argument a: expected vectors with the components on the "
+                             "last axis, shape (..., d), got a number; pass e.g. [x, y]")
     return sqrt(dot(a, a))
 
 
@@ -403,23 +408,35 @@ def inv(a: HyperDual | ArrayLike) -> HyperDual | np.ndarray:
                        else np.asarray(size)[..., None, None])
 
 
+def _items(items, what):
+    """``items`` (a sequence of HyperDuals or real arrays, `_real_operand`) as a list of
+    HyperDuals."""
+    try:
+        items = list(items)
+    except TypeError:                        # a number: nothing to iterate over
+        raise HyperDualError(f"{what} argument items: expected a sequence of HyperDuals or "
+                             f"arrays, got {type(items).__name__}; pass e.g. [a, b]") from None
+    return [HyperDual(_real_operand(v, what, f"items[{i}]")) if not isinstance(v, HyperDual)
+            else v for i, v in enumerate(items)]
+
+
 def stack(items: Sequence[HyperDual | ArrayLike], axis: int = -1) -> HyperDual:
     """Stack HyperDuals (or reals) of broadcast-compatible shapes along a new ``axis``."""
-    items = [v if isinstance(v, HyperDual) else HyperDual(v) for v in items]
-    shape = _broadcast([v.shape for v in items], "hd.stack")
+    items = _items(items, "hd.stack")
+    shape = _broadcast([v.shape for v in items], "hd.stack argument items")
     return HyperDual(*(np.stack([np.broadcast_to(getattr(v, p), shape) for v in items], axis)
                        for p in _PARTS))
 
 
 def concatenate(items: Sequence[HyperDual | ArrayLike], axis: int = -1) -> HyperDual:
     """Join HyperDuals (or reals) along the existing ``axis`` (default the last, components)."""
-    items = [v if isinstance(v, HyperDual) else HyperDual(v) for v in items]
+    items = _items(items, "hd.concatenate")
     try:
         return HyperDual(*(np.concatenate([getattr(v, p) for v in items], axis)
                            for p in _PARTS))
     except ValueError as exc:      # includes numpy AxisError
-        raise HyperDualError(f"hd.concatenate along axis {axis}: expected shapes equal except on "
-                             f"that axis, got {[v.shape for v in items]} ({exc})") from None
+        raise HyperDualError(f"hd.concatenate argument items along axis {axis}: expected "
+                             f"shapes equal except on that axis, got {[v.shape for v in items]} ({exc})") from None
 
 
 def _check_output(out, shape, what, hint=""):

@@ -84,6 +84,19 @@ def test_names_off_the_boundary_are_refused():
     assert dom.on_boundary([[0.5, 0.0], [0.1, 0.0]], "base").tolist() == [True, False]
 
 
+@pytest.mark.parametrize("polyline, where", [
+    ([[0, 0], [1 + 1e-3j, 0]], r"boundaries\['base'\]: expected real numbers, received complex"),
+    (np.ones((2, 2), dtype=bool), r"boundaries\['base'\]: expected real numbers, received bool"),
+    ([[[0, 0], [1, 0]], [[1, 0], [1, 0.5], [1, 1j]]],      # ragged: the polyline is named
+     r"boundaries\['base'\] polyline 1: expected real numbers, received complex")])
+def test_named_coordinates_that_are_not_real_are_refused(polyline, where):
+    """Complex coordinates lost their imaginary part (or raised a bare TypeError) and
+    booleans became a zero-length segment at a corner."""
+    square = [[0, 0], [1, 0], [1, 1], [0, 1]]
+    with pytest.raises(cnem.GeometryError, match=where):
+        cnem.Domain(square, boundaries={"base": polyline})
+
+
 def test_traction_and_dirichlet_by_name_equal_predicates():
     dom = cnem.geometry.plate_with_hole(2.0, 1.0, 0.2)
     model = cnem.discretize(cnem.nodes.irregular(dom, 0.08, seed=3))

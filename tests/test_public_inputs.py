@@ -86,8 +86,7 @@ NOT_ENTRY_POINTS = {
     # inside the energies of the PD and finite-strain materials
     **{f"cnem.hyperdual.{name}": "elementwise hyper-dual math (NumPy semantics)"
        for name in ("sqrt", "exp", "log", "sin", "cos", "tan", "arcsin", "arccos", "arctan",
-                    "sinh", "cosh", "tanh", "power", "dot", "cross", "norm", "stack",
-                    "concatenate")},
+                    "sinh", "cosh", "tanh", "power")},
 }
 
 
@@ -143,6 +142,19 @@ PUBLIC = _public_callables()
 _ARRAY_WORDS = re.compile(r"ArrayLike|ndarray|Sequence\[float|tuple\[float")
 
 
+def _without_callables(text):
+    """An annotation's text without its ``Callable[...]`` parts (brackets matched, so that
+    ``Callable[[str], np.ndarray]`` goes whole: a callable returning an array is no array)."""
+    while (start := text.find("Callable[")) >= 0:
+        depth, end = 0, start + len("Callable")
+        for end in range(end, len(text)):
+            depth += {"[": 1, "]": -1}.get(text[end], 0)
+            if depth == 0:
+                break
+        text = text[:start] + text[end + 1:]
+    return text
+
+
 def _array_parameters(obj):
     """Names of the parameters of ``obj`` whose annotation names an array of numbers
     (a callable's return annotation does not count)."""
@@ -153,8 +165,7 @@ def _array_parameters(obj):
     names = []
     for name, par in signature.parameters.items():
         text = par.annotation if isinstance(par.annotation, str) else str(par.annotation)
-        text = re.sub(r"Callable\[.*?\]\]?", "", text)
-        if _ARRAY_WORDS.search(text):
+        if _ARRAY_WORDS.search(_without_callables(text)):
             names.append(name)
     return names
 
@@ -165,8 +176,15 @@ METHODS = _public_methods(PUBLIC)
 ENTRY_POINTS = [name for name in [*PUBLIC, *METHODS] if name not in NOT_ENTRY_POINTS]
 
 
+def _entry(name):
+    """The entry point an example calls: ``"f (on a Domain3D)"`` is a second example of
+    ``f``, with other arguments (the node clouds on a 3-D body)."""
+    return name.split(" (")[0]
+
+
 def _function(name):
     """The function behind an entry point (a method's, unbound)."""
+    name = _entry(name)
     if name in METHODS:
         cls, method = METHODS[name]
         return getattr(cls, method)
@@ -193,13 +211,17 @@ def fx():
     pd_prob.add_body_force([1.0, 0.0])
     pd_sol = pd_prob.solve_static()
     inside = np.array([[0.3, 0.3], [0.7, 0.8]])
+    box = cnem.geometry.box((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
+    cloud3 = cnem.nodes.regular(box, 0.5)
     p1 = cnem.fem.P1Elasticity(cnem.Domain(square), (1.0, 0.3), nodes=20)
     p1.add_dirichlet(lambda p: p[:, 1] < 1e-9, None)
     p1.add_traction(lambda x, n: x[:, 1] > 1 - 1e-9, [0.0, 1.0])
     return types.SimpleNamespace(p1_sol=p1.solve(), square=square, crack=crack, dom=dom, cloud=cloud, model=model,
                                  prob=prob, sol=sol, lattice=lattice, body=body,
                                  pd_prob=pd_prob, pd_sol=pd_sol, inside=inside,
-                                 tip=np.array([0.5, 0.5]))
+                                 tip=np.array([0.5, 0.5]), box=box, cloud3=cloud3,
+                                 inside3=np.array([[0.3, 0.3, 0.3], [0.7, 0.8, 0.6]]),
+                                 named=cnem.Domain(square, boundaries={"bottom": square[:2]}))
 
 
 def _pd_problem(f):
@@ -244,6 +266,8 @@ _NAN_PER_POINT = ("a law per point: a NaN gradient gives NaN energy and stress t
                   "inverted one does, and Newton names the non-finite residual")
 #: Deformation gradients ``(q, d, d)`` for the hyperelastic laws and hyper-dual matrices.
 _GRADIENTS = np.array([[[1.1, 0.2], [0.0, 0.9]], [[1.0, 0.0], [0.1, 1.2]]])
+#: Two 3-D vectors ``(2, 3)`` for the hyper-dual vector functions.
+_VECTORS = np.array([[1.0, 2.0, 2.0], [0.5, -1.0, 3.0]])
 _WIDE = np.array([[[1.0, 0.5, 0.0], [0.0, 1.0, 0.3]]] * 2)     # (2, 2, 3): not square
 _FIELDS = {("point_data", "nan"): "NaN is the VTU fill value of a field",
            ("cell_data", "nan"): "NaN is the VTU fill value of a field",
@@ -391,7 +415,26 @@ EXAMPLES = {
     "cnem.material.SaintVenantKirchhoff": Example(lambda f: dict(E=1.0, nu=0.3)),
     "cnem.Hyperelasticity": Example(
         lambda f: dict(model=f.model, materials=cnem.material.NeoHookean(1.0, 1.5))),
+    "cnem.Domain3D": Example(lambda f: dict(regions=cnem.geometry.shapes3d.box_surface(
+        np.zeros(3), np.ones(3)))),
+    "cnem.geometry.box": Example(lambda f: dict(lo=np.array([0.0, 0.0, 0.0]),
+                                                hi=np.array([1.0, 2.0, 3.0]))),
+    "cnem.geometry.sphere": Example(
+        lambda f: dict(radius=1.0, center=np.array([1.0, 2.0, 3.0]), subdivisions=1)),
+    "cnem.geometry.hollow_sphere": Example(
+        lambda f: dict(inner=0.5, outer=1.0, center=np.array([1.0, 2.0, 3.0]),
+                       subdivisions=1)),
+    "cnem.geometry.cylinder": Example(
+        lambda f: dict(radius=1.0, height=2.0, base=np.array([1.0, 2.0, 3.0]), segments=8)),
     # methods ("self" is the object called)
+    "cnem.Domain.on_boundary": Example(
+        lambda f: dict(self=f.named, points=f.inside, name="bottom")),
+    **{f"cnem.Domain3D.{method}": Example(lambda f: dict(self=f.box, points=f.inside3))
+       for method in ("contains", "region_of", "to_local")},
+    "cnem.Domain3D.to_global": Example(
+        lambda f: dict(self=f.box, local=f.box.to_local(f.cloud3.points))),
+    "cnem.Domain3D.near_surface": Example(
+        lambda f: dict(self=f.box, points=f.inside3, distance=0.35)),
     "cnem.Domain.contains": Example(lambda f: dict(self=f.dom, points=f.inside)),
     "cnem.Domain.region_of": Example(lambda f: dict(self=f.dom, points=f.inside)),
     "cnem.Model.shape_functions": Example(
@@ -453,6 +496,17 @@ EXAMPLES = {
     "cnem.spatial.RTree.query_ball": Example(
         lambda f: dict(self=cnem.spatial.RTree.from_points(f.lattice), points=f.inside,
                        r=0.3)),
+    "cnem.hyperdual.dot": Example(lambda f: dict(a=_VECTORS, b=_VECTORS[::-1]),
+                                  skip={"nan": _NAN_IN_NAN_OUT}),
+    "cnem.hyperdual.cross": Example(lambda f: dict(a=_VECTORS, b=_VECTORS[::-1]),
+                                    skip={"nan": _NAN_IN_NAN_OUT}),
+    "cnem.hyperdual.norm": Example(lambda f: dict(a=_VECTORS),
+                                   skip={"nan": _NAN_IN_NAN_OUT,
+                                         "shape": "vectors of any length d are valid"}),
+    **{f"cnem.hyperdual.{name}": Example(
+        lambda f: dict(items=[_VECTORS[0], _VECTORS[1]]),
+        skip={"nan": _NAN_IN_NAN_OUT, "shape": "items of any one shape are valid"})
+       for name in ("stack", "concatenate")},
     "cnem.pd.Problem.add_velocity": Example(
         lambda f: dict(self=_pd_problem(f), where=np.array([24]), component=0, value=1.0)),
     "cnem.pd.Problem.run_dynamic": Example(
@@ -464,12 +518,26 @@ EXAMPLES = {
         lambda f: dict(self=f.pd_prob, initial=np.zeros((len(f.lattice), 2)))),
 }
 
+_3D = " (on a Domain3D)"
+EXAMPLES.update({
+    f"cnem.geometry.nodes.{kind}{_3D}": Example(lambda f: dict(domain=f.box, h=0.5))
+    for kind in ("regular", "irregular")})
+EXAMPLES.update({
+    f"cnem.geometry.nodes.graded{_3D}": Example(
+        lambda f: dict(domain=f.box, h=0.5, near=f.inside3[:1], h_min=0.25)),
+    f"cnem.geometry.nodes.from_points{_3D}": Example(
+        lambda f: dict(domain=f.box, points=f.cloud3.points)),
+})
+
+#: What the tests call: every entry point, and the second examples of some.
+CALLS = ENTRY_POINTS + [name for name in EXAMPLES if _entry(name) != name]
+
 
 def _cases():
     """``(entry point, parameter, bad kind)`` for every array parameter of every entry point;
     an entry point without an example gives one case that fails."""
     cases = []
-    for name in ENTRY_POINTS:
+    for name in CALLS:
         if name not in EXAMPLES:
             cases.append(pytest.param(name, None, None, id=f"{name}-missing-example"))
             continue
@@ -527,6 +595,7 @@ def _arguments(name, fixtures):
 def _call(name, kwargs):
     """The entry point ``name`` called with ``kwargs`` (a method on ``kwargs["self"]``, or
     on its class for a class method), positional-only parameters passed by position."""
+    name = _entry(name)
     if name in METHODS:
         cls, method = METHODS[name]
         obj = getattr(kwargs.pop("self"), method) if "self" in kwargs else getattr(cls, method)
@@ -540,7 +609,7 @@ def _call(name, kwargs):
         return obj(*args, **kwargs)
 
 
-@pytest.mark.parametrize("name", ENTRY_POINTS)
+@pytest.mark.parametrize("name", CALLS)
 def test_example_call_is_valid(name, fixtures):
     """The table's call runs: a bad value refused below is refused for itself, not because
     the example was wrong."""
@@ -548,7 +617,8 @@ def test_example_call_is_valid(name, fixtures):
 
 
 def test_table_names_only_public_callables():
-    stale = sorted((set(EXAMPLES) | set(NOT_ENTRY_POINTS)) - set(PUBLIC) - set(METHODS))
+    stale = sorted({_entry(name) for name in [*EXAMPLES, *NOT_ENTRY_POINTS]} - set(PUBLIC)
+                   - set(METHODS))
     assert not stale, f"the table names callables that are not public (any more): {stale}"
 
 

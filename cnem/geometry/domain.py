@@ -120,6 +120,19 @@ def _axis_box(polygon):
     return (x0, y0, x1, y1) if (vertical | horizontal).all() else None
 
 
+def _points_xy(points):
+    """``points`` as a ``(p, 2)`` float array (one point ``(2,)`` as one row), checked by
+    name: real, finite, rows of two."""
+    pts = check_array("points", points, error=GeometryError,
+                      fix="pass finite real coordinates, one row (x, y) per point")
+    if pts.shape == (2,):
+        pts = pts[None]
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise GeometryError(f"points: expected a (2,) or (p, 2) array, received shape "
+                            f"{pts.shape}")
+    return pts
+
+
 def _is_single_polygon(obj):
     """Whether ``obj`` is one polygon rather than a list of polygons."""
     if isinstance(obj, Polygon):
@@ -404,14 +417,21 @@ class Domain:
 
         Parameters
         ----------
-        points : (p, 2) array_like
+        points : (p, 2) or (2,) array_like
         name : str, optional
 
         Returns
         -------
         (p,) bool ndarray
+
+        Raises
+        ------
+        GeometryError
+            Points that are not finite real ``(p, 2)`` coordinates.
+        ConditionError
+            An unknown name (the error lists the known ones).
         """
-        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        pts = _points_xy(points)
         if name is None:
             ring = shapely.transform(self._union.boundary, self._frame.to_local)
             return shapely.dwithin(ring, shapely.points(self._frame.to_local(pts)),
@@ -479,13 +499,7 @@ class Domain:
         (p,) int64 ndarray
             The lowest region index for points on an interface.
         """
-        pts = check_array("points", points, error=GeometryError,
-                          fix="pass finite real coordinates, one row (x, y) per point")
-        if pts.shape == (2,):
-            pts = pts[None]
-        if pts.ndim != 2 or pts.shape[1] != 2:
-            raise GeometryError(f"points: expected a (2,) or (p, 2) array, received shape "
-                                f"{pts.shape}")
+        pts = _points_xy(points)
         out = np.full(len(pts), -1, dtype=np.int64)
         for i in reversed(range(len(self._regions))):
             box = _axis_box(self._regions[i])

@@ -19,7 +19,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from .. import config
-from ..errors import GeometryError, check_points, check_real
+from ..errors import GeometryError, check_array, check_points, check_real
 from .surface_checks import (check_closed, check_faces, check_self_intersections,
                              face_components)
 from .surface_queries import (face_tree, faces_within, region_weights, region_winding,
@@ -340,12 +340,26 @@ class Domain3D:
 
     def to_local(self, points: ArrayLike) -> np.ndarray:
         """(p, 3) ``points`` in the domain's local frame: centred on its bounding box and
-        divided by `size` (the frame every geometric test runs in)."""
-        return (np.asarray(points, dtype=float) - self._centre) / self.size
+        divided by `size` (the frame every geometric test runs in).
+
+        Raises
+        ------
+        GeometryError
+            ``points`` that are not finite real ``(p, 3)`` coordinates.
+        """
+        pts = check_points("points", points, dims=(3,), error=GeometryError)
+        return (pts - self._centre) / self.size
 
     def to_global(self, local: ArrayLike) -> np.ndarray:
-        """(p, 3) points back from the local frame (`to_local`)."""
-        return np.asarray(local, dtype=float) * self.size + self._centre
+        """(p, 3) points back from the local frame (`to_local`).
+
+        Raises
+        ------
+        GeometryError
+            ``local`` that is not finite real ``(p, 3)`` coordinates.
+        """
+        return check_points("local", local, dims=(3,), error=GeometryError) * self.size \
+            + self._centre
 
     @property
     def local_vertices(self) -> np.ndarray:
@@ -359,14 +373,24 @@ class Domain3D:
         ----------
         points : (p, 3) ndarray
         distance : float or (p,) ndarray
+            Non-negative.
 
         Returns
         -------
         (p,) bool ndarray
+
+        Raises
+        ------
+        GeometryError
+            Points that are not finite real ``(p, 3)`` coordinates, or a distance that is
+            not one non-negative number or one per point.
         """
         local = self.to_local(points)
-        point, _, _ = faces_within(local, self._local, self.faces,
-                                   np.asarray(distance, dtype=float) / self.size, self._tree)
+        distance = check_array("distance", distance, shape=(len(local),), broadcast=True,
+                               nonnegative=True, error=GeometryError,
+                               fix="pass one number, or one per point")
+        point, _, _ = faces_within(local, self._local, self.faces, distance / self.size,
+                                   self._tree)
         out = np.zeros(len(local), dtype=bool)
         out[point] = True
         return out

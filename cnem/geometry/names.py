@@ -21,14 +21,17 @@ import numpy as np
 import shapely
 
 from .._predicates import Frame
-from ..errors import ConditionError, GeometryError
+from ..errors import ConditionError, GeometryError, check_real
 
 __all__ = ["as_named_segments", "check_named_segments", "check_region_names", "points_on_segments",
            "unknown_name"]
 
 
 def _polylines(value, name):
-    """The polylines of one name: one ``(k, 2)`` polyline or a list of them."""
+    """The polylines of one name: one ``(k, 2)`` polyline or a list of them (complex
+    numbers and booleans refused by name)."""
+    what = f"boundaries[{name!r}]"
+    check_real(what, value, error=GeometryError)       # a ragged list: each polyline below
     try:
         arr = np.asarray(value, dtype=float)
     except (ValueError, TypeError):
@@ -38,7 +41,8 @@ def _polylines(value, name):
     if arr is not None and arr.ndim == 3:
         return list(arr)
     if arr is None and isinstance(value, (list, tuple)):
-        return [np.asarray(v, dtype=float) for v in value]
+        return [np.asarray(check_real(f"{what} polyline {k}", v, error=GeometryError),
+                           dtype=float) for k, v in enumerate(value)]
     raise GeometryError(f"boundaries[{name!r}]: expected a (k, 2) polyline or a list of them, "
                         f"received {type(value).__name__} of shape {np.shape(value)}")
 
