@@ -133,7 +133,7 @@ def test_degenerate_triangles_leave_the_hierarchy_on_k(monkeypatch, caplog):
     def degenerate(model, *, vector=False):
         raise ValueError("triangle_basis: 1 of 10 triangles are degenerate or clockwise")
 
-    monkeypatch.setattr(elasticity, "triangle_basis", degenerate)
+    monkeypatch.setattr(elasticity, "simplex_basis", degenerate)
     prob = cnem.Elasticity(model, (E, NU))
     prob.add_dirichlet(lambda p: p[:, 0] < model.nodes[:, 0].min() + 1e-9, None)
     prob.add_traction(lambda x, nrm: nrm[:, 0] > 0.5, [3.0, 1.0])

@@ -20,7 +20,7 @@ their centroid alone, exact for the linear fields the shape functions reproduce.
 
 from __future__ import annotations
 
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
@@ -30,7 +30,7 @@ from skfem.refdom import RefTri
 from ..errors import GeometryError
 from .gradients import SmoothedGradient
 
-__all__ = ["facet_rule", "facet_gradient", "pyramid_sub_cells"]
+__all__ = ["facet_rule", "facet_gradient", "pyramid_sub_cells", "cell_gradient_3d", "sub_cell_gradient_3d"]
 
 #: Shape functions at points: ``evaluate(points (q, 3)) -> csr (q, n)``.
 Evaluate = Callable[[np.ndarray], sp.csr_matrix]
@@ -188,3 +188,50 @@ def _edge_keys(cell, p, q):
     """One hashable key per (cell, directed edge) from exact coordinates (rows of bytes)."""
     rows = np.column_stack([cell.astype(np.float64), p, q])
     return np.ascontiguousarray(rows).view(np.dtype((np.void, rows.dtype.itemsize * 7))).ravel()
+
+
+def cell_gradient_3d(model: Any, cells: Any, order: int = 2) -> SmoothedGradient:
+    """``B~`` of a 3-D model's cells (`facet_gradient` on their facet triangles, the
+    model's shape functions).
+
+    Parameters
+    ----------
+    model : Model3D
+    cells : Cells3D
+        ``model.cells`` or other cells of the model with facets.
+    order : int
+        Degree of the triangle rule on the facets.
+
+    Returns
+    -------
+    SmoothedGradient
+    """
+    return facet_gradient(cells.facet_triangles, cells.facet_cell, cells.facet_normal,
+                          cells.volume, model.shape_functions, order=order)
+
+
+def sub_cell_gradient_3d(model: Any, order: int = 2) -> tuple[Any, SmoothedGradient]:
+    """The pyramid sub-cells of a 3-D model's cells and their ``B~``, from the cells'
+    facet points and one point on each spoke.
+
+    Parameters
+    ----------
+    model : Model3D
+    order : int
+        Degree of the triangle rule on the facets.
+
+    Returns
+    -------
+    sub : Cells3D
+        One cell per kept pyramid, with its parent's node and region.
+    grad : SmoothedGradient
+    """
+    cells = model.cells
+    parent, kept, volume, spokes = pyramid_sub_cells(model.nodes[cells.node],
+                                                     cells.facet_triangles, cells.facet_cell)
+    sub = type(cells)(cells.node[parent], cells.region[parent], volume,
+                      cells.facet_triangles[kept], np.arange(len(kept), dtype=np.int64),
+                      cells.facet_normal[kept])
+    grad = facet_gradient(sub.facet_triangles, sub.facet_cell, sub.facet_normal, volume,
+                          model.shape_functions, order=order, spokes=spokes)
+    return sub, grad

@@ -11,18 +11,19 @@ the SCNI matrix itself (see `cnem.solvers.linsolve.solve_spd`).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.sparse as sp
 
+from .. import config
 from ..errors import GeometryError
 from .basis import CellBasis
 
 if TYPE_CHECKING:
     from ..geometry.model import Model
 
-__all__ = ["triangle_basis"]
+__all__ = ["triangle_basis", "tetrahedron_basis", "simplex_basis"]
 
 
 def triangle_basis(model: Model, *, vector: bool = False) -> CellBasis:
@@ -62,3 +63,56 @@ def triangle_basis(model: Model, *, vector: bool = False) -> CellBasis:
 
     return CellBasis.from_operators(model, op(np.full((t, 3), 1.0 / 3.0)), (op(dx), op(dy)),
                                     0.5 * twice, corners.mean(axis=1), vector=vector)
+
+
+def tetrahedron_basis(model: Any, *, vector: bool = False) -> tuple[CellBasis, np.ndarray]:
+    """The P1 hat functions of a 3-D model's nodes on its tetrahedra, one-point rule.
+
+    Parameters
+    ----------
+    model : Model3D
+        ``n`` nodes, ``t`` positively oriented tetrahedra.
+    vector : bool
+
+    Returns
+    -------
+    basis : CellBasis
+        Over the tetrahedra of positive volume (flat slivers of cospherical nodes
+        carry no volume and are left out): values 1/4 at the corners and the
+        constant gradients.
+    keep : (t,) bool ndarray
+        Which of ``model.tetrahedra`` it holds.
+    """
+    corners = model.nodes[model.tetrahedra]                        # (t, 4, 3)
+    edges = corners[:, 1:] - corners[:, :1]
+    six_v = np.linalg.det(edges)
+    size = np.linalg.norm(edges, axis=2).max(axis=1)
+    keep = six_v > config.SHAPE_TOL * size ** 3
+    tets, edges, six_v = model.tetrahedra[keep], edges[keep], six_v[keep]
+    inv = np.linalg.inv(edges)                                    # rows: d lambda_1..3 / dx
+    grad = np.concatenate([-inv.sum(axis=2)[:, None, :], np.transpose(inv, (0, 2, 1))], axis=1)
+    t, n = len(tets), len(model.nodes)
+    indptr = np.arange(0, 4 * t + 1, 4)
+    cols = tets.reshape(-1)
+
+    def op(values):
+        return sp.csr_matrix((values.reshape(-1), cols, indptr), shape=(t, n))
+
+    return CellBasis.from_operators(model, op(np.full((t, 4), 0.25)),
+                                    tuple(op(grad[:, :, i]) for i in range(3)), six_v / 6.0,
+                                    corners[keep].mean(axis=1), vector=vector), keep
+
+
+def simplex_basis(model: Any, *, vector: bool = False) -> tuple[CellBasis, np.ndarray]:
+    """P1 on the model's own simplices: `triangle_basis` in 2-D, `tetrahedron_basis` in 3-D.
+
+    Returns
+    -------
+    basis : CellBasis
+    region : (s,) int64 ndarray
+        The region of each of the basis' simplices.
+    """
+    if model.nodes.shape[1] == 3:
+        basis, keep = tetrahedron_basis(model, vector=vector)
+        return basis, model.tet_region[keep]
+    return triangle_basis(model, vector=vector), model.triangle_region

@@ -19,7 +19,7 @@ from ..assembly.basis import spread_component
 from ..assembly.quadrature import cell_quadrature
 from ..assembly.subdivision import subdivide, tip_cells
 from ..assembly.gradients import GradientCache
-from ..assembly.triangles import triangle_basis
+from ..assembly.triangles import simplex_basis
 from ..solvers.constrained import solve_constrained
 from ..errors import InputError
 from ..material import check_plane, check_stiffness, lame, moduli, parse_materials, stiffness_matrix
@@ -324,7 +324,7 @@ class Elasticity(ModelProblem):
         return options
 
     def preconditioner_matrix(self, dofs: np.ndarray | None = None) -> sp.spmatrix | None:
-        """The P1 stiffness of the nodes on the model's triangles (same materials):
+        """The P1 stiffness of the nodes on the model's triangles or tetrahedra (same materials):
         where smoothed aggregation is built for large solves (see
         `cnem.assembly.triangles`).
 
@@ -342,12 +342,12 @@ class Elasticity(ModelProblem):
         if self.enrichment is not None:
             return None
         try:
-            basis = triangle_basis(self.model, vector=True)
+            basis, region = simplex_basis(self.model, vector=True)
         except ValueError as err:
             log.warning("no P1 preconditioner matrix (%s): smoothed aggregation on K", err)
             return None
         lam, mu = lame(*self.materials.T, self.plane)
-        P = elasticity_form.assemble(basis, groups=self.model.triangle_region, lam=lam, mu=mu)
+        P = elasticity_form.assemble(basis, groups=region, lam=lam, mu=mu)
         return P if dofs is None else principal_submatrix(P, dofs)
 
     # -- solve --------------------------------------------------------------------------
