@@ -1,0 +1,601 @@
+"""Numba kernels of the constrained 3-D natural-neighbour coordinates (arrays and scalars only).
+
+For a query point ``x`` in tetrahedron ``t`` of a constrained Delaunay
+tetrahedrisation (every face between regions, on the boundary or listed as a
+constraint has no neighbour in ``nb``):
+
+* ``x`` at a vertex: the Kronecker delta;
+* ``x`` on a constraint face: linear interpolation between its three nodes
+  (barycentric), on a constraint edge: between its two ends;
+* otherwise the Bowyer-Watson cavity of ``x``: tetrahedra whose circumsphere
+  holds ``x`` strictly, reached from ``t`` across unconstrained faces that
+  ``x`` does not see from behind, then shelled until ``x`` sees every
+  boundary face from the inside (the cavity is star-shaped from ``x``: every
+  natural neighbour is visible). The natural neighbours are its vertices.
+
+Everything is computed relative to ``x``. The Voronoi vertex of the new
+tetrahedron ``(x, f)`` over a cavity-boundary face ``f = (a, b, c)`` is
+``q_f = (|a|^2 b x c + |b|^2 c x a + |c|^2 a x b) / (2 a . b x c)`` and
+moves with ``x`` as ``dq_f/dx = s_f q_f^T`` with
+``s_f = (b x c + c x a + a x b) / (a . b x c)``.
+
+* Laplace: ``w_i = A_i . p_i / |p_i|^2`` with ``A_i`` the vector area of the
+  Voronoi facet between ``x`` and ``i`` (the polygon of the ``q_f`` of the
+  boundary faces around ``i``, signed, so that partition of unity and linear
+  reproduction hold to round-off even where the facet degenerates) and
+  ``p_i = x_i - x``.
+* Sibson: ``w_i = V_i`` the volume of ``x``'s cell taken from ``i``'s, by
+  the divergence theorem about the facet's foot ``p_i / 2``:
+  ``V_i = 1/6 sum_j P_ij . p_j`` over the pieces ``P_ij`` of the old facets
+  ``(i, j)`` inside the new cell (chains of old circumcentres of the cavity
+  tetrahedra around the edge ``(i, j)``, closed by ``q_f``). Gradient
+  ``grad V_i = M_i / |p_i|`` with ``M_i`` the first moment of facet ``i``.
+"""
+
+import numba
+import numpy as np
+
+from .. import _compile  # noqa: F401  (says once when the kernels compile)
+from .._parallel import parallel_kernel
+
+#: Row kinds.
+CAVITY, AT_NODE, ON_FACE, ON_EDGE, FAILED = 0, 1, 2, 3, 4
+
+#: Largest cavity (tetrahedra); its boundary has at most twice as many faces.
+MAX_CAVITY = 1024
+_HASH = 4096                     # half-edge table, a power of two > 3 * 2 * MAX_CAVITY / 2
+
+#: Faces opposite each vertex of a positive tetrahedron, oriented outwards.
+FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]], dtype=np.int64)
+#: The six edges (i, j) of a tetrahedron, with (k, l) so that (i, j, k, l) is even.
+PAIRS = np.array([[0, 1, 2, 3], [0, 2, 3, 1], [0, 3, 1, 2], [1, 2, 0, 3], [1, 3, 2, 0],
+                  [2, 3, 0, 1]], dtype=np.int64)
+
+#: Relative size of a determinant under which a point counts as on a plane.
+PLANE_RTOL = 1e-10
+#: Relative size of the in-sphere determinant under which a point counts as on a sphere.
+SPHERE_RTOL = 1e-14
+
+
+@numba.njit(cache=True, inline="always")
+def _det(ax, ay, az, bx, by, bz, cx, cy, cz):
+    return ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx)
+
+
+@numba.njit(cache=True, inline="always")
+def _face_side(nodes, a, b, c, x):
+    """``det[a - x, b - x, c - x]`` (> 0: ``x`` on the inner side of the outward face
+    ``(a, b, c)``) and its permanent (the scale of its round-off)."""
+    ax, ay, az = nodes[a, 0] - x[0], nodes[a, 1] - x[1], nodes[a, 2] - x[2]
+    bx, by, bz = nodes[b, 0] - x[0], nodes[b, 1] - x[1], nodes[b, 2] - x[2]
+    cx, cy, cz = nodes[c, 0] - x[0], nodes[c, 1] - x[1], nodes[c, 2] - x[2]
+    det = _det(ax, ay, az, bx, by, bz, cx, cy, cz)
+    la = np.sqrt(ax * ax + ay * ay + az * az)
+    lb = np.sqrt(bx * bx + by * by + bz * bz)
+    lc = np.sqrt(cx * cx + cy * cy + cz * cz)
+    return det, la * lb * lc
+
+
+@numba.njit(cache=True)
+def _in_sphere(nodes, tet, t, x):
+    """Whether ``x`` lies strictly inside the circumsphere of positive tetrahedron ``t``
+    (filtered: when round-off could flip the sign the answer is no, consistently)."""
+    p = np.empty((4, 4))
+    for k in range(4):
+        v = tet[t, k]
+        for d in range(3):
+            p[k, d] = nodes[v, d] - x[d]
+        p[k, 3] = p[k, 0] * p[k, 0] + p[k, 1] * p[k, 1] + p[k, 2] * p[k, 2]
+    det = 0.0
+    perm = 0.0
+    for k in range(4):                       # expansion along the lifted column
+        a, b, c = FACES[k, 0], FACES[k, 1], FACES[k, 2]
+        m = _det(p[a, 0], p[a, 1], p[a, 2], p[b, 0], p[b, 1], p[b, 2], p[c, 0], p[c, 1], p[c, 2])
+        det += p[k, 3] * m
+        perm += p[k, 3] * (abs(p[a, 0]) + abs(p[a, 1]) + abs(p[a, 2])) * \
+            (abs(p[b, 0]) + abs(p[b, 1]) + abs(p[b, 2])) * (abs(p[c, 0]) + abs(p[c, 1]) + abs(p[c, 2]))
+    # sum_k |p_k|^2 det(outward face opposite k) = -6 volume * power of x: > 0 inside
+    return det > SPHERE_RTOL * perm
+
+
+@numba.njit(cache=True)
+def _special(nodes, tet, nb, cedges, t, x, tol):
+    """Node, constraint-face or constraint-edge case: ``(kind, a, b, c, la, lb, lc)``."""
+    n = nodes.shape[0]
+    for k in range(4):
+        v = tet[t, k]
+        d2 = 0.0
+        for d in range(3):
+            d2 += (nodes[v, d] - x[d]) ** 2
+        if d2 <= tol * tol:
+            return AT_NODE, v, v, v, 1.0, 0.0, 0.0
+    for k in range(4):
+        if nb[t, k] >= 0:
+            continue
+        a, b, c = tet[t, FACES[k, 0]], tet[t, FACES[k, 1]], tet[t, FACES[k, 2]]
+        e1 = nodes[b] - nodes[a]
+        e2 = nodes[c] - nodes[a]
+        nrm = np.cross(e1, e2)
+        n2 = nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]
+        r = nodes[a] - x
+        dist = (r[0] * nrm[0] + r[1] * nrm[1] + r[2] * nrm[2]) / np.sqrt(n2)
+        if abs(dist) > tol:
+            continue
+        lam = np.empty(3)
+        for m in range(3):            # barycentric coordinates of the foot of x
+            u = nodes[tet[t, FACES[k, (m + 1) % 3]]] - x
+            w = nodes[tet[t, FACES[k, (m + 2) % 3]]] - x
+            cr = np.cross(u, w)
+            lam[m] = max((cr[0] * nrm[0] + cr[1] * nrm[1] + cr[2] * nrm[2]) / n2, 0.0)
+        total = lam[0] + lam[1] + lam[2]
+        return ON_FACE, a, b, c, lam[0] / total, lam[1] / total, lam[2] / total
+    for e in range(6):
+        a, b = tet[t, PAIRS[e, 0]], tet[t, PAIRS[e, 1]]
+        key = min(a, b) * n + max(a, b)
+        pos = np.searchsorted(cedges, key)
+        if pos >= cedges.shape[0] or cedges[pos] != key:
+            continue
+        ed = nodes[b] - nodes[a]
+        r = x - nodes[a]
+        l2 = ed[0] * ed[0] + ed[1] * ed[1] + ed[2] * ed[2]
+        s = (r[0] * ed[0] + r[1] * ed[1] + r[2] * ed[2]) / l2
+        off = r - s * ed
+        if off[0] * off[0] + off[1] * off[1] + off[2] * off[2] <= tol * tol:
+            s = min(max(s, 0.0), 1.0)
+            return ON_EDGE, a, b, b, 1.0 - s, s, 0.0
+    return CAVITY, -1, -1, -1, 0.0, 0.0, 0.0
+
+
+@numba.njit(cache=True)
+def _cavity(nodes, tet, nb, t, x, stamp, mark, cav):
+    """The star-shaped constrained cavity of ``x`` from tetrahedron ``t``: its size, or
+    -1 if it does not fit or has to lose ``t``. ``mark[o] == stamp`` for its members."""
+    cav[0] = t
+    mark[t] = stamp
+    size = 1
+    head = 0
+    while head < size:
+        c = cav[head]
+        head += 1
+        for k in range(4):
+            o = nb[c, k]
+            if o < 0 or mark[o] == stamp or mark[o] == -stamp:
+                continue
+            det, perm = _face_side(nodes, tet[c, FACES[k, 0]], tet[c, FACES[k, 1]],
+                                   tet[c, FACES[k, 2]], x)
+            if det < -PLANE_RTOL * perm:        # x sees the face from behind: not visible
+                continue
+            if not _in_sphere(nodes, tet, o, x):
+                mark[o] = -stamp
+                continue
+            if size == cav.shape[0]:
+                return -1
+            mark[o] = stamp
+            cav[size] = o
+            size += 1
+    for _ in range(cav.shape[0]):       # shell: drop tetrahedra with a face x does not face
+        dropped = -1
+        for m in range(size):
+            c = cav[m]
+            for k in range(4):
+                o = nb[c, k]
+                if o >= 0 and mark[o] == stamp:
+                    continue
+                det, perm = _face_side(nodes, tet[c, FACES[k, 0]], tet[c, FACES[k, 1]],
+                                       tet[c, FACES[k, 2]], x)
+                if det <= PLANE_RTOL * perm:
+                    dropped = m
+                    break
+            if dropped >= 0:
+                break
+        if dropped < 0:
+            return size
+        if cav[dropped] == t:
+            return -1
+        mark[cav[dropped]] = -stamp
+        size -= 1
+        cav[dropped] = cav[size]
+    return -1
+
+
+@numba.njit(cache=True, inline="always")
+def _cross(u, v):
+    return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+
+
+@numba.njit(cache=True)
+def _natural_row(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_mark, node_slot,
+                 fq, fs, fv, bf, twin, hkeys, hval, cc, acc, cols, laplace, gradient):
+    """Coordinates from a cavity: the neighbour count, -1 if inconsistent.
+
+    Work arrays: ``fq, fs (F, 3)`` the new Voronoi vertices and their motions,
+    ``fv (F, 3)`` the boundary faces' nodes (outward), ``bf (C, 4)`` boundary-face
+    index of each cavity face (-1 inside), ``twin (F, 3)`` the face across each
+    half-edge, ``hkeys, hval`` the half-edge hash, ``cc (C, 3)`` the cavity's
+    circumcentres, ``acc (N, 14)`` per neighbour: vector area, Sibson volume, Laplace area gradient,
+    Sibson moment, ``|p|^2``, ``p``.
+    """
+    n = nodes.shape[0]
+    nf = 0
+    count = 0
+    for m in range(size):
+        c = cav[m]
+        pos[c] = m
+        for k in range(4):
+            o = nb[c, k]
+            if o >= 0 and mark[o] == stamp:
+                bf[m, k] = -1
+                continue
+            if nf == fq.shape[0]:
+                return -1
+            bf[m, k] = nf
+            pa = nodes[tet[c, FACES[k, 0]]] - x
+            pb = nodes[tet[c, FACES[k, 1]]] - x
+            pc = nodes[tet[c, FACES[k, 2]]] - x
+            bxc, cxa, axb = _cross(pb, pc), _cross(pc, pa), _cross(pa, pb)
+            det = pa[0] * bxc[0] + pa[1] * bxc[1] + pa[2] * bxc[2]
+            a2 = pa[0] * pa[0] + pa[1] * pa[1] + pa[2] * pa[2]
+            b2 = pb[0] * pb[0] + pb[1] * pb[1] + pb[2] * pb[2]
+            c2 = pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2]
+            for d in range(3):
+                fq[nf, d] = (a2 * bxc[d] + b2 * cxa[d] + c2 * axb[d]) / (2.0 * det)
+                fs[nf, d] = (bxc[d] + cxa[d] + axb[d]) / det
+            for e in range(3):
+                v = tet[c, FACES[k, e]]
+                fv[nf, e] = v
+                if node_mark[v] != stamp:
+                    if count == cols.shape[0]:
+                        return -1
+                    node_mark[v] = stamp
+                    node_slot[v] = count
+                    cols[count] = v
+                    for d in range(14):
+                        acc[count, d] = 0.0
+                    p2 = 0.0
+                    for d in range(3):
+                        p2 += (nodes[v, d] - x[d]) ** 2
+                    acc[count, 10] = p2
+                    count += 1
+                key = v * n + tet[c, FACES[k, (e + 1) % 3]]          # half-edge v -> next
+                h = (key * 2654435761) & (_HASH - 1)
+                for _ in range(_HASH):
+                    if hkeys[h] < 0:
+                        break
+                    h = (h + 1) & (_HASH - 1)
+                hkeys[h] = key
+                hval[h] = nf * 3 + e
+            nf += 1
+    # the face across each half-edge (i -> j) holds (j -> i)
+    for f in range(nf):
+        for e in range(3):
+            i, j = fv[f, e], fv[f, (e + 1) % 3]
+            key = j * n + i
+            h = (key * 2654435761) & (_HASH - 1)
+            twin[f, e] = -1
+            for _ in range(_HASH):
+                if hkeys[h] < 0:
+                    break
+                if hkeys[h] == key:
+                    twin[f, e] = hval[h] // 3
+                    break
+                h = (h + 1) & (_HASH - 1)
+            if twin[f, e] < 0:
+                return -1
+    for f in range(nf):                      # clear the hash for the next point
+        for e in range(3):
+            i, j = fv[f, e], fv[f, (e + 1) % 3]
+            key = i * n + j
+            h = (key * 2654435761) & (_HASH - 1)
+            for _ in range(_HASH):
+                if hkeys[h] < 0:
+                    break
+                hkeys[h] = -1
+                h = (h + 1) & (_HASH - 1)
+    # facets: the Voronoi edge q_f -> q_g dual to (x, i, j), g holding i -> j
+    for g in range(nf):
+        qg = fq[g]
+        for e in range(3):
+            i, j = fv[g, e], fv[g, (e + 1) % 3]
+            f = twin[g, e]
+            qf = fq[f]
+            si = node_slot[i]
+            cr = _cross(qf, qg)
+            for d in range(3):
+                acc[si, d] += 0.5 * cr[d]
+            pi = nodes[i] - x
+            if gradient and laplace:
+                sf, sg = fs[f], fs[g]
+                a1 = _cross(sf, qg)
+                a2 = _cross(qf, sg)
+                c1 = 0.5 * (pi[0] * a1[0] + pi[1] * a1[1] + pi[2] * a1[2])
+                c2 = 0.5 * (pi[0] * a2[0] + pi[1] * a2[1] + pi[2] * a2[2])
+                for d in range(3):
+                    acc[si, 4 + d] += c1 * qf[d] + c2 * qg[d]
+            if not laplace:
+                pj = nodes[j] - x
+                cg = _cross(qg, qf)              # closing edge of the piece (i, j)
+                acc[si, 3] += (cg[0] * pj[0] + cg[1] * pj[1] + cg[2] * pj[2]) / 12.0
+                if gradient:                     # first moment of the facet, about x
+                    mx, my, mz = 0.5 * pi[0], 0.5 * pi[1], 0.5 * pi[2]
+                    tri = _cross((qf[0] - mx, qf[1] - my, qf[2] - mz),
+                                 (qg[0] - mx, qg[1] - my, qg[2] - mz))
+                    area = 0.5 * (tri[0] * pi[0] + tri[1] * pi[1] + tri[2] * pi[2]) / acc[si, 10]
+                    for d in range(3):
+                        acc[si, 7 + d] += area * (0.5 * pi[d] + qf[d] + qg[d]) / 3.0
+    if not laplace:
+        _sibson_chains(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_slot, fq, bf, cc, acc)
+    return count
+
+
+@numba.njit(cache=True)
+def _sibson_chains(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_slot, fq, bf, cc, acc):
+    """Adds to ``acc[:, 3]`` the old-facet pieces of the Sibson volumes: around each
+    edge (i, j), i < j, of a cavity tetrahedron (turning right-handed about i -> j),
+    the Voronoi edge from its circumcentre to the next one (or to the new vertex
+    where the chain leaves the cavity, and from the new vertex where it enters)."""
+    for m in range(size):
+        c = cav[m]
+        u1 = nodes[tet[c, 1]] - nodes[tet[c, 0]]
+        u2 = nodes[tet[c, 2]] - nodes[tet[c, 0]]
+        u3 = nodes[tet[c, 3]] - nodes[tet[c, 0]]
+        c23, c31, c12 = _cross(u2, u3), _cross(u3, u1), _cross(u1, u2)
+        det = 2.0 * (u1[0] * c23[0] + u1[1] * c23[1] + u1[2] * c23[2])
+        n1 = u1[0] * u1[0] + u1[1] * u1[1] + u1[2] * u1[2]
+        n2 = u2[0] * u2[0] + u2[1] * u2[1] + u2[2] * u2[2]
+        n3 = u3[0] * u3[0] + u3[1] * u3[1] + u3[2] * u3[2]
+        for d in range(3):
+            cc[m, d] = nodes[tet[c, 0], d] - x[d] + (n1 * c23[d] + n2 * c31[d] + n3 * c12[d]) / det
+    for m in range(size):
+        c = cav[m]
+        ct = cc[m]
+        for e in range(6):
+            i, j = tet[c, PAIRS[e, 0]], tet[c, PAIRS[e, 1]]
+            kx, lx = PAIRS[e, 2], PAIRS[e, 3]
+            if i > j:              # about the edge from its lower node: each Voronoi edge once
+                i, j, kx, lx = j, i, lx, kx
+            o = nb[c, kx]                            # exit across (i, j, l)
+            nxt = cc[pos[o]] if (o >= 0 and mark[o] == stamp) else fq[bf[m, kx]]
+            ed = _cross(ct, nxt)
+            ex, ey, ez = 0.5 * ed[0], 0.5 * ed[1], 0.5 * ed[2]
+            if bf[m, lx] >= 0:                       # entry from outside, across (i, j, k)
+                en = _cross(fq[bf[m, lx]], ct)
+                ex, ey, ez = ex + 0.5 * en[0], ey + 0.5 * en[1], ez + 0.5 * en[2]
+            pi = nodes[i] - x
+            pj = nodes[j] - x
+            acc[node_slot[i], 3] += (ex * pj[0] + ey * pj[1] + ez * pj[2]) / 6.0
+            acc[node_slot[j], 3] -= (ex * pi[0] + ey * pi[1] + ez * pi[2]) / 6.0
+
+
+@numba.njit(cache=True)
+def _normalise(acc, count, laplace, gradient, vals, grads):
+    """Weights of the neighbours normalised into ``vals`` (and ``grads (N, 3)``);
+    False if they do not sum to a positive total."""
+    total = 0.0
+    gtot = np.zeros(3)
+    for e in range(count):
+        p2 = acc[e, 10]
+        if laplace:
+            w = (acc[e, 0] * acc[e, 11] + acc[e, 1] * acc[e, 12] + acc[e, 2] * acc[e, 13]) / p2
+        else:
+            w = acc[e, 3]
+        vals[e] = w
+        total += w
+        if gradient:
+            for d in range(3):
+                if laplace:        # grad w = (G - A) / |p|^2 + 2 w p / |p|^2
+                    g = (acc[e, 4 + d] - acc[e, d] + 2.0 * w * acc[e, 11 + d]) / p2
+                else:              # grad V_i = M_i / |p_i|
+                    g = acc[e, 7 + d] / np.sqrt(p2)
+                grads[e, d] = g
+                gtot[d] += g
+    if not total > 0.0:
+        return False
+    for e in range(count):
+        vals[e] /= total
+        if gradient:
+            for d in range(3):
+                grads[e, d] = (grads[e, d] - vals[e] * gtot[d]) / total
+    return True
+
+
+@parallel_kernel("points")
+def natural(nodes, tet, nb, cedges, points, tet_of, tol, nch, laplace, gradient, slots):
+    """Laplace (or Sibson) coordinates of many points, one pass, rows in visit order.
+
+    Each chunk of points writes its rows one after the other into its own
+    region of the output, ``slots`` entries per point; a chunk whose rows do not
+    fit stops and is reported (call again with more slots).
+
+    Parameters
+    ----------
+    nodes : (n, 3) float64
+    tet : (t, 4) int64, positively oriented
+    nb : (t, 4) int64
+        Neighbour across the face opposite each vertex; -1 across constraints.
+    cedges : (e,) int64
+        Sorted keys ``min * n + max`` of the edges of the constraint faces.
+    points : (p, 3) float64
+        The points in the order they are visited.
+    tet_of : (p,) int64
+        A tetrahedron containing each point (same order).
+    tol : float
+        Distance under which a point is at a node / on a constraint face or edge.
+    nch : int
+        Work chunks shared between threads.
+    laplace, gradient : bool
+        Laplace instead of Sibson; also the gradients (zero at nodes and on
+        constraint faces and edges, where they are not defined).
+    slots : int
+        Room per point in the chunks' regions.
+
+    Returns
+    -------
+    start, size : (p,) int64
+        Row ``s`` is ``cols[start[s]:start[s] + size[s]]`` (same for the values).
+    cols : (p * slots,) int32
+    vals : (p * slots,) float64
+    grads : (p * slots, 3) float64
+        Empty unless ``gradient``.
+    kinds : (p,) int8
+        ``CAVITY``, ``AT_NODE``, ``ON_FACE``, ``ON_EDGE`` or ``FAILED``.
+    full : bool
+        Some chunk ran out of room (the result is incomplete).
+    """
+    p = points.shape[0]
+    n = nodes.shape[0]
+    nt = tet.shape[0]
+    start = np.zeros(p, dtype=np.int64)
+    size = np.zeros(p, dtype=np.int64)
+    kinds = np.zeros(p, dtype=np.int8)
+    nch = max(1, min(p, nch))
+    out_cols = np.empty(p * slots, dtype=np.int32)
+    out_vals = np.empty(p * slots)
+    out_grad = np.zeros((p * slots if gradient else 0, 3))
+    full = np.zeros(nch, dtype=np.bool_)
+    for ch in numba.prange(nch):
+        mark = np.zeros(nt, dtype=np.int64)
+        pos = np.zeros(nt, dtype=np.int32)
+        node_mark = np.zeros(n, dtype=np.int64)
+        node_slot = np.zeros(n, dtype=np.int32)
+        cav = np.empty(MAX_CAVITY, dtype=np.int64)
+        nfmax = 2 * MAX_CAVITY + 4
+        fq = np.empty((nfmax, 3))
+        fs = np.empty((nfmax, 3))
+        fv = np.empty((nfmax, 3), dtype=np.int64)
+        bf = np.empty((MAX_CAVITY, 4), dtype=np.int64)
+        twin = np.empty((nfmax, 3), dtype=np.int64)
+        hkeys = np.full(_HASH, -1, dtype=np.int64)
+        hval = np.empty(_HASH, dtype=np.int64)
+        cc = np.empty((MAX_CAVITY, 3))
+        acc = np.empty((MAX_CAVITY, 14))
+        cols = np.empty(MAX_CAVITY, dtype=np.int64)
+        vals = np.empty(MAX_CAVITY)
+        grads = np.empty((MAX_CAVITY, 3))
+        lo, hi = ch * p // nch, (ch + 1) * p // nch
+        a, end = lo * slots, hi * slots
+        for s in range(lo, hi):
+            x = points[s]
+            start[s] = a
+            kind, na, nb_, nc, la, lb, lc = _special(nodes, tet, nb, cedges, tet_of[s], x, tol)
+            c = 0
+            if kind == AT_NODE:
+                cols[0], vals[0], c = na, 1.0, 1
+            elif kind == ON_FACE:
+                cols[0], cols[1], cols[2] = na, nb_, nc
+                vals[0], vals[1], vals[2], c = la, lb, lc, 3
+            elif kind == ON_EDGE:
+                cols[0], cols[1], vals[0], vals[1], c = na, nb_, la, lb, 2
+            else:
+                stamp = s + 1
+                csize = _cavity(nodes, tet, nb, tet_of[s], x, stamp, mark, cav)
+                if csize > 0:
+                    c = _natural_row(nodes, tet, nb, x, cav, csize, stamp, mark, pos, node_mark,
+                                     node_slot, fq, fs, fv, bf, twin, hkeys, hval, cc, acc, cols,
+                                     laplace, gradient)
+                if csize <= 0 or c <= 0:
+                    kind, c = FAILED, 0
+                else:
+                    for e in range(c):
+                        for d in range(3):
+                            acc[e, 11 + d] = nodes[cols[e], d] - x[d]
+                    if not _normalise(acc, c, laplace, gradient, vals, grads):
+                        kind, c = FAILED, 0
+            kinds[s] = kind
+            if a + c > end:
+                full[ch] = True
+                break
+            size[s] = c
+            for e in range(c):
+                out_cols[a + e] = cols[e]
+                out_vals[a + e] = vals[e]
+            if gradient and kind == CAVITY:
+                for e in range(c):
+                    for d in range(3):
+                        out_grad[a + e, d] = grads[e, d]
+            a += c
+    return start, size, out_cols, out_vals, out_grad, kinds, full.any()
+
+
+@numba.njit(cache=True)
+def _walk(nodes, tet, nbw, t, x, max_steps):
+    """Visibility walk from tetrahedron ``t`` to the one holding ``x``; -1 if it leaves
+    the tetrahedrisation or takes too long."""
+    for step in range(max_steps):
+        moved = False
+        for r in range(4):
+            k = (r + step) & 3
+            det, perm = _face_side(nodes, tet[t, FACES[k, 0]], tet[t, FACES[k, 1]],
+                                   tet[t, FACES[k, 2]], x)
+            if det < 0.0:
+                t = nbw[t, k]
+                if t < 0:
+                    return -1
+                moved = True
+                break
+        if not moved:
+            return t
+    return -1
+
+
+@parallel_kernel("points")
+def locate_walk(nodes, tet, nbw, points, seeds, nch):
+    """Tetrahedra holding path-ordered points, walking from one point to the next;
+    chunk ``c`` starts from ``seeds[c]``. Points the walk cannot reach get -1."""
+    p = points.shape[0]
+    out = np.full(p, -1, dtype=np.int64)
+    for ch in numba.prange(nch):
+        t = seeds[ch]
+        for s in range(ch * p // nch, (ch + 1) * p // nch):
+            found = _walk(nodes, tet, nbw, t, points[s], 8192)
+            if found >= 0:
+                out[s] = found
+                t = found
+    return out
+
+
+@parallel_kernel("points")
+def locate(nodes, tet, points, cand_off, cand_idx, tol):
+    """The candidate tetrahedron that contains each point best (-1 if none within
+    ``tol``): the largest smallest signed distance to its faces."""
+    p = points.shape[0]
+    out = np.full(p, -1, dtype=np.int64)
+    for q in numba.prange(p):
+        best = -np.inf
+        for c in range(cand_off[q], cand_off[q + 1]):
+            t = cand_idx[c]
+            worst = np.inf
+            for k in range(4):
+                a, b, cc = tet[t, FACES[k, 0]], tet[t, FACES[k, 1]], tet[t, FACES[k, 2]]
+                det, perm = _face_side(nodes, a, b, cc, points[q])
+                nrm = np.cross(nodes[b] - nodes[a], nodes[cc] - nodes[a])
+                worst = min(worst, det / np.sqrt(nrm[0] ** 2 + nrm[1] ** 2 + nrm[2] ** 2))
+            if worst > best:
+                best = worst
+                if worst >= -tol:
+                    out[q] = t
+    return out
+
+
+@parallel_kernel("order")
+def permute_rows(start, size, cols, vals, grads, order):
+    """Rows ``s`` moved to CSR rows ``order[s]``: ``(offsets, cols, vals, grads)``."""
+    p = order.shape[0]
+    moved = np.empty(p, dtype=np.int64)
+    for s in numba.prange(p):
+        moved[order[s]] = size[s]
+    new = np.zeros(p + 1, dtype=np.int64)
+    for q in range(p):
+        new[q + 1] = new[q] + moved[q]
+    out_cols = np.empty(new[p], dtype=np.int32)
+    out_vals = np.empty(new[p])
+    grad = grads.shape[0] > 0
+    out_grad = np.empty((new[p] if grad else 0, 3))
+    for s in numba.prange(p):
+        a, b = start[s], new[order[s]]
+        for e in range(size[s]):
+            out_cols[b + e] = cols[a + e]
+            out_vals[b + e] = vals[a + e]
+            if grad:
+                for d in range(3):
+                    out_grad[b + e, d] = grads[a + e, d]
+    return new, out_cols, out_vals, out_grad
