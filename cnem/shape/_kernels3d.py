@@ -384,8 +384,8 @@ def _normalise(acc, count, laplace, gradient, vals, grads):
             for d in range(3):
                 if laplace:        # grad w = (G - A) / |p|^2 + 2 w p / |p|^2
                     g = (acc[e, 4 + d] - acc[e, d] + 2.0 * w * acc[e, 11 + d]) / p2
-                else:              # grad V_i = M_i / |p_i|
-                    g = acc[e, 7 + d] / np.sqrt(p2)
+                else:              # grad V_i = M_i / |p_i| (accumulated so)
+                    g = acc[e, 7 + d]
                 grads[e, d] = g
                 gtot[d] += g
     if not total > 0.0:
