@@ -51,8 +51,12 @@ FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]], dtype=np.int64)
 PAIRS = np.array([[0, 1, 2, 3], [0, 2, 3, 1], [0, 3, 1, 2], [1, 2, 0, 3], [1, 3, 2, 0],
                   [2, 3, 0, 1]], dtype=np.int64)
 
-#: Relative size of a determinant under which a point counts as on a plane.
-PLANE_RTOL = 1e-10
+#: Relative size of a determinant under which a point counts as on a plane (a point
+#: that near a constraint face of its tetrahedron is on it).
+PLANE_RTOL = 1e-14
+#: At a constraint face, relative size of the determinant under which a cavity face
+#: counts as through the point (its new Voronoi vertex at infinity).
+FLAT_RTOL = 1e-9
 #: Relative size of the in-sphere determinant under which a point counts as on a sphere.
 SPHERE_RTOL = 1e-14
 
@@ -99,8 +103,32 @@ def _in_sphere(nodes, tet, t, x):
 
 
 @numba.njit(cache=True)
-def _special(nodes, tet, nb, cedges, t, x, tol):
-    """Node, constraint-face or constraint-edge case: ``(kind, a, b, c, la, lb, lc)``."""
+def _face_at_edge(tet, nb, t, a, b):
+    """A tetrahedron round the edge ``(a, b)`` from ``t`` with a constraint face holding
+    the edge: ``(tetrahedron, face)``, or ``(-1, -1)``."""
+    prev = -1
+    for _ in range(tet.shape[0]):
+        moved = False
+        for k in range(4):
+            v = tet[t, k]
+            if v == a or v == b:
+                continue
+            o = nb[t, k]
+            if o < 0:
+                return t, k
+            if o != prev and not moved:
+                nxt = o
+                moved = True
+        if not moved:
+            return -1, -1
+        prev, t = t, nxt
+    return -1, -1
+
+
+@numba.njit(cache=True)
+def _special(nodes, tet, nb, cedges, features, t, x, tol):
+    """Node, constraint-face or feature-edge case: ``(kind, a, b, c, la, lb, lc)``;
+    for ``ON_FACE``, ``a`` is the tetrahedron and ``b`` its constraint face holding x."""
     n = nodes.shape[0]
     for k in range(4):
         v = tet[t, k]
@@ -113,43 +141,59 @@ def _special(nodes, tet, nb, cedges, t, x, tol):
         if nb[t, k] >= 0:
             continue
         a, b, c = tet[t, FACES[k, 0]], tet[t, FACES[k, 1]], tet[t, FACES[k, 2]]
-        e1 = nodes[b] - nodes[a]
-        e2 = nodes[c] - nodes[a]
-        nrm = np.cross(e1, e2)
-        n2 = nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]
+        nrm = np.cross(nodes[b] - nodes[a], nodes[c] - nodes[a])
         r = nodes[a] - x
-        dist = (r[0] * nrm[0] + r[1] * nrm[1] + r[2] * nrm[2]) / np.sqrt(n2)
-        if abs(dist) > tol:
+        dist = (r[0] * nrm[0] + r[1] * nrm[1] + r[2] * nrm[2]) / np.sqrt(
+            nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2])
+        det, perm = _face_side(nodes, a, b, c, x)
+        if abs(dist) > tol and det > PLANE_RTOL * perm:
             continue
-        lam = np.empty(3)
-        for m in range(3):            # barycentric coordinates of the foot of x
-            u = nodes[tet[t, FACES[k, (m + 1) % 3]]] - x
-            w = nodes[tet[t, FACES[k, (m + 2) % 3]]] - x
-            cr = np.cross(u, w)
-            lam[m] = max((cr[0] * nrm[0] + cr[1] * nrm[1] + cr[2] * nrm[2]) / n2, 0.0)
-        total = lam[0] + lam[1] + lam[2]
-        return ON_FACE, a, b, c, lam[0] / total, lam[1] / total, lam[2] / total
+        for e in range(3):            # on a feature edge of the face: linear there
+            kind, i, j, s = _on_edge(nodes, cedges, features, tet[t, FACES[k, e]],
+                                     tet[t, FACES[k, (e + 1) % 3]], x, tol, n)
+            if kind == ON_EDGE:
+                return ON_EDGE, i, j, j, 1.0 - s, s, 0.0
+        return ON_FACE, t, k, -1, 0.0, 0.0, 0.0
     for e in range(6):
-        a, b = tet[t, PAIRS[e, 0]], tet[t, PAIRS[e, 1]]
-        key = min(a, b) * n + max(a, b)
-        pos = np.searchsorted(cedges, key)
-        if pos >= cedges.shape[0] or cedges[pos] != key:
-            continue
-        ed = nodes[b] - nodes[a]
-        r = x - nodes[a]
-        l2 = ed[0] * ed[0] + ed[1] * ed[1] + ed[2] * ed[2]
-        s = (r[0] * ed[0] + r[1] * ed[1] + r[2] * ed[2]) / l2
-        off = r - s * ed
-        if off[0] * off[0] + off[1] * off[1] + off[2] * off[2] <= tol * tol:
-            s = min(max(s, 0.0), 1.0)
-            return ON_EDGE, a, b, b, 1.0 - s, s, 0.0
+        kind, i, j, s = _on_edge(nodes, cedges, features, tet[t, PAIRS[e, 0]],
+                                 tet[t, PAIRS[e, 1]], x, tol, n)
+        if kind == ON_EDGE:
+            return ON_EDGE, i, j, j, 1.0 - s, s, 0.0
+        if kind == ON_FACE:
+            u, k = _face_at_edge(tet, nb, t, i, j)
+            if u >= 0:
+                return ON_FACE, u, k, -1, 0.0, 0.0, 0.0
     return CAVITY, -1, -1, -1, 0.0, 0.0, 0.0
 
 
 @numba.njit(cache=True)
-def _cavity(nodes, tet, nb, t, x, stamp, mark, cav):
+def _on_edge(nodes, cedges, features, a, b, x, tol, n):
+    """Whether ``x`` lies on the edge ``(a, b)`` of constraint faces: ``(ON_EDGE, a, b,
+    s)`` on a feature edge (``x = a + s (b - a)``), ``(ON_FACE, a, b, s)`` on an edge
+    inside a flat patch of constraint faces, else ``(CAVITY, ...)``."""
+    key = min(a, b) * n + max(a, b)
+    pos = np.searchsorted(cedges, key)
+    if pos >= cedges.shape[0] or cedges[pos] != key:
+        return CAVITY, a, b, 0.0
+    ed = nodes[b] - nodes[a]
+    r = x - nodes[a]
+    l2 = ed[0] * ed[0] + ed[1] * ed[1] + ed[2] * ed[2]
+    s = (r[0] * ed[0] + r[1] * ed[1] + r[2] * ed[2]) / l2
+    off = r - s * ed
+    if off[0] * off[0] + off[1] * off[1] + off[2] * off[2] > tol * tol:
+        return CAVITY, a, b, 0.0
+    pos = np.searchsorted(features, key)
+    if pos < features.shape[0] and features[pos] == key:
+        return ON_EDGE, a, b, min(max(s, 0.0), 1.0)
+    return ON_FACE, a, b, 0.0
+
+
+@numba.njit(cache=True)
+def _cavity(nodes, tet, nb, t, x, stamp, mark, cav, limit):
     """The star-shaped constrained cavity of ``x`` from tetrahedron ``t``: its size, or
-    -1 if it does not fit or has to lose ``t``. ``mark[o] == stamp`` for its members."""
+    -1 if it does not fit or has to lose ``t``. ``mark[o] == stamp`` for its members.
+    With ``limit`` (``x`` on a constraint face, the cavity of points tending to it
+    from inside) faces through ``x`` stay on its boundary."""
     cav[0] = t
     mark[t] = stamp
     size = 1
@@ -183,7 +227,7 @@ def _cavity(nodes, tet, nb, t, x, stamp, mark, cav):
                     continue
                 det, perm = _face_side(nodes, tet[c, FACES[k, 0]], tet[c, FACES[k, 1]],
                                        tet[c, FACES[k, 2]], x)
-                if det <= PLANE_RTOL * perm:
+                if det < -PLANE_RTOL * perm if limit else det <= PLANE_RTOL * perm:
                     dropped = m
                     break
             if dropped >= 0:
@@ -203,9 +247,20 @@ def _cross(u, v):
     return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
 
 
+@numba.njit(cache=True, inline="always")
+def _product(u, ku, v, kv, nu, limit):
+    """``u x v``, or at a constraint face its leading ``1 / delta`` coefficient when
+    ``u = u0 + (ku / delta) nu`` and ``v = v0 + (kv / delta) nu`` (``delta -> 0``)."""
+    if not limit:
+        return _cross(u, v)
+    a = _cross(nu, v)
+    b = _cross(nu, u)
+    return (ku * a[0] - kv * b[0], ku * a[1] - kv * b[1], ku * a[2] - kv * b[2])
+
+
 @numba.njit(cache=True)
 def _natural_row(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_mark, node_slot,
-                 fq, fs, fv, bf, twin, hkeys, hval, cc, acc, cols, laplace, gradient):
+                 fq, fs, fv, bf, twin, hkeys, hval, cc, acc, cols, laplace, gradient, nu, limit):
     """Coordinates from a cavity: the neighbour count, -1 if inconsistent.
 
     Work arrays: ``fq, fs (F, 3)`` the new Voronoi vertices and their motions,
@@ -214,6 +269,13 @@ def _natural_row(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_mark, node
     half-edge, ``hkeys, hval`` the half-edge hash, ``cc (C, 3)`` the cavity's
     circumcentres, ``acc (N, 14)`` per neighbour: vector area, Sibson volume, Laplace area gradient,
     Sibson moment, ``|p|^2``, ``p``.
+
+    With ``limit``, ``x`` lies on a constraint face of inward normal ``nu`` and the
+    coordinates are the limit from inside: the new tetrahedra on faces through ``x``
+    are flat, their Voronoi vertices ``q_f = o_f + (k_f / delta) nu`` (``o_f`` the
+    face's circumcentre, ``k_f = (|o_f|^2 - r_f^2) / 2``) go to infinity, and every
+    area and volume is replaced by its ``1 / delta`` coefficient (``fs[:, 0]`` holds
+    ``k_f``, zero for the other faces).
     """
     n = nodes.shape[0]
     nf = 0
@@ -237,9 +299,31 @@ def _natural_row(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_mark, node
             a2 = pa[0] * pa[0] + pa[1] * pa[1] + pa[2] * pa[2]
             b2 = pb[0] * pb[0] + pb[1] * pb[1] + pb[2] * pb[2]
             c2 = pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2]
-            for d in range(3):
-                fq[nf, d] = (a2 * bxc[d] + b2 * cxa[d] + c2 * axb[d]) / (2.0 * det)
-                fs[nf, d] = (bxc[d] + cxa[d] + axb[d]) / det
+            if limit and abs(det) <= FLAT_RTOL * np.sqrt(a2 * b2 * c2):
+                ab = pb - pa                   # circumcentre of the face, in its plane
+                ac = pc - pa
+                nn = _cross(ab, ac)
+                n2 = nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]
+                l1 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]
+                l3 = ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2]
+                u1 = _cross(nn, ab)
+                u2 = _cross(ac, nn)
+                o2 = 0.0
+                r2 = 0.0
+                for d in range(3):
+                    off = (l1 * u2[d] + l3 * u1[d]) / (2.0 * n2)
+                    fq[nf, d] = pa[d] + off
+                    o2 += fq[nf, d] ** 2
+                    r2 += off * off
+                fs[nf, 0] = 0.5 * (o2 - r2)
+            elif limit:
+                for d in range(3):
+                    fq[nf, d] = (a2 * bxc[d] + b2 * cxa[d] + c2 * axb[d]) / (2.0 * det)
+                fs[nf, 0] = 0.0
+            else:
+                for d in range(3):
+                    fq[nf, d] = (a2 * bxc[d] + b2 * cxa[d] + c2 * axb[d]) / (2.0 * det)
+                    fs[nf, d] = (bxc[d] + cxa[d] + axb[d]) / det
             for e in range(3):
                 v = tet[c, FACES[k, e]]
                 fv[nf, e] = v
@@ -299,7 +383,7 @@ def _natural_row(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_mark, node
             f = twin[g, e]
             qf = fq[f]
             si = node_slot[i]
-            cr = _cross(qf, qg)
+            cr = _product(qf, fs[f, 0], qg, fs[g, 0], nu, limit)
             for d in range(3):
                 acc[si, d] += 0.5 * cr[d]
             pi = nodes[i] - x
@@ -313,7 +397,7 @@ def _natural_row(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_mark, node
                     acc[si, 4 + d] += c1 * qf[d] + c2 * qg[d]
             if not laplace:
                 pj = nodes[j] - x
-                cg = _cross(qg, qf)              # closing edge of the piece (i, j)
+                cg = _product(qg, fs[g, 0], qf, fs[f, 0], nu, limit)   # closing edge of (i, j)
                 acc[si, 3] += (cg[0] * pj[0] + cg[1] * pj[1] + cg[2] * pj[2]) / 12.0
                 if gradient:                     # first moment of the facet, about x
                     mx, my, mz = 0.5 * pi[0], 0.5 * pi[1], 0.5 * pi[2]
@@ -323,12 +407,14 @@ def _natural_row(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_mark, node
                     for d in range(3):
                         acc[si, 7 + d] += area * (0.5 * pi[d] + qf[d] + qg[d]) / 3.0
     if not laplace:
-        _sibson_chains(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_slot, fq, bf, cc, acc)
+        _sibson_chains(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_slot, fq, fs, bf, cc,
+                       acc, nu, limit)
     return count
 
 
 @numba.njit(cache=True)
-def _sibson_chains(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_slot, fq, bf, cc, acc):
+def _sibson_chains(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_slot, fq, fs, bf, cc, acc,
+                   nu, limit):
     """Adds to ``acc[:, 3]`` the old-facet pieces of the Sibson volumes: around each
     edge (i, j), i < j, of a cavity tetrahedron (turning right-handed about i -> j),
     the Voronoi edge from its circumcentre to the next one (or to the new vertex
@@ -354,11 +440,13 @@ def _sibson_chains(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_slot, fq
             if i > j:              # about the edge from its lower node: each Voronoi edge once
                 i, j, kx, lx = j, i, lx, kx
             o = nb[c, kx]                            # exit across (i, j, l)
-            nxt = cc[pos[o]] if (o >= 0 and mark[o] == stamp) else fq[bf[m, kx]]
-            ed = _cross(ct, nxt)
+            if o >= 0 and mark[o] == stamp:
+                ed = _product(ct, 0.0, cc[pos[o]], 0.0, nu, limit)
+            else:
+                ed = _product(ct, 0.0, fq[bf[m, kx]], fs[bf[m, kx], 0], nu, limit)
             ex, ey, ez = 0.5 * ed[0], 0.5 * ed[1], 0.5 * ed[2]
             if bf[m, lx] >= 0:                       # entry from outside, across (i, j, k)
-                en = _cross(fq[bf[m, lx]], ct)
+                en = _product(fq[bf[m, lx]], fs[bf[m, lx], 0], ct, 0.0, nu, limit)
                 ex, ey, ez = ex + 0.5 * en[0], ey + 0.5 * en[1], ez + 0.5 * en[2]
             pi = nodes[i] - x
             pj = nodes[j] - x
@@ -399,7 +487,7 @@ def _normalise(acc, count, laplace, gradient, vals, grads):
 
 
 @parallel_kernel("points")
-def natural(nodes, tet, nb, cedges, points, tet_of, tol, nch, laplace, gradient, slots):
+def natural(nodes, tet, nb, cedges, features, points, tet_of, tol, nch, laplace, gradient, slots):
     """Laplace (or Sibson) coordinates of many points, one pass, rows in visit order.
 
     Each chunk of points writes its rows one after the other into its own
@@ -414,6 +502,9 @@ def natural(nodes, tet, nb, cedges, points, tet_of, tol, nch, laplace, gradient,
         Neighbour across the face opposite each vertex; -1 across constraints.
     cedges : (e,) int64
         Sorted keys ``min * n + max`` of the edges of the constraint faces.
+    features : (f,) int64
+        The same for the feature edges (where constraint faces of different planes
+        meet): a point on one interpolates linearly between its ends.
     points : (p, 3) float64
         The points in the order they are visited.
     tet_of : (p,) int64
@@ -471,34 +562,50 @@ def natural(nodes, tet, nb, cedges, points, tet_of, tol, nch, laplace, gradient,
         cols = np.empty(MAX_CAVITY, dtype=np.int64)
         vals = np.empty(MAX_CAVITY)
         grads = np.empty((MAX_CAVITY, 3))
+        foot = np.empty(3)
+        nu = np.zeros(3)
         lo, hi = ch * p // nch, (ch + 1) * p // nch
         a, end = lo * slots, hi * slots
         for s in range(lo, hi):
             x = points[s]
             start[s] = a
-            kind, na, nb_, nc, la, lb, lc = _special(nodes, tet, nb, cedges, tet_of[s], x, tol)
+            kind, na, nb_, nc, la, lb, lc = _special(nodes, tet, nb, cedges, features,
+                                                     tet_of[s], x, tol)
             c = 0
             if kind == AT_NODE:
                 cols[0], vals[0], c = na, 1.0, 1
-            elif kind == ON_FACE:
-                cols[0], cols[1], cols[2] = na, nb_, nc
-                vals[0], vals[1], vals[2], c = la, lb, lc, 3
             elif kind == ON_EDGE:
                 cols[0], cols[1], vals[0], vals[1], c = na, nb_, la, lb, 2
             else:
                 stamp = s + 1
-                csize = _cavity(nodes, tet, nb, tet_of[s], x, stamp, mark, cav)
+                t0 = tet_of[s]
+                limit = kind == ON_FACE
+                if limit:                    # the foot of x on the face, the inward normal
+                    t0 = na
+                    v0 = tet[t0, FACES[nb_, 0]]
+                    nrm = np.cross(nodes[tet[t0, FACES[nb_, 1]]] - nodes[v0],
+                                   nodes[tet[t0, FACES[nb_, 2]]] - nodes[v0])
+                    nrm /= -np.sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2])
+                    dist = ((nodes[v0, 0] - x[0]) * nrm[0] + (nodes[v0, 1] - x[1]) * nrm[1]
+                            + (nodes[v0, 2] - x[2]) * nrm[2])
+                    for d in range(3):
+                        foot[d] = x[d] + dist * nrm[d]
+                        nu[d] = nrm[d]
+                else:
+                    for d in range(3):
+                        foot[d] = x[d]
+                csize = _cavity(nodes, tet, nb, t0, foot, stamp, mark, cav, limit)
                 if csize > 0:
-                    c = _natural_row(nodes, tet, nb, x, cav, csize, stamp, mark, pos, node_mark,
-                                     node_slot, fq, fs, fv, bf, twin, hkeys, hval, cc, acc, cols,
-                                     laplace, gradient)
+                    c = _natural_row(nodes, tet, nb, foot, cav, csize, stamp, mark, pos,
+                                     node_mark, node_slot, fq, fs, fv, bf, twin, hkeys, hval, cc,
+                                     acc, cols, laplace, gradient and not limit, nu, limit)
                 if csize <= 0 or c <= 0:
                     kind, c = FAILED, 0
                 else:
                     for e in range(c):
                         for d in range(3):
-                            acc[e, 11 + d] = nodes[cols[e], d] - x[d]
-                    if not _normalise(acc, c, laplace, gradient, vals, grads):
+                            acc[e, 11 + d] = nodes[cols[e], d] - foot[d]
+                    if not _normalise(acc, c, laplace, gradient and not limit, vals, grads):
                         kind, c = FAILED, 0
             kinds[s] = kind
             if a + c > end:

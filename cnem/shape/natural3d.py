@@ -47,6 +47,8 @@ class TetMesh(NamedTuple):
         The same, -1 across the boundary only (for point location).
     constraint_edges : (e,) int64
         Sorted keys ``min * n + max`` of the edges of every constraint face.
+    feature_edges : (f,) int64
+        The same for the edges where constraint faces of different planes meet.
     frame : Frame
         The local frame the kernels run in.
     local_nodes : (n, 3) float64
@@ -60,6 +62,7 @@ class TetMesh(NamedTuple):
     neighbors: np.ndarray
     walk_neighbors: np.ndarray
     constraint_edges: np.ndarray
+    feature_edges: np.ndarray
     frame: Frame
     local_nodes: np.ndarray
     tol: float
@@ -116,14 +119,32 @@ def tet_mesh(nodes: ArrayLike, tetrahedra: ArrayLike, *, tet_region: ArrayLike |
     neg = vol < 0
     tet[neg, 0], tet[neg, 1] = tet[neg, 1], tet[neg, 0].copy()
     walk, cut, boundary_rows = _adjacency(tet, region, constraint_faces, len(pts))
-    n = len(pts)
-    ends = np.concatenate([np.sort(boundary_rows[:, [0, 1]], axis=1),
-                           np.sort(boundary_rows[:, [1, 2]], axis=1),
-                           np.sort(boundary_rows[:, [0, 2]], axis=1)])
-    cedges = np.unique(ends[:, 0] * n + ends[:, 1])
+    cedges, features = _constraint_edges(local, boundary_rows)
     diameter = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
     tol = max(config.SHAPE_TOL * diameter / frame.scale, config.ROUNDOFF_ULPS * frame.resolution)
-    return TetMesh(pts, tet, region, cut, walk, cedges, frame, local, tol)
+    return TetMesh(pts, tet, region, cut, walk, cedges, features, frame, local, tol)
+
+
+def _constraint_edges(local, faces):
+    """Sorted keys ``min * n + max`` of the edges of the constraint ``faces (b, 3)``, and
+    of the feature edges among them: those whose faces do not all lie in one plane."""
+    n = len(local)
+    nrm = np.cross(local[faces[:, 1]] - local[faces[:, 0]], local[faces[:, 2]] - local[faces[:, 0]])
+    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
+    ends = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    keys = ends[:, 0] * n + ends[:, 1]
+    normals = np.tile(nrm, (3, 1))
+    order = np.argsort(keys, kind="stable")
+    keys, normals = keys[order], normals[order]
+    first = np.ones(len(keys), dtype=bool)
+    first[1:] = keys[1:] != keys[:-1]
+    group = np.cumsum(first) - 1
+    ref = normals[first][group]                 # the first face's normal in each group
+    bent = np.linalg.norm(np.cross(normals, ref), axis=1) > 1e-9
+    feature = np.zeros(group[-1] + 1, dtype=bool)
+    np.logical_or.at(feature, group, bent)
+    unique = keys[first]
+    return unique, unique[feature]
 
 
 def _adjacency(tet, region, constraint_faces, n):
@@ -260,7 +281,8 @@ def shape_functions_3d(mesh: TetMesh, points: ArrayLike, *,
     slots = 4 * config.ROW_SLOTS
     while True:
         start, size, cols, vals, grads, kinds, full = K.natural(
-            mesh.local_nodes, mesh.tetrahedra, mesh.neighbors, mesh.constraint_edges, spts,
+            mesh.local_nodes, mesh.tetrahedra, mesh.neighbors, mesh.constraint_edges,
+            mesh.feature_edges, spts,
             tet_of, mesh.tol, work_chunks(), kind == "laplace", gradient, slots)
         if not full:
             break
