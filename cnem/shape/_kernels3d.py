@@ -54,8 +54,9 @@ PAIRS = np.array([[0, 1, 2, 3], [0, 2, 3, 1], [0, 3, 1, 2], [1, 2, 0, 3], [1, 3,
 #: Relative size of a determinant under which a point counts as on a plane (a point
 #: that near a constraint face of its tetrahedron is on it).
 PLANE_RTOL = 1e-14
-#: At a constraint face, relative size of the determinant under which a cavity face
-#: counts as through the point (its new Voronoi vertex at infinity).
+#: At a constraint face, relative size of the determinant (and of the sine of the
+#: angle) under which a cavity face counts as in the plane of the point's face (its
+#: new Voronoi vertex at infinity).
 FLAT_RTOL = 1e-9
 #: Relative size of the in-sphere determinant under which a point counts as on a sphere.
 SPHERE_RTOL = 1e-14
@@ -299,11 +300,14 @@ def _natural_row(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_mark, node
             a2 = pa[0] * pa[0] + pa[1] * pa[1] + pa[2] * pa[2]
             b2 = pb[0] * pb[0] + pb[1] * pb[1] + pb[2] * pb[2]
             c2 = pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2]
-            if limit and abs(det) <= FLAT_RTOL * np.sqrt(a2 * b2 * c2):
-                ab = pb - pa                   # circumcentre of the face, in its plane
-                ac = pc - pa
-                nn = _cross(ab, ac)
-                n2 = nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]
+            ab = pb - pa
+            ac = pc - pa
+            nn = _cross(ab, ac)
+            n2 = nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]
+            along = nn[0] * nu[0] + nn[1] * nu[1] + nn[2] * nu[2]
+            if limit and abs(det) <= FLAT_RTOL * np.sqrt(a2 * b2 * c2) \
+                    and along * along >= (1.0 - FLAT_RTOL) * n2:
+                # a face in the plane of x's face: its circumcentre, in that plane
                 l1 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]
                 l3 = ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2]
                 u1 = _cross(nn, ab)
