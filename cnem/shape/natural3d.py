@@ -1,13 +1,11 @@
 """Constrained natural-neighbour (Laplace and Sibson) coordinates on a tetrahedrisation.
 
->>> import numpy as np
+>>> import numpy as np, scipy.spatial
 >>> from cnem.shape.natural3d import tet_mesh, shape_functions_3d
->>> g = np.linspace(0.0, 1.0, 3)
->>> nodes = np.stack(np.meshgrid(g, g, g, indexing="ij"), -1).reshape(-1, 3)
->>> import scipy.spatial
->>> mesh = tet_mesh(nodes, scipy.spatial.Delaunay(nodes + 1e-3 * np.sin(7 * nodes)).simplices)
->>> phi = shape_functions_3d(mesh, [[0.3, 0.6, 0.45]])
->>> bool(np.allclose(phi @ nodes, [[0.3, 0.6, 0.45]]))
+>>> nodes = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.2, 0.2, 0.2]])
+>>> mesh = tet_mesh(nodes, scipy.spatial.Delaunay(nodes).simplices)
+>>> phi = shape_functions_3d(mesh, [[0.1, 0.3, 0.2]], kind="laplace")
+>>> bool(np.allclose(phi @ nodes, [[0.1, 0.3, 0.2]]))
 True
 """
 
