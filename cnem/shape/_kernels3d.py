@@ -82,10 +82,10 @@ def _face_side(nodes, a, b, c, x):
 
 
 @numba.njit(cache=True)
-def _in_sphere(nodes, tet, t, x):
+def _in_sphere(nodes, tet, t, x, p):
     """Whether ``x`` lies strictly inside the circumsphere of positive tetrahedron ``t``
-    (filtered: when round-off could flip the sign the answer is no, consistently)."""
-    p = np.empty((4, 4))
+    (filtered: when round-off could flip the sign the answer is no, consistently);
+    ``p`` is a ``(4, 4)`` work array."""
     for k in range(4):
         v = tet[t, k]
         for d in range(3):
@@ -190,7 +190,7 @@ def _on_edge(nodes, cedges, features, a, b, x, tol, n):
 
 
 @numba.njit(cache=True)
-def _cavity(nodes, tet, nb, t, x, stamp, mark, cav, limit):
+def _cavity(nodes, tet, nb, t, x, stamp, mark, cav, limit, sph):
     """The star-shaped constrained cavity of ``x`` from tetrahedron ``t``: its size, or
     -1 if it does not fit or has to lose ``t``. ``mark[o] == stamp`` for its members.
     With ``limit`` (``x`` on a constraint face, the cavity of points tending to it
@@ -210,7 +210,7 @@ def _cavity(nodes, tet, nb, t, x, stamp, mark, cav, limit):
                                    tet[c, FACES[k, 2]], x)
             if det < -PLANE_RTOL * perm:        # x sees the face from behind: not visible
                 continue
-            if not _in_sphere(nodes, tet, o, x):
+            if not _in_sphere(nodes, tet, o, x, sph):
                 mark[o] = -stamp
                 continue
             if size == cav.shape[0]:
@@ -244,6 +244,12 @@ def _cavity(nodes, tet, nb, t, x, stamp, mark, cav, limit):
 
 
 @numba.njit(cache=True, inline="always")
+def _rel(nodes, v, x):
+    """``nodes[v] - x`` as a tuple (no array allocated)."""
+    return (nodes[v, 0] - x[0], nodes[v, 1] - x[1], nodes[v, 2] - x[2])
+
+
+@numba.njit(cache=True, inline="always")
 def _cross(u, v):
     return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
 
@@ -257,6 +263,33 @@ def _product(u, ku, v, kv, nu, limit):
     a = _cross(nu, v)
     b = _cross(nu, u)
     return (ku * a[0] - kv * b[0], ku * a[1] - kv * b[1], ku * a[2] - kv * b[2])
+
+
+@numba.njit(cache=True)
+def _in_plane(pa, pb, pc, det, lengths2, nu, fq, fs, nf):
+    """Whether the face ``(pa, pb, pc)`` (relative to x) lies in the plane through x of
+    normal ``nu``; if so ``fq[nf]`` gets its circumcentre and ``fs[nf, 0]`` the
+    coefficient ``k = (|o|^2 - r^2) / 2`` of its Voronoi vertex at infinity."""
+    ab = (pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2])
+    ac = (pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2])
+    nn = _cross(ab, ac)
+    n2 = nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]
+    along = nn[0] * nu[0] + nn[1] * nu[1] + nn[2] * nu[2]
+    if abs(det) > FLAT_RTOL * np.sqrt(lengths2) or along * along < (1.0 - FLAT_RTOL) * n2:
+        return False
+    l1 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]
+    l3 = ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2]
+    u1 = _cross(nn, ab)
+    u2 = _cross(ac, nn)
+    o2 = 0.0
+    r2 = 0.0
+    for d in range(3):
+        off = (l1 * u2[d] + l3 * u1[d]) / (2.0 * n2)
+        fq[nf, d] = pa[d] + off
+        o2 += fq[nf, d] ** 2
+        r2 += off * off
+    fs[nf, 0] = 0.5 * (o2 - r2)
+    return True
 
 
 @numba.njit(cache=True)
@@ -292,34 +325,16 @@ def _natural_row(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_mark, node
             if nf == fq.shape[0]:
                 return -1
             bf[m, k] = nf
-            pa = nodes[tet[c, FACES[k, 0]]] - x
-            pb = nodes[tet[c, FACES[k, 1]]] - x
-            pc = nodes[tet[c, FACES[k, 2]]] - x
+            pa = _rel(nodes, tet[c, FACES[k, 0]], x)
+            pb = _rel(nodes, tet[c, FACES[k, 1]], x)
+            pc = _rel(nodes, tet[c, FACES[k, 2]], x)
             bxc, cxa, axb = _cross(pb, pc), _cross(pc, pa), _cross(pa, pb)
             det = pa[0] * bxc[0] + pa[1] * bxc[1] + pa[2] * bxc[2]
             a2 = pa[0] * pa[0] + pa[1] * pa[1] + pa[2] * pa[2]
             b2 = pb[0] * pb[0] + pb[1] * pb[1] + pb[2] * pb[2]
             c2 = pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2]
-            ab = pb - pa
-            ac = pc - pa
-            nn = _cross(ab, ac)
-            n2 = nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]
-            along = nn[0] * nu[0] + nn[1] * nu[1] + nn[2] * nu[2]
-            if limit and abs(det) <= FLAT_RTOL * np.sqrt(a2 * b2 * c2) \
-                    and along * along >= (1.0 - FLAT_RTOL) * n2:
-                # a face in the plane of x's face: its circumcentre, in that plane
-                l1 = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]
-                l3 = ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2]
-                u1 = _cross(nn, ab)
-                u2 = _cross(ac, nn)
-                o2 = 0.0
-                r2 = 0.0
-                for d in range(3):
-                    off = (l1 * u2[d] + l3 * u1[d]) / (2.0 * n2)
-                    fq[nf, d] = pa[d] + off
-                    o2 += fq[nf, d] ** 2
-                    r2 += off * off
-                fs[nf, 0] = 0.5 * (o2 - r2)
+            if limit and _in_plane(pa, pb, pc, det, a2 * b2 * c2, nu, fq, fs, nf):
+                pass                 # a face in the plane of x's face: its vertex at infinity
             elif limit:
                 for d in range(3):
                     fq[nf, d] = (a2 * bxc[d] + b2 * cxa[d] + c2 * axb[d]) / (2.0 * det)
@@ -390,7 +405,7 @@ def _natural_row(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_mark, node
             cr = _product(qf, fs[f, 0], qg, fs[g, 0], nu, limit)
             for d in range(3):
                 acc[si, d] += 0.5 * cr[d]
-            pi = nodes[i] - x
+            pi = _rel(nodes, i, x)
             if gradient and laplace:
                 sf, sg = fs[f], fs[g]
                 a1 = _cross(sf, qg)
@@ -400,7 +415,7 @@ def _natural_row(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_mark, node
                 for d in range(3):
                     acc[si, 4 + d] += c1 * qf[d] + c2 * qg[d]
             if not laplace:
-                pj = nodes[j] - x
+                pj = _rel(nodes, j, x)
                 cg = _product(qg, fs[g, 0], qf, fs[f, 0], nu, limit)   # closing edge of (i, j)
                 acc[si, 3] += (cg[0] * pj[0] + cg[1] * pj[1] + cg[2] * pj[2]) / 12.0
                 if gradient:                     # first moment of the facet, about x
@@ -425,9 +440,10 @@ def _sibson_chains(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_slot, fq
     where the chain leaves the cavity, and from the new vertex where it enters)."""
     for m in range(size):
         c = cav[m]
-        u1 = nodes[tet[c, 1]] - nodes[tet[c, 0]]
-        u2 = nodes[tet[c, 2]] - nodes[tet[c, 0]]
-        u3 = nodes[tet[c, 3]] - nodes[tet[c, 0]]
+        v0 = nodes[tet[c, 0]]
+        u1 = _rel(nodes, tet[c, 1], v0)
+        u2 = _rel(nodes, tet[c, 2], v0)
+        u3 = _rel(nodes, tet[c, 3], v0)
         c23, c31, c12 = _cross(u2, u3), _cross(u3, u1), _cross(u1, u2)
         det = 2.0 * (u1[0] * c23[0] + u1[1] * c23[1] + u1[2] * c23[2])
         n1 = u1[0] * u1[0] + u1[1] * u1[1] + u1[2] * u1[2]
@@ -452,8 +468,8 @@ def _sibson_chains(nodes, tet, nb, x, cav, size, stamp, mark, pos, node_slot, fq
             if bf[m, lx] >= 0:                       # entry from outside, across (i, j, k)
                 en = _product(fq[bf[m, lx]], fs[bf[m, lx], 0], ct, 0.0, nu, limit)
                 ex, ey, ez = ex + 0.5 * en[0], ey + 0.5 * en[1], ez + 0.5 * en[2]
-            pi = nodes[i] - x
-            pj = nodes[j] - x
+            pi = _rel(nodes, i, x)
+            pj = _rel(nodes, j, x)
             acc[node_slot[i], 3] += (ex * pj[0] + ey * pj[1] + ez * pj[2]) / 6.0
             acc[node_slot[j], 3] -= (ex * pi[0] + ey * pi[1] + ez * pi[2]) / 6.0
 
@@ -568,6 +584,7 @@ def natural(nodes, tet, nb, cedges, features, points, tet_of, tol, nch, laplace,
         grads = np.empty((MAX_CAVITY, 3))
         foot = np.empty(3)
         nu = np.zeros(3)
+        sph = np.empty((4, 4))
         lo, hi = ch * p // nch, (ch + 1) * p // nch
         a, end = lo * slots, hi * slots
         for s in range(lo, hi):
@@ -598,7 +615,7 @@ def natural(nodes, tet, nb, cedges, features, points, tet_of, tol, nch, laplace,
                 else:
                     for d in range(3):
                         foot[d] = x[d]
-                csize = _cavity(nodes, tet, nb, t0, foot, stamp, mark, cav, limit)
+                csize = _cavity(nodes, tet, nb, t0, foot, stamp, mark, cav, limit, sph)
                 if csize > 0:
                     c = _natural_row(nodes, tet, nb, foot, cav, csize, stamp, mark, pos,
                                      node_mark, node_slot, fq, fs, fv, bf, twin, hkeys, hval, cc,

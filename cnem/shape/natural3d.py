@@ -47,6 +47,8 @@ class TetMesh(NamedTuple):
         Sorted keys ``min * n + max`` of the edges of every constraint face.
     feature_edges : (f,) int64
         The same for the edges where constraint faces of different planes meet.
+    node_tet : (n,) int64
+        A tetrahedron of each node (-1 for a node of none), where walks start.
     frame : Frame
         The local frame the kernels run in.
     local_nodes : (n, 3) float64
@@ -61,6 +63,7 @@ class TetMesh(NamedTuple):
     walk_neighbors: np.ndarray
     constraint_edges: np.ndarray
     feature_edges: np.ndarray
+    node_tet: np.ndarray
     frame: Frame
     local_nodes: np.ndarray
     tol: float
@@ -120,7 +123,9 @@ def tet_mesh(nodes: ArrayLike, tetrahedra: ArrayLike, *, tet_region: ArrayLike |
     cedges, features = _constraint_edges(local, boundary_rows)
     diameter = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
     tol = max(config.SHAPE_TOL * diameter / frame.scale, config.ROUNDOFF_ULPS * frame.resolution)
-    return TetMesh(pts, tet, region, cut, walk, cedges, features, frame, local, tol)
+    node_tet = np.full(len(pts), -1, dtype=np.int64)
+    node_tet[tet.ravel()] = np.repeat(np.arange(len(tet)), 4)
+    return TetMesh(pts, tet, region, cut, walk, cedges, features, node_tet, frame, local, tol)
 
 
 def _constraint_edges(local, faces):
@@ -198,12 +203,13 @@ def _locate(mesh, spts):
     nodes, tet = mesh.local_nodes, mesh.tetrahedra
     nch = work_chunks()
     starts = (np.arange(nch) * len(spts)) // nch
-    centroids = nodes[tet].mean(axis=1)
-    tree = scipy.spatial.cKDTree(centroids)
-    seeds = tree.query(spts[starts])[1].astype(np.int64)
+    nearest = [np.argmin(((nodes - p) ** 2).sum(axis=1)) for p in spts[starts]]
+    seeds = mesh.node_tet[nearest]
     tet_of = K.locate_walk(nodes, tet, mesh.walk_neighbors, spts, seeds, nch)
     lost = np.flatnonzero(tet_of < 0)
     if lost.size:
+        centroids = nodes[tet].mean(axis=1)
+        tree = scipy.spatial.cKDTree(centroids)
         reach = float(np.linalg.norm(nodes[tet] - centroids[:, None], axis=2).max()) + mesh.tol
         cands = tree.query_ball_point(spts[lost], reach)
         off = np.zeros(lost.size + 1, dtype=np.int64)
@@ -276,7 +282,7 @@ def shape_functions_3d(mesh: TetMesh, points: ArrayLike, *,
         raise GeometryError(
             f"{outside.size} of {len(pts)} points lie outside the body, first (index: point) "
             + ", ".join(f"{i}: {pts[i].tolist()}" for i in outside[:5]))
-    slots = 4 * config.ROW_SLOTS
+    slots = 2 * config.ROW_SLOTS
     while True:
         start, size, cols, vals, grads, kinds, full = K.natural(
             mesh.local_nodes, mesh.tetrahedra, mesh.neighbors, mesh.constraint_edges,
