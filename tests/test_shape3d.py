@@ -261,3 +261,41 @@ def test_errors_name_the_problem():
         tet_mesh(nodes, [[0, 1, 2, 2]])
     with pytest.raises(GeometryError, match="no face of the tetrahedra"):
         tet_mesh(nodes, tets, constraint_faces=[[0, 1, 26]])
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_regions_do_not_share_weights_across_an_interface(kind):
+    nodes, tets = lattice_box(4)
+    region = (nodes[tets].mean(axis=1)[:, 0] > 0.5).astype(int)
+    mesh = tet_mesh(nodes, tets, tet_region=region)
+    rng = np.random.default_rng(8)
+    points = rng.uniform(0, 1, (2000, 3))
+    phi = shape_functions_3d(mesh, points, kind=kind).toarray()
+    check_rows(phi, nodes, points)
+    left = points[:, 0] < 0.5
+    assert np.abs(phi[np.ix_(left, nodes[:, 0] > 0.5)]).max() == 0.0
+    assert np.abs(phi[np.ix_(~left, nodes[:, 0] < 0.5)]).max() == 0.0
+    # on the interface both sides agree: only its own nodes, continuous from either side
+    on = np.column_stack([np.full(200, 0.5), rng.uniform(0, 1, (200, 2))])
+    here = shape_functions_3d(mesh, on, kind=kind)
+    assert np.abs(here.toarray()[:, nodes[:, 0] != 0.5]).max() == 0.0
+    for side in (-1e-9, 1e-9):
+        assert abs(shape_functions_3d(mesh, on + [side, 0, 0], kind=kind) - here).max() < 1e-7
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_rows_beside_a_reentrant_edge_are_shares(kind, caplog):
+    """Where the cavity's signed coordinates are not non-negative shares (a thin layer
+    beside a re-entrant edge) the row is the barycentric one of the tetrahedron, and
+    the call says how many."""
+    nodes, tets = carved(8, SLOT_REMOVED)
+    mesh = tet_mesh(nodes, tets)
+    points = np.random.default_rng(0).uniform(0, 1, (40000, 3))
+    points = points[inside_carved(points, SLOT_REMOVED)][:20000]
+    phi = shape_functions_3d(mesh, points, kind=kind, gradient=True)
+    check_rows(phi.value, nodes, points, tol=1e-11)
+    assert phi.value.data.min() > -1e-9
+    for d, g in enumerate(phi.gradient):
+        assert np.abs(g @ nodes - np.eye(3)[d]).max() < 1e-9
+    fell = sum(int(r.msg and r.args[0]) for r in caplog.records if "linearly" in r.msg)
+    assert fell < 10

@@ -38,8 +38,12 @@ import numpy as np
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from .._parallel import parallel_kernel
 
-#: Row kinds.
-CAVITY, AT_NODE, ON_FACE, ON_EDGE, FAILED = 0, 1, 2, 3, 4
+#: Row kinds (``FALLBACK``: barycentric in the tetrahedron, where the cavity's
+#: coordinates are not a partition into non-negative weights, see `_bad_row`).
+CAVITY, AT_NODE, ON_FACE, ON_EDGE, FAILED, FALLBACK = 0, 1, 2, 3, 4, 5
+
+#: A weight below ``-NEGATIVE_RTOL`` times the largest makes a row `FALLBACK`.
+NEGATIVE_RTOL = 1e-9
 
 #: Largest cavity (tetrahedra); its boundary has at most twice as many faces.
 MAX_CAVITY = 1024
@@ -506,6 +510,49 @@ def _normalise(acc, count, laplace, gradient, vals, grads):
     return True
 
 
+@numba.njit(cache=True)
+def _bad_row(vals, count):
+    """Whether normalised weights hold a clearly negative one: near a re-entrant edge,
+    on the side where a constraint face's plane runs into the body, the flat new
+    tetrahedron over that face sends its Voronoi vertex far behind it and the signed
+    facet areas stop being a partition into shares."""
+    top = 0.0
+    low = 0.0
+    for e in range(count):
+        top = max(top, vals[e])
+        low = min(low, vals[e])
+    return low < -NEGATIVE_RTOL * top
+
+
+@numba.njit(cache=True)
+def _barycentric_row(nodes, tet, t, x, cols, vals, grads):
+    """The barycentric coordinates of ``x`` in tetrahedron ``t`` and their gradients;
+    the row's length (4)."""
+    total = 0.0
+    for k in range(4):
+        a, b, c = tet[t, FACES[k, 0]], tet[t, FACES[k, 1]], tet[t, FACES[k, 2]]
+        det, perm = _face_side(nodes, a, b, c, x)
+        cols[k] = tet[t, k]
+        vals[k] = max(det, 0.0)
+        total += vals[k]
+        v0 = nodes[a]
+        nrm = _cross(_rel(nodes, b, v0), _rel(nodes, c, v0))
+        for d in range(3):
+            grads[k, d] = -nrm[d]
+    volume6 = 0.0
+    for k in range(4):
+        a = tet[t, FACES[k, 0]]
+        volume6 += (nodes[tet[t, k], 0] - nodes[a, 0]) * grads[k, 0] + \
+            (nodes[tet[t, k], 1] - nodes[a, 1]) * grads[k, 1] + \
+            (nodes[tet[t, k], 2] - nodes[a, 2]) * grads[k, 2]
+    volume6 /= 4.0
+    for k in range(4):
+        vals[k] /= total
+        for d in range(3):
+            grads[k, d] /= volume6
+    return 4
+
+
 @parallel_kernel("points")
 def natural(nodes, tet, nb, cedges, features, points, tet_of, tol, nch, laplace, gradient, slots):
     """Laplace (or Sibson) coordinates of many points, one pass, rows in visit order.
@@ -548,7 +595,7 @@ def natural(nodes, tet, nb, cedges, features, points, tet_of, tol, nch, laplace,
     grads : (p * slots, 3) float64
         Empty unless ``gradient``.
     kinds : (p,) int8
-        ``CAVITY``, ``AT_NODE``, ``ON_FACE``, ``ON_EDGE`` or ``FAILED``.
+        ``CAVITY``, ``AT_NODE``, ``ON_FACE``, ``ON_EDGE``, ``FAILED`` or ``FALLBACK``.
     full : bool
         Some chunk ran out of room (the result is incomplete).
     """
@@ -627,7 +674,10 @@ def natural(nodes, tet, nb, cedges, features, points, tet_of, tol, nch, laplace,
                         for d in range(3):
                             acc[e, 11 + d] = nodes[cols[e], d] - foot[d]
                     if not _normalise(acc, c, laplace, gradient and not limit, vals, grads):
-                        kind, c = FAILED, 0
+                        kind, c = (FAILED, 0) if limit else (FALLBACK, 0)
+                if not limit and (kind == FALLBACK or (kind == CAVITY and _bad_row(vals, c))):
+                    kind = FALLBACK
+                    c = _barycentric_row(nodes, tet, tet_of[s], x, cols, vals, grads)
             kinds[s] = kind
             if a + c > end:
                 full[ch] = True
@@ -636,7 +686,7 @@ def natural(nodes, tet, nb, cedges, features, points, tet_of, tol, nch, laplace,
             for e in range(c):
                 out_cols[a + e] = cols[e]
                 out_vals[a + e] = vals[e]
-            if gradient and kind == CAVITY:
+            if gradient and (kind == CAVITY or kind == FALLBACK):
                 for e in range(c):
                     for d in range(3):
                         out_grad[a + e, d] = grads[e, d]

@@ -11,6 +11,7 @@ True
 
 from __future__ import annotations
 
+import logging
 from typing import Literal, NamedTuple
 
 import numpy as np
@@ -26,6 +27,8 @@ from . import _kernels3d as K
 from .natural import KINDS, ShapeGradients
 
 __all__ = ["TetMesh", "tet_mesh", "shape_functions_3d"]
+
+_log = logging.getLogger(__name__)
 
 
 class TetMesh(NamedTuple):
@@ -296,11 +299,17 @@ def shape_functions_3d(mesh: TetMesh, points: ArrayLike, *,
         raise CNEMError(f"the natural-neighbour cavity of {failed.size} points was inconsistent "
                         f"(round-off on a circumsphere), first {pts[failed[:3]].tolist()}; "
                         "please report this case")
+    fallback = np.sort(order[kinds == K.FALLBACK])
+    if fallback.size:
+        _log.warning("%d of %d points lie where the constrained %s coordinates are not "
+                     "non-negative shares (beside a re-entrant edge, near the plane of a "
+                     "boundary face); they interpolate linearly in their tetrahedron, first %s",
+                     fallback.size, len(pts), kind, pts[fallback[:3]].tolist())
     offsets, cols, vals, grads = K.permute_rows(start, size, cols, vals, grads, order)
     phi = sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n))
     if not gradient:
         return phi
-    singular = np.sort(order[kinds != K.CAVITY])
+    singular = np.sort(order[(kinds != K.CAVITY) & (kinds != K.FALLBACK)])
     if singular.size:
         raise GeometryError(
             f"{singular.size} points lie at a node or on a constraint face or edge, where the "
