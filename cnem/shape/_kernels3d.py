@@ -716,18 +716,12 @@ def _walk(nodes, tet, nbw, t, x, max_steps):
 
 
 @parallel_kernel("points")
-def locate_walk(nodes, tet, nbw, points, seeds, nch):
-    """Tetrahedra holding path-ordered points, walking from one point to the next;
-    chunk ``c`` starts from ``seeds[c]``. Points the walk cannot reach get -1."""
-    p = points.shape[0]
-    out = np.full(p, -1, dtype=np.int64)
-    for ch in numba.prange(nch):
-        t = seeds[ch]
-        for s in range(ch * p // nch, (ch + 1) * p // nch):
-            found = _walk(nodes, tet, nbw, t, points[s], 8192)
-            if found >= 0:
-                out[s] = found
-                t = found
+def locate_walk(nodes, tet, nbw, points, starts):
+    """Tetrahedra holding points, each walked to from its tetrahedron ``starts``
+    (a tetrahedron of its nearest node); -1 where the walk leaves the body."""
+    out = np.empty(points.shape[0], dtype=np.int64)
+    for q in numba.prange(points.shape[0]):
+        out[q] = _walk(nodes, tet, nbw, starts[q], points[q], 8192)
     return out
 
 

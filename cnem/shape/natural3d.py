@@ -52,6 +52,8 @@ class TetMesh(NamedTuple):
         The same for the edges where constraint faces of different planes meet.
     node_tet : (n,) int64
         A tetrahedron of each node (-1 for a node of none), where walks start.
+    node_tree : scipy.spatial.cKDTree
+        Of the local nodes: the nearest node of a point.
     frame : Frame
         The local frame the kernels run in.
     local_nodes : (n, 3) float64
@@ -67,6 +69,7 @@ class TetMesh(NamedTuple):
     constraint_edges: np.ndarray
     feature_edges: np.ndarray
     node_tet: np.ndarray
+    node_tree: scipy.spatial.cKDTree
     frame: Frame
     local_nodes: np.ndarray
     tol: float
@@ -128,7 +131,8 @@ def tet_mesh(nodes: ArrayLike, tetrahedra: ArrayLike, *, tet_region: ArrayLike |
     tol = max(config.SHAPE_TOL * diameter / frame.scale, config.ROUNDOFF_ULPS * frame.resolution)
     node_tet = np.full(len(pts), -1, dtype=np.int64)
     node_tet[tet.ravel()] = np.repeat(np.arange(len(tet)), 4)
-    return TetMesh(pts, tet, region, cut, walk, cedges, features, node_tet, frame, local, tol)
+    return TetMesh(pts, tet, region, cut, walk, cedges, features, node_tet,
+                   scipy.spatial.cKDTree(local), frame, local, tol)
 
 
 def _constraint_edges(local, faces):
@@ -201,14 +205,12 @@ def _path_order(points, lo, hi, per_cell=4):
 
 
 def _locate(mesh, spts):
-    """A tetrahedron holding each path-ordered local point (-1 outside): walks from
-    point to point, then the nearest tetrahedra by centroid for the points lost."""
+    """A tetrahedron holding each local point (-1 outside): a walk from a tetrahedron of
+    its nearest node, then the nearest tetrahedra by centroid for the points lost
+    (walks stop at the boundary)."""
     nodes, tet = mesh.local_nodes, mesh.tetrahedra
-    nch = work_chunks()
-    starts = (np.arange(nch) * len(spts)) // nch
-    nearest = [np.argmin(((nodes - p) ** 2).sum(axis=1)) for p in spts[starts]]
-    seeds = mesh.node_tet[nearest]
-    tet_of = K.locate_walk(nodes, tet, mesh.walk_neighbors, spts, seeds, nch)
+    nearest = mesh.node_tree.query(spts)[1]
+    tet_of = K.locate_walk(nodes, tet, mesh.walk_neighbors, spts, mesh.node_tet[nearest])
     lost = np.flatnonzero(tet_of < 0)
     if lost.size:
         centroids = nodes[tet].mean(axis=1)
@@ -223,8 +225,8 @@ def _locate(mesh, spts):
 
 
 def shape_functions_3d(mesh: TetMesh, points: ArrayLike, *,
-                       kind: Literal["laplace", "sibson"] = "laplace", gradient: bool = False,
-                       tets: ArrayLike | None = None) -> sp.csr_matrix | ShapeGradients:
+                       kind: Literal["laplace", "sibson"] = "laplace",
+                       gradient: bool = False) -> sp.csr_matrix | ShapeGradients:
     """Constrained Laplace or Sibson coordinates of points in a tetrahedrised body.
 
     Parameters
@@ -237,9 +239,6 @@ def shape_functions_3d(mesh: TetMesh, points: ArrayLike, *,
     gradient : bool
         Also return the analytic derivatives, for points inside the cells
         (not at nodes nor on constraint faces or edges, where they are not defined).
-    tets : (p,) array_like of int, optional
-        A tetrahedron holding each point (-1: locate it), e.g. the side of a
-        constraint face wanted.
 
     Returns
     -------
@@ -269,17 +268,7 @@ def shape_functions_3d(mesh: TetMesh, points: ArrayLike, *,
     local = mesh.frame.to_local(pts)
     order = _path_order(local, local.min(axis=0), local.max(axis=0))
     spts = np.ascontiguousarray(local[order])
-    tet_of = np.full(len(pts), -1, dtype=np.int64)
-    if tets is not None:
-        hint = np.asarray(tets, dtype=np.int64).reshape(-1)
-        if hint.shape != (len(pts),) or (hint < -1).any() or (hint >= len(mesh.tetrahedra)).any():
-            raise GeometryError(f"tets: expected {len(pts)} indices into the "
-                                f"{len(mesh.tetrahedra)} tetrahedra (or -1), received shape "
-                                f"{hint.shape}")
-        tet_of = hint[order]
-    todo = np.flatnonzero(tet_of < 0)
-    if todo.size:
-        tet_of[todo] = _locate(mesh, spts[todo])
+    tet_of = _locate(mesh, spts)
     outside = np.sort(order[tet_of < 0])
     if outside.size:
         raise GeometryError(
