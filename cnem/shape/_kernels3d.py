@@ -696,22 +696,20 @@ def natural(nodes, tet, nb, cedges, features, points, tet_of, tol, nch, laplace,
 
 @numba.njit(cache=True)
 def _walk(nodes, tet, nbw, t, x, max_steps):
-    """Visibility walk from tetrahedron ``t`` to the one holding ``x``; -1 if it leaves
-    the tetrahedrisation or takes too long."""
-    for step in range(max_steps):
-        moved = False
-        for r in range(4):
-            k = (r + step) & 3
+    """Walk from tetrahedron ``t`` to the one holding ``x``; -1 if it leaves the
+    tetrahedrisation or takes too long (a cycle: the caller searches then)."""
+    for _ in range(max_steps):       # across the face x lies farthest behind
+        worst, exit_face = 0.0, -1
+        for k in range(4):
             det, perm = _face_side(nodes, tet[t, FACES[k, 0]], tet[t, FACES[k, 1]],
                                    tet[t, FACES[k, 2]], x)
-            if det < 0.0:
-                t = nbw[t, k]
-                if t < 0:
-                    return -1
-                moved = True
-                break
-        if not moved:
+            if det < worst * perm:
+                worst, exit_face = det / perm, k
+        if exit_face < 0:
             return t
+        t = nbw[t, exit_face]
+        if t < 0:
+            return -1
     return -1
 
 
