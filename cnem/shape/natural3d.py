@@ -23,6 +23,7 @@ from .. import config
 from .._parallel import work_chunks
 from .._predicates import Frame, local_frame
 from ..errors import CNEMError, GeometryError, check_choice
+from . import _cavity3d as C
 from . import _kernels3d as K
 from .natural import KINDS, ShapeGradients
 
@@ -160,7 +161,7 @@ def _constraint_edges(local, faces):
 def _adjacency(tet, region, constraint_faces, n):
     """Neighbours across faces: ``(walk, cut, constraint_rows)`` with ``cut`` also -1
     across region changes and constraint faces, whose node triples are returned."""
-    faces = np.sort(tet[:, K.FACES].reshape(-1, 3), axis=1)       # row 4 t + k: opposite k
+    faces = np.sort(tet[:, C.FACES].reshape(-1, 3), axis=1)       # row 4 t + k: opposite k
     given = (np.zeros((0, 3), dtype=np.int64) if constraint_faces is None
              else np.sort(np.asarray(constraint_faces, dtype=np.int64).reshape(-1, 3), axis=1))
     rows = np.concatenate([faces, given])
@@ -210,7 +211,7 @@ def _locate(mesh, spts):
     (walks stop at the boundary)."""
     nodes, tet = mesh.local_nodes, mesh.tetrahedra
     nearest = mesh.node_tree.query(spts)[1]
-    tet_of = K.locate_walk(nodes, tet, mesh.walk_neighbors, spts, mesh.node_tet[nearest])
+    tet_of = C.locate_walk(nodes, tet, mesh.walk_neighbors, spts, mesh.node_tet[nearest])
     lost = np.flatnonzero(tet_of < 0)
     if lost.size:
         centroids = nodes[tet].mean(axis=1)
@@ -220,7 +221,7 @@ def _locate(mesh, spts):
         off = np.zeros(lost.size + 1, dtype=np.int64)
         off[1:] = np.cumsum([len(c) for c in cands])
         idx = np.concatenate([np.asarray(c, dtype=np.int64) for c in cands])
-        tet_of[lost] = K.locate(nodes, tet, spts[lost], off, idx, mesh.tol)
+        tet_of[lost] = C.locate(nodes, tet, spts[lost], off, idx, mesh.tol)
     return tet_of
 
 
@@ -283,12 +284,12 @@ def shape_functions_3d(mesh: TetMesh, points: ArrayLike, *,
         if not full:
             break
         slots *= 2
-    failed = np.sort(order[kinds == K.FAILED])
+    failed = np.sort(order[kinds == C.FAILED])
     if failed.size:
         raise CNEMError(f"the natural-neighbour cavity of {failed.size} points was inconsistent "
                         f"(round-off on a circumsphere), first {pts[failed[:3]].tolist()}; "
                         "please report this case")
-    fallback = np.sort(order[kinds == K.FALLBACK])
+    fallback = np.sort(order[kinds == C.FALLBACK])
     if fallback.size:
         _log.warning("%d of %d points lie where the constrained %s coordinates are not "
                      "non-negative shares (beside a re-entrant edge, near the plane of a "
@@ -298,7 +299,7 @@ def shape_functions_3d(mesh: TetMesh, points: ArrayLike, *,
     phi = sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n))
     if not gradient:
         return phi
-    singular = np.sort(order[(kinds != K.CAVITY) & (kinds != K.FALLBACK)])
+    singular = np.sort(order[(kinds != C.CAVITY) & (kinds != C.FALLBACK)])
     if singular.size:
         raise GeometryError(
             f"{singular.size} points lie at a node or on a constraint face or edge, where the "
