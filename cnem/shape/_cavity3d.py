@@ -145,16 +145,18 @@ def _on_edge(nodes, cedges, features, a, b, x, tol, n):
     """Whether ``x`` lies on the edge ``(a, b)`` of constraint faces: ``(ON_EDGE, a, b,
     s)`` on a feature edge (``x = a + s (b - a)``), ``(ON_FACE, a, b, s)`` on an edge
     inside a flat patch of constraint faces, else ``(CAVITY, ...)``."""
+    ed = _rel(nodes, b, nodes[a])            # the distance first: no search for most
+    r = (x[0] - nodes[a, 0], x[1] - nodes[a, 1], x[2] - nodes[a, 2])
+    l2 = ed[0] * ed[0] + ed[1] * ed[1] + ed[2] * ed[2]
+    s = (r[0] * ed[0] + r[1] * ed[1] + r[2] * ed[2]) / l2
+    off2 = 0.0
+    for d in range(3):
+        off2 += (r[d] - s * ed[d]) ** 2
+    if off2 > tol * tol:
+        return CAVITY, a, b, 0.0
     key = min(a, b) * n + max(a, b)
     pos = np.searchsorted(cedges, key)
     if pos >= cedges.shape[0] or cedges[pos] != key:
-        return CAVITY, a, b, 0.0
-    ed = nodes[b] - nodes[a]
-    r = x - nodes[a]
-    l2 = ed[0] * ed[0] + ed[1] * ed[1] + ed[2] * ed[2]
-    s = (r[0] * ed[0] + r[1] * ed[1] + r[2] * ed[2]) / l2
-    off = r - s * ed
-    if off[0] * off[0] + off[1] * off[1] + off[2] * off[2] > tol * tol:
         return CAVITY, a, b, 0.0
     pos = np.searchsorted(features, key)
     if pos < features.shape[0] and features[pos] == key:
