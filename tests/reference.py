@@ -804,3 +804,73 @@ def lps_force(points, volumes, horizon, u, bulk, shear, factor, thickness=1.0):
             grad[j] += part
             grad[i] -= part
     return -grad / volumes[:, None]
+
+
+# ------------------------------------------------------- 3-D natural neighbours
+# Unconstrained Laplace and Sibson coordinates of a point deep inside a convex
+# cloud, from the Voronoi cells as intersections of half-spaces (scipy's Qhull):
+# the cell of x among nodes + {x}, its facet areas (the cell's vertices on each
+# bisector plane, their 2-D convex hull), and the volumes of its intersections
+# with the old cells.
+
+
+def _voronoi_halfspaces(site, others):
+    """``(k, 4)`` half-spaces ``A y + b <= 0`` of the points nearer ``site`` than ``others``."""
+    a = 2.0 * (others - site)
+    b = site @ site - np.einsum("ij,ij->i", others, others)
+    return np.column_stack([a, b])
+
+
+def _polytope(halfspaces):
+    """The vertices of a bounded intersection of half-spaces (None if it is empty or
+    flat), from an interior point found by linear programming (Chebyshev centre)."""
+    import scipy.optimize
+    import scipy.spatial
+    a, b = halfspaces[:, :3], halfspaces[:, 3]
+    norm = np.linalg.norm(a, axis=1)
+    res = scipy.optimize.linprog([0, 0, 0, -1], A_ub=np.column_stack([a, norm]), b_ub=-b,
+                                 bounds=[(None, None)] * 3 + [(0, None)], method="highs")
+    if res.status != 0 or res.x[3] <= 1e-12:
+        return None
+    hs = scipy.spatial.HalfspaceIntersection(halfspaces, res.x[:3])
+    return hs.intersections
+
+
+def laplace_reference_3d(nodes, x):
+    """Laplace coordinates ``(n,)`` of ``x`` among ``nodes`` (unconstrained; the cell of
+    ``x`` must be bounded): ``(area_i / d_i) / sum_j (area_j / d_j)``."""
+    import scipy.spatial
+    verts = _polytope(_voronoi_halfspaces(x, nodes))
+    w = np.zeros(len(nodes))
+    scale = np.abs(verts - x).max()
+    for i, p in enumerate(nodes):
+        d = np.linalg.norm(p - x)
+        nrm = (p - x) / d
+        on = np.abs((verts - 0.5 * (p + x)) @ nrm) <= 1e-9 * scale
+        if on.sum() < 3:
+            continue
+        e1 = np.cross(nrm, [1.0, 0, 0] if abs(nrm[0]) < 0.9 else [0, 1.0, 0])
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(nrm, e1)
+        flat = np.column_stack([(verts[on] - x) @ e1, (verts[on] - x) @ e2])
+        try:
+            area = scipy.spatial.ConvexHull(flat).volume
+        except scipy.spatial.QhullError:       # a degenerate (zero-area) facet
+            continue
+        w[i] = area / d
+    return w / w.sum()
+
+
+def sibson_reference_3d(nodes, x):
+    """Sibson coordinates ``(n,)`` of ``x`` among ``nodes`` (unconstrained; the cells
+    involved must be bounded): the volume of the cell of ``x`` taken from each old cell."""
+    import scipy.spatial
+    new = _voronoi_halfspaces(x, nodes)
+    w = np.zeros(len(nodes))
+    for i, p in enumerate(nodes):
+        old = _voronoi_halfspaces(p, np.delete(nodes, i, axis=0))
+        verts = _polytope(np.vstack([new, old]))
+        if verts is None:
+            continue
+        w[i] = scipy.spatial.ConvexHull(verts).volume
+    return w / w.sum()

@@ -1,4 +1,4 @@
-"""Shape functions: constrained natural-neighbour (Sibson) coordinates.
+"""Shape functions: constrained natural-neighbour (Sibson, Laplace) coordinates in 2-D and 3-D.
 
 >>> import numpy as np, cnem
 >>> model = cnem.discretize(cnem.nodes.regular(cnem.geometry.rectangle(), 0.25))
@@ -8,5 +8,6 @@ True
 """
 
 from .natural import KINDS, shape_functions
+from .natural3d import TetMesh, shape_functions_3d, tet_mesh
 
-__all__ = ["shape_functions", "KINDS"]
+__all__ = ["shape_functions", "KINDS", "tet_mesh", "TetMesh", "shape_functions_3d"]
