@@ -1,0 +1,251 @@
+"""Constrained Voronoi integration cells in 3-D, with their boundaries as triangles.
+
+A point ``x`` of region ``r`` belongs to the cell of node ``i`` when ``i`` is visible
+from ``x`` (the segment between them crosses no boundary or interface face) and no
+node visible from ``x`` is nearer. A node on an interface owns one cell per region.
+
+Two paths compute the cells:
+
+* the *fast path* (vectorised numpy), for an interior node whose ball of radius
+  ``R`` (its farthest circumcentre) meets no boundary face: its cell is its Voronoi
+  cell, the polyhedron of the circumcentres of its tetrahedra. Each facet is the dual
+  of a Delaunay edge, the circumcentres of the tetrahedra around the edge ordered by
+  angle and fan-triangulated; the volume is ``sum(A d) / 6`` over the facets;
+* the *general path* (`.cells3d_clip`), for every other node: exact clipping of
+  convex polytopes by bisectors, boundary planes and the shadows of the boundary
+  faces (see there).
+
+The cells partition each region: their volumes sum to the region's volume to
+round-off.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..errors import GeometryError
+from .cells3d_clip import GeneralCells
+from .tetrahedra import signed_volumes, tet_neighbors
+
+__all__ = ["Cells3D", "constrained_voronoi_cells"]
+
+#: The six edges of a tetrahedron.
+_EDGES = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])
+#: A tetrahedron is flat when ``|6 V| <= _FLAT * L^3`` (``L`` its longest edge).
+_FLAT = 1e-10
+
+
+@dataclass(frozen=True)
+class Cells3D:
+    """Constrained Voronoi cells of a 3-D model.
+
+    Attributes
+    ----------
+    node : (m,) int64 ndarray
+        The node each cell belongs to (an interface node owns one cell per region).
+    region : (m,) int64 ndarray
+    volume : (m,) float64 ndarray
+    facet_triangles : (q, 3, 3) float64 ndarray
+        The cells' boundaries as triangles (coordinates), counter-clockwise seen from
+        outside their cell.
+    facet_cell : (q,) int64 ndarray
+        The cell each triangle bounds.
+    facet_normal : (q, 3) float64 ndarray
+        Outward unit normal of each triangle.
+    """
+
+    node: np.ndarray
+    region: np.ndarray
+    volume: np.ndarray
+    facet_triangles: np.ndarray
+    facet_cell: np.ndarray
+    facet_normal: np.ndarray
+
+    def __repr__(self) -> str:
+        return (f"<Cells3D {len(self.node)} cells, {len(self.facet_cell)} facet triangles, "
+                f"volume {self.volume.sum():.6g}>")
+
+    def facet_areas(self) -> np.ndarray:
+        """Area ``(q,)`` of each facet triangle."""
+        t = self.facet_triangles
+        return 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+
+
+def _circumcentres(points, tets):
+    """Circumcentres ``(t, 3)`` (NaN for flat tetrahedra), relative to the first vertex."""
+    a = points[tets[:, 0]]
+    m = points[tets[:, 1:]] - a[:, None, :]
+    length = np.sqrt((m ** 2).sum(axis=2).max(axis=1))
+    det = np.linalg.det(m)
+    flat = np.abs(det) <= _FLAT * length ** 3
+    rhs = 0.5 * (m ** 2).sum(axis=2)
+    m[flat] = np.eye(3)
+    c = np.linalg.solve(m, rhs[..., None])[..., 0] + a
+    c[flat] = np.nan
+    return c
+
+
+def _borrow_centres(centre, nb, bound):
+    """A flat tetrahedron (four cocircular nodes) takes a neighbour's circumcentre: every
+    sphere through three of its nodes passes through the fourth."""
+    for _ in range(bound):
+        flat = np.flatnonzero(np.isnan(centre[:, 0]))
+        if len(flat) == 0:
+            break
+        cand = nb[flat]
+        good = (cand >= 0) & ~np.isnan(centre[np.maximum(cand, 0), 0])
+        has = good.any(axis=1)
+        if not has.any():
+            break
+        pick = cand[has, np.argmax(good[has], axis=1)]
+        centre[flat[has]] = centre[pick]
+    return centre
+
+
+def _fast_nodes(points, tets, centre, faces, boundary_node):
+    """Nodes whose ball to their farthest circumcentre meets no boundary face."""
+    n = len(points)
+    far = np.zeros(n)
+    dist = np.linalg.norm(centre[:, None, :] - points[tets], axis=2)
+    np.maximum.at(far, tets.ravel(), np.where(np.isnan(dist), np.inf, dist).ravel())
+    x = points[faces]
+    cen = x.mean(axis=1)
+    rad = np.linalg.norm(x - cen[:, None, :], axis=2).max(axis=1)
+    cand = np.flatnonzero(~boundary_node & np.isfinite(far))
+    tree = cKDTree(cen)
+    d, k = tree.query(points[cand], k=min(8, len(cen)))
+    bound = d - rad.max()
+    ok = bound[:, 0] > far[cand] * (1 + 1e-9)
+    # the nearest centroids alone decide for most nodes; the rest ask for every face in reach
+    for pos in np.flatnonzero(~ok).tolist():
+        i = cand[pos]
+        near = tree.query_ball_point(points[i], far[i] + rad.max())
+        ok[pos] = all(_point_triangle_distance(points[i], x[f]) > far[i] * (1 + 1e-9)
+                      for f in near)
+    fast = np.zeros(n, dtype=bool)
+    fast[cand[ok]] = True
+    return fast
+
+
+def _point_triangle_distance(p, tri):
+    """Distance from ``p (3,)`` to the triangle ``tri (3, 3)``."""
+    a, b, c = tri
+    ab, ac, ap = b - a, c - a, p - a
+    nrm = np.cross(ab, ac)
+    n2 = nrm @ nrm
+    s = np.array([np.cross(ap, ac) @ nrm, np.cross(ab, ap) @ nrm]) / n2
+    if s.min() >= 0 and s.sum() <= 1:
+        return abs(ap @ nrm) / np.sqrt(n2)
+    best = np.inf
+    for u, v in ((a, b), (b, c), (c, a)):
+        e = v - u
+        t = np.clip((p - u) @ e / (e @ e), 0.0, 1.0)
+        best = min(best, np.linalg.norm(p - u - t * e))
+    return best
+
+
+def _fast_facets(points, tets, centre, fast, cell_of):
+    """Facet triangles of the fast cells: the Voronoi facets dual to their edges."""
+    n = len(points)
+    ends = tets[:, _EDGES]                              # (t, 6, 2)
+    lo, hi = ends.min(axis=2).ravel(), ends.max(axis=2).ravel()
+    c = np.repeat(centre, 6, axis=0)
+    want = fast[lo] | fast[hi]
+    lo, hi, c = lo[want], hi[want], c[want]
+    key = lo * n + hi
+    edge = np.unique(key)
+    edge_id = np.searchsorted(edge, key)
+    count = np.bincount(edge_id)
+    mean = np.stack([np.bincount(edge_id, weights=c[:, k]) for k in range(3)], axis=1)
+    mean /= count[:, None]
+    a, b = points[edge // n], points[edge % n]
+    u = b - a
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    helper = np.eye(3)[np.argmin(np.abs(u), axis=1)]
+    e1 = np.cross(u, helper)
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    e2 = np.cross(u, e1)
+    rel = c - mean[edge_id]
+    ang = np.arctan2(np.einsum("ij,ij->i", rel, e2[edge_id]), np.einsum("ij,ij->i", rel, e1[edge_id]))
+    order = np.lexsort((ang, edge_id))
+    edge_id, c = edge_id[order], c[order]
+    start = np.searchsorted(edge_id, np.arange(len(edge)))
+    rank = np.arange(len(edge_id)) - start[edge_id]
+    take = (rank >= 1) & (rank <= count[edge_id] - 2)
+    pos = np.flatnonzero(take)
+    e = edge_id[pos]
+    tri = np.stack([c[start[e]], c[pos], c[pos + 1]], axis=1)      # ccw about u
+    lo_n, hi_n = edge[e] // n, edge[e] % n
+    out_t, out_c, out_n = [], [], []
+    for node, sign, t in ((lo_n, 1.0, tri), (hi_n, -1.0, tri[:, [0, 2, 1]])):
+        keep = fast[node]
+        out_t.append(t[keep])
+        out_c.append(cell_of[node[keep]])
+        out_n.append(sign * u[e[keep]])
+    return np.concatenate(out_t), np.concatenate(out_c), np.concatenate(out_n)
+
+
+def constrained_voronoi_cells(points, tetrahedra, tet_region, boundary_faces,
+                              boundary_face_regions) -> Cells3D:
+    """The constrained Voronoi cells of a boundary-conforming tetrahedrisation.
+
+    Parameters
+    ----------
+    points : (n, 3) array_like
+    tetrahedra : (t, 4) array_like of int
+        A Delaunay tetrahedrisation of ``points`` inside the body that contains every
+        boundary face (`conforming_tetrahedra` gives one).
+    tet_region : (t,) array_like of int
+    boundary_faces : (b, 3) array_like of int
+    boundary_face_regions : (b, 2) array_like of int
+        As `conforming_tetrahedra` takes them.
+
+    Returns
+    -------
+    Cells3D
+        One cell per (node, region) pair, ordered by node then region.
+    """
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    tets = np.ascontiguousarray(tetrahedra, dtype=np.int64)
+    tet_region = np.ascontiguousarray(tet_region, dtype=np.int64)
+    faces = np.ascontiguousarray(boundary_faces, dtype=np.int64)
+    face_regions = np.ascontiguousarray(boundary_face_regions, dtype=np.int64)
+    n = len(points)
+    n_reg = int(tet_region.max()) + 1
+    pair = np.unique(np.repeat(tet_region, 4) + n_reg * tets.ravel())
+    cell_node, cell_region = pair // n_reg, pair % n_reg
+    single = np.bincount(cell_node, minlength=n) == 1
+    cell_of = np.full(n, -1, dtype=np.int64)
+    cell_of[cell_node[single[cell_node]]] = np.flatnonzero(single[cell_node])
+    boundary_node = np.zeros(n, dtype=bool)
+    boundary_node[faces.ravel()] = True
+    centre = _borrow_centres(_circumcentres(points, tets), tet_neighbors(tets, n), 64)
+    fast = _fast_nodes(points, tets, centre, faces, boundary_node) & single
+    tri, fcell, nrm = _fast_facets(points, tets, centre, fast, cell_of)
+    general = GeneralCells(points, tets, tet_region, faces, face_regions)
+    volume = np.zeros(len(cell_node))
+    parts_t, parts_c, parts_n = [tri], [fcell], [nrm]
+    for k in np.flatnonzero(~fast[cell_node]).tolist():
+        t, nr, vol = general.cell(int(cell_node[k]), int(cell_region[k]))
+        parts_t.append(t)
+        parts_c.append(np.full(len(t), k, dtype=np.int64))
+        parts_n.append(nr)
+        volume[k] = vol
+    tri, fcell, nrm = (np.concatenate(parts_t), np.concatenate(parts_c),
+                       np.concatenate(parts_n))
+    # the fast cells' volumes: pyramids from the node over each facet triangle
+    rel = tri - points[cell_node[fcell]][:, None, :]
+    pyramid = np.einsum("ij,ij->i", rel[:, 0], np.cross(rel[:, 1], rel[:, 2])) / 6.0
+    is_fast = fast[cell_node]
+    volume[is_fast] = np.bincount(fcell, weights=pyramid, minlength=len(cell_node))[is_fast]
+    want = np.bincount(tet_region, weights=np.abs(signed_volumes(points, tets)), minlength=n_reg)
+    got = np.bincount(cell_region, weights=volume, minlength=n_reg)
+    if np.abs(got - want).max() > 1e-8 * want.sum():
+        raise GeometryError(
+            f"the cells' volumes per region {got.tolist()} do not sum to the regions' volumes "
+            f"{want.tolist()}; the tetrahedrisation must be Delaunay and contain every "
+            f"boundary face (use conforming_tetrahedra)")
+    return Cells3D(cell_node, cell_region, volume, tri, fcell, nrm)

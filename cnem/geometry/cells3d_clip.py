@@ -1,0 +1,323 @@
+"""The general path of the 3-D cells: exact clipping of convex polytopes.
+
+For node ``i`` of region ``r`` the computation runs in local coordinates (``i`` at
+the origin, lengths in units of its longest Delaunay edge) inside a cube of
+half-side ``a`` (doubled, a bounded number of times, until the cell does not touch
+it):
+
+* when the region's faces within reach are in convex position (no vertex of one
+  beyond another's plane: a box, its edges and corners, a flat interface), the
+  cell is one convex polytope: the cube clipped by those faces' planes and by the
+  bisectors with the region's nodes, nearest first, until the next bisector lies
+  beyond the cell;
+* otherwise (a re-entrant edge, a slot, a cavity nearby) visibility matters. The
+  region's tetrahedra in reach are the convex pieces; from them the shadows of the
+  faces seen from ``i`` are removed (the shadow of a triangle is convex: beyond its
+  plane and inside the three planes through ``i`` and its edges), and each nearer
+  node ``j`` removes the part of the pieces nearer to ``j`` that ``j`` sees (its
+  bisector half-space minus ``j``'s shadows). Every set operation leaves disjoint
+  convex pieces, so the volume is exact. The faces between two pieces of the cell
+  (on a tetrahedron face, a shadow plane, a bisector) cancel: per plane, the
+  polygons of one side minus those of the other are the cell's boundary there
+  (shapely in the plane), so no facet lies inside the cell.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from scipy.spatial import cKDTree
+
+from ..errors import GeometryError
+from .polytope import _ON, Plane, Polytope, subtract
+
+__all__ = ["GeneralCells"]
+
+#: Bound on the doublings of the cube around a cell.
+_GROW = 6
+#: Vertices of a face beyond another face's plane by more than this (local unit) make
+#: the neighbourhood non-convex.
+_REFLEX = 1e-9
+#: A tetrahedron whose edges from the node (local unit) span less than this is flat.
+_FLAT = 1e-10
+
+
+class GeneralCells:
+    """Cells by exact clipping, for the nodes the fast path refuses.
+
+    Parameters
+    ----------
+    points : (n, 3) ndarray
+    tets : (t, 4) int64 ndarray
+    tet_region : (t,) int64 ndarray
+    faces : (b, 3) int64 ndarray
+    face_regions : (b, 2) int64 ndarray
+    """
+
+    def __init__(self, points, tets, tet_region, faces, face_regions):
+        self.points, self.tets, self.tet_region = points, tets, tet_region
+        self.faces = faces
+        n_reg = int(tet_region.max()) + 1
+        x = points[faces]
+        normal = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+        normal /= np.linalg.norm(normal, axis=1)[:, None]
+        centroid = x.mean(axis=1)
+        radius = np.linalg.norm(x - centroid[:, None], axis=2).max(axis=1)
+        self.face_radius = float(radius.max())
+        # per region: its faces with outward normals, its nodes, its tetrahedra
+        self.region_faces, self.region_nodes, self.region_tets = [], [], []
+        tet_x = points[tets]
+        tet_c = tet_x.mean(axis=1)
+        tet_r = np.linalg.norm(tet_x - tet_c[:, None], axis=2).max(axis=1)
+        self.tet_radius = float(tet_r.max()) if len(tet_r) else 0.0
+        for r in range(n_reg):
+            inner, outer = face_regions[:, 0] == r, face_regions[:, 1] == r
+            idx = np.flatnonzero(inner | outer)
+            sign = np.where(inner[idx], 1.0, -1.0)
+            self.region_faces.append((idx, sign[:, None] * normal[idx], cKDTree(centroid[idx])))
+            ts = np.flatnonzero(tet_region == r)
+            nodes = np.unique(tets[ts])
+            self.region_nodes.append((nodes, cKDTree(points[nodes])))
+            self.region_tets.append((ts, cKDTree(tet_c[ts])))
+        edge_len = np.zeros(len(points))
+        for a, b in ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)):
+            d = np.linalg.norm(tet_x[:, a] - tet_x[:, b], axis=1)
+            np.maximum.at(edge_len, tets[:, a], d)
+            np.maximum.at(edge_len, tets[:, b], d)
+        self.scale = edge_len
+        order = np.argsort(tets.ravel(), kind="stable")
+        self.star_tets = order // 4
+        self.star_offsets = np.searchsorted(tets.ravel()[order], np.arange(len(points) + 1))
+
+    def cell(self, i: int, r: int):
+        """Facet triangles ``(q, 3, 3)``, their outward normals ``(q, 3)`` and the volume of
+        the cell of node ``i`` in region ``r``."""
+        x0, s = self.points[i], self.scale[i]
+        half = 1.0
+        for _ in range(_GROW):
+            reach = np.sqrt(3.0) * half
+            pieces = self._pieces(i, r, x0, s, half, reach)
+            if not any(pl.tag[0] == "box" for p in pieces for _, pl in p.faces):
+                break
+            half *= 2.0
+        else:
+            raise GeometryError(
+                f"the cell of node {i} at {x0.tolist()} still touches its bounding cube of "
+                f"half-side {half * s:.6g} after {_GROW} doublings; the region around it holds "
+                f"too few nodes (is the node isolated from its region?)")
+        if not pieces:
+            raise GeometryError(f"node {i} at {x0.tolist()} has an empty cell in region {r}; "
+                                f"it is not visible from any point of its region")
+        tri, normal = _boundary(pieces)
+        volume = sum(p.volume() for p in pieces) * s ** 3
+        return tri * s + x0, normal, volume
+
+    def _near_faces(self, r, x0, s, reach):
+        idx, normal, tree = self.region_faces[r]
+        near = np.array(tree.query_ball_point(x0, reach * s + self.face_radius), dtype=np.int64)
+        if len(near) == 0:
+            return np.zeros((0, 3, 3)), np.zeros((0, 3)), near
+        x = (self.points[self.faces[idx[near]]] - x0) / s
+        return x, normal[near], idx[near]
+
+    def _pieces(self, i, r, x0, s, half, reach):
+        fx, fn, fid = self._near_faces(r, x0, s, 3.0 * reach)
+        offset = np.einsum("ij,ij->i", fn, fx[:, 0])
+        planes = _distinct_planes(fx, fn, offset, np.inf)
+        beyond = fx.reshape(-1, 3) @ fn[planes].T - offset[planes]
+        convex = beyond.max(initial=-np.inf) <= _REFLEX
+        nodes, tree = self.region_nodes[r]
+        near = nodes[tree.query_ball_point(x0, 2.0 * reach * s)]
+        near = near[near != i]
+        y = (self.points[near] - x0) / s
+        dist = np.linalg.norm(y, axis=1)
+        order = np.argsort(dist, kind="stable")
+        box = Polytope.box(half)
+        if convex:
+            poly = box
+            for k in _distinct_planes(fx, fn, offset, reach):
+                poly = poly.clip(Plane(fn[k], float(offset[k]), ("f", int(fid[k]))))
+                if poly is None:
+                    return []
+            pieces = [poly]
+        else:
+            pieces = self._cones(i, r, x0, s, box)
+            # only faces with some of the region beyond their plane cast shadows that matter
+            corners = np.concatenate([y, fx.reshape(-1, 3)])
+            behind = (corners @ fn.T - offset > _REFLEX).any(axis=0)
+            # the others bound the region: their half-spaces clip like a convex neighbourhood's
+            support = np.flatnonzero(~behind)
+            for k in _distinct_planes(fx[support], fn[support], offset[support], reach):
+                k = support[k]
+                plane = Plane(fn[k], float(offset[k]), ("f", int(fid[k])))
+                pieces = [q for q in (p.clip(plane) for p in pieces) if q is not None]
+            fx, fn, offset, fid = fx[behind], fn[behind], offset[behind], fid[behind]
+            own = _shadows(np.zeros(3), fx, fn, offset, fid, ("i", i))
+            for shadow in own:
+                pieces = subtract(pieces, shadow)
+        for k in order.tolist():
+            if not pieces or 0.5 * dist[k] >= max(p.radius() for p in pieces) * (1 + 1e-12):
+                break
+            u = y[k] / dist[k]
+            nearer_i = Plane(u, 0.5 * dist[k], ("b", int(near[k])))
+            if convex:
+                pieces = [p for p in (pieces[0].clip(nearer_i),) if p is not None]
+                continue
+            shadows_j = _shadows(y[k], fx, fn, offset, fid, ("j", int(near[k])))
+            pieces = _claim(pieces, nearer_i, shadows_j)
+        return pieces
+
+    def _cones(self, i, r, x0, s, box):
+        """The cube cut into the cones at node ``i`` of its tetrahedra in region ``r``: disjoint
+        convex pieces covering the region's side of ``i``'s neighbourhood."""
+        star = self.star_tets[self.star_offsets[i]:self.star_offsets[i + 1]]
+        star = star[self.tet_region[star] == r]
+        pieces = []
+        for t in star.tolist():
+            v = self.tets[t]
+            x = (self.points[v] - x0) / s
+            k = int(np.flatnonzero(v == i)[0])
+            e = x - x[k]
+            if abs(np.linalg.det(e[[q for q in range(4) if q != k]])) <= _FLAT:
+                continue                        # a flat sliver: an empty cone
+            cone = box
+            for m in range(4):
+                if m == k:
+                    continue
+                f = [q for q in range(4) if q != m]
+                nrm = np.cross(x[f[1]] - x[f[0]], x[f[2]] - x[f[0]])
+                nrm /= np.linalg.norm(nrm)
+                if nrm @ (x[m] - x[f[0]]) > 0:
+                    nrm = -nrm
+                a, b, c = sorted(int(v[q]) for q in f)
+                cone = cone.clip(Plane(nrm, float(nrm @ x[k]), ("c", a, b, c)))
+                if cone is None:
+                    break
+            if cone is not None:
+                pieces.append(cone)
+        return pieces
+
+
+def _distinct_planes(fx, fn, offset, reach):
+    """Indices of the faces within ``reach`` of the origin, one per distinct plane."""
+    if len(fn) == 0:
+        return []
+    a, b, c = fx[:, 0], fx[:, 1], fx[:, 2]
+    centre = (a + b + c) / 3.0
+    radius = np.linalg.norm(fx - centre[:, None], axis=2).max(axis=1)
+    within = np.flatnonzero(np.linalg.norm(centre, axis=1) <= reach + radius)
+    key = np.round(np.column_stack([fn[within], offset[within]]) * 1e9)
+    return within[np.unique(key, axis=0, return_index=True)[1]].tolist()
+
+
+def _shadows(origin, fx, fn, offset, fid, who):
+    """The shadows (lists of planes) that the faces cast seen from ``origin``."""
+    out = []
+    side = fn @ origin - offset
+    for k in range(len(fid)):
+        if abs(side[k]) <= _ON * 1e3:
+            continue                    # seen edge-on: no shadow
+        planes = [Plane(-fn[k], -float(offset[k]), ("f", int(fid[k]))) if side[k] < 0
+                  else Plane(fn[k], float(offset[k]), ("f", int(fid[k])))]
+        a = fx[k] - origin
+        flat = False
+        for e in range(3):
+            p, q, third = a[e], a[(e + 1) % 3], a[(e + 2) % 3]
+            m = np.cross(p, q)
+            norm = np.linalg.norm(m)
+            if norm <= _ON * 1e3:
+                flat = True
+                break
+            m = m / norm
+            if m @ third > 0:
+                m = -m
+            planes.append(Plane(m, float(m @ origin), ("e", who, int(fid[k]), e)))
+        if not flat:
+            out.append(planes)
+    return out
+
+
+def _claim(pieces, nearer_i, shadows_j):
+    """The pieces minus the points nearer to ``j`` that ``j`` sees."""
+    out = []
+    for p in pieces:
+        mine, theirs = p.split(nearer_i)
+        if theirs is None:
+            out.append(p)
+            continue
+        if mine is not None:
+            out.append(mine)
+        rest = [theirs]
+        for shadow in shadows_j:            # the parts hidden from j stay
+            nxt = []
+            for y in rest:
+                inner = y
+                for pl in shadow:
+                    inner, outer = inner.split(pl)
+                    if outer is not None:
+                        nxt.append(outer)
+                    if inner is None:
+                        break
+                if inner is not None:
+                    out.append(inner)
+            rest = nxt
+            if not rest:
+                break
+    return out
+
+
+def _boundary(pieces):
+    """Triangles and outward normals of the union's boundary: faces shared by two pieces
+    (same plane, opposite sides) cancel where they overlap."""
+    groups: dict = {}
+    for p in pieces:
+        for idx, pl in p.faces:
+            groups.setdefault(pl.tag, []).append((p.vertices[idx], pl))
+    tris, normals = [], []
+    for polys in groups.values():
+        ref = polys[0][1].normal
+        plus = [x for x, pl in polys if pl.normal @ ref > 0]
+        minus = [x for x, pl in polys if pl.normal @ ref <= 0]
+        if not minus or not plus:
+            for x, pl in polys:
+                for k in range(1, len(x) - 1):
+                    tris.append((x[0], x[k], x[k + 1]))
+                    normals.append(pl.normal)
+            continue
+        for mine, other, sign in ((plus, minus, 1.0), (minus, plus, -1.0)):
+            for t in _difference(mine, other, ref, polys[0][1].offset):
+                tris.append(t if sign > 0 else t[[0, 2, 1]])
+                normals.append(sign * ref)
+    if not tris:
+        return np.zeros((0, 3, 3)), np.zeros((0, 3))
+    return np.array(tris), np.array(normals)
+
+
+def _difference(mine, other, normal, offset):
+    """Triangles ``(3, 3)`` (counter-clockwise about ``normal``) of the union of the polygons
+    ``mine`` minus the union of ``other``, all lying in one plane."""
+    helper = np.eye(3)[np.argmin(np.abs(normal))]
+    e1 = np.cross(normal, helper)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(normal, e1)
+    base = normal * offset
+
+    def flat(x):
+        return shapely.Polygon(np.column_stack([(x - base) @ e1, (x - base) @ e2]))
+
+    grid = 1e-13
+    a = shapely.union_all([flat(x) for x in mine], grid_size=grid)
+    b = shapely.union_all([flat(x) for x in other], grid_size=grid)
+    rest = shapely.difference(a, b, grid_size=grid)
+    out = []
+    if rest.is_empty or rest.area <= 1e-20:
+        return out
+    for tri in shapely.get_parts(shapely.constrained_delaunay_triangles(rest)):
+        xy = np.asarray(tri.exterior.coords)[:3]
+        if abs(shapely.area(tri)) <= 1e-24:
+            continue
+        x = base + xy[:, :1] * e1 + xy[:, 1:] * e2
+        if np.cross(x[1] - x[0], x[2] - x[0]) @ normal < 0:
+            x = x[[0, 2, 1]]
+        out.append(x)
+    return out
