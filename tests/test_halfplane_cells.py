@@ -15,6 +15,7 @@ from cnem._parallel import always_parallel
 from cnem.geometry import cells
 from cnem.geometry._clip_kernels import CLIPPED, GROW, clip_cell
 from cnem.geometry._kernels import fan_regions
+from cnem.geometry._reflex_kernels import reflex_cell
 from cnem.geometry.halfplane import HalfPlaneCells
 from cnem.geometry.model import triangulate
 from cnem.geometry.topology import circumcenters, vertex_triangles
@@ -85,7 +86,8 @@ def test_cells_of_an_irregular_thin_strip_need_no_shapely(h):
 def _per_cell(half, i, r, start):
     """The half-plane cell of node ``i`` in region ``r`` one at a time, as before the
     batching (issue 19): three k-d trees (nodes, constraint-edge midpoints, constraint
-    ends) queried per cell, candidates in index order, the box doubled on `GROW`."""
+    ends) queried per cell, candidates in index order, the box doubled on `GROW`; at a
+    reflex corner, `reflex_cell` instead of `clip_cell`."""
     nodes, edges = half.nodes, half.edges
     edge_tree = cKDTree(0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]]))
     node_tree = cKDTree(nodes)
@@ -106,9 +108,16 @@ def _per_cell(half, i, r, start):
         j = j[np.argsort(np.hypot(*(nodes[j] - x).T), kind="stable")]
         near_ends = nodes[ends[np.hypot(*(nodes[ends] - x).T) <= reach]].reshape(-1, 2)
         scratch = [np.empty((2 * (4 + len(wedge) + len(e) + len(j)) + 8, c)) for c in (2, 2, 3)]
-        status, k = clip_cell(x, box, half.extent, wedge, nodes[edges[e]].reshape(-1, 4),
-                              np.ascontiguousarray(nodes[j]), half.wedge[j],
-                              np.ascontiguousarray(near_ends), half.tol, *scratch)
+        if half.reflex[i]:
+            if half.twin[i]:
+                return None
+            status, k = reflex_cell(nodes, i, box, half.extent, half.prev, half.next, half.kind,
+                                    half.twin, j, len(j), nodes[edges[e]].reshape(-1, 4), len(e),
+                                    half.tol, *scratch[:2])
+        else:
+            status, k = clip_cell(x, box, half.extent, wedge, nodes[edges[e]].reshape(-1, 4),
+                                  np.ascontiguousarray(nodes[j]), half.wedge[j],
+                                  np.ascontiguousarray(near_ends), half.tol, *scratch)
         if status == CLIPPED:
             return scratch[0][:k]
         if status != GROW or ((box[:2] <= half.extent[:2]).all() and (box[2:] >= half.extent[2:]).all()):
