@@ -96,7 +96,7 @@ def _per_cell(half, i, r, start):
     wedge = np.zeros((0, 4))
     if half.next[i] >= 0:
         wedge = np.concatenate([nodes[half.prev[i]], x, x, nodes[half.next[i]]]).reshape(2, 4)
-    size = start
+    size = 2.0 * start if half.reflex[i] else start       # as `HalfPlaneCells.cells`
     for _ in range(64):
         box = np.concatenate([np.maximum(x - size, half.extent[:2]), np.minimum(x + size, half.extent[2:])])
         reach = size * np.sqrt(2.0)

@@ -94,6 +94,44 @@ def _faces(nodes, j, prev, nxt, cx, cy, tol):
 
 
 @numba.njit(cache=True)
+def _wedge(nodes, i, a, b, box, poly, work):
+    """Write to ``poly`` the wedge of node ``i`` (counter-clockwise from its edge to ``b`` to
+    its edge from ``a``) cut to ``box``, starting at the node; its vertex count."""
+    x = nodes[i]
+    start = np.arctan2(nodes[b, 1] - x[1], nodes[b, 0] - x[0])
+    sweep = np.arctan2(nodes[a, 1] - x[1], nodes[a, 0] - x[0]) - start
+    if sweep <= 0.0:
+        sweep += 2.0 * np.pi
+    reach = 0.0
+    for cx in (box[0], box[2]):
+        for cy in (box[1], box[3]):
+            reach = max(reach, np.hypot(cx - x[0], cy - x[1]))
+    far = 2.0 * reach / np.cos(0.5 * sweep / _SIDES)
+    poly[0, 0], poly[0, 1] = x[0], x[1]
+    for k in range(_SIDES + 1):
+        angle = start + sweep * k / _SIDES
+        poly[k + 1, 0], poly[k + 1, 1] = x[0] + far * np.cos(angle), x[1] + far * np.sin(angle)
+    n = _clip(poly, _SIDES + 2, box[2], box[3], 1.0, 0.0, 0.0, work)
+    n = _clip(poly, n, box[0], box[1], -1.0, 0.0, 0.0, work)
+    n = _clip(poly, n, box[2], box[3], 0.0, 1.0, 0.0, work)
+    return _clip(poly, n, box[0], box[1], 0.0, -1.0, 0.0, work)
+
+
+@numba.njit(cache=True)
+def _past(nodes, x, j, poly, n):
+    """How far ``poly[:n]`` reaches past the bisector of ``x`` and node ``j``, towards ``j``
+    (-inf for a node at ``x``)."""
+    ux, uy = nodes[j, 0] - x[0], nodes[j, 1] - x[1]
+    dj = np.hypot(ux, uy)
+    if dj == 0.0:
+        return -np.inf
+    top = -np.inf
+    for v in range(n):
+        top = max(top, ux * (poly[v, 0] - x[0]) + uy * (poly[v, 1] - x[1]))
+    return (top - 0.5 * dj * dj) / dj
+
+
+@numba.njit(cache=True)
 def reflex_cell(nodes, i, box, extent, prev, nxt, kind, twin, near, p, edges, m, tol, poly, work):
     """The cell of reflex corner node ``i``, clipped and proved exact (module docstring).
 
@@ -114,7 +152,7 @@ def reflex_cell(nodes, i, box, extent, prev, nxt, kind, twin, near, p, edges, m,
     twin : (n,) bool
         Nodes within ``tol`` of another (the copies of a crack-face node).
     near : (p,) int64
-        The region's nodes in the box but ``i``, nearest first.
+        The region's nodes in the box but ``i``, nearest first (ties by index).
     p : int
     edges : (m, 4) float64
         The region's constraint edges but ``i``'s two that may meet the box.
@@ -138,34 +176,26 @@ def reflex_cell(nodes, i, box, extent, prev, nxt, kind, twin, near, p, edges, m,
     own = np.empty((2, 4))
     own[0, 0], own[0, 1], own[0, 2], own[0, 3] = nodes[a, 0], nodes[a, 1], x[0], x[1]
     own[1, 0], own[1, 1], own[1, 2], own[1, 3] = x[0], x[1], nodes[b, 0], nodes[b, 1]
-    start = np.arctan2(nodes[b, 1] - x[1], nodes[b, 0] - x[0])
-    sweep = np.arctan2(nodes[a, 1] - x[1], nodes[a, 0] - x[0]) - start
-    if sweep <= 0.0:
-        sweep += 2.0 * np.pi                    # the wedge, counter-clockwise from i -> nxt
-    reach = 0.0
-    for cx in (box[0], box[2]):
-        for cy in (box[1], box[3]):
-            reach = max(reach, np.hypot(cx - x[0], cy - x[1]))
-    far = 2.0 * reach / np.cos(0.5 * sweep / _SIDES)
-    poly[0, 0], poly[0, 1] = x[0], x[1]
-    for k in range(_SIDES + 1):
-        t = start + sweep * k / _SIDES
-        poly[k + 1, 0], poly[k + 1, 1] = x[0] + far * np.cos(t), x[1] + far * np.sin(t)
-    n = _clip(poly, _SIDES + 2, box[2], box[3], 1.0, 0.0, 0.0, work)
-    n = _clip(poly, n, box[0], box[1], -1.0, 0.0, 0.0, work)
-    n = _clip(poly, n, box[2], box[3], 0.0, 1.0, 0.0, work)
-    n = _clip(poly, n, box[0], box[1], 0.0, -1.0, 0.0, work)
+    n = _wedge(nodes, i, a, b, box, poly, work)
     radius = _radius(poly, n, x)
+    touching = np.empty(p, dtype=np.int64)      # the nodes whose bisectors come near the cell
+    t = 0
     for k in range(p):
         j = near[k]
-        qx, qy = nodes[j, 0], nodes[j, 1]
-        dj = np.hypot(qx - x[0], qy - x[1])
+        dj = np.hypot(nodes[j, 0] - x[0], nodes[j, 1] - x[1])
         if dj > 2.0 * radius:
             break
-        n = _clip(poly, n, 0.5 * (qx + x[0]), 0.5 * (qy + x[1]), qx - x[0], qy - x[1], 0.0, work)
-        if n < 3:
-            return REFUSED, 0
-        radius = _radius(poly, n, x)
+        past = _past(nodes, x, j, poly, n)
+        if past < -tol or dj <= tol:
+            continue                             # nor will it come near the smaller cell to be
+        touching[t] = j
+        t += 1
+        if past > 0.0:
+            n = _clip(poly, n, 0.5 * (nodes[j, 0] + x[0]), 0.5 * (nodes[j, 1] + x[1]),
+                      nodes[j, 0] - x[0], nodes[j, 1] - x[1], 0.0, work)
+            if n < 3:
+                return REFUSED, 0
+            radius = _radius(poly, n, x)
     grow = 2.0 * radius + tol
     if ((x[0] - grow < box[0] and box[0] > extent[0]) or (x[1] - grow < box[1] and box[1] > extent[1])
             or (x[0] + grow > box[2] and box[2] < extent[2])
@@ -180,12 +210,10 @@ def reflex_cell(nodes, i, box, extent, prev, nxt, kind, twin, near, p, edges, m,
         if _meets_any(tri, 3, edges, m, own, tol):
             return REFUSED, 0
     # 2. each node whose bisector bounds the cell sees beyond its chord
-    for k in range(p):
-        j = near[k]
+    for k in range(t):
+        j = touching[k]
         qx, qy = nodes[j, 0], nodes[j, 1]
         dj = np.hypot(qx - x[0], qy - x[1])
-        if dj > 2.0 * (radius + tol):
-            break
         nx, ny = (qx - x[0]) / dj, (qy - x[1]) / dj
         mx, my = 0.5 * (qx + x[0]), 0.5 * (qy + x[1])
         lo, hi = np.inf, -np.inf

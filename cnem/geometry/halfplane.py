@@ -127,6 +127,9 @@ class HalfPlaneCells:
         node = np.asarray(node, dtype=np.int64)
         region = np.asarray(region, dtype=np.int64)
         size = np.array(start, dtype=np.float64)
+        # a reflex corner's cell reaches past its fan (beyond a hole's fine edges): it needs
+        # a box twice as large, not a first try that fails
+        size[self.reflex[node]] *= 2.0
         todo = np.arange(len(node))
         done, counts, vertices = [], [], []
         # at most 64 doublings (boxes up to 1.8e19 times the first): a cell still growing
