@@ -13,7 +13,7 @@ import cases
 import cnem
 from cnem._parallel import always_parallel
 from cnem.geometry import cells
-from cnem.geometry._clip_kernels import CLIPPED, GROW, clip_cell
+from cnem.geometry._clip_kernels import CLIPPED, GROW, clip_cell, collinear_reach
 from cnem.geometry._kernels import fan_regions
 from cnem.geometry._reflex_kernels import reflex_cell
 from cnem.geometry.halfplane import HalfPlaneCells
@@ -87,7 +87,8 @@ def _per_cell(half, i, r, start):
     """The half-plane cell of node ``i`` in region ``r`` one at a time, as before the
     batching (issue 19): three k-d trees (nodes, constraint-edge midpoints, constraint
     ends) queried per cell, candidates in index order, the box doubled on `GROW`; at a
-    reflex corner, `reflex_cell` instead of `clip_cell`."""
+    reflex corner, `reflex_cell` instead of `clip_cell`; a chord's `collinear_reach`
+    found per chord."""
     nodes, edges = half.nodes, half.edges
     edge_tree = cKDTree(0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]]))
     node_tree = cKDTree(nodes)
@@ -115,7 +116,10 @@ def _per_cell(half, i, r, start):
                                     half.twin, j, len(j), nodes[edges[e]].reshape(-1, 4), len(e),
                                     half.tol, *scratch[:2])
         else:
-            status, k = clip_cell(x, box, half.extent, wedge, nodes[edges[e]].reshape(-1, 4),
+            reach_on = [collinear_reach(nodes, u, v, half.prev, half.next, half.kind, i, box, half.tol)
+                        for u, v in edges[e]]
+            chords = np.column_stack([nodes[edges[e]].reshape(-1, 4), np.reshape(reach_on, (-1, 2))])
+            status, k = clip_cell(x, box, half.extent, wedge, chords,
                                   np.ascontiguousarray(nodes[j]), half.wedge[j],
                                   np.ascontiguousarray(near_ends), half.tol, *scratch)
         if status == CLIPPED:

@@ -7,7 +7,7 @@ import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from .._parallel import parallel_kernel
-from ._clip_kernels import GROW, REFUSED, clip_cell
+from ._clip_kernels import GROW, REFUSED, clip_cell, collinear_reach
 from ._reflex_kernels import reflex_cell
 
 #: Lists longer than this are sorted by numba's sort, shorter ones by insertion.
@@ -115,7 +115,7 @@ def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedg
         near = np.empty((most, 2))
         near_wedge = np.empty((most, 4))
         seg = np.empty(big, dtype=np.int64)
-        chords = np.empty((big, 4))
+        chords = np.empty((big, 6))
         poly, work, seen = np.empty((big, 2)), np.empty((big, 2)), np.empty((big, 3))
         for s in range(first, last):
             status[s], counts[s] = _batch_cell(
@@ -207,6 +207,7 @@ def _batch_cell(s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_
         u, v = edges[seg[k], 0], edges[seg[k], 1]
         chords[k, 0], chords[k, 1], chords[k, 2], chords[k, 3] = (nodes[u, 0], nodes[u, 1],
                                                                   nodes[v, 0], nodes[v, 1])
+        chords[k, 4], chords[k, 5] = collinear_reach(nodes, u, v, prev, nxt, kind, i, box, tol)
     _sort_near(keep, dist, p)
     if reflex[i]:
         st, n = reflex_cell(nodes, i, box, extent, prev, nxt, kind, twin, keep, p, chords, m, tol,

@@ -19,6 +19,9 @@ from .. import _compile  # noqa: F401  (says once when the kernels compile)
 #: Status codes of `clip_cell`.
 CLIPPED, GROW, REFUSED = 0, 1, 2
 
+#: Kinds of node by their constraint edges: none, one in and one out, any other.
+BARE, SIMPLE, COMPLEX = 0, 1, 2
+
 
 @numba.njit(cache=True)
 def _clip(poly, n, px, py, nx, ny, off, out):
@@ -82,8 +85,9 @@ def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol, poly, w
     wedge : (w, 4) float64
         The node's own constraint edges ``u -> v`` (region on their left); none for
         an interior node, two at a convex boundary node.
-    edges : (e, 4) float64
-        The other constraint edges of the region that may meet the box.
+    edges : (e, 6) float64
+        The other constraint edges of the region that may meet the box: ``u``, ``v``,
+        then how far the boundary runs on along their line (`collinear_reach`).
     near : (p, 2) float64
         Nodes of the region in the box, nearest first (the node itself excluded).
     near_wedge : (p, 4) float64
@@ -138,7 +142,7 @@ def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol, poly, w
                     tmax = max(tmax, t)
             if tmax <= tol or tmin >= length - tol:
                 continue                           # the segment lies beside the part
-            if tmin < -tol or tmax > length + tol:
+            if tmin < edges[k, 4] - tol or tmax > edges[k, 5] + tol:
                 return REFUSED, 0                  # it ends inside the visible part
             di = (dx * (x[1] - uy) - dy * (x[0] - ux)) / length
             if abs(di) <= tol:
@@ -194,3 +198,41 @@ def clip_cell(x, box, extent, wedge, edges, near, near_wedge, ends, tol, poly, w
             or (x[1] + reach > box[3] and box[3] < extent[3])):
         return GROW, 0
     return CLIPPED, n
+
+
+@numba.njit(cache=True)
+def collinear_reach(nodes, u, v, prev, nxt, kind, stop, box, tol):
+    """How far the constraint edge ``u -> v`` runs on along its line: the boundary
+    before ``u`` and after ``v`` through nodes with one edge in and one out, while it
+    stays within ``tol`` of the line and inside ``box`` (and short of node ``stop``).
+
+    A straight boundary cut into many edges (the long side of a sliver, seen from a node
+    across it) crosses a cell from side to side though none of its edges does.
+
+    Returns
+    -------
+    lo, hi : float
+        Its extent along ``u -> v`` from ``u``: ``lo <= 0``, ``hi >= |v - u|``.
+    """
+    dx, dy = nodes[v, 0] - nodes[u, 0], nodes[v, 1] - nodes[u, 1]
+    length = np.hypot(dx, dy)
+    lo, hi = 0.0, length
+    for forward in (True, False):
+        w = v if forward else u
+        for _ in range(nodes.shape[0]):
+            inside = box[0] <= nodes[w, 0] <= box[2] and box[1] <= nodes[w, 1] <= box[3]
+            if kind[w] != SIMPLE or not inside:
+                break
+            z = nxt[w] if forward else prev[w]
+            if z == stop:
+                break
+            off = (dx * (nodes[z, 1] - nodes[u, 1]) - dy * (nodes[z, 0] - nodes[u, 0])) / length
+            t = (dx * (nodes[z, 0] - nodes[u, 0]) + dy * (nodes[z, 1] - nodes[u, 1])) / length
+            if abs(off) > tol or (t <= hi if forward else t >= lo):
+                break
+            if forward:
+                hi = t
+            else:
+                lo = t
+            w = z
+    return lo, hi

@@ -26,10 +26,7 @@ import numba
 import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
-from ._clip_kernels import CLIPPED, GROW, REFUSED, _clip, _radius
-
-#: `reflex_cell`'s kinds of node: no constraint edge, one edge in and one out, any other.
-BARE, SIMPLE, COMPLEX = 0, 1, 2
+from ._clip_kernels import CLIPPED, COMPLEX, GROW, REFUSED, SIMPLE, _clip, _radius
 
 #: Sides of the polygon that covers the wedge (each under 72 degrees, so that a side
 #: stays farther than ``cos(36 deg)`` of its radius from the node).
@@ -148,14 +145,14 @@ def reflex_cell(nodes, i, box, extent, prev, nxt, kind, twin, near, p, edges, m,
     prev, nxt : (n,) int64
         A boundary node's constraint neighbours (`clip_cells`).
     kind : (n,) int8
-        `BARE`, `SIMPLE` or `COMPLEX`: the node's constraint edges.
+        ``BARE``, ``SIMPLE`` or ``COMPLEX`` (`._clip_kernels`): the node's constraint edges.
     twin : (n,) bool
         Nodes within ``tol`` of another (the copies of a crack-face node).
     near : (p,) int64
         The region's nodes in the box but ``i``, nearest first (ties by index).
     p : int
-    edges : (m, 4) float64
-        The region's constraint edges but ``i``'s two that may meet the box.
+    edges : (m, 4 or more) float64
+        The region's constraint edges but ``i``'s two that may meet the box (``u``, ``v``).
     m : int
     tol : float
         Absolute length under which points are on a line.

@@ -23,8 +23,7 @@ from .._parallel import work_chunks
 from .._predicates import bounding_box
 from ..spatial import RTree
 from ._batch_clip_kernels import clip_cells
-from ._clip_kernels import CLIPPED, GROW
-from ._reflex_kernels import BARE, COMPLEX, SIMPLE
+from ._clip_kernels import BARE, CLIPPED, COMPLEX, GROW, SIMPLE
 from ._mesh_kernels import region_members
 from .topology import constraint_edges
 
