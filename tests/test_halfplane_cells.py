@@ -116,8 +116,8 @@ def _per_cell(half, i, r, start):
                                     half.twin, j, len(j), nodes[edges[e]].reshape(-1, 4), len(e),
                                     half.tol, *scratch[:2])
         else:
-            reach_on = [collinear_reach(nodes, u, v, half.prev, half.next, half.kind, i, box, half.tol)
-                        for u, v in edges[e]]
+            reach_on = [collinear_reach(nodes, u, v, half.prev, half.next, half.kind, i, box,
+                                        half.line_tol) for u, v in edges[e]]
             chords = np.column_stack([nodes[edges[e]].reshape(-1, 4), np.reshape(reach_on, (-1, 2))])
             status, k = clip_cell(x, box, half.extent, wedge, chords,
                                   np.ascontiguousarray(nodes[j]), half.wedge[j],

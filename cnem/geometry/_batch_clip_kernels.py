@@ -24,7 +24,7 @@ def _within(nodes, j, x, reach):
 @parallel_kernel("cell_node")
 def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedge, member, safe,
                reflex, kind, twin, edges, edge_region, edge_half, edge_ptr, edge_idx, group,
-               near_ptr, near_idx, tol, chunks):
+               near_ptr, near_idx, tol, line_tol, chunks):
     """`clip_cell` (`reflex_cell` at a reflex corner) of many (node, region) cells, each in
     its own box, from candidate lists shared by groups of nearby cells.
 
@@ -71,6 +71,9 @@ def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedg
         within ``reach + edge_half + tol`` of each cell of its group.
     tol : float
         Absolute length under which points are on a line.
+    line_tol : float
+        The same for the nodes of a straight boundary (`collinear_reach`): ``tol`` or
+        the coordinates' round-off, the larger.
     chunks : int
         Work chunks the cells are cut into (`cnem._parallel.work_chunks`).
 
@@ -121,7 +124,8 @@ def clip_cells(nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedg
             status[s], counts[s] = _batch_cell(
                 s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedge, member, safe,
                 reflex, kind, twin, edges, edge_region, edge_half, edge_ptr, edge_idx, group,
-                near_ptr, near_idx, tol, box, wedge, keep, dist, ends, near, near_wedge, seg, chords, poly, work, seen)
+                near_ptr, near_idx, tol, line_tol, box, wedge, keep, dist, ends, near, near_wedge,
+                seg, chords, poly, work, seen)
             for k in range(counts[s]):
                 out[starts[s] + k, 0] = poly[k, 0]
                 out[starts[s] + k, 1] = poly[k, 1]
@@ -162,8 +166,8 @@ def _sort_near(keep, dist, p):
 @numba.njit(cache=True)
 def _batch_cell(s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_wedge, member, safe,
                 reflex, kind, twin, edges, edge_region, edge_half, edge_ptr, edge_idx, group,
-                near_ptr, near_idx, tol, box, wedge, keep, dist, ends, near, near_wedge, seg, chords,
-                poly, work, seen):
+                near_ptr, near_idx, tol, line_tol, box, wedge, keep, dist, ends, near, near_wedge,
+                seg, chords, poly, work, seen):
     """Cell ``s`` of `clip_cells` in the scratch arrays that follow ``tol``: its
     ``(status, vertex count)``, the cell in ``poly``."""
     i, r = cell_node[s], cell_region[s]
@@ -207,7 +211,8 @@ def _batch_cell(s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_
         u, v = edges[seg[k], 0], edges[seg[k], 1]
         chords[k, 0], chords[k, 1], chords[k, 2], chords[k, 3] = (nodes[u, 0], nodes[u, 1],
                                                                   nodes[v, 0], nodes[v, 1])
-        chords[k, 4], chords[k, 5] = collinear_reach(nodes, u, v, prev, nxt, kind, i, box, tol)
+        chords[k, 4], chords[k, 5] = collinear_reach(nodes, u, v, prev, nxt, kind, i, box,
+                                                     line_tol)
     _sort_near(keep, dist, p)
     if reflex[i]:
         st, n = reflex_cell(nodes, i, box, extent, prev, nxt, kind, twin, keep, p, chords, m, tol,

@@ -484,7 +484,7 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     if len(slow_node):
         constraints = constraint_edges(triangles, nb)
         half = HalfPlaneCells(nodes, triangles, region, nb, extent=extent,
-                              constraints=constraints)
+                              constraints=constraints, resolution=resolution)
         done, half_count, half_verts = half.cells(slow_node, slow_region, reach)
         rest = np.setdiff1d(np.arange(len(slow_node)), done)
         exact_polys = []

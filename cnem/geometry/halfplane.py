@@ -45,17 +45,23 @@ class HalfPlaneCells:
         The nodes' bounding box (`cnem._predicates.bounding_box`), if already known.
     constraints : two ndarray, optional
         `constraint_edges` of ``triangles`` and ``nb``, if already known.
+    resolution : float, optional
+        The round-off of the caller's coordinates in those of ``nodes``
+        (`cnem._predicates.Frame.resolution`): constraint edges within
+        ``ROUNDOFF_ULPS`` of it of one line are one line (`collinear_reach`).
     """
 
     def __init__(self, nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray,
                  nb: np.ndarray, *, extent: tuple[np.ndarray, np.ndarray] | None = None,
-                 constraints: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+                 constraints: tuple[np.ndarray, np.ndarray] | None = None,
+                 resolution: float = 0.0) -> None:
         n = len(nodes)
         self.nodes = nodes
         lo, hi = bounding_box(nodes) if extent is None else extent
         self.box = (lo, hi)
         self.extent = np.array([lo[0], lo[1], hi[0], hi[1]])
         self.tol = config.MERGE_TOL * float(np.hypot(*(hi - lo)))
+        self.line_tol = max(self.tol, config.ROUNDOFF_ULPS * resolution)
         edges, owner = constraint_edges(triangles, nb) if constraints is None else constraints
         self.edges, self.edge_region = edges, region[owner]
         self.member = region_members(np.ascontiguousarray(triangles, dtype=np.int64),
@@ -145,7 +151,7 @@ class HalfPlaneCells:
                 self.nodes, node[todo], region[todo], size[todo], self.extent, self.prev,
                 self.next, self.wedge, self.member, self.safe, self.reflex, self.kind, self.twin,
                 self.edges, self.edge_region, self.edge_half, self.edge_ptr, self.edge_idx, group,
-                near_ptr, near_idx, self.tol, work_chunks())
+                near_ptr, near_idx, self.tol, self.line_tol, work_chunks())
             ok = np.flatnonzero(status == CLIPPED)
             done.append(todo[ok])
             counts.append(count[ok])
