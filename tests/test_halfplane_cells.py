@@ -16,6 +16,7 @@ from cnem.geometry import cells
 from cnem.geometry._clip_kernels import CLIPPED, GROW, clip_cell, collinear_reach
 from cnem.geometry._kernels import fan_regions
 from cnem.geometry._reflex_kernels import reflex_cell
+from cnem.geometry import halfplane
 from cnem.geometry.halfplane import HalfPlaneCells
 from cnem.geometry.model import triangulate
 from cnem.geometry.topology import circumcenters, vertex_triangles
@@ -97,7 +98,7 @@ def _per_cell(half, i, r, start):
     wedge = np.zeros((0, 4))
     if half.next[i] >= 0:
         wedge = np.concatenate([nodes[half.prev[i]], x, x, nodes[half.next[i]]]).reshape(2, 4)
-    size = 2.0 * start if half.reflex[i] else start       # as `HalfPlaneCells.cells`
+    size = start * (halfplane._REFLEX_START if half.reflex[i] else 1.0)   # as `HalfPlaneCells.cells`
     for _ in range(64):
         box = np.concatenate([np.maximum(x - size, half.extent[:2]), np.minimum(x + size, half.extent[2:])])
         reach = size * np.sqrt(2.0)

@@ -206,13 +206,15 @@ def _batch_cell(s, nodes, cell_node, cell_region, size, extent, prev, nxt, node_
             if not safe[j]:
                 ends[q, 0], ends[q, 1] = nodes[j, 0], nodes[j, 1]
                 q += 1
-    _sort_ints(seg, m)
+    if not reflex[i]:                    # `reflex_cell` only asks whether any edge crosses
+        _sort_ints(seg, m)
     for k in range(m):
         u, v = edges[seg[k], 0], edges[seg[k], 1]
         chords[k, 0], chords[k, 1], chords[k, 2], chords[k, 3] = (nodes[u, 0], nodes[u, 1],
                                                                   nodes[v, 0], nodes[v, 1])
-        chords[k, 4], chords[k, 5] = collinear_reach(nodes, u, v, prev, nxt, kind, i, box,
-                                                     line_tol)
+        if not reflex[i]:
+            chords[k, 4], chords[k, 5] = collinear_reach(nodes, u, v, prev, nxt, kind, i, box,
+                                                         line_tol)
     _sort_near(keep, dist, p)
     if reflex[i]:
         st, n = reflex_cell(nodes, i, box, extent, prev, nxt, kind, twin, keep, p, chords, m, tol,

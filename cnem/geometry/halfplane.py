@@ -29,6 +29,9 @@ from .topology import constraint_edges
 
 __all__ = ["HalfPlaneCells"]
 
+#: The first box of a reflex corner's cell, in half-sizes of its fan (`HalfPlaneCells.cells`).
+_REFLEX_START = 1.25
+
 
 class HalfPlaneCells:
     """The constraint structure the half-plane path needs, built once per diagram.
@@ -132,9 +135,10 @@ class HalfPlaneCells:
         node = np.asarray(node, dtype=np.int64)
         region = np.asarray(region, dtype=np.int64)
         size = np.array(start, dtype=np.float64)
-        # a reflex corner's cell reaches past its fan (beyond a hole's fine edges): it needs
-        # a box twice as large, not a first try that fails
-        size[self.reflex[node]] *= 2.0
+        # a reflex corner's cell reaches about half its fan's size past it (beyond a hole's
+        # fine edges, to the circumcentres), and its box must hold twice the cell's radius: a
+        # box a quarter larger than the fan, not a first try that fails
+        size[self.reflex[node]] *= _REFLEX_START
         todo = np.arange(len(node))
         done, counts, vertices = [], [], []
         # at most 64 doublings (boxes up to 1.8e19 times the first): a cell still growing
