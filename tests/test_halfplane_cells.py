@@ -13,8 +13,10 @@ import cases
 import cnem
 from cnem._parallel import always_parallel
 from cnem.geometry import cells
-from cnem.geometry._clip_kernels import CLIPPED, GROW, clip_cell
+from cnem.geometry._clip_kernels import CLIPPED, GROW, clip_cell, collinear_reach
 from cnem.geometry._kernels import fan_regions
+from cnem.geometry._reflex_kernels import reflex_cell
+from cnem.geometry import halfplane
 from cnem.geometry.halfplane import HalfPlaneCells
 from cnem.geometry.model import triangulate
 from cnem.geometry.topology import circumcenters, vertex_triangles
@@ -85,7 +87,9 @@ def test_cells_of_an_irregular_thin_strip_need_no_shapely(h):
 def _per_cell(half, i, r, start):
     """The half-plane cell of node ``i`` in region ``r`` one at a time, as before the
     batching (issue 19): three k-d trees (nodes, constraint-edge midpoints, constraint
-    ends) queried per cell, candidates in index order, the box doubled on `GROW`."""
+    ends) queried per cell, candidates in index order, the box doubled on `GROW`; at a
+    reflex corner, `reflex_cell` instead of `clip_cell`; a chord's `collinear_reach`
+    found per chord."""
     nodes, edges = half.nodes, half.edges
     edge_tree = cKDTree(0.5 * (nodes[edges[:, 0]] + nodes[edges[:, 1]]))
     node_tree = cKDTree(nodes)
@@ -94,7 +98,7 @@ def _per_cell(half, i, r, start):
     wedge = np.zeros((0, 4))
     if half.next[i] >= 0:
         wedge = np.concatenate([nodes[half.prev[i]], x, x, nodes[half.next[i]]]).reshape(2, 4)
-    size = start
+    size = start * (halfplane._REFLEX_START if half.reflex[i] else 1.0)   # as `HalfPlaneCells.cells`
     for _ in range(64):
         box = np.concatenate([np.maximum(x - size, half.extent[:2]), np.minimum(x + size, half.extent[2:])])
         reach = size * np.sqrt(2.0)
@@ -106,9 +110,19 @@ def _per_cell(half, i, r, start):
         j = j[np.argsort(np.hypot(*(nodes[j] - x).T), kind="stable")]
         near_ends = nodes[ends[np.hypot(*(nodes[ends] - x).T) <= reach]].reshape(-1, 2)
         scratch = [np.empty((2 * (4 + len(wedge) + len(e) + len(j)) + 8, c)) for c in (2, 2, 3)]
-        status, k = clip_cell(x, box, half.extent, wedge, nodes[edges[e]].reshape(-1, 4),
-                              np.ascontiguousarray(nodes[j]), half.wedge[j],
-                              np.ascontiguousarray(near_ends), half.tol, *scratch)
+        if half.reflex[i]:
+            if half.twin[i]:
+                return None
+            status, k = reflex_cell(nodes, i, box, half.extent, half.prev, half.next, half.kind,
+                                    half.twin, j, len(j), nodes[edges[e]].reshape(-1, 4), len(e),
+                                    half.tol, *scratch[:2])
+        else:
+            reach_on = [collinear_reach(nodes, u, v, half.prev, half.next, half.kind, i, box,
+                                        half.line_tol) for u, v in edges[e]]
+            chords = np.column_stack([nodes[edges[e]].reshape(-1, 4), np.reshape(reach_on, (-1, 2))])
+            status, k = clip_cell(x, box, half.extent, wedge, chords,
+                                  np.ascontiguousarray(nodes[j]), half.wedge[j],
+                                  np.ascontiguousarray(near_ends), half.tol, *scratch)
         if status == CLIPPED:
             return scratch[0][:k]
         if status != GROW or ((box[:2] <= half.extent[:2]).all() and (box[2:] >= half.extent[2:]).all()):

@@ -28,7 +28,7 @@ from skfem.quadrature import get_quadrature
 from skfem.refdom import RefTri
 
 from ..errors import GeometryError
-from .gradients import SmoothedGradient
+from .smoothed_gradient import SmoothedGradient
 
 __all__ = ["facet_rule", "facet_gradient", "pyramid_sub_cells", "cell_gradient_3d", "sub_cell_gradient_3d"]
 

@@ -1,4 +1,5 @@
-"""The SCNI smoothed gradient operator ``B~`` (C-NEM paper §4.2, eq. 26-32), and
+"""The SCNI smoothed gradient operator ``B~`` (C-NEM paper §4.2, eq. 26-32; the
+operator itself is `SmoothedGradient`, in `.smoothed_gradient`), and
 `GradientCache`, the owner that computes it once for a model."""
 
 from __future__ import annotations
@@ -6,99 +7,20 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 
 from .._aliases import renamed_attributes
 from ..errors import GeometryError
 from .edge_quadrature import boundary_quadratures, check_gauss
+from .facet_gradients import cell_gradient_3d, sub_cell_gradient_3d
 from .fan_quadrature import fan_quadratures
 from .passes import cell_runs, gradients_in_passes
+from .smoothed_gradient import SmoothedGradient
 from .subdivision import subdivide, tip_cells
 
 if TYPE_CHECKING:
     from ..geometry.model import Cells, Model
 
 __all__ = ["SmoothedGradient", "GradientCache", "smoothed_gradient", "fan_gradient"]
-
-
-class SmoothedGradient:
-    """The operator ``B~`` of eq. 30: smoothed derivatives of every shape function,
-    one sparse matrix per direction: ``SmoothedGradient(x, y, points)`` in 2-D,
-    ``SmoothedGradient(x, y, z, points)`` in 3-D (``points`` also by keyword).
-
-    Parameters
-    ----------
-    *parts : scipy.sparse matrices, shape (m, n), then int
-        ``d`` derivative matrices (d = 2 or 3), along x, y (and z), then
-        ``points`` unless given by keyword.
-    points : int
-        Number of quadrature points evaluated for it on the cell boundaries (with
-        the other sets of cells computed in the same passes, `fan_gradient`: their
-        shared count).
-
-    Attributes
-    ----------
-    components : tuple of scipy.sparse.csr_matrix, shape (m, n)
-        ``components[i][k, j] = b~_ij(cell k)``, the derivative along axis ``i``.
-    dim : int
-    x, y, z : scipy.sparse.csr_matrix, shape (m, n)
-        ``components[0]``, ``[1]``, ``[2]`` (``z`` in 3-D only).
-    points : int
-
-    Examples
-    --------
-    >>> import scipy.sparse as sp
-    >>> g = SmoothedGradient(sp.eye(2, format="csr"), sp.eye(2, format="csr"), points=0)
-    >>> g.dim, g.y is g.components[1]
-    (2, True)
-    """
-
-    def __init__(self, *parts: sp.csr_matrix | int, points: int | None = None):
-        if points is None:
-            *components, points = parts or (None,)
-        else:
-            components = parts
-        shapes = [getattr(c, "shape", None) for c in components]
-        if len(components) not in (2, 3) or None in shapes or len(set(shapes)) != 1:
-            raise GeometryError(f"expected 2 or 3 derivative matrices of one shape (m, n) and "
-                                f"the number of points, received {len(parts)} arguments, "
-                                f"shapes {shapes}")
-        self.components, self.points = tuple(components), points
-
-    @property
-    def dim(self) -> int:
-        """The dimension: the number of `components`."""
-        return len(self.components)
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        """``(m, n)``: cells by functions."""
-        return self.components[0].shape
-
-    @property
-    def x(self) -> sp.csr_matrix:
-        """The derivatives along x, ``(m, n)``."""
-        return self.components[0]
-
-    @property
-    def y(self) -> sp.csr_matrix:
-        """The derivatives along y, ``(m, n)``."""
-        return self.components[1]
-
-    @property
-    def z(self) -> sp.csr_matrix:
-        """The derivatives along z, ``(m, n)`` (3-D only)."""
-        if self.dim < 3:
-            raise AttributeError("a 2-D SmoothedGradient has no z component")
-        return self.components[2]
-
-    def __iter__(self):
-        return iter(self.components)
-
-    def __repr__(self):
-        m, n = self.shape
-        return (f"<SmoothedGradient {self.dim}-D, {m} cells x {n} nodes, {self.x.nnz} "
-                f"non-zeros, {self.points} points>")
 
 
 def smoothed_gradient(model: Model, *, gauss: int = 2, cells: Cells | None = None
@@ -126,7 +48,6 @@ def smoothed_gradient(model: Model, *, gauss: int = 2, cells: Cells | None = Non
     gauss = check_gauss(gauss)
     every = model.cells if cells is None else cells
     if model.nodes.shape[1] == 3:
-        from .facet_gradients import cell_gradient_3d          # (it builds SmoothedGradients)
         return cell_gradient_3d(model, every, order=gauss)
     runs = cell_runs(model, every)
     (grad,), points = gradients_in_passes(
@@ -164,7 +85,6 @@ def _fan_gradients(model, gauss, with_cells):
     """``(cells' B~ or None, fan sub-cells, their B~)``, the two from one set of
     points in the same passes (the sub-cells go with their cells' runs)."""
     if model.nodes.shape[1] == 3:
-        from .facet_gradients import sub_cell_gradient_3d      # (it builds SmoothedGradients)
         sub, grad = sub_cell_gradient_3d(model, order=gauss)
         return (smoothed_gradient(model, gauss=gauss) if with_cells else None), sub, grad
     cells = model.cells

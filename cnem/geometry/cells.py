@@ -15,10 +15,14 @@ Three paths compute the cells:
 * the *half-plane path* (`.halfplane`), for a node the fast path refuses whose
   neighbourhood is convex (no reflex corner, tip or interface node within twice
   its cell's radius: a thin strip, circumcentres behind a straight boundary): a
-  box cut by its wedge, the constraint chords and the bisectors, in numba;
+  box cut by its wedge, the constraint chords and the bisectors, in numba; and
+  for a node at a reflex corner (a vertex of a hole) whose cell, its wedge cut
+  by the bisectors, it proves exact: no constraint crosses the cell, and every
+  node whose bisector bounds it sees past it (`._reflex_kernels`);
 * the *exact path* (shapely, snap-rounded overlays), for every other node and
-  region (reflex corners, crack tips, interfaces, circumcentres behind a
-  constraint): the cell is the part of a bounding box that node ``i`` sees
+  region (reflex corners whose shadows reach into their cells, crack tips,
+  interfaces, circumcentres behind a constraint): the cell is the part of a
+  bounding box that node ``i`` sees
   (its wedge between its constraint edges minus the shadows of every
   constraint segment), minus, for each nearby node ``j`` of the region, the
   points nearer to ``j`` that ``j`` sees.
@@ -480,7 +484,7 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     if len(slow_node):
         constraints = constraint_edges(triangles, nb)
         half = HalfPlaneCells(nodes, triangles, region, nb, extent=extent,
-                              constraints=constraints)
+                              constraints=constraints, resolution=resolution)
         done, half_count, half_verts = half.cells(slow_node, slow_region, reach)
         rest = np.setdiff1d(np.arange(len(slow_node)), done)
         exact_polys = []

@@ -1,14 +1,17 @@
-"""The half-plane path of the constrained Voronoi cells (`._clip_kernels.clip_cell`).
+"""The half-plane path of the constrained Voronoi cells (`._clip_kernels.clip_cell`,
+`._reflex_kernels.reflex_cell`).
 
 Between the fast path (a cell made of circumcentres) and the exact shapely
 clipping: a node whose circumcentres lie behind a constraint but whose
 neighbourhood is convex (a thin strip, a coarse boundary with nodes
-crowded inside) gets its cell by clipping a box with half-planes, a few
-microseconds instead of milliseconds. All such cells are done at once: an R-tree
-over the nodes near them only (`cnem.spatial.RTree.from_points_in`), one query per leaf
-of it gathers the candidate nodes of the leaf's cells (and through them their
-constraint edges), one kernel (`._clip_kernels.clip_cells`) clips them all, and the
-cells whose box was too small are retried together in boxes twice as large.
+crowded inside), or a node at a reflex corner whose cell its clipping proves
+exact (the vertices of a hole, finer than the nodes around it), gets its cell by
+clipping a box with half-planes, a few microseconds instead of milliseconds. All
+such cells are done at once: an R-tree over the nodes near them only
+(`cnem.spatial.RTree.from_points_in`), one query per leaf of it gathers the
+candidate nodes of the leaf's cells (and through them their constraint edges), one
+kernel (`._batch_clip_kernels.clip_cells`) clips them all, and the cells whose box was
+too small are retried together in boxes twice as large.
 """
 
 from __future__ import annotations
@@ -19,11 +22,15 @@ from .. import config
 from .._parallel import work_chunks
 from .._predicates import bounding_box
 from ..spatial import RTree
-from ._clip_kernels import CLIPPED, GROW, clip_cells
+from ._batch_clip_kernels import clip_cells
+from ._clip_kernels import BARE, CLIPPED, COMPLEX, GROW, SIMPLE
 from ._mesh_kernels import region_members
 from .topology import constraint_edges
 
 __all__ = ["HalfPlaneCells"]
+
+#: The first box of a reflex corner's cell, in half-sizes of its fan (`HalfPlaneCells.cells`).
+_REFLEX_START = 1.25
 
 
 class HalfPlaneCells:
@@ -41,17 +48,23 @@ class HalfPlaneCells:
         The nodes' bounding box (`cnem._predicates.bounding_box`), if already known.
     constraints : two ndarray, optional
         `constraint_edges` of ``triangles`` and ``nb``, if already known.
+    resolution : float, optional
+        The round-off of the caller's coordinates in those of ``nodes``
+        (`cnem._predicates.Frame.resolution`): constraint edges within
+        ``ROUNDOFF_ULPS`` of it of one line are one line (`collinear_reach`).
     """
 
     def __init__(self, nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray,
                  nb: np.ndarray, *, extent: tuple[np.ndarray, np.ndarray] | None = None,
-                 constraints: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+                 constraints: tuple[np.ndarray, np.ndarray] | None = None,
+                 resolution: float = 0.0) -> None:
         n = len(nodes)
         self.nodes = nodes
         lo, hi = bounding_box(nodes) if extent is None else extent
         self.box = (lo, hi)
         self.extent = np.array([lo[0], lo[1], hi[0], hi[1]])
         self.tol = config.MERGE_TOL * float(np.hypot(*(hi - lo)))
+        self.line_tol = max(self.tol, config.ROUNDOFF_ULPS * resolution)
         edges, owner = constraint_edges(triangles, nb) if constraints is None else constraints
         self.edges, self.edge_region = edges, region[owner]
         self.member = region_members(np.ascontiguousarray(triangles, dtype=np.int64),
@@ -81,6 +94,14 @@ class HalfPlaneCells:
         self.safe = (out_deg == 0) & (in_deg == 0)
         self.safe[b[convex]] = True
         self.wedge[~self.safe] = 0.0
+        # reflex corners: one edge in and one out, turning right (not a crack tip, whose
+        # edges run back along each other)
+        self.reflex = np.zeros(n, dtype=bool)
+        self.reflex[b[cross < -1e-12 * size]] = True
+        self.kind = np.full(n, COMPLEX, dtype=np.int8)
+        self.kind[self.safe & ~simple] = BARE
+        self.kind[simple] = SIMPLE
+        self.twin = np.zeros(n, dtype=bool)      # found near the cells asked for (`_near`)
         self.edge_idx = np.argsort(edges.ravel(), kind="stable") // 2
         self.edge_ptr = np.zeros(n + 1, dtype=np.int64)
         np.cumsum(out_deg + in_deg, out=self.edge_ptr[1:])
@@ -114,6 +135,10 @@ class HalfPlaneCells:
         node = np.asarray(node, dtype=np.int64)
         region = np.asarray(region, dtype=np.int64)
         size = np.array(start, dtype=np.float64)
+        # a reflex corner's cell reaches about half its fan's size past it (beyond a hole's
+        # fine edges, to the circumcentres), and its box must hold twice the cell's radius: a
+        # box a quarter larger than the fan, not a first try that fails
+        size[self.reflex[node]] *= _REFLEX_START
         todo = np.arange(len(node))
         done, counts, vertices = [], [], []
         # at most 64 doublings (boxes up to 1.8e19 times the first): a cell still growing
@@ -121,15 +146,16 @@ class HalfPlaneCells:
         for _ in range(64):
             if todo.size:
                 tree, subset = self._near(node[todo], size[todo])
-                todo = todo[self.safe[node[todo]]]
+                at = node[todo]
+                todo = todo[self.safe[at] | (self.reflex[at] & ~self.twin[at])]
             if todo.size == 0:
                 break
             group, near_ptr, near_idx = self._candidates(node[todo], size[todo], tree, subset)
             status, count, first, out = clip_cells(
                 self.nodes, node[todo], region[todo], size[todo], self.extent, self.prev,
-                self.next, self.wedge, self.member, self.safe, self.edges, self.edge_region,
-                self.edge_half, self.edge_ptr, self.edge_idx, group, near_ptr, near_idx, self.tol,
-                work_chunks())
+                self.next, self.wedge, self.member, self.safe, self.reflex, self.kind, self.twin,
+                self.edges, self.edge_region, self.edge_half, self.edge_ptr, self.edge_idx, group,
+                near_ptr, near_idx, self.tol, self.line_tol, work_chunks())
             ok = np.flatnonzero(status == CLIPPED)
             done.append(todo[ok])
             counts.append(count[ok])
@@ -166,6 +192,7 @@ class HalfPlaneCells:
         ptr, _ = tree.query_ball(self.nodes[subset], max(self.tol, 0.0))
         twins = subset[np.diff(ptr) > 1]           # a node finds itself
         self.safe[twins] = False
+        self.twin[twins] = True
         self.wedge[twins] = 0.0
         return tree, subset
 

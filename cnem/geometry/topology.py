@@ -53,7 +53,8 @@ def vertex_triangles(triangles: np.ndarray, n: int) -> tuple[np.ndarray, np.ndar
 
 
 def circumcenters(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Circumcentres of triangles, computed relative to the first vertex.
+    """Circumcentres of triangles, computed relative to the vertex opposite the longest
+    edge (`._mesh_kernels.circumcentres`).
 
     Returns
     -------
