@@ -169,6 +169,8 @@ class _TieRecovery:
         out = set()
         for k in self.star.get(a, ()):
             t = self.tets[k]
+            if not _solid(self.points, np.array([t]))[0]:
+                continue
             rest = [v for v in t if v != a]
             for i in range(3):
                 out.add(frozenset((a, rest[i], rest[(i + 1) % 3])))
@@ -305,7 +307,17 @@ def _delaunay(points, centre, scale):
     return np.ascontiguousarray(tri.simplices, dtype=np.int64)
 
 
-def _missing_faces(tets, faces, n):
+def _solid(points, tets):
+    """Which tetrahedra ``(t,)`` are not flat slivers (four coplanar nodes)."""
+    x = points[tets]
+    length = np.linalg.norm(x[:, None] - x[:, :, None], axis=3).max(axis=(1, 2))
+    return np.abs(signed_volumes(points, tets)) > _TIE * length ** 3
+
+
+def _missing_faces(points, tets, faces):
+    """Faces that no solid tetrahedron has (a face of flat slivers only does not separate)."""
+    n = len(points)
+    tets = tets[_solid(points, tets)]
     keys = np.unique(_face_keys(tets[:, _FACES].reshape(-1, 3), n))
     return np.flatnonzero(~np.isin(_face_keys(faces, n), keys))
 
@@ -321,6 +333,17 @@ def _classify(points, tets, faces, face_regions):
     pair = np.flatnonzero(sk[1:] == sk[:-1])
     inner = ~np.isin(sk[pair], bkeys)
     i0, i1 = order[pair[inner]] // 4, order[pair[inner] + 1] // 4
+    # a flat sliver (four coplanar nodes) of boundary nodes may lie in an interface plane,
+    # on both sides at once: it does not connect
+    x = points[tets]
+    length = np.linalg.norm(x[:, None] - x[:, :, None], axis=3).max(axis=(1, 2))
+    flat = np.abs(signed_volumes(points, tets)) <= _TIE * length ** 3
+    on_boundary = np.zeros(n, dtype=bool)
+    on_boundary[faces.ravel()] = True
+    flat &= on_boundary[tets].all(axis=1)
+    solid = ~flat[i0] & ~flat[i1]
+    nb_flat = (i0[~solid], i1[~solid])
+    i0, i1 = i0[solid], i1[solid]
     graph = coo_matrix((np.ones(len(i0)), (i0, i1)), shape=(t, t))
     n_comp, label = connected_components(graph, directed=False)
     # every slot holding a boundary face votes for the region on its tetrahedron's side
@@ -350,7 +373,31 @@ def _classify(points, tets, faces, face_regions):
             f"tetrahedra lie on both sides of the faces' orientation; orient every face with its "
             f"normal pointing out of boundary_face_regions[:, 0] and close every surface")
     comp_region = np.where(top > 0, best - 1, -1)
-    return comp_region[label]
+    region = comp_region[label]
+    region[flat] = -1
+    return _flat_regions(region, flat, *nb_flat)
+
+
+def _flat_regions(region, flat, i0, i1):
+    """A flat sliver takes the region of its solid neighbours (through faces that are not
+    boundary faces) when they agree, else it is dropped (it has no volume)."""
+    for _ in range(8):
+        todo = flat & (region < 0)
+        a = np.concatenate([i0, i1])
+        b = np.concatenate([i1, i0])
+        take = todo[a] & (region[b] >= 0)
+        if not take.any():
+            break
+        lo = np.full(len(region), np.iinfo(np.int64).max)
+        hi = np.full(len(region), -1)
+        np.minimum.at(lo, a[take], region[b[take]])
+        np.maximum.at(hi, a[take], region[b[take]])
+        agree = todo & (hi >= 0) & (lo == hi)
+        if not agree.any():
+            break
+        region[agree] = hi[agree]
+        flat = flat & ~agree
+    return region
 
 
 def conforming_tetrahedra(points, boundary_faces, boundary_face_regions, *,
@@ -385,12 +432,12 @@ def conforming_tetrahedra(points, boundary_faces, boundary_face_regions, *,
     centre, scale = 0.5 * (lo + hi), float(np.linalg.norm(hi - lo))
     for _ in range(max_rounds):
         tets = _delaunay(points, centre, scale)
-        missing = _missing_faces(tets, faces, len(points))
+        missing = _missing_faces(points, tets, faces)
         if len(missing):
             fixer = _TieRecovery(points, tets, np.unique(faces[missing]), scale)
             still = [f for f in missing.tolist() if not fixer.recover(faces[f])]
             tets = fixer.result()
-            missing = _missing_faces(tets, faces, len(points)) if still else still
+            missing = _missing_faces(points, tets, faces) if still else still
         if len(missing) == 0:
             break
         points, faces, face_regions = _split(points, faces, face_regions, np.asarray(missing))
