@@ -34,7 +34,7 @@ __all__ = ["Tetrahedrisation", "conforming_tetrahedra", "signed_volumes", "regio
 #: The faces of a tetrahedron (a, b, c, d), each opposite one vertex.
 _FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 #: Relative tolerance of the tie tests (cospherical, coplanar), in units of the model's size.
-_TIE = 1e-9
+_TIE = 1e-8
 
 
 @dataclass(frozen=True)
@@ -202,9 +202,12 @@ class _TieRecovery:
         if abs(np.dot(p[c] - p[a], np.cross(p[b] - p[a], p[d] - p[a]))) > _TIE * s ** 3:
             return False                       # a, b, c, d not coplanar: no tie
         ring = sorted(self.star[a] & self.star[c])
-        if not ring:
+        # a flat sliver of the four nodes themselves holds both diagonals: it goes
+        quad = [k for k in ring if set(self.tets[k]) == {a, b, c, d}]
+        solid = [k for k in ring if k not in quad]
+        if not solid:
             return False
-        old = np.array([self.tets[k] for k in ring])
+        old = np.array([self.tets[k] for k in solid])
         count: dict[frozenset, int] = {}
         for t in old.tolist():
             for f in _FACES:
@@ -213,16 +216,16 @@ class _TieRecovery:
         ends = {f for f, m in count.items() if m == 1 and {a, c} <= f}
         if ends and ends != {frozenset((a, c, b)), frozenset((a, c, d))}:
             return False                       # an open ring must end at the tied pair
-        caps = [f for f, m in count.items() if m == 1 and not {a, c} <= f and b not in f]
-        new = np.array([[b, *sorted(f)] for f in caps], dtype=np.int64)
-        if len(new) == 0:
-            return False
         v_old = np.abs(signed_volumes(p, old)).sum()
-        v_new = np.abs(signed_volumes(p, new)).sum()
-        if abs(v_new - v_old) > 1e-10 * max(v_old, s ** 3 * 1e-12):
-            return False
         verts = np.unique(old)
-        if not _empty_spheres(p, new, verts, s):
+        for apex in (b, d):                        # a cone from either end of the diagonal
+            caps = [f for f, m in count.items() if m == 1 and not {a, c} <= f and apex not in f]
+            new = np.array([[apex, *sorted(f)] for f in caps], dtype=np.int64).reshape(-1, 4)
+            v_new = np.abs(signed_volumes(p, new)).sum()
+            # an overlap would differ by a tetrahedron
+            if len(new) and abs(v_new - v_old) <= 1e-6 * v_old and _empty_spheres(p, new, verts, s):
+                break
+        else:
             return False
         for k in ring:
             self._remove(k)
