@@ -106,45 +106,41 @@ def _borrow_centres(centre, nb, bound):
 
 
 def _fast_nodes(points, tets, centre, faces, boundary_node):
-    """Nodes whose ball to their farthest circumcentre meets no boundary face."""
+    """Nodes whose Voronoi cell (the hull of their circumcentres) meets no boundary face.
+
+    Sufficient test: every face whose bounding sphere the ball to the farthest
+    circumcentre reaches has the node and all its circumcentres strictly on one side
+    of its plane.
+    """
     n = len(points)
-    far = np.zeros(n)
     dist = np.linalg.norm(centre[:, None, :] - points[tets], axis=2)
+    far = np.zeros(n)
     np.maximum.at(far, tets.ravel(), np.where(np.isnan(dist), np.inf, dist).ravel())
     x = points[faces]
     cen = x.mean(axis=1)
     rad = np.linalg.norm(x - cen[:, None, :], axis=2).max(axis=1)
+    normal = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
     cand = np.flatnonzero(~boundary_node & np.isfinite(far))
-    tree = cKDTree(cen)
-    d, k = tree.query(points[cand], k=min(8, len(cen)))
-    bound = d - rad.max()
-    ok = bound[:, 0] > far[cand] * (1 + 1e-9)
-    # the nearest centroids alone decide for most nodes; the rest ask for every face in reach
-    for pos in np.flatnonzero(~ok).tolist():
-        i = cand[pos]
-        near = tree.query_ball_point(points[i], far[i] + rad.max())
-        ok[pos] = all(_point_triangle_distance(points[i], x[f]) > far[i] * (1 + 1e-9)
-                      for f in near)
+    hits = cKDTree(cen).query_ball_point(points[cand], far[cand] + rad.max())
+    count = np.array([len(h) for h in hits], dtype=np.int64)
+    node = np.repeat(cand, count)
+    face = np.concatenate([np.asarray(h, dtype=np.int64) for h in hits] + [node[:0]])
+    # one row per (node, face, tetrahedron at the node)
+    order = np.argsort(tets.ravel(), kind="stable")
+    start = np.searchsorted(tets.ravel()[order], np.arange(n + 1))
+    deg = start[node + 1] - start[node]
+    pair = np.repeat(np.arange(len(node)), deg)
+    within = np.arange(deg.sum()) - np.repeat(np.cumsum(deg) - deg, deg)
+    tet = order[np.repeat(start[node], deg) + within] // 4
+    f = face[pair]
+    own = np.einsum("ij,ij->i", points[node] - x[face, 0], normal[face])
+    cc = np.einsum("ij,ij->i", centre[tet] - x[f, 0], normal[f])
+    same = (own[pair] * cc > 0) & (np.abs(cc) > 1e-9 * np.linalg.norm(normal[f], axis=1) * rad[f])
+    good = np.bincount(pair, weights=~same, minlength=len(node)) == 0
     fast = np.zeros(n, dtype=bool)
-    fast[cand[ok]] = True
+    fast[cand] = True
+    fast[np.unique(node[~good])] = False
     return fast
-
-
-def _point_triangle_distance(p, tri):
-    """Distance from ``p (3,)`` to the triangle ``tri (3, 3)``."""
-    a, b, c = tri
-    ab, ac, ap = b - a, c - a, p - a
-    nrm = np.cross(ab, ac)
-    n2 = nrm @ nrm
-    s = np.array([np.cross(ap, ac) @ nrm, np.cross(ab, ap) @ nrm]) / n2
-    if s.min() >= 0 and s.sum() <= 1:
-        return abs(ap @ nrm) / np.sqrt(n2)
-    best = np.inf
-    for u, v in ((a, b), (b, c), (c, a)):
-        e = v - u
-        t = np.clip((p - u) @ e / (e @ e), 0.0, 1.0)
-        best = min(best, np.linalg.norm(p - u - t * e))
-    return best
 
 
 def _fast_facets(points, tets, centre, fast, cell_of):

@@ -141,7 +141,7 @@ class GeneralCells:
                     return []
             pieces = [poly]
         else:
-            pieces = self._cones(i, r, x0, s, box)
+            pieces = self._wedge(i, r, x0, s, box, fx, fn, offset, fid)
             # only faces with some of the region beyond their plane cast shadows that matter
             corners = np.concatenate([y, fx.reshape(-1, 3)])
             behind = (corners @ fn.T - offset > _REFLEX).any(axis=0)
@@ -152,9 +152,10 @@ class GeneralCells:
                 plane = Plane(fn[k], float(offset[k]), ("f", int(fid[k])))
                 pieces = [q for q in (p.clip(plane) for p in pieces) if q is not None]
             fx, fn, offset, fid = fx[behind], fn[behind], offset[behind], fid[behind]
-            own = _shadows(np.zeros(3), fx, fn, offset, fid, ("i", i))
-            for shadow in own:
-                pieces = subtract(pieces, shadow)
+            if pieces:
+                corners = np.concatenate([p.vertices for p in pieces])
+                for shadow in _shadows(np.zeros(3), fx, fn, offset, fid, ("i", i), corners):
+                    pieces = subtract(pieces, shadow)
         for k in order.tolist():
             if not pieces or 0.5 * dist[k] >= max(p.radius() for p in pieces) * (1 + 1e-12):
                 break
@@ -163,9 +164,24 @@ class GeneralCells:
             if convex:
                 pieces = [p for p in (pieces[0].clip(nearer_i),) if p is not None]
                 continue
-            shadows_j = _shadows(y[k], fx, fn, offset, fid, ("j", int(near[k])))
-            pieces = _claim(pieces, nearer_i, shadows_j)
+            pieces = _claim(pieces, nearer_i, y[k], (fx, fn, offset, fid), ("j", int(near[k])))
         return pieces
+
+    def _wedge(self, i, r, x0, s, box, fx, fn, offset, fid):
+        """The cube cut to the region's side of node ``i``: by the planes of its faces when
+        they are in convex position (an interior node has none), else into cones."""
+        mine = np.flatnonzero((self.faces[fid] == i).any(axis=1))
+        planes = _distinct_planes(fx[mine], fn[mine], offset[mine], np.inf)
+        planes = mine[planes] if len(planes) else mine[:0]
+        beyond = fx[mine].reshape(-1, 3) @ fn[planes].T - offset[planes]
+        if beyond.max(initial=-np.inf) > _REFLEX:
+            return self._cones(i, r, x0, s, box)
+        poly = box
+        for k in planes.tolist():
+            poly = poly.clip(Plane(fn[k], float(offset[k]), ("f", int(fid[k]))))
+            if poly is None:
+                return []
+        return [poly]
 
     def _cones(self, i, r, x0, s, box):
         """The cube cut into the cones at node ``i`` of its tetrahedra in region ``r``: disjoint
@@ -210,59 +226,63 @@ def _distinct_planes(fx, fn, offset, reach):
     return within[np.unique(key, axis=0, return_index=True)[1]].tolist()
 
 
-def _shadows(origin, fx, fn, offset, fid, who):
-    """The shadows (lists of planes) that the faces cast seen from ``origin``."""
-    out = []
+def _shadows(origin, fx, fn, offset, fid, who, corners):
+    """The shadows (lists of planes) that the faces cast seen from ``origin`` and that
+    reach some of ``corners`` (the vertices of the pieces they could cut)."""
     side = fn @ origin - offset
-    for k in range(len(fid)):
-        if abs(side[k]) <= _ON * 1e3:
-            continue                    # seen edge-on: no shadow
-        planes = [Plane(-fn[k], -float(offset[k]), ("f", int(fid[k]))) if side[k] < 0
-                  else Plane(fn[k], float(offset[k]), ("f", int(fid[k])))]
-        a = fx[k] - origin
-        flat = False
-        for e in range(3):
-            p, q, third = a[e], a[(e + 1) % 3], a[(e + 2) % 3]
-            m = np.cross(p, q)
-            norm = np.linalg.norm(m)
-            if norm <= _ON * 1e3:
-                flat = True
-                break
-            m = m / norm
-            if m @ third > 0:
-                m = -m
-            planes.append(Plane(m, float(m @ origin), ("e", who, int(fid[k]), e)))
-        if not flat:
-            out.append(planes)
+    a = fx - origin                                     # (f, 3, 3) from the origin
+    b = a[:, [1, 2, 0]]
+    m = np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
+                  a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                  a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)   # (f, 3 edges, 3)
+    norm = np.linalg.norm(m, axis=2)
+    ok = (np.abs(side) > _ON * 1e3) & (norm.min(axis=1) > _ON * 1e3)
+    m = m / np.where(norm > 0, norm, 1.0)[..., None]
+    third = a[:, [2, 0, 1]]
+    m = np.where((np.einsum("fej,fej->fe", m, third) > 0)[..., None], -m, m)
+    face_n = np.where((side < 0)[:, None], -fn, fn)
+    face_d = np.where(side < 0, -offset, offset)
+    normals = np.concatenate([face_n[:, None], m], axis=1)          # (f, 4, 3)
+    offsets = np.concatenate([face_d[:, None], m @ origin], axis=1)  # (f, 4)
+    inside = np.einsum("cj,fkj->fkc", corners, normals) < offsets[..., None] - _ON
+    ok &= inside.any(axis=2).all(axis=1)
+    out = []
+    for k in np.flatnonzero(ok).tolist():
+        planes = [Plane(normals[k, 0], float(offsets[k, 0]), ("f", int(fid[k])))]
+        planes += [Plane(normals[k, e + 1], float(offsets[k, e + 1]), ("e", who, int(fid[k]), e))
+                   for e in range(3)]
+        out.append(planes)
     return out
 
 
-def _claim(pieces, nearer_i, shadows_j):
+def _claim(pieces, nearer_i, origin_j, faces, who):
     """The pieces minus the points nearer to ``j`` that ``j`` sees."""
-    out = []
+    out, theirs = [], []
     for p in pieces:
-        mine, theirs = p.split(nearer_i)
-        if theirs is None:
-            out.append(p)
-            continue
+        mine, other = p.split(nearer_i)
         if mine is not None:
             out.append(mine)
-        rest = [theirs]
-        for shadow in shadows_j:            # the parts hidden from j stay
-            nxt = []
-            for y in rest:
-                inner = y
-                for pl in shadow:
-                    inner, outer = inner.split(pl)
-                    if outer is not None:
-                        nxt.append(outer)
-                    if inner is None:
-                        break
-                if inner is not None:
-                    out.append(inner)
-            rest = nxt
-            if not rest:
-                break
+        if other is not None:
+            theirs.append(other)
+    if not theirs:
+        return out
+    corners = np.concatenate([p.vertices for p in theirs])
+    rest = theirs
+    for shadow in _shadows(origin_j, *faces, who, corners):    # the parts hidden from j stay
+        nxt = []
+        for y in rest:
+            inner = y
+            for pl in shadow:
+                inner, outer = inner.split(pl)
+                if outer is not None:
+                    nxt.append(outer)
+                if inner is None:
+                    break
+            if inner is not None:
+                out.append(inner)
+        rest = nxt
+        if not rest:
+            break
     return out
 
 

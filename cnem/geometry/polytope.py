@@ -111,7 +111,8 @@ class Polytope:
             centre = pts.mean(axis=0)
             u = pts[np.argmax(np.linalg.norm(pts - centre, axis=1))] - centre
             u /= np.linalg.norm(u)
-            w = np.cross(plane.normal, u)
+            n = plane.normal
+            w = np.array([n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]])
             ang = np.arctan2((pts - centre) @ w, (pts - centre) @ u)
             faces.append((np.array(cap)[np.argsort(ang)], plane))
         if len(faces) < 4:

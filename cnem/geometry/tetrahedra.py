@@ -34,7 +34,7 @@ __all__ = ["Tetrahedrisation", "conforming_tetrahedra", "signed_volumes", "regio
 #: The faces of a tetrahedron (a, b, c, d), each opposite one vertex.
 _FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 #: Relative tolerance of the tie tests (cospherical, coplanar), in units of the model's size.
-_TIE = 1e-9
+_TIE = 1e-8
 
 
 @dataclass(frozen=True)
@@ -169,6 +169,8 @@ class _TieRecovery:
         out = set()
         for k in self.star.get(a, ()):
             t = self.tets[k]
+            if not _solid(self.points, np.array([t]))[0]:
+                continue
             rest = [v for v in t if v != a]
             for i in range(3):
                 out.add(frozenset((a, rest[i], rest[(i + 1) % 3])))
@@ -200,9 +202,12 @@ class _TieRecovery:
         if abs(np.dot(p[c] - p[a], np.cross(p[b] - p[a], p[d] - p[a]))) > _TIE * s ** 3:
             return False                       # a, b, c, d not coplanar: no tie
         ring = sorted(self.star[a] & self.star[c])
-        if not ring:
+        # a flat sliver of the four nodes themselves holds both diagonals: it goes
+        quad = [k for k in ring if set(self.tets[k]) == {a, b, c, d}]
+        solid = [k for k in ring if k not in quad]
+        if not solid:
             return False
-        old = np.array([self.tets[k] for k in ring])
+        old = np.array([self.tets[k] for k in solid])
         count: dict[frozenset, int] = {}
         for t in old.tolist():
             for f in _FACES:
@@ -211,16 +216,16 @@ class _TieRecovery:
         ends = {f for f, m in count.items() if m == 1 and {a, c} <= f}
         if ends and ends != {frozenset((a, c, b)), frozenset((a, c, d))}:
             return False                       # an open ring must end at the tied pair
-        caps = [f for f, m in count.items() if m == 1 and not {a, c} <= f and b not in f]
-        new = np.array([[b, *sorted(f)] for f in caps], dtype=np.int64)
-        if len(new) == 0:
-            return False
         v_old = np.abs(signed_volumes(p, old)).sum()
-        v_new = np.abs(signed_volumes(p, new)).sum()
-        if abs(v_new - v_old) > 1e-10 * max(v_old, s ** 3 * 1e-12):
-            return False
         verts = np.unique(old)
-        if not _empty_spheres(p, new, verts, s):
+        for apex in (b, d):                        # a cone from either end of the diagonal
+            caps = [f for f, m in count.items() if m == 1 and not {a, c} <= f and apex not in f]
+            new = np.array([[apex, *sorted(f)] for f in caps], dtype=np.int64).reshape(-1, 4)
+            v_new = np.abs(signed_volumes(p, new)).sum()
+            # an overlap would differ by a tetrahedron
+            if len(new) and abs(v_new - v_old) <= 1e-6 * v_old and _empty_spheres(p, new, verts, s):
+                break
+        else:
             return False
         for k in ring:
             self._remove(k)
@@ -305,7 +310,17 @@ def _delaunay(points, centre, scale):
     return np.ascontiguousarray(tri.simplices, dtype=np.int64)
 
 
-def _missing_faces(tets, faces, n):
+def _solid(points, tets):
+    """Which tetrahedra ``(t,)`` are not flat slivers (four coplanar nodes)."""
+    x = points[tets]
+    length = np.linalg.norm(x[:, None] - x[:, :, None], axis=3).max(axis=(1, 2))
+    return np.abs(signed_volumes(points, tets)) > _TIE * length ** 3
+
+
+def _missing_faces(points, tets, faces):
+    """Faces that no solid tetrahedron has (a face of flat slivers only does not separate)."""
+    n = len(points)
+    tets = tets[_solid(points, tets)]
     keys = np.unique(_face_keys(tets[:, _FACES].reshape(-1, 3), n))
     return np.flatnonzero(~np.isin(_face_keys(faces, n), keys))
 
@@ -321,6 +336,17 @@ def _classify(points, tets, faces, face_regions):
     pair = np.flatnonzero(sk[1:] == sk[:-1])
     inner = ~np.isin(sk[pair], bkeys)
     i0, i1 = order[pair[inner]] // 4, order[pair[inner] + 1] // 4
+    # a flat sliver (four coplanar nodes) of boundary nodes may lie in an interface plane,
+    # on both sides at once: it does not connect
+    x = points[tets]
+    length = np.linalg.norm(x[:, None] - x[:, :, None], axis=3).max(axis=(1, 2))
+    flat = np.abs(signed_volumes(points, tets)) <= _TIE * length ** 3
+    on_boundary = np.zeros(n, dtype=bool)
+    on_boundary[faces.ravel()] = True
+    flat &= on_boundary[tets].all(axis=1)
+    solid = ~flat[i0] & ~flat[i1]
+    nb_flat = (i0[~solid], i1[~solid])
+    i0, i1 = i0[solid], i1[solid]
     graph = coo_matrix((np.ones(len(i0)), (i0, i1)), shape=(t, t))
     n_comp, label = connected_components(graph, directed=False)
     # every slot holding a boundary face votes for the region on its tetrahedron's side
@@ -350,7 +376,31 @@ def _classify(points, tets, faces, face_regions):
             f"tetrahedra lie on both sides of the faces' orientation; orient every face with its "
             f"normal pointing out of boundary_face_regions[:, 0] and close every surface")
     comp_region = np.where(top > 0, best - 1, -1)
-    return comp_region[label]
+    region = comp_region[label]
+    region[flat] = -1
+    return _flat_regions(region, flat, *nb_flat)
+
+
+def _flat_regions(region, flat, i0, i1):
+    """A flat sliver takes the region of its solid neighbours (through faces that are not
+    boundary faces) when they agree, else it is dropped (it has no volume)."""
+    for _ in range(8):
+        todo = flat & (region < 0)
+        a = np.concatenate([i0, i1])
+        b = np.concatenate([i1, i0])
+        take = todo[a] & (region[b] >= 0)
+        if not take.any():
+            break
+        lo = np.full(len(region), np.iinfo(np.int64).max)
+        hi = np.full(len(region), -1)
+        np.minimum.at(lo, a[take], region[b[take]])
+        np.maximum.at(hi, a[take], region[b[take]])
+        agree = todo & (hi >= 0) & (lo == hi)
+        if not agree.any():
+            break
+        region[agree] = hi[agree]
+        flat = flat & ~agree
+    return region
 
 
 def conforming_tetrahedra(points, boundary_faces, boundary_face_regions, *,
@@ -385,12 +435,12 @@ def conforming_tetrahedra(points, boundary_faces, boundary_face_regions, *,
     centre, scale = 0.5 * (lo + hi), float(np.linalg.norm(hi - lo))
     for _ in range(max_rounds):
         tets = _delaunay(points, centre, scale)
-        missing = _missing_faces(tets, faces, len(points))
+        missing = _missing_faces(points, tets, faces)
         if len(missing):
             fixer = _TieRecovery(points, tets, np.unique(faces[missing]), scale)
             still = [f for f in missing.tolist() if not fixer.recover(faces[f])]
             tets = fixer.result()
-            missing = _missing_faces(tets, faces, len(points)) if still else still
+            missing = _missing_faces(points, tets, faces) if still else still
         if len(missing) == 0:
             break
         points, faces, face_regions = _split(points, faces, face_regions, np.asarray(missing))
