@@ -16,7 +16,7 @@ import pytest
 import scipy.sparse as sp
 from scipy.spatial import Delaunay
 
-from cnem.assembly.facet_gradients import facet_gradient, facet_rule, pyramid_sub_cells
+from cnem.assembly.facet_gradients import facet_gradient, facet_points, pyramid_sub_cells
 from cnem.errors import GeometryError
 
 
@@ -101,20 +101,23 @@ def test_sub_cell_gradients_are_the_p1_gradients_and_fill_the_cell(apex):
         np.testing.assert_allclose(dense, expected, atol=1e-10)
 
 
-def test_facet_rule_integrates_quadratics_on_a_3d_triangle():
-    tri = np.array([[[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 3.0]]])
-    _, pts, w = facet_rule(tri, 2)
-    area = 0.5 * np.linalg.norm(np.cross(tri[0, 1] - tri[0, 0], tri[0, 2] - tri[0, 0]))
-    assert np.isclose(w.sum(), area)
-    # int x^2 over the triangle = area / 6 (sum of squares + sum of pairwise products)
-    x = tri[0, :, 0]
-    exact = area / 6.0 * (np.sum(x ** 2) + x[0] * x[1] + x[1] * x[2] + x[0] * x[2])
-    assert np.isclose(np.sum(w * pts[:, 0] ** 2), exact)
-
-
 def test_cells_without_volume_are_refused():
     nodes, dt, tets = _lattice(k=3)
     tets, tri, cell, nrm, vol = _facets(nodes, tets)
     vol[2] = 0.0
     with pytest.raises(GeometryError, match="positive volume"):
         facet_gradient(tri, cell, nrm, vol, _p1(nodes, dt))
+
+
+def test_a_facet_gets_one_point_whatever_its_triangles():
+    """A square facet cut along either diagonal, or into four, gives the same point
+    and area-normal: the two cells sharing it evaluate it alike."""
+    sq = np.array([[0.0, 0.0, 0.5], [1.0, 0.0, 0.5], [1.0, 1.0, 0.5], [0.0, 1.0, 0.5]]) * 0.3
+    cuts = [sq[[[0, 1, 2], [0, 2, 3]]], sq[[[0, 1, 3], [1, 2, 3]]],
+            np.array([[sq[i], sq[(i + 1) % 4], sq.mean(axis=0)] for i in range(4)])]
+    for tri in cuts:
+        cell, point, area_normal = facet_points(tri, np.zeros(len(tri), dtype=np.int64),
+                                                np.tile([0.0, 0.0, 1.0], (len(tri), 1)))
+        assert cell.tolist() == [0]
+        np.testing.assert_allclose(point, [sq.mean(axis=0)], rtol=1e-15, atol=1e-16)
+        np.testing.assert_allclose(area_normal, [[0.0, 0.0, 0.09]], rtol=1e-14)

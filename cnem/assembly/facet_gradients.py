@@ -6,9 +6,12 @@ cells' facets, cut into triangles); the smoothed derivative of shape function
 
     b~_Ii(k) = 1 / V_k  sum_f  int_f phi_I n_i dA
 
-integrated by a triangle rule on every facet triangle. Any rule exact for
-linear functions keeps the integration constraint (the patch test): the shape
-functions reproduce ``x`` and ``int_dV x (x) n dA = V I`` over a closed surface.
+integrated by one point per facet, its centroid (`facet_points`). The rule is
+exact for linear functions, which keeps the divergence consistency (the shape
+functions reproduce ``x`` and ``int_dV x (x) n dA = V I`` over a closed
+surface), and it depends on the facet polygon alone, so the two cells that share
+a facet evaluate it at the same point and the integration constraint holds
+whatever triangles each cell's facets were cut into.
 
 The stabilisation's sub-cells are the pyramids from each cell's node to its
 facet triangles (tetrahedra: a constrained Voronoi cell is star-shaped from its
@@ -24,48 +27,59 @@ from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
-from skfem.quadrature import get_quadrature
-from skfem.refdom import RefTri
-
 from ..errors import GeometryError
 from .smoothed_gradient import SmoothedGradient
 
-__all__ = ["facet_rule", "facet_gradient", "pyramid_sub_cells", "cell_gradient_3d", "sub_cell_gradient_3d"]
+__all__ = ["facet_points", "facet_gradient", "pyramid_sub_cells", "cell_gradient_3d", "sub_cell_gradient_3d"]
+
+#: Facet normals are told apart to ``1 / PLANE_RESOLUTION`` (unit normals of one
+#: cell's distinct Voronoi facets differ by far more).
+PLANE_RESOLUTION = 2.0 ** 24
 
 #: Shape functions at points: ``evaluate(points (q, 3)) -> csr (q, n)``.
 Evaluate = Callable[[np.ndarray], sp.csr_matrix]
 
 
-def facet_rule(triangles: np.ndarray, order: int = 2) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Points and weights of a triangle rule of degree ``order`` on 3-D triangles.
+def facet_points(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_normal: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One point per facet of every cell: the centroid of its triangles, with their
+    summed area times the facet's normal.
+
+    A facet is the set of a cell's triangles of one outward normal (to
+    `PLANE_RESOLUTION`). Its centroid and area depend on the polygon only, not on
+    how it was cut into triangles, so the two cells that share a facet evaluate
+    the shape functions at the same point and their integrals cancel (the
+    integration constraint), whichever triangles each was given.
 
     Parameters
     ----------
-    triangles : (t, 3, 3) ndarray
-        Corners of each triangle.
-    order : int
-        Polynomial degree integrated exactly (scikit-fem's rules).
+    facet_triangles : (f, 3, 3) ndarray
+    facet_cell : (f,) int64 ndarray
+    facet_normal : (f, 3) ndarray
+        Outward unit normals.
 
     Returns
     -------
-    triangle : (q,) int64 ndarray
-        The triangle of each point.
-    points : (q, 3) ndarray
-    weights : (q,) ndarray
-        Positive, summing to each triangle's area.
+    cell : (k,) int64 ndarray
+    point : (k, 3) ndarray
+    area_normal : (k, 3) ndarray
     """
-    ref, w = get_quadrature(RefTri, order)              # reference triangle, area 1/2
-    e1 = triangles[:, 1] - triangles[:, 0]
-    e2 = triangles[:, 2] - triangles[:, 0]
-    jac = np.linalg.norm(np.cross(e1, e2), axis=1)      # twice the area
-    points = (triangles[:, None, 0] + ref[0][None, :, None] * e1[:, None]
-              + ref[1][None, :, None] * e2[:, None])
-    owner = np.repeat(np.arange(len(triangles), dtype=np.int64), len(w))
-    return owner, points.reshape(-1, 3), (jac[:, None] * w[None, :]).reshape(-1)
+    tri = facet_triangles
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    key = np.column_stack([facet_cell, np.round(facet_normal * PLANE_RESOLUTION)]).astype(np.int64)
+    _, first, group = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    group = group.reshape(-1)
+    total = np.bincount(group, weights=area, minlength=len(first))
+    centre = tri.mean(axis=1)
+    point = np.column_stack([np.bincount(group, weights=area * centre[:, i], minlength=len(first))
+                             for i in range(3)]) / total[:, None]
+    normal = np.column_stack([np.bincount(group, weights=area * facet_normal[:, i],
+                                          minlength=len(first)) for i in range(3)])
+    return facet_cell[first], point, normal
 
 
 def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_normal: np.ndarray,
-                   volume: np.ndarray, evaluate: Evaluate, *, order: int = 2,
+                   volume: np.ndarray, evaluate: Evaluate, *,
                    spokes: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
                    ) -> SmoothedGradient:
     """``B~`` of 3-D cells from their boundary triangles.
@@ -84,8 +98,6 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
         The cells' volumes.
     evaluate : callable ``(q, 3) -> csr (q, n)``
         The shape functions at points.
-    order : int
-        Degree of the triangle rule on the facets.
     spokes : (centroid (s, 3), area-normal (s, 3), cell_a (s,), cell_b (s,)), optional
         Faces integrated by one point (the sub-cells' spokes, `pyramid_sub_cells`),
         with the normal out of ``cell_a`` and, where ``cell_b >= 0``, the opposite
@@ -101,10 +113,8 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
         bad = np.flatnonzero(~(volume > 0))[:5]
         raise GeometryError(f"expected cells of positive volume, received volumes "
                             f"{volume[bad].tolist()} at cells {bad.tolist()}")
-    owner, points, weights = facet_rule(facet_triangles, order)
+    cell, points, flux = facet_points(facet_triangles, facet_cell, facet_normal)
     column = np.arange(len(points), dtype=np.int64)
-    cell = facet_cell[owner]
-    flux = weights[:, None] * facet_normal[owner]                       # (q, 3)
     if spokes is not None:
         centre, area_normal, a, b = spokes
         shared = np.flatnonzero(b >= 0)
@@ -190,7 +200,7 @@ def _edge_keys(cell, p, q):
     return np.ascontiguousarray(rows).view(np.dtype((np.void, rows.dtype.itemsize * 7))).ravel()
 
 
-def cell_gradient_3d(model: Any, cells: Any, order: int = 2) -> SmoothedGradient:
+def cell_gradient_3d(model: Any, cells: Any) -> SmoothedGradient:
     """``B~`` of a 3-D model's cells (`facet_gradient` on their facet triangles, the
     model's shape functions).
 
@@ -199,26 +209,22 @@ def cell_gradient_3d(model: Any, cells: Any, order: int = 2) -> SmoothedGradient
     model : Model3D
     cells : Cells3D
         ``model.cells`` or other cells of the model with facets.
-    order : int
-        Degree of the triangle rule on the facets.
 
     Returns
     -------
     SmoothedGradient
     """
     return facet_gradient(cells.facet_triangles, cells.facet_cell, cells.facet_normal,
-                          cells.volume, model.shape_functions, order=order)
+                          cells.volume, model.shape_functions)
 
 
-def sub_cell_gradient_3d(model: Any, order: int = 2) -> tuple[Any, SmoothedGradient]:
+def sub_cell_gradient_3d(model: Any) -> tuple[Any, SmoothedGradient]:
     """The pyramid sub-cells of a 3-D model's cells and their ``B~``, from the cells'
     facet points and one point on each spoke.
 
     Parameters
     ----------
     model : Model3D
-    order : int
-        Degree of the triangle rule on the facets.
 
     Returns
     -------
@@ -233,5 +239,5 @@ def sub_cell_gradient_3d(model: Any, order: int = 2) -> tuple[Any, SmoothedGradi
                       cells.facet_triangles[kept], np.arange(len(kept), dtype=np.int64),
                       cells.facet_normal[kept])
     grad = facet_gradient(sub.facet_triangles, sub.facet_cell, sub.facet_normal, volume,
-                          model.shape_functions, order=order, spokes=spokes)
+                          model.shape_functions, spokes=spokes)
     return sub, grad

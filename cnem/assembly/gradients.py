@@ -34,8 +34,8 @@ def smoothed_gradient(model: Model, *, gauss: int = 2, cells: Cells | None = Non
         ``n`` nodes, ``m`` integration cells.
     gauss : int
         Gauss points on each piece of a cell edge between circumcircle
-        crossings (in 3-D: the degree of the triangle rule on each facet
-        triangle). The patch test holds for any value; more points make
+        crossings (in 3-D each facet takes one point, see
+        `cnem.assembly.facet_gradients`). The patch test holds for any value; more points make
         ``b~`` converge to the exact boundary integrals (see docs/elasticity.md).
     cells : Cells, optional
         Integration cells other than ``model.cells``.
@@ -48,7 +48,7 @@ def smoothed_gradient(model: Model, *, gauss: int = 2, cells: Cells | None = Non
     gauss = check_gauss(gauss)
     every = model.cells if cells is None else cells
     if model.nodes.shape[1] == 3:
-        return cell_gradient_3d(model, every, order=gauss)
+        return cell_gradient_3d(model, every)
     runs = cell_runs(model, every)
     (grad,), points = gradients_in_passes(
         model, [every], lambda sets, _: boundary_quadratures(model, sets, gauss=gauss),
@@ -85,7 +85,7 @@ def _fan_gradients(model, gauss, with_cells):
     """``(cells' B~ or None, fan sub-cells, their B~)``, the two from one set of
     points in the same passes (the sub-cells go with their cells' runs)."""
     if model.nodes.shape[1] == 3:
-        sub, grad = sub_cell_gradient_3d(model, order=gauss)
+        sub, grad = sub_cell_gradient_3d(model)
         return (smoothed_gradient(model, gauss=gauss) if with_cells else None), sub, grad
     cells = model.cells
     sub, parent = subdivide(cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
