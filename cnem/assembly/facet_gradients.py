@@ -66,9 +66,7 @@ def facet_points(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_norm
     """
     tri = facet_triangles
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    key = np.column_stack([facet_cell, np.round(facet_normal * PLANE_RESOLUTION)]).astype(np.int64)
-    _, first, group = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    group = group.reshape(-1)
+    group, first = _facet_groups(facet_cell, facet_normal)
     total = np.bincount(group, weights=area, minlength=len(first))
     centre = tri.mean(axis=1)
     point = np.column_stack([np.bincount(group, weights=area * centre[:, i], minlength=len(first))
@@ -76,6 +74,14 @@ def facet_points(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_norm
     normal = np.column_stack([np.bincount(group, weights=area * facet_normal[:, i],
                                           minlength=len(first)) for i in range(3)])
     return facet_cell[first], point, normal
+
+
+def _facet_groups(facet_cell, facet_normal):
+    """The facet (cell, normal) of each triangle, numbered in the order of the cells,
+    and a triangle of each facet."""
+    key = np.column_stack([facet_cell, np.round(facet_normal * PLANE_RESOLUTION)]).astype(np.int64)
+    _, first, group = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    return group.reshape(-1), first
 
 
 def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_normal: np.ndarray,
@@ -100,8 +106,7 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
         The shape functions at points.
     spokes : (centroid (s, 3), area-normal (s, 3), cell_a (s,), cell_b (s,)), optional
         Faces integrated by one point (the sub-cells' spokes, `pyramid_sub_cells`),
-        with the normal out of ``cell_a`` and, where ``cell_b >= 0``, the opposite
-        one out of ``cell_b``.
+        with the normal out of ``cell_a`` and the opposite one out of ``cell_b``.
 
     Returns
     -------
@@ -117,12 +122,11 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
     column = np.arange(len(points), dtype=np.int64)
     if spokes is not None:
         centre, area_normal, a, b = spokes
-        shared = np.flatnonzero(b >= 0)
         at = len(points) + np.arange(len(centre), dtype=np.int64)
         points = np.concatenate([points, centre])
-        column = np.concatenate([column, at, at[shared]])
-        cell = np.concatenate([cell, a, b[shared]])
-        flux = np.concatenate([flux, area_normal, -area_normal[shared]])
+        column = np.concatenate([column, at, at])
+        cell = np.concatenate([cell, a, b])
+        flux = np.concatenate([flux, area_normal, -area_normal])
     phi = evaluate(points)
     q = len(points)
     parts = []
@@ -133,8 +137,18 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
 
 
 def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_cell: np.ndarray,
-                      rtol: float = 1e-12) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple]:
-    """The tetrahedra from each cell's node to its facet triangles, as sub-cells.
+                      facet_normal: np.ndarray, rtol: float = 1e-12
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple]:
+    """The pyramids from each cell's node to its facets, as sub-cells.
+
+    A facet is a group of triangles of one cell and one normal (`facet_points`).
+    Its pyramid's boundary is the facet itself and one spoke triangle (node, edge)
+    per edge of its outline, shared with the pyramid of the neighbouring facet,
+    where the two cancel. A facet through the node (a node on the cell's
+    boundary) makes a flat pyramid: it joins a neighbouring pyramid, whose
+    boundary then takes that facet instead of the spoke between them. So every
+    facet point of a cell belongs to exactly one of its sub-cells, and
+    ``sum_s V_s b~_s = V_k b~_k`` holds for any functions.
 
     Parameters
     ----------
@@ -143,55 +157,87 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     facet_triangles : (f, 3, 3) ndarray
         The cells' boundary triangles, oriented with outward normals (right-hand rule).
     facet_cell : (f,) int64 ndarray
+    facet_normal : (f, 3) ndarray
     rtol : float
-        Sub-cells thinner than this fraction of their facet's size (the facets
-        through the node: the cell's boundary faces on which the node lies) are
-        dropped; they have no volume.
+        Pyramids thinner than this fraction of their facet's size are flat.
 
     Returns
     -------
     sub_parent : (s,) int64 ndarray
-        The cell each sub-cell belongs to; its facet triangle is ``kept[i]``.
-    kept : (s,) int64 ndarray
-        Index of each sub-cell's facet triangle.
+        The cell each sub-cell belongs to.
+    triangle_sub : (f,) int64 ndarray
+        The sub-cell of each facet triangle.
     volume : (s,) ndarray
-    spokes : (centroid (k, 3), area-normal (k, 3), sub_a (k,), sub_b (k,))
-        The spoke faces shared by two sub-cells, oriented out of ``sub_a``.
+    spokes : (centroid (e, 3), area-normal (e, 3), sub_a (e,), sub_b (e,))
+        The spoke faces between two sub-cells, oriented out of ``sub_a``.
+
+    Raises
+    ------
+    GeometryError
+        A cell all of whose facets pass through its node (no volume).
     """
+    group, _ = _facet_groups(facet_cell, facet_normal)
     apex = node_xyz[facet_cell]
     a, b, c = (facet_triangles[:, i] - apex for i in range(3))
     six_v = np.einsum("ij,ij->i", a, np.cross(b, c))            # > 0: apex behind the facet
     size = np.max(np.linalg.norm(facet_triangles - facet_triangles[:, [1, 2, 0]], axis=2), axis=1)
-    kept = np.flatnonzero(six_v > rtol * size ** 3)
-    # each spoke (apex, p, q) of a kept facet triangle, keyed by its cell and edge
-    tri = facet_triangles[kept]
-    parent = facet_cell[kept]
-    spoke_p = np.concatenate([tri[:, i] for i in range(3)])
-    spoke_q = np.concatenate([tri[:, (i + 1) % 3] for i in range(3)])
-    owner = np.tile(np.arange(len(kept), dtype=np.int64), 3)
-    centre_apex = node_xyz[parent[owner]]
-    # the spoke face (apex, q, p) seen from sub-cell `owner` has the outward normal
-    # (q - apex) x (p - apex) (the facet triangle (p, q, .) turns the other way)
-    area_normal = 0.5 * np.cross(spoke_q - centre_apex, spoke_p - centre_apex)
-    centroid = (centre_apex + spoke_p + spoke_q) / 3.0
-    # match each spoke with its twin (the same edge traversed q -> p in the same cell)
-    key_pq = _edge_keys(parent[owner], spoke_p, spoke_q)
-    key_qp = _edge_keys(parent[owner], spoke_q, spoke_p)
+    n_groups = group.max() + 1 if len(group) else 0
+    volume = np.bincount(group, weights=six_v, minlength=n_groups) / 6.0
+    scale = np.zeros(n_groups)
+    np.maximum.at(scale, group, size)
+    # the directed edges of every triangle; an edge met both ways in one facet is inside it
+    p = np.concatenate([facet_triangles[:, i] for i in range(3)])
+    q = np.concatenate([facet_triangles[:, (i + 1) % 3] for i in range(3)])
+    edge_group = np.tile(group, 3)
+    edge_cell = np.tile(facet_cell, 3)
+    outline = ~_has_reverse(edge_group, p, q)
+    p, q, edge_group, edge_cell = p[outline], q[outline], edge_group[outline], edge_cell[outline]
+    twin = _reverse_in(edge_cell, p, q)
+    if np.any(twin < 0):
+        raise GeometryError(f"expected closed cells, received {int(np.sum(twin < 0))} facet edges "
+                            "without a neighbouring facet")
+    # flat facets join a neighbouring pyramid (through flat neighbours, a bounded walk)
+    owner = np.where(volume > rtol * scale ** 3, np.arange(n_groups), -1)
+    for _ in range(n_groups):
+        todo = owner[edge_group] < 0
+        if not todo.any():
+            break
+        across = owner[edge_group[twin]]
+        give = todo & (across >= 0)
+        if not give.any():
+            bad = np.unique(edge_cell[todo])[:5]
+            raise GeometryError(f"cells {bad.tolist()}: every facet passes through the cell's "
+                                "node; expected cells of positive volume")
+        owner[edge_group[give]] = across[give]
+    kept, sub_of_owner = np.unique(owner, return_inverse=True)
+    triangle_sub = sub_of_owner[group]
+    edge_sub = sub_of_owner[owner[edge_group]]
+    between = (edge_sub != edge_sub[twin]) & (np.arange(len(p)) < twin)
+    apex_of = node_xyz[edge_cell[between]]
+    pb, qb = p[between], q[between]
+    # seen from its sub-cell the spoke (apex, q, p) has the outward normal (q - apex) x (p - apex)
+    area_normal = 0.5 * np.cross(qb - apex_of, pb - apex_of)
+    centroid = (apex_of + pb + qb) / 3.0
+    sub_volume = np.bincount(triangle_sub, weights=six_v, minlength=len(kept)) / 6.0
+    parent = np.zeros(len(kept), dtype=np.int64)
+    parent[triangle_sub] = facet_cell
+    return parent, triangle_sub, sub_volume, (centroid, area_normal, edge_sub[between],
+                                             edge_sub[twin[between]])
+
+
+def _has_reverse(owner, p, q):
+    """Whether each directed edge ``p -> q`` of ``owner`` is met as ``q -> p`` in the same owner."""
+    return _reverse_in(owner, p, q) >= 0
+
+
+def _reverse_in(owner, p, q):
+    """The index of the edge ``q -> p`` of the same owner for each edge ``p -> q``, -1 if none."""
+    key_pq = _edge_keys(owner, p, q)
+    key_qp = _edge_keys(owner, q, p)
     order = np.argsort(key_pq, kind="stable")
-    pos = np.searchsorted(key_pq[order], key_qp)
-    pos = np.minimum(pos, len(order) - 1)
-    twin = order[pos]
-    matched = key_pq[twin] == key_qp
-    first = matched & (np.arange(len(owner)) < twin)
-    unmatched = ~matched
-    # an unmatched spoke lies on a dropped (flat) sub-cell's side: its face is then part
-    # of the cell boundary through the node and carries no flux difference; keep it
-    # one-sided so that each sub-cell stays closed
-    sub_a = np.concatenate([owner[first], owner[unmatched]])
-    sub_b = np.concatenate([owner[twin[first]], np.full(unmatched.sum(), -1, dtype=np.int64)])
-    centre = np.concatenate([centroid[first], centroid[unmatched]])
-    an = np.concatenate([area_normal[first], area_normal[unmatched]])
-    return parent, kept, six_v[kept] / 6.0, (centre, an, sub_a, sub_b)
+    pos = np.minimum(np.searchsorted(key_pq[order], key_qp), max(len(order) - 1, 0))
+    twin = order[pos] if len(order) else np.zeros(0, dtype=np.int64)
+    return np.where(key_pq[twin] == key_qp, twin, -1)
 
 
 def _edge_keys(cell, p, q):
@@ -233,11 +279,10 @@ def sub_cell_gradient_3d(model: Any) -> tuple[Any, SmoothedGradient]:
     grad : SmoothedGradient
     """
     cells = model.cells
-    parent, kept, volume, spokes = pyramid_sub_cells(model.nodes[cells.node],
-                                                     cells.facet_triangles, cells.facet_cell)
-    sub = type(cells)(cells.node[parent], cells.region[parent], volume,
-                      cells.facet_triangles[kept], np.arange(len(kept), dtype=np.int64),
-                      cells.facet_normal[kept])
+    parent, triangle_sub, volume, spokes = pyramid_sub_cells(
+        model.nodes[cells.node], cells.facet_triangles, cells.facet_cell, cells.facet_normal)
+    sub = type(cells)(cells.node[parent], cells.region[parent], volume, cells.facet_triangles,
+                      triangle_sub, cells.facet_normal)
     grad = facet_gradient(sub.facet_triangles, sub.facet_cell, sub.facet_normal, volume,
                           model.shape_functions, spokes=spokes)
     return sub, grad
