@@ -68,6 +68,30 @@ class Cells3D:
         return (f"<Cells3D {len(self.node)} cells, {len(self.facet_cell)} facet triangles, "
                 f"volume {self.volume.sum():.6g}>")
 
+    def __len__(self) -> int:
+        return len(self.node)
+
+    @property
+    def measure(self) -> np.ndarray:
+        """``(m,)`` the cells' volumes (as the areas of 2-D cells), for dimension-generic code."""
+        return self.volume
+
+    def centroid(self) -> np.ndarray:
+        """Centroids ``(m, 3)``: the sum over the facet triangles of the tetrahedra they
+        make with a point of their cell's (its first facet vertex), weighted by their
+        signed volumes (exact for any closed facet surface)."""
+        tri = self.facet_triangles
+        first = np.full(len(self.node), -1, dtype=np.int64)
+        first[self.facet_cell[::-1]] = np.arange(len(tri))[::-1]
+        apex = tri[first[self.facet_cell], 0]
+        a, b, c = (tri[:, i] - apex for i in range(3))
+        six_v = np.einsum("ij,ij->i", a, np.cross(b, c))
+        moment = six_v[:, None] * (apex + tri.sum(axis=1)) / 4.0
+        total = np.bincount(self.facet_cell, weights=six_v, minlength=len(self.node))
+        return np.column_stack([np.bincount(self.facet_cell, weights=moment[:, i],
+                                            minlength=len(self.node)) for i in range(3)]) \
+            / total[:, None]
+
     def facet_areas(self) -> np.ndarray:
         """Area ``(q,)`` of each facet triangle."""
         t = self.facet_triangles

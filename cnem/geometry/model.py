@@ -291,7 +291,8 @@ def check_model(model: object, caller: str) -> Model:
     InputError
         Anything but a `Model`.
     """
-    if not isinstance(model, Model):
+    from .model3d import Model3D
+    if not isinstance(model, (Model, Model3D)):
         hint = ("discretize it first: cnem.discretize(cloud)" if isinstance(model, NodeCloud)
                 else "make one with cnem.discretize(cnem.nodes.regular(domain, h))")
         raise InputError(f"{caller} expects a Model, received {type(model).__name__}; {hint}")
@@ -312,6 +313,8 @@ def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:
     Returns
     -------
     Model
+        A `cnem.geometry.model3d.Model3D` for a cloud on a `cnem.Domain3D`
+        (boundary-conforming tetrahedra and constrained Voronoi cells).
 
     Raises
     ------
@@ -319,6 +322,9 @@ def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:
         Crossing constraints (`triangle` would need Steiner points), nodes that
         are not vertices of the triangulation.
     """
+    if cloud.dim == 3:
+        from .model3d import discretize_3d
+        return discretize_3d(cloud)
     timings = {}
     nodes, node_of_point, tri, region, segments, kind, neighbors = triangulate(cloud, timings)
     t2 = time.perf_counter()

@@ -1,0 +1,157 @@
+"""A discretised 3-D body: nodes, boundary-conforming tetrahedra, constrained Voronoi cells.
+
+`discretize_3d` (what `cnem.discretize` does with a 3-D node cloud) tetrahedrises
+the nodes so that every boundary triangle of the cloud is a face
+(`conforming_tetrahedra`: boundary nodes are added where the input does not
+allow it, and are nodes like the others, ``node_of_point == -1``), then cuts the
+constrained Voronoi cells (`constrained_voronoi_cells`). `Model3D` answers the
+questions the problems ask of a model: shape functions (constrained Laplace or
+Sibson coordinates, `cnem.shape.natural3d`), its boundary with outward normals,
+its cells.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike
+
+from ..shape.natural import ShapeGradients
+from ..shape.natural3d import TetMesh, shape_functions_3d, tet_mesh
+from .cells3d import Cells3D, constrained_voronoi_cells
+from .cloud import NodeCloud
+from .tetrahedra import conforming_tetrahedra
+
+__all__ = ["Model3D", "discretize_3d"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, repr=False)
+class Model3D:
+    """A discretised 3-D body.
+
+    Attributes
+    ----------
+    cloud : NodeCloud
+        The 3-D cloud it was made from (``cloud.domain`` a `cnem.Domain3D`).
+    nodes : (n, 3) ndarray
+        The cloud's points, then the boundary nodes the tetrahedrisation added.
+    node_of_point : (n,) int64 ndarray
+        Index into ``cloud.points`` of each node, -1 for an added one.
+    tetrahedra : (t, 4) int64 ndarray
+        Positively oriented, inside the body.
+    tet_region : (t,) int64 ndarray
+    boundary_faces : (b, 3) int64 ndarray
+        Triangles tiling every boundary and interface, oriented out of
+        ``boundary_face_regions[:, 0]``.
+    boundary_face_regions : (b, 2) int64 ndarray
+        Region inside each face and on its other side (-1: outside the body).
+    cells : Cells3D
+    timings : dict
+        Seconds spent in each stage.
+    """
+
+    cloud: NodeCloud
+    nodes: np.ndarray
+    node_of_point: np.ndarray
+    tetrahedra: np.ndarray
+    tet_region: np.ndarray
+    boundary_faces: np.ndarray
+    boundary_face_regions: np.ndarray
+    cells: Cells3D
+    timings: dict
+    #: what `tet_mesh` computed, kept
+    _derived: dict = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def dim(self) -> int:
+        """int: 3."""
+        return 3
+
+    @property
+    def domain(self):
+        """Domain3D: the body this model discretises."""
+        return self.cloud.domain
+
+    def tet_mesh(self) -> TetMesh:
+        """The tetrahedrisation prepared for the shape functions, the boundary and
+        interface faces as constraints (built on first call, then kept)."""
+        if "tet mesh" not in self._derived:
+            self._derived["tet mesh"] = tet_mesh(self.nodes, self.tetrahedra,
+                                                 tet_region=self.tet_region,
+                                                 constraint_faces=self.boundary_faces)
+        return self._derived["tet mesh"]
+
+    def shape_functions(self, points: ArrayLike, *, kind: Literal["laplace", "sibson"] = "laplace",
+                        gradient: bool = False) -> sp.csr_matrix | ShapeGradients:
+        """Constrained natural-neighbour coordinates at points of the body.
+
+        Parameters
+        ----------
+        points : (p, 3) array_like
+        kind : {"laplace", "sibson"}
+        gradient : bool
+            Also their derivatives (not at nodes nor on boundary faces).
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix, shape (p, n)
+            Or a `ShapeGradients` ``(Phi, dPhi_dx, dPhi_dy, dPhi_dz)``.
+        """
+        return shape_functions_3d(self.tet_mesh(), points, kind=kind, gradient=gradient)
+
+    def boundary_with_normals(self) -> tuple[np.ndarray, np.ndarray]:
+        """The triangles of the body's outer surface (cavities included, interfaces
+        not) and their outward unit normals.
+
+        Returns
+        -------
+        faces : (e, 3) int64 ndarray
+            Counter-clockwise seen from outside.
+        normal : (e, 3) ndarray
+        """
+        outer = self.boundary_face_regions[:, 1] < 0
+        faces = self.boundary_faces[outer]
+        corners = self.domain.to_local(self.nodes[faces].reshape(-1, 3)).reshape(-1, 3, 3)
+        nrm = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        return faces, nrm / np.linalg.norm(nrm, axis=1)[:, None]
+
+    def __repr__(self):
+        added = int(np.count_nonzero(self.node_of_point < 0))
+        return (f"<Model3D {len(self.nodes)} nodes ({added} added on the boundary), "
+                f"{len(self.tetrahedra)} tetrahedra, {len(self.cells.node)} cells, "
+                f"{self.domain.n_regions} region{'s' * (self.domain.n_regions != 1)}>")
+
+
+def discretize_3d(cloud: NodeCloud) -> Model3D:
+    """Boundary-conforming tetrahedrisation and constrained Voronoi cells of a 3-D cloud.
+
+    Parameters
+    ----------
+    cloud : NodeCloud
+        On a `cnem.Domain3D`, with its ``boundary_faces``.
+
+    Returns
+    -------
+    Model3D
+    """
+    timings = {}
+    t0 = time.perf_counter()
+    tets = conforming_tetrahedra(cloud.points, cloud.boundary_faces, cloud.boundary_face_regions)
+    t1 = time.perf_counter()
+    timings["tetrahedra"] = t1 - t0
+    cells = constrained_voronoi_cells(tets.points, tets.tetrahedra, tets.tet_region,
+                                      tets.boundary_faces, tets.boundary_face_regions)
+    timings["cells"] = time.perf_counter() - t1
+    node_of_point = np.full(len(tets.points), -1, dtype=np.int64)
+    node_of_point[:tets.n_input] = np.arange(tets.n_input)
+    log.info("discretize: %d nodes, %s", len(tets.points),
+             ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
+    return Model3D(cloud, tets.points, node_of_point, tets.tetrahedra, tets.tet_region,
+                   tets.boundary_faces, tets.boundary_face_regions, cells, timings)
