@@ -25,6 +25,7 @@ from ..shape.natural import ShapeGradients
 from ..shape.natural3d import TetMesh, shape_functions_3d, tet_mesh
 from .cells3d import Cells3D, constrained_voronoi_cells
 from .cloud import NodeCloud
+from .domain3d import Domain3D
 from .tetrahedra import conforming_tetrahedra
 
 __all__ = ["Model3D", "discretize_3d"]
@@ -75,7 +76,7 @@ class Model3D:
         return 3
 
     @property
-    def domain(self):
+    def domain(self) -> Domain3D:
         """Domain3D: the body this model discretises."""
         return self.cloud.domain
 
