@@ -27,14 +27,19 @@ from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.spatial import cKDTree
 from ..errors import GeometryError
 from .smoothed_gradient import SmoothedGradient
 
-__all__ = ["facet_points", "facet_gradient", "pyramid_sub_cells", "cell_gradient_3d", "sub_cell_gradient_3d"]
+__all__ = ["facet_points", "facet_gradient", "boundary_points_3d", "pyramid_sub_cells", "cell_gradient_3d", "sub_cell_gradient_3d"]
 
 #: Facet normals are told apart to ``1 / PLANE_RESOLUTION`` (unit normals of one
 #: cell's distinct Voronoi facets differ by far more).
 PLANE_RESOLUTION = 2.0 ** 24
+
+#: Two facet points closer than this fraction of the model's size are one point (the
+#: two sides of a shared facet, computed from the same polygon).
+PAIR_RTOL = 1e-10
 
 #: Shape functions at points: ``evaluate(points (q, 3)) -> csr (q, n)``.
 Evaluate = Callable[[np.ndarray], sp.csr_matrix]
@@ -282,7 +287,76 @@ def sub_cell_gradient_3d(model: Any) -> tuple[Any, SmoothedGradient]:
     parent, triangle_sub, volume, spokes = pyramid_sub_cells(
         model.nodes[cells.node], cells.facet_triangles, cells.facet_cell, cells.facet_normal)
     sub = type(cells)(cells.node[parent], cells.region[parent], volume, cells.facet_triangles,
-                      triangle_sub, cells.facet_normal)
+                      triangle_sub, cells.facet_normal, apex=model.nodes[cells.node[parent]])
     grad = facet_gradient(sub.facet_triangles, sub.facet_cell, sub.facet_normal, volume,
                           model.shape_functions, spokes=spokes)
     return sub, grad
+
+
+def boundary_points_3d(model: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The facet points of a 3-D model's cells that lie on its outer boundary, with the
+    boundary face each lies on: where tractions are integrated, so that a load
+    ``sum_q phi_I(x_q) t_q A_q`` takes the very points of the cells' boundary
+    integrals (the patch test with tractions holds to round-off).
+
+    A cell's facet is on the outer boundary when no other cell has a facet at its
+    point with the opposite area-normal (interior and interface facets come in
+    such pairs).
+
+    Parameters
+    ----------
+    model : Model3D
+
+    Returns
+    -------
+    point : (k, 3) ndarray
+    area_normal : (k, 3) ndarray
+        Outward, of length the facet's area.
+    face : (k,) int64 ndarray
+        The row of ``model.boundary_with_normals()`` the point lies on.
+    """
+    cells = model.cells
+    _, point, area_normal = facet_points(cells.facet_triangles, cells.facet_cell,
+                                         cells.facet_normal)
+    size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
+    tree = cKDTree(point)
+    pairs = tree.query_pairs(PAIR_RTOL * size, output_type="ndarray")
+    opposite = np.einsum("ij,ij->i", area_normal[pairs[:, 0]], area_normal[pairs[:, 1]]) < 0
+    shared = np.zeros(len(point), dtype=bool)
+    shared[pairs[opposite].ravel()] = True
+    outer = np.flatnonzero(~shared)
+    faces, normal = model.boundary_with_normals()
+    corners = model.nodes[faces]
+    face = _face_holding(point[outer], area_normal[outer], corners, normal, size)
+    keep = face >= 0
+    if not keep.all():
+        raise GeometryError(f"{int((~keep).sum())} cell facets on the boundary lie on no "
+                            f"boundary triangle, first at {point[outer][~keep][:3].tolist()}")
+    return point[outer], area_normal[outer], face
+
+
+def _face_holding(points, area_normal, corners, normal, size):
+    """The boundary triangle (of the same outward normal) holding each point, -1 if none."""
+    centre = corners.mean(axis=1)
+    reach = np.linalg.norm(corners - centre[:, None], axis=2).max(axis=1)
+    tree = cKDTree(centre)
+    out = np.full(len(points), -1, dtype=np.int64)
+    candidates = tree.query_ball_point(points, r=float(reach.max()) * (1.0 + 1e-9))
+    unit = area_normal / np.linalg.norm(area_normal, axis=1)[:, None]
+    for i, cand in enumerate(candidates):
+        cand = np.asarray(cand, dtype=np.int64)
+        cand = cand[np.einsum("ij,j->i", normal[cand], unit[i]) > 1.0 - 1e-6]
+        if len(cand) == 0:
+            continue
+        a, b, c = corners[cand, 0], corners[cand, 1], corners[cand, 2]
+        e1, e2, d = b - a, c - a, points[i] - a
+        n = np.cross(e1, e2)
+        nn = np.einsum("ij,ij->i", n, n)
+        s = np.einsum("ij,ij->i", np.cross(d, e2), n) / nn
+        t = np.einsum("ij,ij->i", np.cross(e1, d), n) / nn
+        off = np.abs(np.einsum("ij,ij->i", d, n)) / np.sqrt(nn)
+        tol = PAIR_RTOL * 1e3
+        inside = (s >= -tol) & (t >= -tol) & (s + t <= 1.0 + tol) & (off <= PAIR_RTOL * size)
+        if inside.any():
+            out[i] = cand[np.flatnonzero(inside)[0]]
+    return out

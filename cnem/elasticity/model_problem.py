@@ -20,9 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from skfem.quadrature import get_quadrature
-from skfem.refdom import RefTri
-
+from ..assembly.facet_gradients import boundary_points_3d
 from ..assembly.gradients import GradientCache
 from ..errors import GeometryError
 from ..geometry.model import check_model
@@ -79,6 +77,7 @@ class ModelProblem(Conditions):
                                 f"GradientCache(model, gauss={gauss})")
         self.gradients = gradients
         self.cells = model.cells
+        self._boundary_points = None
         super().__init__()
 
     @property
@@ -104,10 +103,10 @@ class ModelProblem(Conditions):
         return edges, normal
 
     def nodal_load(self) -> np.ndarray:
-        """The nodes' share of the tractions (3-point Gauss rule on each edge, a
-        degree-4 rule on each 3-D boundary triangle: exact up to quadratic tractions)
-        and of the body forces (one value per cell, at its node), on the reference
-        configuration.
+        """The nodes' share of the tractions (3-point Gauss rule on each edge, exact up
+        to quadratic tractions; in 3-D the cells' boundary facet points, see
+        `_facet_loads`) and of the body forces (one value per cell, at its node), on
+        the reference configuration.
 
         Returns
         -------
@@ -121,7 +120,7 @@ class ModelProblem(Conditions):
         for traction in self.tractions:
             edges, normal, t = traction.edges, traction.normal, traction.value
             if d == 3:
-                f += triangle_loads(x, edges, normal, t)
+                f += self._facet_loads(traction.index, t)
                 continue
             a, b = x[edges[:, 0]], x[edges[:, 1]]
             length = np.linalg.norm(b - a, axis=1)
@@ -135,30 +134,21 @@ class ModelProblem(Conditions):
             np.add.at(f, cells.node, cells.measure[:, None] * b)
         return f
 
+    def _facet_loads(self, faces: np.ndarray, t) -> np.ndarray:
+        """``sum_q phi_I(x_q) t(x_q) A_q`` over the 3-D cells' boundary facet points on
+        the boundary triangles ``faces`` (`boundary_points_3d`): the points of the
+        cells' own boundary integrals, so that a constant stress gives loads that
+        balance ``K u`` exactly (the shape functions on a boundary face are not the
+        linear hats of its triangles).
 
-def triangle_loads(x: np.ndarray, faces: np.ndarray, normal: np.ndarray, t) -> np.ndarray:
-    """The nodes' share ``int t N_a dA`` of a traction on boundary triangles, where the
-    shape functions are linear between the three nodes of each face.
-
-    Parameters
-    ----------
-    x : (n, 3) ndarray
-    faces : (e, 3) int64 ndarray
-    normal : (e, 3) ndarray
-        Outward unit normals.
-    t : (3,) array_like or callable ``(x, nrm) -> (q, 3)``
-
-    Returns
-    -------
-    (n, 3) ndarray
-    """
-    ref, w = get_quadrature(RefTri, 4)                   # reference triangle, area 1/2
-    corners = x[faces]
-    e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
-    twice_area = np.linalg.norm(np.cross(e1, e2), axis=1)
-    f = np.zeros_like(x)
-    for r, s, wk in zip(ref[0], ref[1], w):
-        tr = traction_at(t, corners[:, 0] + r * e1 + s * e2, normal)
-        for a, shape in enumerate((1.0 - r - s, r, s)):
-            np.add.at(f, faces[:, a], (wk * shape * twice_area)[:, None] * tr)
-    return f
+        Returns
+        -------
+        (n, 3) ndarray
+        """
+        if self._boundary_points is None:
+            self._boundary_points = boundary_points_3d(self.model)
+        points, area_normal, face = self._boundary_points
+        take = np.isin(face, faces)
+        area = np.linalg.norm(area_normal[take], axis=1)
+        tr = traction_at(t, points[take], area_normal[take] / area[:, None])
+        return np.asarray(self.model.shape_functions(points[take]).T @ (area[:, None] * tr))

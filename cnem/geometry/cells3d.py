@@ -55,6 +55,10 @@ class Cells3D:
         The cell each triangle bounds.
     facet_normal : (q, 3) float64 ndarray
         Outward unit normal of each triangle.
+    apex : (m, 3) float64 ndarray or None
+        A point each cell is star-shaped from, whose cones over the facets make the
+        cell (sub-cells: the pyramids of `cnem.assembly.facet_gradients`, whose
+        spokes are not among the facets); None for closed cells.
     """
 
     node: np.ndarray
@@ -63,6 +67,7 @@ class Cells3D:
     facet_triangles: np.ndarray
     facet_cell: np.ndarray
     facet_normal: np.ndarray
+    apex: np.ndarray | None = None
 
     def __repr__(self) -> str:
         return (f"<Cells3D {len(self.node)} cells, {len(self.facet_cell)} facet triangles, "
@@ -78,12 +83,16 @@ class Cells3D:
 
     def centroid(self) -> np.ndarray:
         """Centroids ``(m, 3)``: the sum over the facet triangles of the tetrahedra they
-        make with a point of their cell's (its first facet vertex), weighted by their
-        signed volumes (exact for any closed facet surface)."""
+        make with the cell's `apex` (else its first facet vertex), weighted by their
+        signed volumes (exact for any closed facet surface, and for a pyramid from
+        its apex over its facets)."""
         tri = self.facet_triangles
-        first = np.full(len(self.node), -1, dtype=np.int64)
-        first[self.facet_cell[::-1]] = np.arange(len(tri))[::-1]
-        apex = tri[first[self.facet_cell], 0]
+        if self.apex is not None:
+            apex = self.apex[self.facet_cell]
+        else:
+            first = np.full(len(self.node), -1, dtype=np.int64)
+            first[self.facet_cell[::-1]] = np.arange(len(tri))[::-1]
+            apex = tri[first[self.facet_cell], 0]
         a, b, c = (tri[:, i] - apex for i in range(3))
         six_v = np.einsum("ij,ij->i", a, np.cross(b, c))
         moment = six_v[:, None] * (apex + tri.sum(axis=1)) / 4.0
