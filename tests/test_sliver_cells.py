@@ -54,3 +54,11 @@ def test_the_cells_of_a_sliver_tile_it(height, moved):
     for k, i in enumerate(cells.node):
         want = _clipped_voronoi(local, box, i) * dom.frame.scale ** 2
         assert cells.area[k] == pytest.approx(want, rel=1e-9), i
+
+
+def test_a_sliver_thinner_than_round_off_is_named():
+    """At a height of 1e-9 the nodes of both long sides fall on one line: `triangle`
+    returns no triangle, and discretize says so (it raised a bare KeyError)."""
+    dom = cnem.Domain([[0.0, 0.0], [1.0, 0.0], [0.5, 1e-9]])
+    with pytest.raises(cnem.GeometryError, match="make no triangle.*collinear"):
+        cnem.discretize(cnem.nodes.regular(dom, 0.1))

@@ -48,8 +48,9 @@ def constrained_delaunay(cloud: NodeCloud) -> tuple[np.ndarray, np.ndarray]:
     Raises
     ------
     GeometryError
-        If `triangle` had to insert a Steiner point (segments cross) or a node
-        is not a vertex of any triangle (duplicated or outside the domain).
+        If `triangle` had to insert a Steiner point (segments cross), a node is
+        not a vertex of any triangle (duplicated or outside the domain), or the
+        nodes make no triangle at all (collinear).
     """
     points = np.ascontiguousarray(cloud.points, dtype=float)
     segments = np.ascontiguousarray(cloud.segments, dtype=np.int32)
@@ -58,6 +59,12 @@ def constrained_delaunay(cloud: NodeCloud) -> tuple[np.ndarray, np.ndarray]:
     if len(verts) != len(points) or not np.array_equal(verts, points):
         extra = verts[len(points):]
         raise _steiner_error(points, cloud.segments, extra, cloud.domain.tolerance)
+    if len(out.get("triangles", ())) == 0:
+        raise GeometryError(
+            f"the {len(points)} nodes make no triangle: they are (to round-off) collinear; a "
+            f"body this thin ({cloud.domain.area:.3g} in area over a diameter of "
+            f"{cloud.domain.diameter:.3g}) needs a spacing below its thickness, or model it "
+            f"as a line")
     tri = np.ascontiguousarray(out["triangles"])           # int32 from triangle, ours
     region = cloud.domain.region_of(orient_and_centroids(points, tri))
     inside = region >= 0
