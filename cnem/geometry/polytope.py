@@ -106,11 +106,14 @@ class Polytope:
             if len(out) >= 3:
                 faces.append((np.array(out), pl))
         verts = np.array(verts)
+        spread = 0.0
         if len(cap) >= 3:
             pts = verts[cap]
             centre = pts.mean(axis=0)
             u = pts[np.argmax(np.linalg.norm(pts - centre, axis=1))] - centre
-            u /= np.linalg.norm(u)
+            spread = float(np.linalg.norm(u))
+        if spread > _ON:                        # else the cut only grazes a point
+            u /= spread
             n = plane.normal
             w = np.array([n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]])
             ang = np.arctan2((pts - centre) @ w, (pts - centre) @ u)
