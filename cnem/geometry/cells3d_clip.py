@@ -54,7 +54,8 @@ class GeneralCells:
     face_regions : (b, 2) int64 ndarray
     """
 
-    def __init__(self, points, tets, tet_region, faces, face_regions):
+    def __init__(self, points: np.ndarray, tets: np.ndarray, tet_region: np.ndarray,
+                 faces: np.ndarray, face_regions: np.ndarray):
         self.points, self.tets, self.tet_region = points, tets, tet_region
         self.faces = faces
         n_reg = int(tet_region.max()) + 1
@@ -89,7 +90,7 @@ class GeneralCells:
         self.star_tets = order // 4
         self.star_offsets = np.searchsorted(tets.ravel()[order], np.arange(len(points) + 1))
 
-    def cell(self, i: int, r: int):
+    def cell(self, i: int, r: int) -> tuple[np.ndarray, np.ndarray, float]:
         """Facet triangles ``(q, 3, 3)``, their outward normals ``(q, 3)`` and the volume of
         the cell of node ``i`` in region ``r``."""
         x0, s = self.points[i], self.scale[i]
