@@ -29,7 +29,7 @@ import shapely
 from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
-from .polytope import _ON, Plane, Polytope, subtract
+from .polytope import _ON, Plane, Polytope, cut, subtract
 
 __all__ = ["GeneralCells"]
 
@@ -272,13 +272,8 @@ def _claim(pieces, nearer_i, origin_j, faces, who):
     for shadow in _shadows(origin_j, *faces, who, corners):    # the parts hidden from j stay
         nxt = []
         for y in rest:
-            inner = y
-            for pl in shadow:
-                inner, outer = inner.split(pl)
-                if outer is not None:
-                    nxt.append(outer)
-                if inner is None:
-                    break
+            inner, outside = cut(y, shadow)
+            nxt.extend(outside)
             if inner is not None:
                 out.append(inner)
         rest = nxt
