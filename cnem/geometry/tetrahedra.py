@@ -145,16 +145,18 @@ class _TieRecovery:
         self.points, self.scale = points, scale
         self.tets = [tuple(t) for t in tets.tolist()]
         self.alive = [True] * len(self.tets)
+        self.solid = _solid(points, tets).tolist()
         self.star: dict[int, set[int]] = {int(v): set() for v in watched}
         flat = tets.ravel()
         hit = np.flatnonzero(np.isin(flat, watched))
         for pos in hit.tolist():
             self.star[int(flat[pos])].add(pos // 4)
 
-    def _add(self, tet):
+    def _add(self, tet, solid):
         k = len(self.tets)
         self.tets.append(tet)
         self.alive.append(True)
+        self.solid.append(solid)
         for v in tet:
             if v in self.star:
                 self.star[v].add(k)
@@ -170,7 +172,7 @@ class _TieRecovery:
         out = set()
         for k in self.star.get(a, ()):
             t = self.tets[k]
-            if not _solid(self.points, np.array([t]))[0]:
+            if not self.solid[k]:
                 continue
             rest = [v for v in t if v != a]
             for i in range(3):
@@ -230,8 +232,8 @@ class _TieRecovery:
             return False
         for k in ring:
             self._remove(k)
-        for t in new.tolist():
-            self._add(tuple(t))
+        for t, solid in zip(new.tolist(), _solid(p, new).tolist()):
+            self._add(tuple(t), solid)
         return True
 
     def result(self):
