@@ -25,6 +25,7 @@ import warnings
 from collections.abc import Callable
 
 import numpy as np
+import scipy.spatial
 import pytest
 
 import cnem
@@ -52,6 +53,7 @@ NOT_ENTRY_POINTS = {
     "cnem.pd.Relaxation": "a result of Problem.relax",
     "cnem.fem.P1Solution": "a result of P1Elasticity.solve",
     "cnem.assembly.SmoothedGradient": "sparse operators built by smoothed_gradient",
+    "cnem.shape.TetMesh": "a result of cnem.shape.tet_mesh",
     # callables that take functions, forms or sparse matrices, not arrays of numbers
     "cnem.assembly.BilinearForm": "wraps a Python function (a weak form)",
     "cnem.assembly.LinearForm": "wraps a Python function (a weak form)",
@@ -213,6 +215,7 @@ def fx():
     inside = np.array([[0.3, 0.3], [0.7, 0.8]])
     box = cnem.geometry.box((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
     cloud3 = cnem.nodes.regular(box, 0.5)
+    tet_nodes = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.2, 0.2, 0.2]], float)
     p1 = cnem.fem.P1Elasticity(cnem.Domain(square), (1.0, 0.3), nodes=20)
     p1.add_dirichlet(lambda p: p[:, 1] < 1e-9, None)
     p1.add_traction(lambda x, n: x[:, 1] > 1 - 1e-9, [0.0, 1.0])
@@ -221,7 +224,8 @@ def fx():
                                  pd_prob=pd_prob, pd_sol=pd_sol, inside=inside,
                                  tip=np.array([0.5, 0.5]), box=box, cloud3=cloud3,
                                  inside3=np.array([[0.3, 0.3, 0.3], [0.7, 0.8, 0.6]]),
-                                 named=cnem.Domain(square, boundaries={"bottom": square[:2]}))
+                                 named=cnem.Domain(square, boundaries={"bottom": square[:2]}),
+                                 tet_nodes=tet_nodes, tets=scipy.spatial.Delaunay(tet_nodes).simplices)
 
 
 def _pd_problem(f):
@@ -364,6 +368,12 @@ EXAMPLES = {
     "cnem.plot.region_color": Example(lambda f: dict(region=np.array([0, 1]))),
     "cnem.shape.shape_functions": Example(lambda f: dict(model=f.model, points=f.inside,
                                                          triangles=np.array([-1, -1]))),
+    "cnem.shape.tet_mesh": Example(
+        lambda f: dict(nodes=f.tet_nodes, tetrahedra=f.tets, tet_region=np.zeros(len(f.tets)),
+                       constraint_faces=f.tets[:1, :3])),
+    "cnem.shape.shape_functions_3d": Example(
+        lambda f: dict(mesh=cnem.shape.tet_mesh(f.tet_nodes, f.tets),
+                       points=np.array([[0.1, 0.3, 0.2], [0.2, 0.2, 0.1]]))),
     "cnem.spatial.RTree": Example(lambda f: dict(lo=f.lattice, hi=f.lattice + 0.1,
                                                  period=np.array([2.0, 2.0])),
                                   skip={("lo", "shape"): _THREE_D, ("hi", "shape"): _THREE_D,

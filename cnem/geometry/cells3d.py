@@ -24,6 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
@@ -217,8 +218,9 @@ def _fast_facets(points, tets, centre, fast, cell_of):
     return np.concatenate(out_t), np.concatenate(out_c), np.concatenate(out_n)
 
 
-def constrained_voronoi_cells(points, tetrahedra, tet_region, boundary_faces,
-                              boundary_face_regions) -> Cells3D:
+def constrained_voronoi_cells(points: ArrayLike, tetrahedra: ArrayLike, tet_region: ArrayLike,
+                              boundary_faces: ArrayLike,
+                              boundary_face_regions: ArrayLike) -> Cells3D:
     """The constrained Voronoi cells of a boundary-conforming tetrahedrisation.
 
     Parameters

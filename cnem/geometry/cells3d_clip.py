@@ -29,7 +29,7 @@ import shapely
 from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
-from .polytope import _ON, Plane, Polytope, subtract
+from .polytope import _ON, Plane, Polytope, cut, subtract
 
 __all__ = ["GeneralCells"]
 
@@ -54,7 +54,8 @@ class GeneralCells:
     face_regions : (b, 2) int64 ndarray
     """
 
-    def __init__(self, points, tets, tet_region, faces, face_regions):
+    def __init__(self, points: np.ndarray, tets: np.ndarray, tet_region: np.ndarray,
+                 faces: np.ndarray, face_regions: np.ndarray):
         self.points, self.tets, self.tet_region = points, tets, tet_region
         self.faces = faces
         n_reg = int(tet_region.max()) + 1
@@ -89,7 +90,7 @@ class GeneralCells:
         self.star_tets = order // 4
         self.star_offsets = np.searchsorted(tets.ravel()[order], np.arange(len(points) + 1))
 
-    def cell(self, i: int, r: int):
+    def cell(self, i: int, r: int) -> tuple[np.ndarray, np.ndarray, float]:
         """Facet triangles ``(q, 3, 3)``, their outward normals ``(q, 3)`` and the volume of
         the cell of node ``i`` in region ``r``."""
         x0, s = self.points[i], self.scale[i]
@@ -271,13 +272,8 @@ def _claim(pieces, nearer_i, origin_j, faces, who):
     for shadow in _shadows(origin_j, *faces, who, corners):    # the parts hidden from j stay
         nxt = []
         for y in rest:
-            inner = y
-            for pl in shadow:
-                inner, outer = inner.split(pl)
-                if outer is not None:
-                    nxt.append(outer)
-                if inner is None:
-                    break
+            inner, outside = cut(y, shadow)
+            nxt.extend(outside)
             if inner is not None:
                 out.append(inner)
         rest = nxt

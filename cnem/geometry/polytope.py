@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Polytope", "Plane", "subtract"]
+__all__ = ["Polytope", "Plane", "cut", "subtract"]
 
 #: Distance (in the local unit) below which a vertex counts as on a cutting plane.
 _ON = 1e-12
@@ -106,11 +106,14 @@ class Polytope:
             if len(out) >= 3:
                 faces.append((np.array(out), pl))
         verts = np.array(verts)
+        spread = 0.0
         if len(cap) >= 3:
             pts = verts[cap]
             centre = pts.mean(axis=0)
             u = pts[np.argmax(np.linalg.norm(pts - centre, axis=1))] - centre
-            u /= np.linalg.norm(u)
+            spread = float(np.linalg.norm(u))
+        if spread > _ON:                        # else the cut only grazes a point
+            u /= spread
             n = plane.normal
             w = np.array([n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0]])
             ang = np.arctan2((pts - centre) @ w, (pts - centre) @ u)
@@ -151,16 +154,20 @@ class Polytope:
         return float(np.sqrt((self.vertices ** 2).sum(axis=1).max()))
 
 
+def cut(piece: Polytope, planes: list) -> tuple[Polytope | None, list]:
+    """The part of ``piece`` inside every plane (None if empty) and the disjoint convex
+    pieces of the rest."""
+    outside = []
+    inner = piece
+    for pl in planes:
+        inner, outer = inner.split(pl)
+        if outer is not None:
+            outside.append(outer)
+        if inner is None:
+            break
+    return inner, outside
+
+
 def subtract(pieces: list, planes: list) -> list:
     """Disjoint convex pieces of ``pieces`` minus the convex set ``planes`` bound."""
-    out = []
-    for p in pieces:
-        rest = p
-        for pl in planes:
-            inner, outer = rest.split(pl)
-            if outer is not None:
-                out.append(outer)
-            rest = inner
-            if rest is None:
-                break
-    return out
+    return [q for p in pieces for q in cut(p, planes)[1]]

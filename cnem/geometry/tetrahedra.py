@@ -22,6 +22,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay
@@ -144,16 +145,18 @@ class _TieRecovery:
         self.points, self.scale = points, scale
         self.tets = [tuple(t) for t in tets.tolist()]
         self.alive = [True] * len(self.tets)
+        self.solid = _solid(points, tets).tolist()
         self.star: dict[int, set[int]] = {int(v): set() for v in watched}
         flat = tets.ravel()
         hit = np.flatnonzero(np.isin(flat, watched))
         for pos in hit.tolist():
             self.star[int(flat[pos])].add(pos // 4)
 
-    def _add(self, tet):
+    def _add(self, tet, solid):
         k = len(self.tets)
         self.tets.append(tet)
         self.alive.append(True)
+        self.solid.append(solid)
         for v in tet:
             if v in self.star:
                 self.star[v].add(k)
@@ -169,7 +172,7 @@ class _TieRecovery:
         out = set()
         for k in self.star.get(a, ()):
             t = self.tets[k]
-            if not _solid(self.points, np.array([t]))[0]:
+            if not self.solid[k]:
                 continue
             rest = [v for v in t if v != a]
             for i in range(3):
@@ -229,8 +232,8 @@ class _TieRecovery:
             return False
         for k in ring:
             self._remove(k)
-        for t in new.tolist():
-            self._add(tuple(t))
+        for t, solid in zip(new.tolist(), _solid(p, new).tolist()):
+            self._add(tuple(t), solid)
         return True
 
     def result(self):
@@ -403,7 +406,8 @@ def _flat_regions(region, flat, i0, i1):
     return region
 
 
-def conforming_tetrahedra(points, boundary_faces, boundary_face_regions, *,
+def conforming_tetrahedra(points: ArrayLike, boundary_faces: ArrayLike,
+                          boundary_face_regions: ArrayLike, *,
                           max_rounds: int = 8) -> Tetrahedrisation:
     """Delaunay tetrahedrisation of ``points`` that contains every boundary face.
 
