@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 from .. import config
 from .._parallel import work_chunks
 from .._predicates import Frame, local_frame
-from ..errors import CNEMError, GeometryError, check_choice
+from ..errors import CNEMError, GeometryError, check_array, check_choice
 from . import _cavity3d as C
 from . import _kernels3d as K
 from .natural import KINDS, ShapeGradients
@@ -101,19 +101,17 @@ def tet_mesh(nodes: ArrayLike, tetrahedra: ArrayLike, *, tet_region: ArrayLike |
         Bad shapes, indices out of range, flat tetrahedra, a face shared by more
         than two tetrahedra, a constraint face that is no face of the tetrahedra.
     """
-    pts = np.ascontiguousarray(nodes, dtype=np.float64)
-    tet = np.array(tetrahedra, dtype=np.int64)
-    if pts.ndim != 2 or pts.shape[1] != 3 or not np.isfinite(pts).all():
-        raise GeometryError(f"nodes: expected a (n, 3) array of finite coordinates, received "
-                            f"shape {pts.shape}")
-    if tet.ndim != 2 or tet.shape[1] != 4 or len(tet) == 0 or tet.min() < 0 \
-            or tet.max() >= len(pts):
-        raise GeometryError(f"tetrahedra: expected a non-empty (t, 4) array of indices into the "
-                            f"{len(pts)} nodes, received shape {tet.shape}")
+    pts = check_array("nodes", nodes, shape=(None, 3), error=GeometryError,
+                      fix="give the nodes' coordinates as a (n, 3) array")
+    tet = _indices("tetrahedra", tetrahedra, (None, 4), len(pts), "nodes")
+    if len(tet) == 0:
+        raise GeometryError("tetrahedra: expected a non-empty (t, 4) array of node indices, "
+                            "received none")
     region = (np.zeros(len(tet), dtype=np.int64) if tet_region is None
-              else np.asarray(tet_region, dtype=np.int64).reshape(-1))
-    if region.shape != (len(tet),):
-        raise GeometryError(f"tet_region: expected {len(tet)} values, received {region.shape}")
+              else _indices("tet_region", tet_region, (len(tet),), None, None))
+    if constraint_faces is not None:
+        constraint_faces = _indices("constraint_faces", constraint_faces, (None, 3), len(pts),
+                                    "nodes")
     frame = local_frame(np.stack([pts.min(axis=0), pts.max(axis=0)]))
     local = frame.to_local(pts)
     v = local[tet]
@@ -134,6 +132,21 @@ def tet_mesh(nodes: ArrayLike, tetrahedra: ArrayLike, *, tet_region: ArrayLike |
     node_tet[tet.ravel()] = np.repeat(np.arange(len(tet)), 4)
     return TetMesh(pts, tet, region, cut, walk, cedges, features, node_tet,
                    scipy.spatial.cKDTree(local), frame, local, tol)
+
+
+def _indices(name, value, shape, count, of):
+    """``value`` as whole numbers of ``shape`` (int64), in ``0..count-1`` when ``count`` is
+    given; complex, boolean, fractional or out-of-range entries raise a `GeometryError`."""
+    arr = check_array(name, value, shape=shape, error=GeometryError,
+                      fix="give whole numbers (indices)")
+    if np.any(arr != np.round(arr)):
+        raise GeometryError(f"{name}: expected whole numbers (indices), received fractions, "
+                            f"first {arr[arr != np.round(arr)][:3].tolist()}")
+    if count is not None and arr.size and (arr.min() < 0 or arr.max() >= count):
+        raise GeometryError(f"{name}: expected indices into the {count} {of} (0 to "
+                            f"{count - 1}), received values from {int(arr.min())} to "
+                            f"{int(arr.max())}")
+    return arr.astype(np.int64)
 
 
 def _constraint_edges(local, faces):
@@ -257,10 +270,8 @@ def shape_functions_3d(mesh: TetMesh, points: ArrayLike, *,
         Points outside the body, or gradients asked at nodes / on constraint faces.
     """
     check_choice("kind", kind, KINDS)
-    pts = np.ascontiguousarray(points, dtype=np.float64)
-    if pts.ndim != 2 or pts.shape[1] != 3 or not np.isfinite(pts).all():
-        raise GeometryError(f"points: expected a (p, 3) array of finite coordinates, received "
-                            f"shape {pts.shape}")
+    pts = check_array("points", points, shape=(None, 3), error=GeometryError,
+                      fix="give the points as a (p, 3) array")
     n = len(mesh.nodes)
     if len(pts) == 0:
         empty = sp.csr_matrix((0, n))
