@@ -19,6 +19,12 @@ node, since every point of it sees the node). A sub-cell's boundary is its facet
 triangle plus three *spokes* (node, facet edge), shared with the neighbouring
 sub-cells of the same cell, where they cancel; the spokes are integrated by
 their centroid alone, exact for the linear fields the shape functions reproduce.
+
+A facet on a material interface is not shared: the cells of the two regions cut
+the interface into different polygons. Those facets are integrated on the common
+refinement of the two sides (`.interface_facets`), one point per piece, used by
+both cells with opposite normals, so the integration constraint holds across
+interfaces too; each piece goes to the sub-cell of its facet.
 """
 
 from __future__ import annotations
@@ -29,7 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 from ..errors import GeometryError
-from .interface_facets import InterfacePieces, interface_pieces
+from .interface_facets import InterfacePieces, interface_pieces, on_triangles
 from .smoothed_gradient import SmoothedGradient
 
 __all__ = ["facet_points", "facet_gradient", "boundary_points_3d", "pyramid_sub_cells", "cell_gradient_3d",
@@ -332,7 +338,7 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
     group, _ = _facet_groups(cells.facet_cell, cells.facet_normal)
     between = model.boundary_face_regions[:, 1] >= 0
     size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
-    return interface_pieces(cells.facet_triangles, cells.facet_cell, cells.facet_normal, group,
+    return interface_pieces(cells.facet_triangles, cells.facet_normal, group,
                             model.nodes[model.boundary_faces[between]], size)
 
 
@@ -392,15 +398,8 @@ def _face_holding(points, area_normal, corners, normal, size):
         cand = cand[np.einsum("ij,j->i", normal[cand], unit[i]) > 1.0 - 1e-6]
         if len(cand) == 0:
             continue
-        a, b, c = corners[cand, 0], corners[cand, 1], corners[cand, 2]
-        e1, e2, d = b - a, c - a, points[i] - a
-        n = np.cross(e1, e2)
-        nn = np.einsum("ij,ij->i", n, n)
-        s = np.einsum("ij,ij->i", np.cross(d, e2), n) / nn
-        t = np.einsum("ij,ij->i", np.cross(e1, d), n) / nn
-        off = np.abs(np.einsum("ij,ij->i", d, n)) / np.sqrt(nn)
-        tol = PAIR_RTOL * 1e3
-        inside = (s >= -tol) & (t >= -tol) & (s + t <= 1.0 + tol) & (off <= PAIR_RTOL * size)
+        inside = on_triangles(np.broadcast_to(points[i], (len(cand), 3)), corners[cand],
+                              PAIR_RTOL * 1e3, PAIR_RTOL * size)
         if inside.any():
             out[i] = cand[np.flatnonzero(inside)[0]]
     return out

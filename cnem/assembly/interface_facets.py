@@ -16,12 +16,11 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-import shapely
 from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
 
-__all__ = ["InterfacePieces", "interface_pieces"]
+__all__ = ["InterfacePieces", "interface_pieces", "on_triangles"]
 
 #: A facet lies in an interface face's plane when its normal is parallel to the
 #: face's to this (``1 - |cos|``) ...
@@ -60,16 +59,15 @@ class InterfacePieces(NamedTuple):
     on_interface: np.ndarray
 
 
-def interface_pieces(facet_triangles: np.ndarray, facet_cell: np.ndarray,
-                     facet_normal: np.ndarray, facet_group: np.ndarray,
-                     face_corners: np.ndarray, size: float) -> InterfacePieces:
+def interface_pieces(facet_triangles: np.ndarray, facet_normal: np.ndarray,
+                     facet_group: np.ndarray, face_corners: np.ndarray, size: float
+                     ) -> InterfacePieces:
     """The common refinement of the cells' facets on interface faces.
 
     Parameters
     ----------
     facet_triangles : (f, 3, 3) ndarray
         The cells' boundary triangles.
-    facet_cell : (f,) int64 ndarray
     facet_normal : (f, 3) ndarray
         Outward unit normals.
     facet_group : (f,) int64 ndarray
@@ -88,13 +86,11 @@ def interface_pieces(facet_triangles: np.ndarray, facet_cell: np.ndarray,
     GeometryError
         An interface facet the other side's facets do not cover.
     """
-    f = len(facet_triangles)
     on = _on_faces(facet_triangles, facet_normal, face_corners, size)
-    empty = InterfacePieces(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
-                            np.zeros(0, np.int64),
-                            np.zeros(0, np.int64), np.zeros(f, dtype=bool))
     if not on.any():
-        return empty
+        none = np.zeros(0, dtype=np.int64)
+        return InterfacePieces(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)), none, none,
+                               on)
     # the whole facet of any triangle on an interface
     on = np.isin(facet_group, facet_group[on])
     tri_idx = np.flatnonzero(on)
@@ -102,15 +98,13 @@ def interface_pieces(facet_triangles: np.ndarray, facet_cell: np.ndarray,
     # the pair's triangles in the 2-D frame of ta's plane, about ta's centre
     origin = facet_triangles[ta].mean(axis=1)
     e1, e2 = _plane_basis(facet_normal[ta])
-    poly_a = _polygons(facet_triangles[ta] - origin[:, None], e1, e2)
-    poly_b = _polygons(facet_triangles[tb] - origin[:, None], e1, e2)
-    piece = shapely.intersection(poly_a, poly_b)
-    area = shapely.area(piece)
+    xy_a = _in_plane(facet_triangles[ta] - origin[:, None], e1, e2)
+    xy_b = _in_plane(facet_triangles[tb] - origin[:, None], e1, e2)
+    area, centre = _triangle_overlaps(xy_a, xy_b)
     keep = area > 0
-    ta, tb, area, piece = ta[keep], tb[keep], area[keep], piece[keep]
+    ta, tb, area, centre = ta[keep], tb[keep], area[keep], centre[keep]
     origin, e1, e2 = origin[keep], e1[keep], e2[keep]
-    c = shapely.centroid(piece)
-    point = origin + shapely.get_x(c)[:, None] * e1 + shapely.get_y(c)[:, None] * e2
+    point = origin + centre[:, :1] * e1 + centre[:, 1:] * e2
     # one piece per pair of facets
     pair = np.column_stack([facet_group[ta], facet_group[tb]])
     _, first, which = np.unique(pair, axis=0, return_index=True, return_inverse=True)
@@ -145,19 +139,37 @@ def _on_faces(tri, normal, corners, size):
     count = np.array([len(h) for h in hits], dtype=np.int64)
     t = np.repeat(near, count)
     face = np.concatenate([np.asarray(h, dtype=np.int64) for h in hits] + [t[:0]])
-    a, b, c = corners[face, 0], corners[face, 1], corners[face, 2]
-    e1, e2, d = b - a, c - a, point[t] - a
-    nf = np.cross(e1, e2)
-    nn = np.einsum("ij,ij->i", nf, nf)
-    s = np.einsum("ij,ij->i", np.cross(d, e2), nf) / nn
-    u = np.einsum("ij,ij->i", np.cross(e1, d), nf) / nn
-    off = np.abs(np.einsum("ij,ij->i", d, nf)) / np.sqrt(nn)
-    cos = np.abs(np.einsum("ij,ij->i", normal[t], nf)) / np.sqrt(nn)
-    tol = 1e-9
-    inside = ((s >= -tol) & (u >= -tol) & (s + u <= 1.0 + tol) & (off <= PLANE_RTOL * size)
+    nf = np.cross(corners[face, 1] - corners[face, 0], corners[face, 2] - corners[face, 0])
+    cos = np.abs(np.einsum("ij,ij->i", normal[t], nf)) / np.linalg.norm(nf, axis=1)
+    inside = (on_triangles(point[t], corners[face], 1e-9, PLANE_RTOL * size)
               & (cos >= 1.0 - PARALLEL_TOL))
     out[t[inside]] = True
     return out
+
+
+def on_triangles(points: np.ndarray, corners: np.ndarray, rtol: float, plane_tol: float
+                 ) -> np.ndarray:
+    """Whether each point lies on its triangle: barycentric coordinates above ``-rtol``
+    and distance from the triangle's plane at most ``plane_tol``.
+
+    Parameters
+    ----------
+    points : (k, 3) ndarray
+    corners : (k, 3, 3) ndarray
+    rtol, plane_tol : float
+
+    Returns
+    -------
+    (k,) bool ndarray
+    """
+    a = corners[:, 0]
+    e1, e2, d = corners[:, 1] - a, corners[:, 2] - a, points - a
+    n = np.cross(e1, e2)
+    nn = np.einsum("ij,ij->i", n, n)
+    s = np.einsum("ij,ij->i", np.cross(d, e2), n) / nn
+    t = np.einsum("ij,ij->i", np.cross(e1, d), n) / nn
+    off = np.abs(np.einsum("ij,ij->i", d, n)) / np.sqrt(nn)
+    return (s >= -rtol) & (t >= -rtol) & (s + t <= 1.0 + rtol) & (off <= plane_tol)
 
 
 def _overlapping(tri, normal, index, size):
@@ -187,10 +199,59 @@ def _plane_basis(normal):
     return e1, np.cross(normal, e1)
 
 
-def _polygons(tri, e1, e2):
-    """Shapely triangles from ``(k, 3, 3)`` corners in the frames ``e1, e2``."""
-    xy = np.stack([np.einsum("kij,kj->ki", tri, e1), np.einsum("kij,kj->ki", tri, e2)], axis=2)
-    return shapely.polygons(xy)
+def _in_plane(tri, e1, e2):
+    """``(k, 3, 2)`` coordinates of ``(k, 3, 3)`` triangles in the frames ``e1, e2``."""
+    return np.stack([np.einsum("kij,kj->ki", tri, e1), np.einsum("kij,kj->ki", tri, e2)], axis=2)
+
+
+def _triangle_overlaps(a, b):
+    """Area ``(k,)`` and centroid ``(k, 2)`` of the intersections of the 2-D triangles
+    ``a`` and ``b`` ``(k, 3, 2)``: ``a`` clipped by the three half-planes of ``b``
+    (Sutherland-Hodgman; a convex polygon clipped by a half-plane gains at most one
+    vertex, so at most six)."""
+    k = len(a)
+    ccw = _cross(b[:, 1] - b[:, 0], b[:, 2] - b[:, 0]) > 0
+    b = np.where(ccw[:, None, None], b, b[:, ::-1])
+    poly = np.zeros((k, 7, 2))
+    poly[:, :3] = a
+    count = np.full(k, 3, dtype=np.int64)
+    rows = np.arange(k)
+    for edge in range(3):
+        p, q = b[:, edge], b[:, (edge + 1) % 3]
+        side = _cross((q - p)[:, None, :], poly - p[:, None, :])       # (k, 7), >= 0 inside
+        out = np.zeros_like(poly)
+        n_out = np.zeros(k, dtype=np.int64)
+        for i in range(6):
+            valid = i < count
+            j = np.where(i + 1 < count, i + 1, 0)
+            si, sj = side[:, i], side[rows, j]
+            vi, vj = poly[:, i], poly[rows, j]
+            keep = valid & (si >= 0)
+            out[rows[keep], n_out[keep]] = vi[keep]
+            n_out += keep
+            cut = valid & (si * sj < 0)
+            t = si[cut] / (si[cut] - sj[cut])
+            out[rows[cut], n_out[cut]] = vi[cut] + t[:, None] * (vj[cut] - vi[cut])
+            n_out += cut
+        poly, count = out, n_out
+    # shoelace over the closed polygon (slots past the count repeat the first vertex)
+    slot = np.arange(7)[None, :]
+    poly = np.where((slot < count[:, None])[..., None], poly, poly[:, :1])
+    nxt = np.roll(poly, -1, axis=1)
+    cross = _cross(poly, nxt)
+    twice = cross.sum(axis=1)
+    area = 0.5 * np.abs(twice)
+    safe = np.where(twice != 0, twice, 1.0)
+    centre = ((poly + nxt) * cross[..., None]).sum(axis=1) / (3.0 * safe[:, None])
+    # a sliver's centroid is all round-off: keep it in its box (nearer the true one,
+    # and in the body; its tiny area makes the moment's error round-off)
+    centre = np.clip(centre, poly.min(axis=1), poly.max(axis=1))
+    return np.where(count >= 3, area, 0.0), centre
+
+
+def _cross(u, v):
+    """The 2-D cross product of ``(..., 2)`` vectors."""
+    return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
 
 
 def _facet_area_normals(tri, normal, group):
