@@ -19,6 +19,12 @@ node, since every point of it sees the node). A sub-cell's boundary is its facet
 triangle plus three *spokes* (node, facet edge), shared with the neighbouring
 sub-cells of the same cell, where they cancel; the spokes are integrated by
 their centroid alone, exact for the linear fields the shape functions reproduce.
+
+A facet on a material interface is not shared: the cells of the two regions cut
+the interface into different polygons. Those facets are integrated on the common
+refinement of the two sides (`.interface_facets`), one point per piece, used by
+both cells with opposite normals, so the integration constraint holds across
+interfaces too; each piece goes to the sub-cell of its facet.
 """
 
 from __future__ import annotations
@@ -29,9 +35,11 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 from ..errors import GeometryError
+from .interface_facets import InterfacePieces, interface_pieces, on_triangles
 from .smoothed_gradient import SmoothedGradient
 
-__all__ = ["facet_points", "facet_gradient", "boundary_points_3d", "pyramid_sub_cells", "cell_gradient_3d", "sub_cell_gradient_3d"]
+__all__ = ["facet_points", "facet_gradient", "boundary_points_3d", "pyramid_sub_cells", "cell_gradient_3d",
+           "model_interface_pieces", "sub_cell_gradient_3d"]
 
 #: Facet normals are told apart to ``1 / PLANE_RESOLUTION`` (unit normals of one
 #: cell's distinct Voronoi facets differ by far more).
@@ -69,6 +77,11 @@ def facet_points(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_norm
     point : (k, 3) ndarray
     area_normal : (k, 3) ndarray
     """
+    return _grouped_facet_points(facet_triangles, facet_cell, facet_normal)[1:]
+
+
+def _grouped_facet_points(facet_triangles, facet_cell, facet_normal):
+    """`facet_points`, after the facet of every triangle."""
     tri = facet_triangles
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
     group, first = _facet_groups(facet_cell, facet_normal)
@@ -78,7 +91,7 @@ def facet_points(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_norm
                              for i in range(3)]) / total[:, None]
     normal = np.column_stack([np.bincount(group, weights=area * facet_normal[:, i],
                                           minlength=len(first)) for i in range(3)])
-    return facet_cell[first], point, normal
+    return group, facet_cell[first], point, normal
 
 
 def _facet_groups(facet_cell, facet_normal):
@@ -91,8 +104,8 @@ def _facet_groups(facet_cell, facet_normal):
 
 def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_normal: np.ndarray,
                    volume: np.ndarray, evaluate: Evaluate, *,
-                   spokes: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
-                   ) -> SmoothedGradient:
+                   spokes: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None,
+                   interface: InterfacePieces | None = None) -> SmoothedGradient:
     """``B~`` of 3-D cells from their boundary triangles.
 
     Parameters
@@ -112,6 +125,9 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
     spokes : (centroid (s, 3), area-normal (s, 3), cell_a (s,), cell_b (s,)), optional
         Faces integrated by one point (the sub-cells' spokes, `pyramid_sub_cells`),
         with the normal out of ``cell_a`` and the opposite one out of ``cell_b``.
+    interface : InterfacePieces, optional
+        The common refinement of the facets on material interfaces
+        (`interface_pieces`, on these triangles): it replaces their facet points.
 
     Returns
     -------
@@ -123,15 +139,21 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
         bad = np.flatnonzero(~(volume > 0))[:5]
         raise GeometryError(f"expected cells of positive volume, received volumes "
                             f"{volume[bad].tolist()} at cells {bad.tolist()}")
-    cell, points, flux = facet_points(facet_triangles, facet_cell, facet_normal)
+    group, cell, points, flux = _grouped_facet_points(facet_triangles, facet_cell, facet_normal)
+    two_sided = [] if spokes is None else [(spokes[0], spokes[1], -spokes[1], *spokes[2:])]
+    if interface is not None and len(interface.tri_a):
+        whole = np.ones(len(points), dtype=bool)
+        whole[group[interface.on_interface]] = False
+        cell, points, flux = cell[whole], points[whole], flux[whole]
+        two_sided.append((interface.point, interface.area_normal_a, interface.area_normal_b,
+                          facet_cell[interface.tri_a], facet_cell[interface.tri_b]))
     column = np.arange(len(points), dtype=np.int64)
-    if spokes is not None:
-        centre, area_normal, a, b = spokes
+    for centre, flux_a, flux_b, a, b in two_sided:
         at = len(points) + np.arange(len(centre), dtype=np.int64)
         points = np.concatenate([points, centre])
         column = np.concatenate([column, at, at])
         cell = np.concatenate([cell, a, b])
-        flux = np.concatenate([flux, area_normal, -area_normal])
+        flux = np.concatenate([flux, flux_a, flux_b])
     phi = evaluate(points)
     q = len(points)
     parts = []
@@ -150,7 +172,8 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     Its pyramid's boundary is the facet itself and one spoke triangle (node, edge)
     per edge of its outline, shared with the pyramid of the neighbouring facet,
     where the two cancel. A facet through the node (a node on the cell's
-    boundary) makes a flat pyramid: it joins a neighbouring pyramid, whose
+    boundary) makes a flat pyramid: it joins the largest neighbouring pyramid
+    (not a sliver, whose gradient it would make ill-conditioned), whose
     boundary then takes that facet instead of the spoke between them. So every
     facet point of a cell belongs to exactly one of its sub-cells, and
     ``sum_s V_s b~_s = V_k b~_k`` holds for any functions.
@@ -201,7 +224,8 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     if np.any(twin < 0):
         raise GeometryError(f"expected closed cells, received {int(np.sum(twin < 0))} facet edges "
                             "without a neighbouring facet")
-    # flat facets join a neighbouring pyramid (through flat neighbours, a bounded walk)
+    # flat facets join the largest neighbouring pyramid (through flat neighbours, a
+    # bounded walk)
     owner = np.where(volume > rtol * scale ** 3, np.arange(n_groups), -1)
     for _ in range(n_groups):
         todo = owner[edge_group] < 0
@@ -213,7 +237,10 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
             bad = np.unique(edge_cell[todo])[:5]
             raise GeometryError(f"cells {bad.tolist()}: every facet passes through the cell's "
                                 "node; expected cells of positive volume")
-        owner[edge_group[give]] = across[give]
+        largest = np.full(n_groups, -np.inf)
+        np.maximum.at(largest, edge_group[give], volume[across[give]])
+        best = give & (volume[np.maximum(across, 0)] == largest[edge_group])
+        owner[edge_group[best]] = across[best]
     kept, sub_of_owner = np.unique(owner, return_inverse=True)
     triangle_sub = sub_of_owner[group]
     edge_sub = sub_of_owner[owner[edge_group]]
@@ -266,7 +293,8 @@ def cell_gradient_3d(model: Any, cells: Any) -> SmoothedGradient:
     SmoothedGradient
     """
     return facet_gradient(cells.facet_triangles, cells.facet_cell, cells.facet_normal,
-                          cells.volume, model.shape_functions)
+                          cells.volume, model.shape_functions,
+                          interface=model_interface_pieces(model, cells))
 
 
 def sub_cell_gradient_3d(model: Any) -> tuple[Any, SmoothedGradient]:
@@ -288,9 +316,30 @@ def sub_cell_gradient_3d(model: Any) -> tuple[Any, SmoothedGradient]:
         model.nodes[cells.node], cells.facet_triangles, cells.facet_cell, cells.facet_normal)
     sub = type(cells)(cells.node[parent], cells.region[parent], volume, cells.facet_triangles,
                       triangle_sub, cells.facet_normal, apex=model.nodes[cells.node[parent]])
+    # the sub-cells' triangles are the cells': the interface pieces go to their sub-cells
     grad = facet_gradient(sub.facet_triangles, sub.facet_cell, sub.facet_normal, volume,
-                          model.shape_functions, spokes=spokes)
+                          model.shape_functions, spokes=spokes,
+                          interface=model_interface_pieces(model, cells))
     return sub, grad
+
+
+def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
+    """`interface_pieces` of a 3-D model's cells on its interface faces.
+
+    Parameters
+    ----------
+    model : Model3D
+    cells : Cells3D
+
+    Returns
+    -------
+    InterfacePieces
+    """
+    group, _ = _facet_groups(cells.facet_cell, cells.facet_normal)
+    between = model.boundary_face_regions[:, 1] >= 0
+    size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
+    return interface_pieces(cells.facet_triangles, cells.facet_normal, group,
+                            model.nodes[model.boundary_faces[between]], size)
 
 
 def boundary_points_3d(model: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -316,14 +365,15 @@ def boundary_points_3d(model: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         The row of ``model.boundary_with_normals()`` the point lies on.
     """
     cells = model.cells
-    _, point, area_normal = facet_points(cells.facet_triangles, cells.facet_cell,
-                                         cells.facet_normal)
+    group, _, point, area_normal = _grouped_facet_points(cells.facet_triangles, cells.facet_cell,
+                                                         cells.facet_normal)
     size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
     tree = cKDTree(point)
     pairs = tree.query_pairs(PAIR_RTOL * size, output_type="ndarray")
     opposite = np.einsum("ij,ij->i", area_normal[pairs[:, 0]], area_normal[pairs[:, 1]]) < 0
     shared = np.zeros(len(point), dtype=bool)
     shared[pairs[opposite].ravel()] = True
+    shared[group[model_interface_pieces(model, cells).on_interface]] = True
     outer = np.flatnonzero(~shared)
     faces, normal = model.boundary_with_normals()
     corners = model.nodes[faces]
@@ -348,15 +398,8 @@ def _face_holding(points, area_normal, corners, normal, size):
         cand = cand[np.einsum("ij,j->i", normal[cand], unit[i]) > 1.0 - 1e-6]
         if len(cand) == 0:
             continue
-        a, b, c = corners[cand, 0], corners[cand, 1], corners[cand, 2]
-        e1, e2, d = b - a, c - a, points[i] - a
-        n = np.cross(e1, e2)
-        nn = np.einsum("ij,ij->i", n, n)
-        s = np.einsum("ij,ij->i", np.cross(d, e2), n) / nn
-        t = np.einsum("ij,ij->i", np.cross(e1, d), n) / nn
-        off = np.abs(np.einsum("ij,ij->i", d, n)) / np.sqrt(nn)
-        tol = PAIR_RTOL * 1e3
-        inside = (s >= -tol) & (t >= -tol) & (s + t <= 1.0 + tol) & (off <= PAIR_RTOL * size)
+        inside = on_triangles(np.broadcast_to(points[i], (len(cand), 3)), corners[cand],
+                              PAIR_RTOL * 1e3, PAIR_RTOL * size)
         if inside.any():
             out[i] = cand[np.flatnonzero(inside)[0]]
     return out
