@@ -322,6 +322,7 @@ def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:
         Crossing constraints (`triangle` would need Steiner points), nodes that
         are not vertices of the triangulation.
     """
+    _check_cloud(cloud, "discretize")
     if cloud.dim == 3:
         from .model3d import discretize_3d
         return discretize_3d(cloud)
@@ -340,6 +341,13 @@ def discretize(cloud: NodeCloud, *, progress: bool | None = None) -> Model:
     cells = Cells(node, cell_region, offsets, vertices)
     return Model(cloud, nodes, node_of_point, tri, region, segments, kind, cells, timings,
                  _derived={"neighbors": neighbors, "local nodes": local})
+
+
+def _check_cloud(cloud, caller):
+    """Refuse anything but a `NodeCloud`, naming how to make one."""
+    if not isinstance(cloud, NodeCloud):
+        raise GeometryError(f"{caller} expects a NodeCloud from cnem.nodes, received "
+                            f"{type(cloud).__name__}; build one with cnem.nodes.from_points")
 
 
 def triangulate(cloud, timings, caller="discretize"):
@@ -363,9 +371,7 @@ def triangulate(cloud, timings, caller="discretize"):
         (`Model.neighbors`), then the vertex star they were found from
         (`cnem.geometry.topology.vertex_triangles`).
     """
-    if not isinstance(cloud, NodeCloud):
-        raise GeometryError(f"{caller} expects a NodeCloud from cnem.nodes, received "
-                            f"{type(cloud).__name__}; build one with cnem.nodes.from_points")
+    _check_cloud(cloud, caller)
     t0 = time.perf_counter()
     tri, region = constrained_delaunay(cloud)
     t1 = time.perf_counter()

@@ -98,8 +98,7 @@ def torsion(n: int = 7, *, slenderness: int = 2, m: float = 1.5, angle: float = 
     body = pd.Body(x, h ** 3, m * h * (1 + EPS))
     C3 = constant_for_ratio(3, TORSION_RATIO, 3, body.horizon)
     top = x[:, 2] > x[:, 2].max() - EPS
-    prob = pd.Problem(body, pd.CPD(1.0, 0.0, C3, exponent=0.0))
-    prob.add_dirichlet(x[:, 2] < EPS, None, 0.0)
+    material = pd.CPD(1.0, 0.0, C3, exponent=0.0)
 
     def turn(p, theta):
         r = p[:, :2] - 0.5
@@ -110,8 +109,10 @@ def torsion(n: int = 7, *, slenderness: int = 2, m: float = 1.5, angle: float = 
           f"C3 = {C3:.4g}, {steps} steps of {angle / steps:g} degrees")
     levels = np.linspace(0.0, angle, steps + 1)[1:]
     u, history, start = None, [], time.perf_counter()
-    for theta in np.radians(levels):             # the top's values of this angle replace
-        prob.add_dirichlet(top, None, lambda p, t=theta: turn(p, t))   # the previous ones
+    for theta in np.radians(levels):             # one problem per angle, started from the last
+        prob = pd.Problem(body, material)
+        prob.add_dirichlet(x[:, 2] < EPS, None, 0.0)
+        prob.add_dirichlet(top, None, lambda p, t=theta: turn(p, t))
         sol = prob.solve(tol=TOL, initial=u)
         u, history = sol.u, history + sol.residual_history
     seconds = time.perf_counter() - start
