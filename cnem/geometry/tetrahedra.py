@@ -429,14 +429,12 @@ def _remove_flats(points, tets, faces, scale):
     fixer = _TieRecovery(points, tets, np.unique(tets[flat]), scale)
     keep = {frozenset(f) for f in faces.tolist()}
     todo = flat.tolist()
-    for _ in range(64 + 4 * len(todo)):
+    for _ in range(16):
         todo = [k for k in todo if not fixer.remove_flat(k, keep)]
         if not todo:
             break
-        # stuck: push one sliver to its tie's border, where the next tie may take it
-        for k in todo:
-            if fixer.remove_flat(k, keep, push=True):
-                break
+        # stuck: push the slivers to their ties' borders, where the next ties may take them
+        todo = [k for k in todo if not fixer.remove_flat(k, keep, push=True)]
         todo = [k for k in todo + fixer.made_flat if fixer.alive[k]]
         fixer.made_flat.clear()
     return fixer.result()
