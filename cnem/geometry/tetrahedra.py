@@ -306,12 +306,7 @@ class _TieRecovery:
         # pushed slivers walk at random (seeded) among the ties, so that they do not
         # go back and forth between two of them
         new, flat = fits[-1] if not fits[-1][1].any() else fits[self.rng.integers(len(fits))]
-        for j in tie:
-            self._remove(j)
-        for t, f in zip(new.tolist(), flat.tolist()):
-            if f:
-                self.made_flat.append(len(self.tets))
-            self._add(tuple(t))
+        self._replace(tie, new, flat)
         return True
 
     def _remove_twins(self, k, keep) -> bool:
@@ -373,13 +368,17 @@ class _TieRecovery:
                 break
         else:
             return False
-        for k in ring:
+        self._replace(ring, new, flat)
+        return True
+
+    def _replace(self, old, new, flat):
+        """Remove the tetrahedra ``old`` and add ``new``; the ``flat`` ones are noted."""
+        for k in old:
             self._remove(k)
         for t, f in zip(new.tolist(), flat.tolist()):
             if f:
                 self.made_flat.append(len(self.tets))
             self._add(tuple(t))
-        return True
 
     def result(self):
         return np.array([t for t, ok in zip(self.tets, self.alive) if ok], dtype=np.int64)
