@@ -124,7 +124,8 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
         The shape functions at points.
     spokes : (centroid (s, 3), area-normal (s, 3), cell_a (s,), cell_b (s,)), optional
         Faces integrated by one point (the sub-cells' spokes, `pyramid_sub_cells`),
-        with the normal out of ``cell_a`` and the opposite one out of ``cell_b``.
+        with the normal out of ``cell_a`` and, where ``cell_b >= 0``, the opposite
+        one out of ``cell_b``.
     interface : InterfacePieces, optional
         The common refinement of the facets on material interfaces
         (`interface_pieces`, on these triangles): it replaces their facet points.
@@ -150,10 +151,11 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
     column = np.arange(len(points), dtype=np.int64)
     for centre, flux_a, flux_b, a, b in two_sided:
         at = len(points) + np.arange(len(centre), dtype=np.int64)
+        other = b >= 0                                  # a one-sided spoke has b = -1
         points = np.concatenate([points, centre])
-        column = np.concatenate([column, at, at])
-        cell = np.concatenate([cell, a, b])
-        flux = np.concatenate([flux, flux_a, flux_b])
+        column = np.concatenate([column, at, at[other]])
+        cell = np.concatenate([cell, a, b[other]])
+        flux = np.concatenate([flux, flux_a, flux_b[other]])
     phi = evaluate(points)
     q = len(points)
     parts = []
@@ -197,7 +199,9 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
         The sub-cell of each facet triangle.
     volume : (s,) ndarray
     spokes : (centroid (e, 3), area-normal (e, 3), sub_a (e,), sub_b (e,))
-        The spoke faces between two sub-cells, oriented out of ``sub_a``.
+        The spoke faces between two sub-cells, oriented out of ``sub_a``; ``sub_b``
+        is -1 for a spoke whose edge the neighbouring facet cut otherwise (each side
+        then closes its own sub-cell).
 
     Raises
     ------
@@ -220,10 +224,11 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     edge_cell = np.tile(facet_cell, 3)
     outline = ~_has_reverse(edge_group, p, q)
     p, q, edge_group, edge_cell = p[outline], q[outline], edge_group[outline], edge_cell[outline]
+    # an edge's twin is the same edge the other way in a neighbouring facet; a facet
+    # cut differently on the two sides of an edge leaves it without (its spoke is then
+    # one-sided, see facet_gradient)
     twin = _reverse_in(edge_cell, p, q)
-    if np.any(twin < 0):
-        raise GeometryError(f"expected closed cells, received {int(np.sum(twin < 0))} facet edges "
-                            "without a neighbouring facet")
+    paired = twin >= 0
     # flat facets join the largest neighbouring pyramid (through flat neighbours, a
     # bounded walk)
     owner = np.where(volume > rtol * scale ** 3, np.arange(n_groups), -1)
@@ -231,7 +236,7 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
         todo = owner[edge_group] < 0
         if not todo.any():
             break
-        across = owner[edge_group[twin]]
+        across = np.where(paired, owner[edge_group[np.maximum(twin, 0)]], -1)
         give = todo & (across >= 0)
         if not give.any():
             bad = np.unique(edge_cell[todo])[:5]
@@ -244,7 +249,8 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     kept, sub_of_owner = np.unique(owner, return_inverse=True)
     triangle_sub = sub_of_owner[group]
     edge_sub = sub_of_owner[owner[edge_group]]
-    between = (edge_sub != edge_sub[twin]) & (np.arange(len(p)) < twin)
+    other = np.where(paired, edge_sub[np.maximum(twin, 0)], -1)
+    between = (paired & (edge_sub != other) & (np.arange(len(p)) < twin)) | ~paired
     apex_of = node_xyz[edge_cell[between]]
     pb, qb = p[between], q[between]
     # seen from its sub-cell the spoke (apex, q, p) has the outward normal (q - apex) x (p - apex)
@@ -254,7 +260,7 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     parent = np.zeros(len(kept), dtype=np.int64)
     parent[triangle_sub] = facet_cell
     return parent, triangle_sub, sub_volume, (centroid, area_normal, edge_sub[between],
-                                             edge_sub[twin[between]])
+                                             other[between])
 
 
 def _has_reverse(owner, p, q):

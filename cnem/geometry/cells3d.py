@@ -190,7 +190,7 @@ def _fast_facets(points, tets, centre, fast, cell_of):
     edge_id = np.searchsorted(edge, key)
     count = np.bincount(edge_id)
     mean = np.stack([np.bincount(edge_id, weights=c[:, k]) for k in range(3)], axis=1)
-    mean /= count[:, None]
+    mean = mean / count[:, None]                       # (float also when no edge is wanted)
     a, b = points[edge // n], points[edge % n]
     u = b - a
     u /= np.linalg.norm(u, axis=1)[:, None]

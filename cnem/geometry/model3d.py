@@ -30,6 +30,10 @@ from .tetrahedra import conforming_tetrahedra
 
 __all__ = ["Model3D", "discretize_3d"]
 
+#: A cell's facet triangle whose sides are below this fraction of the model's size (its
+#: area below the square) is flat: round-off of coincident circumcentres.
+FLAT_FACET_RTOL = 1e-10
+
 log = logging.getLogger(__name__)
 
 
@@ -149,6 +153,7 @@ def discretize_3d(cloud: NodeCloud) -> Model3D:
     timings["tetrahedra"] = t1 - t0
     cells = constrained_voronoi_cells(tets.points, tets.tetrahedra, tets.tet_region,
                                       tets.boundary_faces, tets.boundary_face_regions)
+    cells = _without_flat_facets(cells, float(np.linalg.norm(np.ptp(tets.points, axis=0))))
     timings["cells"] = time.perf_counter() - t1
     node_of_point = np.full(len(tets.points), -1, dtype=np.int64)
     node_of_point[:tets.n_input] = np.arange(tets.n_input)
@@ -156,3 +161,27 @@ def discretize_3d(cloud: NodeCloud) -> Model3D:
              ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
     return Model3D(cloud, tets.points, node_of_point, tets.tetrahedra, tets.tet_region,
                    tets.boundary_faces, tets.boundary_face_regions, cells, timings)
+
+
+def _without_flat_facets(cells: Cells3D, size: float) -> Cells3D:
+    """The cells without their facet triangles of no area (on lattices, cospherical
+    tetrahedra share a circumcentre and the dual polygons repeat vertices): they carry
+    no flux, and their normals mean nothing.
+
+    Parameters
+    ----------
+    cells : Cells3D
+    size : float
+        The model's diameter; a triangle is flat below ``(FLAT_FACET_RTOL size)^2``.
+
+    Returns
+    -------
+    Cells3D
+    """
+    tri = cells.facet_triangles
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    keep = area > (FLAT_FACET_RTOL * size) ** 2
+    if keep.all():
+        return cells
+    return Cells3D(cells.node, cells.region, cells.volume, tri[keep], cells.facet_cell[keep],
+                   cells.facet_normal[keep], cells.apex)

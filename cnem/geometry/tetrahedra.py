@@ -10,7 +10,12 @@ Every boundary (and interface) triangle becomes a face of the tetrahedrisation:
 3. a face still missing is split at its circumcentre (or at the midpoint of its
    longest edge when the circumcentre falls outside it): the new nodes are boundary
    nodes, returned after the input points, and the faces are refined. Qhull runs
-   again, at most ``max_rounds`` times. No interior Steiner point is ever added.
+   again, at most ``max_rounds`` times. No interior Steiner point is ever added;
+4. a flat sliver (four coplanar, cocircular nodes: Qhull's tie on a lattice square)
+   holds both diagonals of its quadrilateral, one towards each side. The tetrahedra
+   around one diagonal are re-coned from an end of the other (step 2's flip), so that
+   both sides share one diagonal, and the sliver goes; the side whose faces are
+   boundary faces is kept, and no boundary face is flipped away.
 
 Tetrahedra outside the body are removed by a walk: tetrahedra connected through
 faces that are not boundary faces form components, and each component takes the
@@ -20,9 +25,9 @@ region that the boundary faces' orientation names on its side.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from itertools import combinations
 
 import numpy as np
-from numpy.typing import ArrayLike
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay
@@ -36,7 +41,6 @@ __all__ = ["Tetrahedrisation", "conforming_tetrahedra", "signed_volumes", "regio
 _FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 #: Relative tolerance of the tie tests (cospherical, coplanar), in units of the model's size.
 _TIE = 1e-8
-
 
 @dataclass(frozen=True)
 class Tetrahedrisation:
@@ -53,8 +57,8 @@ class Tetrahedrisation:
     boundary_face_regions : (b, 2) int64 ndarray
         Region inside (the normal points away from it) and region outside (-1: none).
     tetrahedra : (t, 4) int64 ndarray
-        Positively oriented tetrahedra inside the body (zero-volume slivers of
-        cospherical nodes may occur).
+        Positively oriented tetrahedra inside the body (none flat: the slivers of
+        cospherical nodes are flipped away).
     tet_region : (t,) int64 ndarray
     """
 
@@ -139,40 +143,54 @@ def _check_input(points, faces, face_regions):
 
 
 class _TieRecovery:
-    """Tied boundary faces recovered by re-coning the tetrahedra around a diagonal."""
+    """Ties resolved by re-coning the tetrahedra around a diagonal: boundary faces
+    recovered (`recover`), flat slivers removed (`remove_flat`)."""
 
     def __init__(self, points, tets, watched, scale):
         self.points, self.scale = points, scale
         self.tets = [tuple(t) for t in tets.tolist()]
         self.alive = [True] * len(self.tets)
-        self.solid = _solid(points, tets).tolist()
-        self.star: dict[int, set[int]] = {int(v): set() for v in watched}
-        flat = tets.ravel()
-        hit = np.flatnonzero(np.isin(flat, watched))
-        for pos in hit.tolist():
-            self.star[int(flat[pos])].add(pos // 4)
+        self.watched = {int(v) for v in watched}
+        #: flat tetrahedra that flips made (`remove_flat` with ``solid_only=False``)
+        self.made_flat: list[int] = []
+        self.rng = np.random.default_rng(0)
+        ends = tets.ravel()
+        self._order = np.argsort(ends, kind="stable")
+        self._start = np.searchsorted(ends[self._order], np.arange(len(points) + 1))
+        self._stars: dict[int, set[int]] = {}
+        self._added: dict[int, set[int]] = {}
 
-    def _add(self, tet, solid):
+    def star(self, v) -> set[int]:
+        """The living tetrahedra at node ``v`` (built on first use)."""
+        s = self._stars.get(v)
+        if s is None:
+            first = self._order[self._start[v]:self._start[v + 1]] // 4
+            s = {k for k in first.tolist() if self.alive[k]} | self._added.get(v, set())
+            self._stars[v] = s
+        return s
+
+    def _add(self, tet):
         k = len(self.tets)
         self.tets.append(tet)
         self.alive.append(True)
-        self.solid.append(solid)
         for v in tet:
-            if v in self.star:
-                self.star[v].add(k)
+            self._added.setdefault(v, set()).add(k)
+            if v in self._stars:
+                self._stars[v].add(k)
 
     def _remove(self, k):
         self.alive[k] = False
         for v in self.tets[k]:
-            if v in self.star:
-                self.star[v].discard(k)
+            self._added.get(v, set()).discard(k)
+            if v in self._stars:
+                self._stars[v].discard(k)
 
     def _faces_at(self, a):
         """Faces (as frozensets) of the tetrahedra at ``a`` that contain ``a``."""
         out = set()
-        for k in self.star.get(a, ()):
+        for k in self.star(a):
             t = self.tets[k]
-            if not self.solid[k]:
+            if not _solid(self.points, np.array([t]))[0]:
                 continue
             rest = [v for v in t if v != a]
             for i in range(3):
@@ -184,7 +202,7 @@ class _TieRecovery:
         face = [int(v) for v in face]
         for i in range(3):
             a, b, d = face[i], face[(i + 1) % 3], face[(i + 2) % 3]
-            if a not in self.star:
+            if a not in self.watched:
                 return False
             at_a = self._faces_at(a)
             if frozenset(face) in at_a:
@@ -192,19 +210,135 @@ class _TieRecovery:
             ends_b = {next(iter(f - {a, b})) for f in at_a if b in f}
             ends_d = {next(iter(f - {a, d})) for f in at_a if d in f}
             for c in sorted(ends_b & ends_d):
-                if c in (b, d) or c not in self.star:
+                if c in (b, d) or c not in self.watched:
                     continue
                 if self._flip(a, c, b, d):
                     return True
         return False
 
-    def _flip(self, a, c, b, d) -> bool:
-        """Replace the tetrahedra around edge ``a-c`` by cones from ``b`` (tie only)."""
+    def remove_flat(self, k, keep, *, push=False) -> bool:
+        """Remove the flat sliver ``k``: flip one side's tetrahedra to the other side's
+        diagonal, or re-cone its whole tie (`_recone_tie`; with ``push`` flat slivers
+        may be left on the tie's border, in `made_flat`, for the next tie to take);
+        no face of ``keep`` (frozensets) is removed. True when done."""
+        if not self.alive[k]:
+            return True
+        quad = self.tets[k]
+        if self._remove_twins(k, keep):
+            return True
+        for a, c, b, d in _diagonals(self.points, quad):
+            side = (frozenset((a, c, b)), frozenset((a, c, d)))
+            if side[0] in keep or side[1] in keep:
+                continue                       # these faces stay: flip the other side
+            others = [set(self.tets[j]) for j in self.star(a) & self.star(c) if j != k]
+            held = [any(f <= t for t in others) for f in side]
+            if not any(held):                  # nothing on this side (the hull): drop it
+                across = [set(self.tets[j]) for j in self.star(b) & self.star(d) if j != k]
+                if not all(any(f <= t for t in across) for f in ({a, b, d}, {c, b, d})):
+                    continue                   # nothing on the other side either
+                self._remove(k)
+                return True
+            if all(held) and self._flip(a, c, b, d, keep=keep, solid_only=True):
+                return True
+        return self._recone_tie(k, keep, push)
+
+    def _recone_tie(self, k, keep, push, max_size=256) -> bool:
+        """Re-cone the whole tie around the flat sliver ``k``: the tetrahedra reached
+        from it across faces not in ``keep`` whose nodes all lie on the circumsphere
+        of one of its solid neighbours (a convex polytope inscribed in it, slivers
+        included) become cones from one of its nodes, the first that makes no flat
+        tetrahedron. True when done."""
+        p, quad = self.points, set(self.tets[k])
+        for f in combinations(sorted(quad), 3):
+            nb = [j for j in set.intersection(*(self.star(v) for v in f)) if j != k]
+            if len(nb) != 1 or not _solid(p, np.array([self.tets[nb[0]]]))[0]:
+                continue
+            x = p[list(self.tets[nb[0]])]
+            m = x[1:] - x[0]
+            centre = x[0] + np.linalg.solve(m, 0.5 * np.einsum("ij,ij->i", m, m))
+            r2 = np.sum((x[0] - centre) ** 2)
+            tol = _TIE * self.scale ** 2
+            tie, todo = {k}, [k]
+            while todo and len(tie) <= max_size:
+                t = self.tets[todo.pop()]
+                for g in combinations(t, 3):
+                    if frozenset(g) in keep:
+                        continue
+                    for j in set.intersection(*(self.star(v) for v in g)) - tie:
+                        if np.abs(np.sum((p[list(self.tets[j])] - centre) ** 2, axis=1)
+                                  - r2).max() <= tol:
+                            tie.add(j)
+                            todo.append(j)
+            if len(tie) > max_size:
+                continue
+            if self._cone(sorted(tie), keep, push):
+                return True
+        return False
+
+    def _cone(self, tie, keep, push) -> bool:
+        """Replace the tetrahedra ``tie`` (a convex polytope) by cones from one of their
+        nodes with no flat tetrahedron (with ``push``, the fewest flat ones, none
+        holding a face of ``keep``); True when one fits."""
+        p = self.points
+        old = np.array([self.tets[j] for j in tie])
+        count: dict[frozenset, int] = {}
+        for t in old.tolist():
+            for f in combinations(t, 3):
+                key = frozenset(f)
+                count[key] = count.get(key, 0) + 1
+        if any(m == 2 and f in keep for f, m in count.items()):
+            return False
+        hull = [sorted(f) for f, m in count.items() if m == 1]
+        v_old = np.abs(signed_volumes(p, old)).sum()
+        fits = []
+        for apex in np.unique(old).tolist():
+            new = np.array([[apex, *f] for f in hull if apex not in f], dtype=np.int64)
+            flat = ~_solid(p, new) if len(new) else np.zeros(0, dtype=bool)
+            if len(new) == 0 or (flat.any() and not push) or \
+                    abs(np.abs(signed_volumes(p, new)).sum() - v_old) > 1e-6 * v_old or \
+                    any(frozenset(f) in keep for t in new[flat].tolist() for f in combinations(t, 3)):
+                continue
+            fits.append((new, flat))
+            if not flat.any():
+                break
+        if not fits:
+            return False
+        # pushed slivers walk at random (seeded) among the ties, so that they do not
+        # go back and forth between two of them
+        new, flat = fits[-1] if not fits[-1][1].any() else fits[self.rng.integers(len(fits))]
+        self._replace(tie, new, flat)
+        return True
+
+    def _remove_twins(self, k, keep) -> bool:
+        """Remove ``k`` and a second flat sliver of the same four nodes when the two are
+        glued to each other and their other faces to the same triangles on both
+        sides (so both sides already share one diagonal)."""
+        quad = set(self.tets[k])
+        near = set.intersection(*(self.star(v) for v in quad)) - {k}
+        twins = [j for j in near if set(self.tets[j]) == quad]
+        if len(twins) != 1:
+            return False
+        rest = near - set(twins)
+        for f in combinations(sorted(quad), 3):
+            held = sum(set(f) <= set(self.tets[j]) for j in rest)
+            if held == 1 or (held == 0 and frozenset(f) in keep):
+                return False
+        self._remove(k)
+        self._remove(twins[0])
+        return True
+
+    def _flip(self, a, c, b, d, *, keep=frozenset(), solid_only=False) -> bool:
+        """Replace the tetrahedra around edge ``a-c`` by cones from ``b`` (tie only);
+        refused when it would remove a face of ``keep`` or, with ``solid_only``,
+        make a flat tetrahedron."""
         p = self.points
         s = self.scale
         if abs(np.dot(p[c] - p[a], np.cross(p[b] - p[a], p[d] - p[a]))) > _TIE * s ** 3:
             return False                       # a, b, c, d not coplanar: no tie
-        ring = sorted(self.star[a] & self.star[c])
+        ring = sorted(self.star(a) & self.star(c))
+        if keep and any(frozenset(f) in keep for k in ring
+                        for f in combinations(self.tets[k], 3) if {a, c} <= set(f)):
+            return False
         # a flat sliver of the four nodes themselves holds both diagonals: it goes
         quad = [k for k in ring if set(self.tets[k]) == {a, b, c, d}]
         solid = [k for k in ring if k not in quad]
@@ -226,15 +360,25 @@ class _TieRecovery:
             new = np.array([[apex, *sorted(f)] for f in caps], dtype=np.int64).reshape(-1, 4)
             v_new = np.abs(signed_volumes(p, new)).sum()
             # an overlap would differ by a tetrahedron
+            flat = ~_solid(p, new)
+            if solid_only and flat.any() or any(frozenset(f) in keep for t in new[flat].tolist()
+                                                for f in combinations(t, 3)):
+                continue                       # a flat sliver would hold a face that stays
             if len(new) and abs(v_new - v_old) <= 1e-6 * v_old and _empty_spheres(p, new, verts, s):
                 break
         else:
             return False
-        for k in ring:
-            self._remove(k)
-        for t, solid in zip(new.tolist(), _solid(p, new).tolist()):
-            self._add(tuple(t), solid)
+        self._replace(ring, new, flat)
         return True
+
+    def _replace(self, old, new, flat):
+        """Remove the tetrahedra ``old`` and add ``new``; the ``flat`` ones are noted."""
+        for k in old:
+            self._remove(k)
+        for t, f in zip(new.tolist(), flat.tolist()):
+            if f:
+                self.made_flat.append(len(self.tets))
+            self._add(tuple(t))
 
     def result(self):
         return np.array([t for t, ok in zip(self.tets, self.alive) if ok], dtype=np.int64)
@@ -255,6 +399,44 @@ def _empty_spheres(points, tets, verts, scale):
         if (d2 < r2 - _TIE * scale * scale).any():
             return False
     return True
+
+
+def _diagonals(points, quad):
+    """The two diagonals of the convex quadrilateral of four coplanar nodes ``quad``,
+    as ``[(a, c, b, d), (b, d, a, c)]`` (``a-c`` and ``b-d`` cross); [] when the four
+    are not in convex position."""
+    x = points[list(quad)]
+    normal = max((np.cross(x[i] - x[0], x[j] - x[0]) for i, j in ((1, 2), (1, 3), (2, 3))),
+                 key=lambda v: v @ v)
+    for i, j, k, m in ((0, 1, 2, 3), (0, 2, 1, 3), (0, 3, 1, 2)):
+        # i-j and k-m cross when each separates the other's ends
+        s_km = [np.dot(np.cross(x[j] - x[i], x[e] - x[i]), normal) for e in (k, m)]
+        s_ij = [np.dot(np.cross(x[m] - x[k], x[e] - x[k]), normal) for e in (i, j)]
+        if s_km[0] * s_km[1] < 0 and s_ij[0] * s_ij[1] < 0:
+            a, c, b, d = (quad[e] for e in (i, j, k, m))
+            return [(a, c, b, d), (b, d, a, c)]
+    return []
+
+
+def _remove_flats(points, tets, faces, scale):
+    """Tetrahedra ``(t', 4)`` without the flat slivers that flips can remove (see the
+    module's step 4); the boundary ``faces`` all stay. A few rounds, for slivers that
+    wait on their neighbours."""
+    flat = np.flatnonzero(~_solid(points, tets))
+    if len(flat) == 0:
+        return tets
+    fixer = _TieRecovery(points, tets, np.unique(tets[flat]), scale)
+    keep = {frozenset(f) for f in faces.tolist()}
+    todo = flat.tolist()
+    for _ in range(16):
+        todo = [k for k in todo if not fixer.remove_flat(k, keep)]
+        if not todo:
+            break
+        # stuck: push the slivers to their ties' borders, where the next ties may take them
+        todo = [k for k in todo if not fixer.remove_flat(k, keep, push=True)]
+        todo = [k for k in todo + fixer.made_flat if fixer.alive[k]]
+        fixer.made_flat.clear()
+    return fixer.result()
 
 
 def _split(points, faces, face_regions, missing):
@@ -406,8 +588,7 @@ def _flat_regions(region, flat, i0, i1):
     return region
 
 
-def conforming_tetrahedra(points: ArrayLike, boundary_faces: ArrayLike,
-                          boundary_face_regions: ArrayLike, *,
+def conforming_tetrahedra(points, boundary_faces, boundary_face_regions, *,
                           max_rounds: int = 8) -> Tetrahedrisation:
     """Delaunay tetrahedrisation of ``points`` that contains every boundary face.
 
@@ -440,11 +621,16 @@ def conforming_tetrahedra(points: ArrayLike, boundary_faces: ArrayLike,
     for _ in range(max_rounds):
         tets = _delaunay(points, centre, scale)
         missing = _missing_faces(points, tets, faces)
-        if len(missing):
-            fixer = _TieRecovery(points, tets, np.unique(faces[missing]), scale)
-            still = [f for f in missing.tolist() if not fixer.recover(faces[f])]
-            tets = fixer.result()
-            missing = _missing_faces(points, tets, faces) if still else still
+        for _ in range(3):            # each pass may leave a face held by a sliver only
+            if len(missing):
+                fixer = _TieRecovery(points, tets, np.unique(faces[missing]), scale)
+                for f in missing.tolist():
+                    fixer.recover(faces[f])
+                tets = fixer.result()
+            tets = _remove_flats(points, tets, faces, scale)
+            missing = _missing_faces(points, tets, faces)
+            if len(missing) == 0:
+                break
         if len(missing) == 0:
             break
         points, faces, face_regions = _split(points, faces, face_regions, np.asarray(missing))
