@@ -28,6 +28,7 @@ from dataclasses import dataclass
 from itertools import combinations
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay
@@ -588,7 +589,8 @@ def _flat_regions(region, flat, i0, i1):
     return region
 
 
-def conforming_tetrahedra(points, boundary_faces, boundary_face_regions, *,
+def conforming_tetrahedra(points: ArrayLike, boundary_faces: ArrayLike,
+                          boundary_face_regions: ArrayLike, *,
                           max_rounds: int = 8) -> Tetrahedrisation:
     """Delaunay tetrahedrisation of ``points`` that contains every boundary face.
 
