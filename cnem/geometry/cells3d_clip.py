@@ -229,7 +229,18 @@ def _distinct_planes(fx, fn, offset, reach):
 
 def _shadows(origin, fx, fn, offset, fid, who, corners):
     """The shadows (lists of planes) that the faces cast seen from ``origin`` and that
-    reach some of ``corners`` (the vertices of the pieces they could cut)."""
+    reach some of ``corners`` (the vertices of the pieces they could cut).
+
+    A face hides a point only if it crosses the segment from ``origin`` to it, inside the
+    convex hull of ``origin`` and ``corners``: faces clear of a ball around that hull are
+    dropped first."""
+    hull = np.vstack([corners, origin])
+    centre = 0.5 * (hull.min(axis=0) + hull.max(axis=0))
+    ball = np.linalg.norm(hull - centre, axis=1).max()
+    face_c = fx.mean(axis=1)
+    face_r = np.linalg.norm(fx - face_c[:, None], axis=2).max(axis=1)
+    keep = np.linalg.norm(face_c - centre, axis=1) <= ball + face_r + _ON
+    fx, fn, offset, fid = fx[keep], fn[keep], offset[keep], fid[keep]
     side = fn @ origin - offset
     a = fx - origin                                     # (f, 3, 3) from the origin
     b = a[:, [1, 2, 0]]

@@ -157,6 +157,9 @@ class Polytope:
 def cut(piece: Polytope, planes: list) -> tuple[Polytope | None, list]:
     """The part of ``piece`` inside every plane (None if empty) and the disjoint convex
     pieces of the rest."""
+    for pl in planes:                           # wholly outside one plane: untouched, unsplit
+        if (piece.vertices @ pl.normal).min() >= pl.offset - _ON:
+            return None, [piece]
     outside = []
     inner = piece
     for pl in planes:
