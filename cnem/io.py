@@ -59,6 +59,10 @@ SUFFIXES = {".vtu": "vtu"}
 RESERVED = ("region", "node", "area", "cell")
 
 
+#: Suffixes of geometry files, which `cnem.Domain.from_file` / `cnem.Domain3D.from_file` read.
+GEOMETRY_SUFFIXES = (".msh", ".dxf", ".geojson", ".json", ".wkt", ".stl", ".obj", ".ply")
+
+
 def _format(path):
     path = pathlib.Path(path)
     suffix = path.suffix.lower()
@@ -73,6 +77,11 @@ def _format(path):
         raise FormatError(f"cannot use {path.name!r}: meshio's XDMF writer has no polygon "
                           f"topology for the integration cells; supported suffixes: "
                           f"{supported} (open .vtu files in ParaView)")
+    if suffix in GEOMETRY_SUFFIXES:
+        raise FormatError(f"cannot use {path.name!r}: cnem.io reads and writes models and "
+                          f"results (supported suffixes: {supported}); read a geometry file with "
+                          f"cnem.Domain.from_file({str(path)!r}) (2-D) or "
+                          f"cnem.Domain3D.from_file (3-D surfaces)")
     raise FormatError(f"unknown file suffix {suffix or '(none)'!r} in {str(path)!r}; "
                       f"supported suffixes: {supported}")
 

@@ -88,3 +88,16 @@ def test_patch_test_with_tractions(box_model, stabilization, request):
     np.testing.assert_allclose(sol.u, model.nodes @ A.T + B, atol=1e-12)
     np.testing.assert_allclose(sol.stress, np.broadcast_to(sv, sol.stress.shape),
                                atol=1e-10 * np.abs(sv).max())
+
+
+def test_boundary_nodes_of_a_3d_model(box_model):
+    """The outer surface's nodes, by coordinates; a predicate picks among them; names are
+    refused until 3-D bodies have them."""
+    nodes = box_model.nodes
+    lo, hi = np.zeros(3), np.array([1.0, 0.8, 0.6])
+    on = np.flatnonzero(np.any(np.isclose(nodes, lo) | np.isclose(nodes, hi), axis=1))
+    np.testing.assert_array_equal(box_model.boundary_nodes(), on)
+    np.testing.assert_array_equal(box_model.boundary_nodes(lambda p: p[:, 2] > 0.5),
+                                  on[nodes[on, 2] > 0.5])
+    with pytest.raises(cnem.ConditionError, match="no named boundaries"):
+        box_model.boundary_nodes("top")

@@ -80,6 +80,12 @@ def test_bad_suffix_names_supported_ones(suffix, tmp_path):
         cnem.io.read(tmp_path / f"cells{suffix}")
 
 
+@pytest.mark.parametrize("suffix", [".dxf", ".msh", ".geojson", ".stl"])
+def test_a_geometry_file_is_sent_to_domain_from_file(suffix, tmp_path):
+    with pytest.raises(cnem.io.FormatError, match=r"Domain\.from_file"):
+        cnem.io.read(tmp_path / f"bracket{suffix}")
+
+
 def test_wrong_lengths_and_reserved_names(tmp_path):
     _, _, m = model("graded_inclined_crack")
     with pytest.raises(cnem.io.FormatError, match=f"{len(m.nodes)} rows"):

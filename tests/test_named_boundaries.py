@@ -188,3 +188,15 @@ def test_file_names_pick_the_same_nodes_moved_and_scaled(tmp_path, suffix):
         picked.append(names)
     for name in picked[0]:
         assert np.array_equal(picked[0][name], picked[1][name]), name
+
+
+def test_get_dofs_takes_the_whole_boundary_or_a_name():
+    """`CellBasis.get_dofs()` with no predicate means the whole boundary (what a
+    scikit-fem user expects), and a boundary name means that boundary's nodes."""
+    dom = cnem.geometry.rectangle(1.0, 1.0)
+    model = cnem.discretize(cnem.nodes.regular(dom, 0.25))
+    basis = cnem.assembly.CellBasis(model)
+    x, y = model.nodes.T
+    edge = (np.isclose(x, 0) | np.isclose(x, 1) | np.isclose(y, 0) | np.isclose(y, 1))
+    np.testing.assert_array_equal(basis.get_dofs(), np.flatnonzero(edge))
+    np.testing.assert_array_equal(basis.get_dofs("left"), np.flatnonzero(np.isclose(x, 0)))

@@ -230,13 +230,15 @@ class CellBasis:
                              f"pass one value per dof of this basis")
         return self._field(np.array([op @ u for op in self.operators]))
 
-    def get_dofs(self, where: Callable[..., np.ndarray] | ArrayLike,
+    def get_dofs(self, where: str | Callable[..., np.ndarray] | ArrayLike | None = None,
                  component: Literal[0, 1, 2] | None = None) -> np.ndarray:
         """Dofs of the nodes selected by ``where``.
 
         Parameters
         ----------
-        where : callable ``(p, dim) -> (p,) bool``, or a boolean mask or index array over nodes
+        where : None, str, callable ``(p, dim) -> (p,) bool``, or a boolean mask or index
+            array over nodes. None: every node of the boundary; a str: the nodes on that
+            named boundary (`Model.boundary_nodes`).
         component : {None, 0, 1} (2 too in 3-D)
             For a vector basis: one component, or all.
 
@@ -244,7 +246,10 @@ class CellBasis:
         -------
         (k,) int64 ndarray
         """
-        nodes = select_nodes(self.model.nodes, where)
+        if where is None or isinstance(where, str):
+            nodes = self.model.boundary_nodes(where)
+        else:
+            nodes = select_nodes(self.model.nodes, where)
         if not self.vector:
             if component not in (None, 0):
                 raise ConditionError(f"component: a scalar basis has component 0 only, "

@@ -12,12 +12,13 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
 from .._predicates import Frame
-from ..errors import ConditionError, GeometryError, InputError
+from ..errors import GeometryError, InputError
 from ._kernels import polygon_moments
 from .cells import voronoi_cells
 from .cloud import NodeCloud
 from .cracks import split_cracks
 from .pslg import SegmentKind
+from .selection import boundary_subset
 from ..shape import shape_functions
 from ..spatial.rtree import RTree
 from .topology import (circumcenters, cut_between_regions, triangle_neighbors,
@@ -231,18 +232,7 @@ class Model:
         if isinstance(name_or_predicate, str):
             return np.flatnonzero(self.domain.on_boundary(self.nodes, name_or_predicate))
         on = np.unique(self.segments[self.segment_kind == SegmentKind.BOUNDARY])
-        if name_or_predicate is None:
-            return on
-        if not callable(name_or_predicate):
-            raise ConditionError(f"name_or_predicate: expected None, a boundary name or a "
-                                 f"predicate (p, 2) -> (p,) bool, received "
-                                 f"{type(name_or_predicate).__name__}")
-        mask = np.asarray(name_or_predicate(self.nodes[on]))
-        if mask.shape != on.shape or mask.dtype != bool:
-            raise ConditionError(f"name_or_predicate: expected a predicate returning a "
-                                 f"({len(on)},) bool array for the {len(on)} boundary nodes, "
-                                 f"received dtype {mask.dtype} shape {mask.shape}")
-        return on[mask]
+        return boundary_subset(self.nodes, on, name_or_predicate)
 
     def node_sides(self) -> np.ndarray:
         """A point on the side of each node: the area-weighted centroid of its cells

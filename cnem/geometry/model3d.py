@@ -15,7 +15,7 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Callable, Literal
 
 import numpy as np
 import scipy.sparse as sp
@@ -24,8 +24,10 @@ from numpy.typing import ArrayLike
 from ..shape.natural import ShapeGradients
 from ..shape.natural3d import TetMesh, shape_functions_3d, tet_mesh
 from .cells3d import Cells3D, constrained_voronoi_cells
+from ..errors import ConditionError
 from .cloud import NodeCloud
 from .domain3d import Domain3D
+from .selection import boundary_subset
 from .tetrahedra import conforming_tetrahedra
 
 __all__ = ["Model3D", "discretize_3d"]
@@ -126,6 +128,31 @@ class Model3D:
         corners = self.domain.to_local(self.nodes[faces].reshape(-1, 3)).reshape(-1, 3, 3)
         nrm = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
         return faces, nrm / np.linalg.norm(nrm, axis=1)[:, None]
+
+    def boundary_nodes(self, name_or_predicate: Callable | None = None) -> np.ndarray:
+        """Indices of the nodes on the body's outer surface (cavities included,
+        interfaces not), or of those where a predicate holds.
+
+        Parameters
+        ----------
+        name_or_predicate : None or callable ``(p, 3) -> (p,) bool``
+            3-D bodies have no named boundaries yet.
+
+        Returns
+        -------
+        (k,) int64 ndarray
+            Sorted.
+
+        Raises
+        ------
+        ConditionError
+            A name, or a predicate that does not return one bool per point.
+        """
+        if isinstance(name_or_predicate, str):
+            raise ConditionError(f"{name_or_predicate!r}: a 3-D body has no named boundaries "
+                                 "yet; select the nodes with a predicate (p, 3) -> (p,) bool")
+        faces, _ = self.boundary_with_normals()
+        return boundary_subset(self.nodes, np.unique(faces), name_or_predicate)
 
     def __repr__(self):
         added = int(np.count_nonzero(self.node_of_point < 0))
