@@ -284,7 +284,8 @@ def _edge_keys(cell, p, q):
     return np.ascontiguousarray(rows).view(np.dtype((np.void, rows.dtype.itemsize * 7))).ravel()
 
 
-def cell_gradient_3d(model: Any, cells: Any) -> SmoothedGradient:
+def cell_gradient_3d(model: Any, cells: Any,
+                     interface: InterfacePieces | None = None) -> SmoothedGradient:
     """``B~`` of a 3-D model's cells (`facet_gradient` on their facet triangles, the
     model's shape functions).
 
@@ -293,23 +294,29 @@ def cell_gradient_3d(model: Any, cells: Any) -> SmoothedGradient:
     model : Model3D
     cells : Cells3D
         ``model.cells`` or other cells of the model with facets.
+    interface : InterfacePieces, optional
+        `model_interface_pieces` of these cells, when already known.
 
     Returns
     -------
     SmoothedGradient
     """
+    if interface is None:
+        interface = model_interface_pieces(model, cells)
     return facet_gradient(cells.facet_triangles, cells.facet_cell, cells.facet_normal,
-                          cells.volume, model.shape_functions,
-                          interface=model_interface_pieces(model, cells))
+                          cells.volume, model.shape_functions, interface=interface)
 
 
-def sub_cell_gradient_3d(model: Any) -> tuple[Any, SmoothedGradient]:
+def sub_cell_gradient_3d(model: Any, interface: InterfacePieces | None = None
+                         ) -> tuple[Any, SmoothedGradient]:
     """The pyramid sub-cells of a 3-D model's cells and their ``B~``, from the cells'
     facet points and one point on each spoke.
 
     Parameters
     ----------
     model : Model3D
+    interface : InterfacePieces, optional
+        `model_interface_pieces` of ``model.cells``, when already known.
 
     Returns
     -------
@@ -323,9 +330,10 @@ def sub_cell_gradient_3d(model: Any) -> tuple[Any, SmoothedGradient]:
     sub = type(cells)(cells.node[parent], cells.region[parent], volume, cells.facet_triangles,
                       triangle_sub, cells.facet_normal, apex=model.nodes[cells.node[parent]])
     # the sub-cells' triangles are the cells': the interface pieces go to their sub-cells
+    if interface is None:
+        interface = model_interface_pieces(model, cells)
     grad = facet_gradient(sub.facet_triangles, sub.facet_cell, sub.facet_normal, volume,
-                          model.shape_functions, spokes=spokes,
-                          interface=model_interface_pieces(model, cells))
+                          model.shape_functions, spokes=spokes, interface=interface)
     return sub, grad
 
 
@@ -348,7 +356,8 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
                             model.nodes[model.boundary_faces[between]], size)
 
 
-def boundary_points_3d(model: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def boundary_points_3d(model: Any, interface: InterfacePieces | None = None
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The facet points of a 3-D model's cells that lie on its outer boundary, with the
     boundary face each lies on: where tractions are integrated, so that a load
     ``sum_q phi_I(x_q) t_q A_q`` takes the very points of the cells' boundary
@@ -361,6 +370,8 @@ def boundary_points_3d(model: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     Parameters
     ----------
     model : Model3D
+    interface : InterfacePieces, optional
+        `model_interface_pieces` of ``model.cells``, when already known.
 
     Returns
     -------
@@ -379,7 +390,9 @@ def boundary_points_3d(model: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     opposite = np.einsum("ij,ij->i", area_normal[pairs[:, 0]], area_normal[pairs[:, 1]]) < 0
     shared = np.zeros(len(point), dtype=bool)
     shared[pairs[opposite].ravel()] = True
-    shared[group[model_interface_pieces(model, cells).on_interface]] = True
+    if interface is None:
+        interface = model_interface_pieces(model, cells)
+    shared[group[interface.on_interface]] = True
     outer = np.flatnonzero(~shared)
     faces, normal = model.boundary_with_normals()
     corners = model.nodes[faces]

@@ -11,13 +11,14 @@ import numpy as np
 from .._aliases import renamed_attributes
 from ..errors import GeometryError
 from .edge_quadrature import boundary_quadratures, check_gauss
-from .facet_gradients import cell_gradient_3d, sub_cell_gradient_3d
+from .facet_gradients import cell_gradient_3d, model_interface_pieces, sub_cell_gradient_3d
 from .fan_quadrature import fan_quadratures
 from .passes import cell_runs, gradients_in_passes
 from .smoothed_gradient import SmoothedGradient
 from .subdivision import subdivide, tip_cells
 
 if TYPE_CHECKING:
+    from .interface_facets import InterfacePieces
     from ..geometry.model import Cells, Model
 
 __all__ = ["SmoothedGradient", "GradientCache", "smoothed_gradient", "fan_gradient"]
@@ -81,12 +82,15 @@ def fan_gradient(model: Model, *, gauss: int = 2) -> tuple[Cells, SmoothedGradie
     return sub, grad
 
 
-def _fan_gradients(model, gauss, with_cells):
+def _fan_gradients(model, gauss, with_cells, interface=None):
     """``(cells' B~ or None, fan sub-cells, their B~)``, the two from one set of
-    points in the same passes (the sub-cells go with their cells' runs)."""
+    points in the same passes (the sub-cells go with their cells' runs); in 3-D from
+    one set of interface pieces (``interface``, else computed here)."""
     if model.nodes.shape[1] == 3:
-        sub, grad = sub_cell_gradient_3d(model)
-        return (smoothed_gradient(model, gauss=gauss) if with_cells else None), sub, grad
+        if interface is None:
+            interface = model_interface_pieces(model, model.cells)
+        sub, grad = sub_cell_gradient_3d(model, interface)
+        return (cell_gradient_3d(model, model.cells, interface) if with_cells else None), sub, grad
     cells = model.cells
     sub, parent = subdivide(cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
     runs = cell_runs(model, cells)
@@ -147,11 +151,22 @@ class GradientCache:
                                 f"received shape {cells.shape}")
         self._cells = cells
         self._fan = None
+        self._interface = None
+
+    def interface(self) -> InterfacePieces:
+        """The pieces on which a 3-D model's cells integrate their material interfaces
+        (`cnem.assembly.facet_gradients.model_interface_pieces`): computed once for the
+        cells' and sub-cells' ``B~`` and the traction points."""
+        if self._interface is None:
+            self._interface = model_interface_pieces(self.model, self.model.cells)
+        return self._interface
 
     def cells(self) -> SmoothedGradient:
         """``B~`` of ``model.cells``, ``(m, n)`` (computed on first call, then kept)."""
         if self._cells is None:
-            self._cells = smoothed_gradient(self.model, gauss=self.gauss)
+            self._cells = (cell_gradient_3d(self.model, self.model.cells, self.interface())
+                           if self.model.nodes.shape[1] == 3
+                           else smoothed_gradient(self.model, gauss=self.gauss))
         return self._cells
 
     def of(self, cells: Cells) -> SmoothedGradient:
@@ -180,8 +195,10 @@ class GradientCache:
             As `fan_gradient` returns them.
         """
         if self._fan is None:
+            interface = self.interface() if self.model.nodes.shape[1] == 3 else None
             of_cells, sub, grad = _fan_gradients(self.model, self.gauss,
-                                                 with_cells=self._cells is None)
+                                                 with_cells=self._cells is None,
+                                                 interface=interface)
             if of_cells is not None:
                 self._cells = of_cells
             self._fan = sub, grad

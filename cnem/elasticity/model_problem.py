@@ -146,7 +146,7 @@ class ModelProblem(Conditions):
         (n, 3) ndarray
         """
         if self._boundary_points is None:
-            self._boundary_points = boundary_points_3d(self.model)
+            self._boundary_points = boundary_points_3d(self.model, self.gradients.interface())
         points, area_normal, face = self._boundary_points
         take = np.isin(face, faces)
         area = np.linalg.norm(area_normal[take], axis=1)
