@@ -276,3 +276,9 @@ SIF_SPACINGS = 3.0
 #: The largest side of a picture in pixels that `cnem.plot` accepts (larger windows make
 #: VTK allocate more than any machine has and abort the interpreter).
 PLOT_MAX_PIXELS = 16384
+
+# ---------------------------------------------------------------- files
+#: A solution's displacement at a cell vertex, written for ParaView, is interpolated at
+#: the point this fraction of the way from the vertex to the cell's node: inside the
+#: cell, so that a vertex on a crack face or the boundary takes the cell's side.
+VERTEX_NUDGE = 1e-6

@@ -47,8 +47,9 @@ from .geometry.model import Cells
 
 if TYPE_CHECKING:
     from .geometry.model import Model
+    from .geometry.model3d import Model3D
 
-__all__ = ["write", "write_nodes", "write_points", "read", "CellMesh", "FormatError", "SUFFIXES"]
+__all__ = ["write", "cell_points", "write_nodes", "write_points", "read", "CellMesh", "FormatError", "SUFFIXES"]
 
 log = logging.getLogger(__name__)
 
@@ -110,6 +111,64 @@ def cell_topology(cells):
     return points, np.asarray(cells.offsets, np.int64), connectivity.reshape(-1).astype(np.int64)
 
 
+def cell_points(model: Model | Model3D) -> tuple[np.ndarray, np.ndarray]:
+    """The points `write` stores after the nodes, and a cell each of them bounds.
+
+    Parameters
+    ----------
+    model : Model or Model3D
+        ``m`` integration cells.
+
+    Returns
+    -------
+    points : (q, d) float64 ndarray
+        The distinct vertices of the cells (2-D polygons; 3-D facet triangles).
+        Point ``n + j`` of the file is ``points[j]``.
+    cell : (q,) int64 ndarray
+        Index in ``model.cells`` of one cell with vertex ``j`` (the lowest).
+    """
+    if _polyhedral(model.cells):
+        points, triangles = _polyhedron_topology(model.cells)
+        corner_cell = np.repeat(np.asarray(model.cells.facet_cell, np.int64), 3)
+        corners = triangles.reshape(-1)
+    else:
+        points, offsets, corners = cell_topology(model.cells)
+        corner_cell = np.repeat(np.arange(len(offsets) - 1, dtype=np.int64), np.diff(offsets))
+    cell = np.full(len(points), len(model.cells), dtype=np.int64)
+    np.minimum.at(cell, corners, corner_cell)
+    return points, cell
+
+
+def _polyhedral(cells):
+    """Whether ``cells`` are 3-D cells bounded by facet triangles (`cnem.geometry.Cells3D`)."""
+    return hasattr(cells, "facet_triangles")
+
+
+def _polyhedron_topology(cells):
+    """Distinct vertices ``(q, 3)`` of the 3-D cells' facet triangles and the
+    triangles as indices into them ``(t, 3)`` (bit-for-bit equal vertices merged)."""
+    corners = np.ascontiguousarray(cells.facet_triangles, dtype=np.float64).reshape(-1, 3)
+    points, index = np.unique(corners, axis=0, return_inverse=True)
+    return points, index.reshape(-1, 3).astype(np.int64)
+
+
+def _polyhedron_blocks(cells, triangles, shift):
+    """meshio ``polyhedron<k>`` blocks (faces of each cell; ``k`` its vertex count, in
+    increasing order, which meshio's reader needs to keep the cell data in step) and the
+    cell order they use."""
+    m = len(cells.node)
+    order = np.argsort(cells.facet_cell, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(np.bincount(cells.facet_cell, minlength=m))])
+    faces = [triangles[order[starts[c]:starts[c + 1]]] + shift for c in range(m)]
+    sizes = np.array([len(np.unique(f)) for f in faces], dtype=np.int64)
+    blocks, ids = [], []
+    for size in np.unique(sizes):
+        members = np.flatnonzero(sizes == size)
+        blocks.append(meshio.CellBlock(f"polyhedron{size}", [list(faces[c]) for c in members]))
+        ids.append(members)
+    return blocks, ids
+
+
 def _blocks(offsets, connectivity, shift):
     """meshio ``polygon`` blocks (one per vertex count) and the cell order they use."""
     sizes = np.diff(offsets)
@@ -139,23 +198,31 @@ def _checked(value, count, name):
     return arr, fill
 
 
-def write(model: Model, path: str | os.PathLike, *, point_data: Mapping[str, ArrayLike] | None = None,
+def write(model: Model | Model3D, path: str | os.PathLike, *,
+          point_data: Mapping[str, ArrayLike] | None = None,
           cell_data: Mapping[str, ArrayLike] | None = None) -> pathlib.Path:
     """Write the nodes and integration cells of a model to a ``.vtu`` file.
 
+    A 2-D model's cells are ``polygon`` cells after one ``vertex`` cell per node;
+    a 3-D model's cells are ``polyhedron`` cells (VTK polyhedra whose faces are the
+    cells' facet triangles; ParaView and pyvista clip, slice and measure them), with
+    no vertex cells (meshio cannot mix them with polyhedra) and a cell-data
+    ``volume`` instead of ``area``.
+
     Parameters
     ----------
-    model : Model
+    model : Model or Model3D
         From `cnem.discretize`: ``n`` nodes, ``m`` integration cells.
     path : str or os.PathLike
         Suffix ``.vtu``.
-    point_data : dict of str -> (n,) or (n, c) array_like, optional
-        Values at the nodes (displacements, say). The cell vertices that are
-        not nodes get NaN (``-1`` for integer arrays).
+    point_data : dict of str -> (n,) or (n, c), or (n + q,) or (n + q, c) array_like, optional
+        Values at the nodes (displacements, say), or at every point of the file
+        (the nodes, then the ``q`` cell vertices of `cell_points`). With ``n`` rows
+        the cell vertices get NaN (``-1`` for integer arrays).
     cell_data : dict of str -> (m,) or (m, c) array_like, optional
         Values on the integration cells (stresses, say); the node vertex
-        cells get NaN (``-1``). The names ``region``, ``node``, ``area`` and
-        ``cell`` are reserved.
+        cells get NaN (``-1``). The names ``region``, ``node``, ``area``
+        (``volume``) and ``cell`` are reserved.
 
     Returns
     -------
@@ -170,28 +237,36 @@ def write(model: Model, path: str | os.PathLike, *, point_data: Mapping[str, Arr
     path, fmt = _format(path)
     cells, nodes = model.cells, np.asarray(model.nodes, np.float64)
     n, m = len(nodes), len(cells)
-    vpoints, offsets, connectivity = cell_topology(cells)
+    if _polyhedral(model.cells):
+        vpoints, triangles = _polyhedron_topology(cells)
+        blocks, ids = _polyhedron_blocks(cells, triangles, n)
+        head, measure = [], ("volume", np.asarray(cells.volume, np.float64))
+    else:
+        vpoints, offsets, connectivity = cell_topology(cells)
+        blocks, ids = _blocks(offsets, connectivity, n)
+        head = [meshio.CellBlock("vertex", np.arange(n, dtype=np.int64)[:, None])]
+        measure = ("area", np.asarray(cells.area, np.float64))
     points = np.zeros((n + len(vpoints), 3))
     points[:n, :nodes.shape[1]] = nodes
     points[n:, :vpoints.shape[1]] = vpoints
-    blocks, ids = _blocks(offsets, connectivity, n)
-    all_ids = [np.full(n, -1, dtype=np.int64)] + ids
 
-    def per_block(values, fill):
+    def per_block(values, fill, nodes_value=None):
         """Split ``values`` (m rows) over the blocks; the vertex block gets ``fill``."""
-        head = np.full((n,) + values.shape[1:], fill, dtype=values.dtype)
-        return [head] + [values[i] for i in ids]
+        first = [] if not head else [
+            np.full((n,) + values.shape[1:], fill, dtype=values.dtype) if nodes_value is None
+            else nodes_value]
+        return first + [values[i] for i in ids]
 
     cdata = {
         "region": per_block(np.asarray(cells.region, np.int64), -1),
-        "node": [np.arange(n, dtype=np.int64)] + [np.asarray(cells.node, np.int64)[i] for i in ids],
-        "area": per_block(np.asarray(cells.area, np.float64), np.nan),
-        "cell": all_ids,
+        "node": per_block(np.asarray(cells.node, np.int64), -1, np.arange(n, dtype=np.int64)),
+        measure[0]: per_block(measure[1], np.nan),
+        "cell": per_block(np.arange(m, dtype=np.int64), -1),
     }
     for name, value in (cell_data or {}).items():
-        if name in RESERVED:
+        if name in RESERVED + (measure[0],):
             raise FormatError(f"cell_data name {name!r} is reserved by cnem.io "
-                              f"({', '.join(RESERVED)}); rename it")
+                              f"({', '.join(cdata)}); rename it")
         arr, fill = _checked(value, m, f"cell_data[{name!r}]")
         cdata[name] = per_block(arr, fill)
 
@@ -200,15 +275,15 @@ def write(model: Model, path: str | os.PathLike, *, point_data: Mapping[str, Arr
     for name, value in (point_data or {}).items():
         if name == "node_of_point":
             raise FormatError("point_data name 'node_of_point' is reserved by cnem.io; rename it")
-        arr, fill = _checked(value, n, f"point_data[{name!r}]")
+        rows = len(points) if np.ndim(value) and len(value) == len(points) else n
+        arr, fill = _checked(value, rows, f"point_data[{name!r}]")
         full = np.full((len(points),) + arr.shape[1:], fill, dtype=arr.dtype)
-        full[:n] = arr
+        full[:rows] = arr
         pdata[name] = full
 
-    vertex = meshio.CellBlock("vertex", np.arange(n, dtype=np.int64)[:, None])
-    mesh = meshio.Mesh(points, [vertex] + blocks, point_data=pdata, cell_data=cdata)
+    mesh = meshio.Mesh(points, head + blocks, point_data=pdata, cell_data=cdata)
     meshio.write(path, mesh, file_format=fmt, binary=True)
-    log.info("cnem.io.write: %d nodes, %d cells, %d polygon sizes -> %s", n, m, len(blocks), path)
+    log.info("cnem.io.write: %d nodes, %d cells, %d cell sizes -> %s", n, m, len(blocks), path)
     return path
 
 
@@ -393,6 +468,10 @@ def read(path: str | os.PathLike) -> CellMesh:
     """
     path, fmt = _format(path)
     mesh = _meshio_read(path, fmt)
+    if any(block.type.startswith("polyhedron") for block in mesh.cells):
+        raise FormatError(f"{str(path)!r} holds the polyhedra of a 3-D model; cnem.io.read "
+                          f"reads the polygon cells of 2-D models only: open it with "
+                          f"meshio.read or pyvista.read")
     missing = [k for k in RESERVED if k not in mesh.cell_data]
     if missing:
         raise FormatError(f"{str(path)!r} lacks the cell data {missing} that cnem.io.write "

@@ -8,7 +8,9 @@ from typing import Any, Callable, Literal
 import numpy as np
 
 from ..assembly.quadrature import cell_quadrature
-from ..solvers.solution import Solution, energy_error_density, engineering_strain, von_mises
+from .. import config
+from ..solvers.solution import (Solution, energy_error_density, engineering_strain, vector3,
+                                von_mises)
 from ..errors import GeometryError, check_choice, check_points
 
 __all__ = ["CellSolution", "ElasticSolution", "von_mises", "energy_error_density"]
@@ -50,8 +52,16 @@ class CellSolution(Solution):
 
     def write_fields(self, path: str, point_data: dict[str, np.ndarray],
                      cell_data: dict[str, np.ndarray]) -> None:
-        """Nodes and integration cells with the fields (`cnem.io.write`)."""
+        """Nodes and integration cells with the fields (`cnem.io.write`); the
+        ``displacement`` also at the cells' vertices (interpolated just inside each
+        vertex's cell, `cnem.config.VERTEX_NUDGE`), so that the cells warp with it."""
         from .. import io
+        if "displacement" in point_data:
+            vertices, cell = io.cell_points(self.model)
+            node = self.model.nodes[self.model.cells.node[cell]]
+            inside = vertices + config.VERTEX_NUDGE * (node - vertices)
+            point_data = {**point_data, "displacement": np.concatenate(
+                [point_data["displacement"], vector3(self.displacement(inside))])}
         io.write(self.model, path, point_data=point_data, cell_data=cell_data)
 
 

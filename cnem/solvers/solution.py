@@ -13,7 +13,9 @@ for the same meanings:
 ``stress_at``          ``"cells"``, ``"triangles"`` or ``"points"``: where they live
 ``von_mises``          ``(k,)``
 ``displacement(p)``    ``(p, d)`` at any points of the body
-``write(path)``        ``.vtu`` with ``u``, ``stress``, ``strain``, ``von_mises``
+``write(path)``        ``.vtu`` for ParaView (`paraview_fields`): ``displacement``
+                       ``(n, 3)``, ``stress`` and ``strain`` as ``(k, 9)`` tensors,
+                       ``von_mises``; ``.pvd``: the `series` of states
 ``plot(path=None)``    off-screen picture of the deformed body (`cnem.plot.solution`)
 =====================  ===================================================================
 """
@@ -21,6 +23,8 @@ for the same meanings:
 from __future__ import annotations
 
 import inspect
+import os
+import pathlib
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -33,6 +37,62 @@ __all__ = ["Solution", "von_mises", "engineering_strain", "voigt", "energy_error
 #: The tensor entries of the Voigt order, by dimension.
 VOIGT = {2: ((0, 0), (1, 1), (0, 1)),
          3: ((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))}
+
+#: Point vectors of the solutions -> their names in the files.
+VECTORS = {"u": "displacement", "velocity": "velocity"}
+
+#: Voigt fields written as tensors, and whether their shears are engineering ones (2 e_xy).
+TENSORS = {"stress": False, "strain": True}
+
+
+def vector3(values: np.ndarray) -> np.ndarray:
+    """Vectors ``(k, d)`` as ``(k, 3)`` float64 (``z = 0`` when ``d = 2``)."""
+    values = np.asarray(values, dtype=np.float64)
+    out = np.zeros((len(values), 3))
+    out[:, :values.shape[1]] = values
+    return out
+
+
+def tensor9(voigt: np.ndarray, *, engineering: bool = False) -> np.ndarray:
+    """Voigt ``(k, 3)`` ``[xx, yy, xy]`` or ``(k, 6)`` ``[xx, yy, zz, yz, xz, xy]`` as full
+    symmetric tensors ``(k, 9)``, row-major; ``engineering`` halves the shears."""
+    voigt = np.asarray(voigt, dtype=np.float64)
+    dim = {3: 2, 6: 3}[voigt.shape[1]]
+    out = np.zeros((len(voigt), 3, 3))
+    for column, (i, j) in enumerate(VOIGT[dim]):
+        value = voigt[:, column] * (0.5 if engineering and i != j else 1.0)
+        out[:, i, j] = out[:, j, i] = value
+    return out.reshape(-1, 9)
+
+
+def paraview_fields(point_data: dict[str, np.ndarray],
+                    cell_data: dict[str, np.ndarray]) -> tuple[dict, dict]:
+    """A solution's fields (`Solution.fields`) in the form written to files.
+
+    Parameters
+    ----------
+    point_data : dict of str -> (n, ...) ndarray
+    cell_data : dict of str -> (k, ...) ndarray
+
+    Returns
+    -------
+    point_data, cell_data : dict of str -> ndarray
+        The vectors of `VECTORS` renamed and ``(n, 3)``; the Voigt fields of
+        `TENSORS` ``(k, 9)`` (in 2-D the in-plane components, ``zz``, ``xz`` and
+        ``yz`` 0: the out-of-plane stress of plane strain is not part of the 2-D
+        solution); every other array as given.
+    """
+    def convert(data):
+        out = {}
+        for name, value in data.items():
+            if name in VECTORS:
+                out[VECTORS[name]] = vector3(value)
+            elif name in TENSORS:
+                out[name] = tensor9(value, engineering=TENSORS[name])
+            else:
+                out[name] = value
+        return out
+    return convert(point_data), convert(cell_data)
 
 
 def voigt(tensor: np.ndarray) -> np.ndarray:
@@ -200,16 +260,31 @@ class Solution:
         """Write `fields` to ``path`` (see `write`)."""
         raise NotImplementedError
 
-    def write(self, path: str) -> str:
-        """Write the nodes (points), their ``u`` and the ``stress``, ``strain`` and
-        ``von_mises`` fields to a ``.vtu`` file (see `cnem.io`).
+    def write(self, path: str | os.PathLike) -> str | os.PathLike:
+        """Write the solution for ParaView.
+
+        A ``.vtu`` path gets the nodes (points) and the fields of `paraview_fields`:
+        point vectors ``displacement`` ``(n, 3)`` (``z = 0`` in 2-D), the tensors
+        ``stress`` and ``strain`` ``(k, 9)``, ``von_mises`` and the solution's other
+        scalars (see `cnem.io`). A ``.pvd`` path gets one ``.vtu`` per state of
+        `series` beside it, ``<stem>_<i>.vtu``, and the collection with their times.
 
         Returns
         -------
         path
         """
-        self.write_fields(path, *self.fields())
+        if pathlib.Path(path).suffix.lower() == ".pvd":
+            from .series import write_series
+            write_series(path, self.series())
+            return path
+        self.write_fields(path, *paraview_fields(*self.fields()))
         return path
+
+    def series(self) -> list[tuple[float, Solution]]:
+        """The states a ``.pvd`` file holds, ``(time or load factor, solution)`` in
+        increasing time: here the solution alone at 1; solutions with load steps or
+        frames give each of them."""
+        return [(1.0, self)]
 
     def plot(self, path: str | None = None, *, field: str = "von_mises", scale: float | None = None,
              **kwargs: Any) -> Any:
