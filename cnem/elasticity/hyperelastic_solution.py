@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -35,6 +35,9 @@ class HyperelasticSolution(CellSolution):
         First Piola-Kirchhoff stress ``P`` per cell.
     residual_history : list of list of float
         Newton's residual norms, one list per load step.
+    steps : list of (float, (d n,) ndarray)
+        The load factor (``k / steps``) and the unknowns after each load step (the
+        last is ``dofs``); `series` makes them solutions, ``write("run.pvd")`` files.
     energy : float
         Stored energy ``sum_k V_k W(F~_k)``.
     cells : Cells
@@ -57,12 +60,14 @@ class HyperelasticSolution(CellSolution):
     timings: dict
     model: Any
     plane: Any
+    steps: list = field(default_factory=list)
 
     @classmethod
     def from_dofs(cls, problem: Any, dofs: np.ndarray, history: list,
-                  timings: dict[str, float]) -> HyperelasticSolution:
-        """The solution of ``problem`` (a `cnem.Hyperelasticity`) with unknowns ``dofs``
-        and Newton's residual ``history``."""
+                  timings: dict[str, float], *, steps: list | None = None
+                  ) -> HyperelasticSolution:
+        """The solution of ``problem`` (a `cnem.Hyperelasticity`) with unknowns ``dofs``,
+        Newton's residual ``history`` and the load ``steps`` (``(factor, dofs)``)."""
         operator = problem.operator
         F = operator.deformation_gradient(dofs)
         W, P, _ = operator.laws(F, tangent=False)
@@ -76,12 +81,25 @@ class HyperelasticSolution(CellSolution):
                    stress=voigt(cauchy), strain=strain, first_piola=P,
                    residual_history=history, energy=float(operator.basis.dx @ W),
                    cells=problem.cells, dofs=dofs, timings=timings, model=problem.model,
-                   plane=problem.plane)
+                   plane=problem.plane, steps=list(steps or []))
+
+    def series(self) -> list[tuple[float, HyperelasticSolution]]:
+        """The solution after each load step, with its load factor (for a ``.pvd``
+        file; the solution alone at 1 when it has no steps)."""
+        if not self.steps:
+            return [(1.0, self)]
+        return [(factor, self if k == len(self.steps) - 1 else
+                 HyperelasticSolution.from_dofs(self.problem, dofs,
+                                                self.residual_history[:k + 1], self.timings))
+                for k, (factor, dofs) in enumerate(self.steps)]
 
     def fields(self) -> tuple[dict, dict]:
         """`cnem.solvers.solution.Solution.fields` and, per cell, the deformation
-        gradient ``F`` (row-major) and ``J = det F``."""
+        gradient ``F`` ``(m, 9)`` (row-major 3 x 3, ``F33 = 1`` in plane strain) and
+        ``J = det F``."""
         point_data, cell_data = super().fields()
         F = self.deformation_gradient
-        cell_data.update(F=F.reshape(len(F), -1), J=np.linalg.det(F))
+        full = np.broadcast_to(np.eye(3), (len(F), 3, 3)).copy()      # F33 = 1 in plane strain
+        full[:, :F.shape[1], :F.shape[2]] = F
+        cell_data.update(F=full.reshape(len(F), 9), J=np.linalg.det(F))
         return point_data, cell_data

@@ -175,7 +175,9 @@ class Hyperelasticity(ModelProblem):
         Returns
         -------
         HyperelasticSolution
-            With ``residual_history``, one list of residual norms per load step.
+            With ``residual_history``, one list of residual norms per load step, and
+            ``steps``, the displacements after each (``sol.write("run.pvd")`` writes them
+            as a series over the load factor).
 
         Raises
         ------
@@ -189,12 +191,14 @@ class Hyperelasticity(ModelProblem):
         system = self.system
         t1 = time.perf_counter()
         D, values = self.prescribed()
+        states = []
         u, history = newton(system.evaluate, self.load(), D, values, points=self.model.nodes,
                             tol=tol, steps=steps, max_iterations=max_iterations,
-                            line_search=line_search)
+                            line_search=line_search,
+                            on_step=lambda step, dofs: states.append((step / steps, dofs)))
         t2 = time.perf_counter()
         timings = dict(gradients=t1 - t0, newton=t2 - t1)
         log.info("hyperelasticity: %d load steps, %d Newton iterations, %s", len(history),
                  sum(len(h) - 1 for h in history),
                  ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
-        return HyperelasticSolution.from_dofs(self, u, history, timings)
+        return HyperelasticSolution.from_dofs(self, u, history, timings, steps=states)

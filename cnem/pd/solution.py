@@ -7,7 +7,7 @@ every solver (``u``, ``stress``, ``strain``, ``von_mises``, ``displacement``,
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import numpy as np
@@ -165,9 +165,23 @@ class DynamicRun(PointSolution):
     files: list = field(default_factory=list)
 
     def fields(self) -> tuple:
-        """`Solution.fields` with ``damage`` and ``velocity`` at the points."""
+        """`Solution.fields` with ``damage`` and ``velocity`` at the points (the stored
+        frames of `series` have no velocity)."""
         point_data, cell_data = super().fields()
-        return {**point_data, "damage": self.damage, "velocity": self.velocity}, cell_data
+        extra = {"damage": self.damage}
+        if self.velocity is not None:
+            extra["velocity"] = self.velocity
+        return {**point_data, **extra}, cell_data
+
+    def series(self) -> list[tuple[float, DynamicRun]]:
+        """The stored frames at their times, as runs ending there (``u`` and ``damage``;
+        no velocity; their stresses and strains through the problem's bonds as they are
+        at the end of the run); the final state alone when no frame was stored."""
+        if not self.frames:
+            return super().series()
+        return [(float(time), replace(self, u=u, damage=damage, velocity=None, frames=[],
+                                      times=self.times[:k + 1], files=[]))
+                for k, (time, (u, damage)) in enumerate(zip(self.times, self.frames))]
 
     def __repr__(self):
         return (f"<DynamicRun {len(self.u)} points, t = {self.times[-1]:.3e}, "

@@ -42,7 +42,9 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
            points: np.ndarray | None, pattern: sp.spmatrix | None = None,
            initial: ArrayLike | None = None, tol: float = 1e-10, steps: int = 1,
            max_iterations: int = 20, line_search: bool = False, linear: bool = False,
-           halvings: int = LINE_SEARCH_HALVINGS) -> tuple[np.ndarray, list[list[float]]]:
+           halvings: int = LINE_SEARCH_HALVINGS,
+           on_step: Callable[[int, np.ndarray], None] | None = None
+           ) -> tuple[np.ndarray, list[list[float]]]:
     """Newton-Raphson with the exact tangent, Dirichlet values and loads ramped in
     ``steps`` equal increments.
 
@@ -87,6 +89,8 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
         ``f_int = K u`` with a constant ``K``: every correction is solved to round-off.
     halvings : int
         Most halvings of the line search.
+    on_step : callable ``(step, u (N,)) -> None``, optional
+        Called after each converged load step ``1..steps`` with a copy of ``u``.
 
     Returns
     -------
@@ -165,6 +169,8 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
             residual = f - step_load
             res.append(float(np.linalg.norm(residual[free])))
         history.append(res)
+        if on_step is not None:
+            on_step(step, u.copy())
     return u, history
 
 
