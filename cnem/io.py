@@ -128,7 +128,7 @@ def cell_points(model: Model | Model3D) -> tuple[np.ndarray, np.ndarray]:
         Index in ``model.cells`` of one cell with vertex ``j`` (the lowest).
     """
     if _polyhedral(model.cells):
-        points, triangles = _polyhedron_topology(model.cells)
+        points, triangles = polyhedron_topology(model.cells)
         corner_cell = np.repeat(np.asarray(model.cells.facet_cell, np.int64), 3)
         corners = triangles.reshape(-1)
     else:
@@ -144,7 +144,7 @@ def _polyhedral(cells):
     return hasattr(cells, "facet_triangles")
 
 
-def _polyhedron_topology(cells):
+def polyhedron_topology(cells):
     """Distinct vertices ``(q, 3)`` of the 3-D cells' facet triangles and the
     triangles as indices into them ``(t, 3)`` (bit-for-bit equal vertices merged)."""
     corners = np.ascontiguousarray(cells.facet_triangles, dtype=np.float64).reshape(-1, 3)
@@ -238,7 +238,7 @@ def write(model: Model | Model3D, path: str | os.PathLike, *,
     cells, nodes = model.cells, np.asarray(model.nodes, np.float64)
     n, m = len(nodes), len(cells)
     if _polyhedral(model.cells):
-        vpoints, triangles = _polyhedron_topology(cells)
+        vpoints, triangles = polyhedron_topology(cells)
         blocks, ids = _polyhedron_blocks(cells, triangles, n)
         head, measure = [], ("volume", np.asarray(cells.volume, np.float64))
     else:

@@ -57,12 +57,18 @@ class CellSolution(Solution):
         vertex's cell, `cnem.config.VERTEX_NUDGE`), so that the cells warp with it."""
         from .. import io
         if "displacement" in point_data:
-            vertices, cell = io.cell_points(self.model)
-            node = self.model.nodes[self.model.cells.node[cell]]
-            inside = vertices + config.VERTEX_NUDGE * (node - vertices)
             point_data = {**point_data, "displacement": np.concatenate(
-                [point_data["displacement"], vector3(self.displacement(inside))])}
+                [point_data["displacement"], vector3(self.vertex_displacement())])}
         io.write(self.model, path, point_data=point_data, cell_data=cell_data)
+
+    def vertex_displacement(self) -> np.ndarray:
+        """Displacements ``(q, d)`` at the cell vertices of `cnem.io.cell_points`, each
+        interpolated just inside a cell it bounds (`cnem.config.VERTEX_NUDGE` of the way
+        to the cell's node), so that a vertex on a crack face takes that cell's side."""
+        from .. import io
+        vertices, cell = io.cell_points(self.model)
+        node = self.model.nodes[self.model.cells.node[cell]]
+        return self.displacement(vertices + config.VERTEX_NUDGE * (node - vertices))
 
 
 @dataclass(eq=False, repr=False)

@@ -1,5 +1,5 @@
-"""Pictures, off-screen: pyvista scenes of models and solutions (`fields`), matplotlib
-charts (`charts`).
+"""Pictures, off-screen: pyvista scenes of models and solutions (`fields`), of 3-D
+solutions clipped by a plane (`solid`), matplotlib charts (`charts`).
 
 Neither pyvista nor matplotlib is imported before a picture is drawn, so
 ``import cnem.plot`` works without them; drawing without them raises `PlotError`
@@ -14,6 +14,7 @@ with the command that installs them (``pip install "cnem[plot]"``).
 """
 
 from .charts import offscreen_pyplot
+from .solid import SOLID_FIELDS, SOLID_LABELS, solution3d
 from .fields import (FIELD_LABELS, REGION_COLORS, SOLUTION_FIELDS, PlotError, cells_polydata,
                      model, region_color, solution)
 # the scenes' helpers stay reachable as ``cnem.plot.<name>`` (not in __all__)
@@ -21,4 +22,5 @@ from .fields import (BAR, BAR_TITLE_GAP, INSTALL_HINT, colour_bar_font,  # noqa:
                      font_file, nice_length, nodal_field, use_font)
 
 __all__ = ["model", "solution", "cells_polydata", "region_color", "PlotError", "REGION_COLORS",
-           "SOLUTION_FIELDS", "FIELD_LABELS", "offscreen_pyplot"]
+           "SOLUTION_FIELDS", "FIELD_LABELS", "offscreen_pyplot", "solution3d", "SOLID_FIELDS",
+           "SOLID_LABELS"]

@@ -289,6 +289,9 @@ class Solution:
     def plot(self, path: str | None = None, *, field: str = "von_mises", scale: float | None = None,
              **kwargs: Any) -> Any:
         """Off-screen picture of the deformed body coloured by a field (see
-        `cnem.plot.solution`)."""
+        `cnem.plot.solution`; a solution on 3-D cells: `cnem.plot.solution3d`, the body
+        clipped by a plane, ``clip="-y"`` by default)."""
         from .. import plot
+        if hasattr(getattr(self, "cells", None), "facet_triangles"):
+            return plot.solution3d(self, path, field=field, scale=scale, **kwargs)
         return plot.solution(self, path, field=field, scale=scale, **kwargs)
