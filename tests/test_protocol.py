@@ -153,7 +153,8 @@ def test_cpd_solutions_write_without_stress(tmp_path):
     with pytest.raises(NotImplementedError, match="CPD"):
         sol.stress
     assert sol.strain.shape == (len(pts), 3)
-    assert set(meshio.read(sol.write(tmp_path / "cpd.vtu")).point_data) == {"u", "strain"}
+    assert set(meshio.read(sol.write(tmp_path / "cpd.vtu")).point_data) == {"displacement",
+                                                                          "strain"}
 
 
 def test_every_solution_has_the_same_fields(solved, tmp_path):
@@ -176,13 +177,20 @@ def test_every_solution_has_the_same_fields(solved, tmp_path):
     path = sol.write(tmp_path / f"{name}.vtu")
     mesh = meshio.read(path)
     np.testing.assert_array_equal(mesh.points[:n, :2], prob.condition_points)
-    np.testing.assert_array_equal(mesh.point_data["u"][:n], sol.u)
+    # ParaView's form (issue 39): a 3-component displacement, 9-component tensors
+    np.testing.assert_array_equal(mesh.point_data["displacement"][:n, :2], sol.u)
+    assert (mesh.point_data["displacement"][:, 2] == 0).all()
     stored = mesh.point_data if where == "points" else {
         key: np.concatenate(blocks) for key, blocks in mesh.cell_data.items()}
-    for field in ("stress", "strain", "von_mises"):
+    for field in ("stress", "strain"):
         values = stored[field]
-        assert len(values) >= k and np.isfinite(values).any(), field
-        assert np.isin(getattr(sol, field).ravel(), values.ravel()).all(), field
+        assert values.shape[1:] == (9,) and len(values) >= k and np.isfinite(values).any(), field
+        xx, yy, xy = getattr(sol, field).T
+        if field == "strain":
+            xy = xy / 2                                     # tensor, not engineering, shears
+        for column, entry in ((0, xx), (4, yy), (1, xy), (3, xy)):
+            assert np.isin(entry, values[:, column]).all(), (field, column)
+    assert np.isin(sol.von_mises, stored["von_mises"]).all()
 
 
 def test_every_solution_plots(solved, tmp_path):

@@ -197,6 +197,15 @@ def _function(name):
 
 
 @functools.cache
+def _solid_solution():
+    """A 3-D elasticity solution on the fixtures' box cloud (for 3-D pictures)."""
+    prob = cnem.Elasticity(cnem.discretize(fx().cloud3), (1.0, 0.3))
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+    prob.add_body_force([0.0, 0.0, -1.0])
+    return prob.solve(progress=False)
+
+
+@functools.cache
 def fx():
     """Tiny models shared by the examples (built once, on first use)."""
     square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
@@ -357,6 +366,10 @@ EXAMPLES = {
                        point_data=dict(u=f.lattice), cell_data=dict(a=np.ones(1))),
         skip={**_FIELDS, ("points", "shape"): _THREE_D}),
     "cnem.io.read": Example(lambda f: dict(path=cnem.io.write(f.model, f.tmp / "r.vtu"))),
+    "cnem.io.cell_points": Example(lambda f: dict(model=f.model)),
+    "cnem.plot.solution3d": Example(
+        lambda f: dict(sol=_solid_solution(), path=f.tmp / "s3.png", window_size=(200, 150),
+                       clip=(0.0, -1.0, 0.0), origin=(0.5, 0.5, 0.5))),
     "cnem.plot.model": Example(
         lambda f: dict(model=f.model, path=f.tmp / "m.png", window_size=(200, 200),
                        bounds=(0.0, 0.0, 1.0, 1.0))),

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..errors import PlotInputError
+from ..errors import PlotInputError, check_array
 from ..io import polyhedron_topology
 from .fields import (BAR, _legend, _plotter, _pyvista, _save, colour_bar_font, use_font,
                      window_pixels)
@@ -61,17 +61,21 @@ def _plane(clip, origin, model):
     """The clipping plane's unit normal and origin (default the body's centre), or None."""
     if clip is None:
         return None
-    normal = _NORMALS.get(clip) if isinstance(clip, str) else clip
-    normal = np.asarray(normal if normal is not None else np.nan, dtype=float).reshape(-1)
-    if normal.shape != (3,) or not np.isfinite(normal).all() or not np.linalg.norm(normal):
-        raise PlotInputError(f"clip: expected None, one of {tuple(_NORMALS)} or a normal "
-                             f"(3,), received {clip!r}; e.g. clip='y'")
+    fix = f"pass None, one of {tuple(_NORMALS)} or a normal (3,), e.g. clip='-y'"
+    if isinstance(clip, str):
+        if clip not in _NORMALS:
+            raise PlotInputError(f"clip: expected None, one of {tuple(_NORMALS)} or a normal "
+                                 f"(3,), received {clip!r}; e.g. clip='-y'")
+        normal = np.array(_NORMALS[clip])
+    else:
+        normal = check_array("clip", clip, shape=(3,), error=PlotInputError, fix=fix)
+        if not np.linalg.norm(normal):
+            raise PlotInputError(f"clip: expected a normal (3,) of nonzero length, received "
+                                 f"{clip!r}; {fix}")
     nodes = model.nodes
-    centre = 0.5 * (nodes.min(axis=0) + nodes.max(axis=0)) if origin is None else origin
-    centre = np.asarray(centre, dtype=float).reshape(-1)
-    if centre.shape != (3,) or not np.isfinite(centre).all():
-        raise PlotInputError(f"origin: expected a point (3,) on the clipping plane, received "
-                             f"{origin!r}")
+    centre = 0.5 * (nodes.min(axis=0) + nodes.max(axis=0)) if origin is None else \
+        check_array("origin", origin, shape=(3,), error=PlotInputError,
+                    fix="pass a point (x, y, z) of the clipping plane, or None for the centre")
     return normal / np.linalg.norm(normal), centre
 
 
