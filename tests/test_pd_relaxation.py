@@ -8,6 +8,8 @@ size about the strain: the bond-based cases use strains of 1e-7 to 1e-6).
 
 from __future__ import annotations
 
+import re
+
 import meshio
 import numpy as np
 import pytest
@@ -113,10 +115,19 @@ def test_dynamic_run_writes_vtu_frames(tmp_path, output, pattern):
         mesh = meshio.read(path)
         np.testing.assert_array_equal(mesh.points, np.column_stack([pts, np.zeros(len(pts))]))
         np.testing.assert_array_equal(mesh.cells_dict["vertex"].ravel(), np.arange(len(pts)))
-        assert mesh.point_data["u"].shape == mesh.point_data["velocity"].shape == (len(pts), 2)
-        np.testing.assert_array_equal(mesh.point_data["u"], u)
+        # ParaView's form (issue 39): 3-component vectors, z = 0 in 2-D
+        shape = (len(pts), 3)
+        assert mesh.point_data["displacement"].shape == mesh.point_data["velocity"].shape == shape
+        np.testing.assert_array_equal(mesh.point_data["displacement"][:, :2], u)
+        assert (mesh.point_data["displacement"][:, 2] == 0).all()
         np.testing.assert_array_equal(mesh.point_data["damage"], damage)
-    np.testing.assert_array_equal(meshio.read(files[-1]).point_data["velocity"], run.velocity)
+    np.testing.assert_array_equal(meshio.read(files[-1]).point_data["velocity"][:, :2],
+                                  run.velocity)
+    # the .pvd beside the frames lists them with the run's times
+    pvd = files[0].with_name(files[0].name.rsplit("_", 1)[0] + ".pvd")
+    listed = re.findall(r'timestep="([^"]+)" group="" part="0" file="([^"]+)"', pvd.read_text())
+    np.testing.assert_array_equal([float(t) for t, _ in listed], run.times)
+    assert [name for _, name in listed] == [f.name for f in files]
     assert prob.run_dynamic(0.1, 2, progress=False).files == []
 
 

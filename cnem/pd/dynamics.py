@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..solvers.conditions import per_point, vector_constant
+from ..solvers.solution import vector3
 from ..solvers.stepping import Prescribed, velocity_verlet
 from ..errors import InputError
 from .frames import FrameWriter
@@ -76,7 +77,8 @@ class Dynamics:
         output : str or os.PathLike, optional
             A folder or a path stem: every frame is also written to a VTU file
             (``<stem>_<step>.vtu``, see `cnem.pd.frames.FrameWriter`) with the point
-            data ``u (n, d)``, ``damage (n,)`` and ``velocity (n, d)``.
+            data ``displacement (n, 3)``, ``damage (n,)`` and ``velocity (n, 3)``
+            (``z = 0`` in 2-D), and listed with its time in ``<stem>.pvd``.
         progress : bool, optional
 
         Returns
@@ -126,7 +128,8 @@ class Dynamics:
             frames.append((u.copy(), self.damage()))
             energy.append(self._energy(u, v))
             if writer is not None:
-                files.append(writer.write(step, u=u, damage=frames[-1][1], velocity=v))
+                files.append(writer.write(step, step * dt, displacement=vector3(u),
+                                          damage=frames[-1][1], velocity=vector3(v)))
 
         velocity_verlet(u, v, dt, steps, forces=forces, mass=self.material.density,
                         prescribed=prescribed, after_step=check, frame=store, every=every,

@@ -1,7 +1,9 @@
 """Frames of a peridynamic run as numbered VTU files (meshio, one ``vertex`` cell per point).
 
 ParaView opens a series ``stem_000000.vtu, stem_000010.vtu, ...`` as one
-time-dependent data set; show the points as spheres or with "Point Gaussian".
+time-dependent data set; given the frames' times, the writer also keeps
+``stem.pvd``, the collection with the real times, up to date after every frame. Show the
+points as spheres or with "Point Gaussian".
 """
 
 from __future__ import annotations
@@ -12,6 +14,8 @@ from typing import TYPE_CHECKING
 
 import meshio
 import numpy as np
+
+from ..solvers.series import write_pvd
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -49,9 +53,11 @@ class FrameWriter:
         self.points = np.zeros((len(pts), 3))
         self.points[:, :pts.shape[1]] = pts
         self.cells = [meshio.CellBlock("vertex", np.arange(len(pts), dtype=np.int64)[:, None])]
+        self.written = []
 
-    def write(self, step: int, **point_data: Any) -> Path | None:
-        """Write ``point_data`` (arrays of ``n`` rows, as given) for ``step``.
+    def write(self, step: int, time: float | None = None, **point_data: Any) -> Path | None:
+        """Write ``point_data`` (arrays of ``n`` rows, as given) for ``step``; with its
+        ``time``, also list the frame in ``<stem>.pvd``.
 
         Returns
         -------
@@ -61,4 +67,7 @@ class FrameWriter:
         data = {name: np.asarray(value) for name, value in point_data.items()}
         meshio.write(path, meshio.Mesh(self.points, self.cells, point_data=data),
                      file_format="vtu", binary=True)
+        if time is not None:
+            self.written.append((float(time), path))
+            write_pvd(self.stem.with_suffix(".pvd"), self.written)
         return path
