@@ -177,6 +177,8 @@ def test_history_writes_one_frame_per_state_and_its_pictures(sent_run, tmp_path)
         mesh = cnem.io.read(f)
         assert np.array_equal(mesh.nodes, state.solution.model.nodes)
         assert mesh.area.sum() == pytest.approx(2.0, rel=1e-12)
+    pvd = (tmp_path / "frames" / "steps.pvd").read_text()          # the series, over the step
+    assert pvd.count("<DataSet ") == 3 and 'timestep="2.0"' in pvd and "step_002.vtu" in pvd
     for kind in ("paths", "sif", "load"):
         sent_run.plot(tmp_path / f"{kind}.png", kind=kind)
         assert (tmp_path / f"{kind}.png").stat().st_size > 10_000

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .._aliases import renamed_attributes
+from ..solvers.series import write_pvd
 
 if TYPE_CHECKING:
     import os
@@ -205,20 +206,26 @@ class GrowthHistory:
         return "\n".join(lines)
 
     def write(self, folder: str | os.PathLike) -> list:
-        """One VTU per state, ``step_000.vtu`` ... (``u``, stress, strain, von Mises;
-        see `cnem.io.write`), written from the solutions kept with ``keep=True``.
+        """One VTU per state, ``step_000.vtu`` ... (displacement, stress, strain, von
+        Mises; see `cnem.solvers.solution.Solution.write`), written from the solutions
+        kept with ``keep=True``, and ``steps.pvd``, their collection over the growth step
+        (time ``k`` for ``step_k``), which ParaView opens as one series.
 
         Returns
         -------
         list of pathlib.Path
+            The VTU files.
         """
         out = pathlib.Path(folder)
         out.mkdir(parents=True, exist_ok=True)
-        files = []
+        files, steps = [], []
         for k, s in enumerate(self._all()):
             if s.solution is None:
                 continue
             files.append(pathlib.Path(s.solution.write(out / f"step_{k:03d}.vtu")))
+            steps.append(k)
+        if files:
+            write_pvd(out / "steps.pvd", list(zip(steps, files)))
         return files
 
     def plot(self, path: str | None = None, *, kind: Literal["paths", "sif", "load"] = "paths",
