@@ -3,7 +3,8 @@
 `write` stores one unstructured grid that ParaView opens directly:
 
 * points: the ``n`` nodes first (point ``i`` is node ``i``), then every
-  distinct vertex of the integration cells, as float64 with ``z = 0`` in 2-D
+  distinct vertex of the integration cells (every cell's own vertices in a
+  cracked model, so that the crack faces part), as float64 with ``z = 0`` in 2-D
   (`read` gives back ``(n, 2)`` nodes then, ``(n, 3)`` when a ``z`` is not 0);
 * cells: one ``vertex`` cell per node, then the integration cells as
   ``polygon`` cells, grouped by vertex count (meshio keeps one block per
@@ -87,7 +88,7 @@ def _format(path):
                       f"supported suffixes: {supported}")
 
 
-def cell_topology(cells):
+def cell_topology(cells, *, shared: bool = True):
     """Distinct vertices and polygon connectivity of integration cells.
 
     Vertices that are bit-for-bit equal become one point, so neighbouring
@@ -97,6 +98,10 @@ def cell_topology(cells):
     ----------
     cells : Cells
         ``model.cells``, ``m`` cells with ``k`` vertices in all.
+    shared : bool
+        False gives every cell its own copies of its vertices (``q = k``): the
+        cells on the two faces of a crack then move apart with their own
+        displacements.
 
     Returns
     -------
@@ -107,6 +112,9 @@ def cell_topology(cells):
     connectivity : (k,) int64 ndarray
     """
     vertices = np.ascontiguousarray(cells.vertices, dtype=np.float64)
+    if not shared:
+        return vertices, np.asarray(cells.offsets, np.int64), np.arange(len(vertices),
+                                                                        dtype=np.int64)
     points, connectivity = np.unique(vertices, axis=0, return_inverse=True)
     return points, np.asarray(cells.offsets, np.int64), connectivity.reshape(-1).astype(np.int64)
 
@@ -132,11 +140,16 @@ def cell_points(model: Model | Model3D) -> tuple[np.ndarray, np.ndarray]:
         corner_cell = np.repeat(np.asarray(model.cells.facet_cell, np.int64), 3)
         corners = triangles.reshape(-1)
     else:
-        points, offsets, corners = cell_topology(model.cells)
+        points, offsets, corners = cell_topology(model.cells, shared=not _cracked(model))
         corner_cell = np.repeat(np.arange(len(offsets) - 1, dtype=np.int64), np.diff(offsets))
     cell = np.full(len(points), len(model.cells), dtype=np.int64)
     np.minimum.at(cell, corners, corner_cell)
     return points, cell
+
+
+def _cracked(model):
+    """Whether the model's domain has cracks (its file then shares no cell vertices)."""
+    return len(getattr(getattr(model, "domain", None), "cracks", ())) > 0
 
 
 def _polyhedral(cells):
@@ -242,7 +255,7 @@ def write(model: Model | Model3D, path: str | os.PathLike, *,
         blocks, ids = _polyhedron_blocks(cells, triangles, n)
         head, measure = [], ("volume", np.asarray(cells.volume, np.float64))
     else:
-        vpoints, offsets, connectivity = cell_topology(cells)
+        vpoints, offsets, connectivity = cell_topology(cells, shared=not _cracked(model))
         blocks, ids = _blocks(offsets, connectivity, n)
         head = [meshio.CellBlock("vertex", np.arange(n, dtype=np.int64)[:, None])]
         measure = ("area", np.asarray(cells.area, np.float64))

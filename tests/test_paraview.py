@@ -132,6 +132,33 @@ def test_vtu_reads_in_pyvista_and_warps(case, request, tmp_path):
         np.testing.assert_allclose(grid.cell_data["volume"], model.cells.volume[order])
 
 
+def test_cracked_cells_warp_with_their_own_side(tmp_path):
+    """In a cracked model every polygon has its own vertices, each with the displacement
+    inside that polygon, so the crack faces part in ParaView's Warp By Vector (shared
+    vertices took one face's displacement for both)."""
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.5, 0.5]]])
+    model = cnem.discretize(cnem.nodes.irregular(dom, 0.1, seed=1))
+    prob = cnem.Elasticity(model, (E, NU), plane="strain")
+    prob.add_dirichlet(lambda p: p[:, 1] < 1e-9, None)
+    prob.add_traction(lambda x, n: x[:, 1] > 1 - 1e-9, [0.0, 1.0])
+    sol = prob.solve(progress=False)
+    mesh = meshio.read(sol.write(tmp_path / "crack.vtu"))
+    u = mesh.point_data["displacement"][:, :2]
+    n, cells = len(model.nodes), model.cells
+    for block, ids in zip(mesh.cells[1:], mesh.cell_data["cell"][1:]):
+        corners = mesh.points[block.data, :2]                          # (b, k, 2)
+        node = model.nodes[cells.node[ids]][:, None, :]
+        inside = (corners + config.VERTEX_NUDGE * (node - corners)).reshape(-1, 2)
+        np.testing.assert_allclose(u[block.data.reshape(-1)], sol.displacement(inside),
+                                   rtol=0, atol=1e-12 * np.abs(sol.u).max())
+    points = np.round(mesh.points[n:, :2], 12)
+    _, first, group = np.unique(points, axis=0, return_index=True, return_inverse=True)
+    jump = np.linalg.norm(u[n:] - u[n:][first[group.reshape(-1)]], axis=1)
+    on_crack = np.isclose(points[:, 1], 0.5) & (points[:, 0] < 0.45)
+    assert jump[on_crack].max() > 0.1 * np.abs(sol.u).max()          # the faces part
+    assert jump[~on_crack & (np.abs(points[:, 1] - 0.5) > 0.05)].max() < 1e-6 * np.abs(sol.u).max()
+
+
 def test_a_3d_file_is_not_read_as_2d_cells(solid, tmp_path):
     with pytest.raises(FormatError, match="polyhedra of a 3-D model"):
         cnem.io.read(solid.write(tmp_path / "s.vtu"))
