@@ -50,7 +50,8 @@ if TYPE_CHECKING:
     from .geometry.model import Model
     from .geometry.model3d import Model3D
 
-__all__ = ["write", "cell_points", "write_nodes", "write_points", "read", "CellMesh", "FormatError", "SUFFIXES"]
+__all__ = ["write", "cell_points", "write_nodes", "write_points", "read", "CellMesh", "FormatError",
+           "SUFFIXES"]
 
 log = logging.getLogger(__name__)
 
@@ -130,10 +131,11 @@ def cell_points(model: Model | Model3D) -> tuple[np.ndarray, np.ndarray]:
     Returns
     -------
     points : (q, d) float64 ndarray
-        The distinct vertices of the cells (2-D polygons; 3-D facet triangles).
-        Point ``n + j`` of the file is ``points[j]``.
+        The distinct vertices of the cells (2-D polygons; 3-D facet triangles),
+        every cell's own in a cracked model. Point ``n + j`` of the file is
+        ``points[j]``.
     cell : (q,) int64 ndarray
-        Index in ``model.cells`` of one cell with vertex ``j`` (the lowest).
+        Index in ``model.cells`` of a cell with vertex ``j`` (the lowest).
     """
     if _polyhedral(model.cells):
         points, triangles = polyhedron_topology(model.cells)
