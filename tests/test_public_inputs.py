@@ -84,6 +84,8 @@ NOT_ENTRY_POINTS = {
         "cnem.pd.CPD.measure_derivatives", "cnem.pd.Problem.energy_density",
         "cnem.pd.Problem.displacement_gradient", "cnem.pd.Problem.stress_tensor")},
     "cnem.pd.Problem.add_traction": "refuses every call (a PD body has no boundary edges)",
+    "cnem.pd.StaticSolution.stress_at": "refuses every call (the base Solution.stress_at: "
+                                        "no pointwise stress but C-NEM's)",
     # hyper-dual arithmetic: elementwise NumPy semantics on any shape (NaN in, NaN out),
     # inside the energies of the PD and finite-strain materials
     **{f"cnem.hyperdual.{name}": "elementwise hyper-dual math (NumPy semantics)"
@@ -473,6 +475,7 @@ EXAMPLES = {
        for cls, attr in _SOLUTIONS.items()},
     "cnem.ElasticSolution.displacement_gradient": Example(
         lambda f: dict(self=f.sol, points=f.inside)),
+    "cnem.ElasticSolution.stress_at": Example(lambda f: dict(self=f.sol, points=f.inside)),
     "cnem.assembly.CellBasis.get_dofs": Example(
         lambda f: dict(self=cnem.assembly.CellBasis(f.model), where=np.array([0, 1])),
         skip={("where", "bool"): _MASK}),
