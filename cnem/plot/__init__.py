@@ -1,5 +1,5 @@
 """Pictures, off-screen: pyvista scenes of models and solutions (`fields`), matplotlib
-charts (`charts`).
+charts (`charts`), scalar fields at the nodes (`scalar`: a temperature).
 
 Neither pyvista nor matplotlib is imported before a picture is drawn, so
 ``import cnem.plot`` works without them; drawing without them raises `PlotError`
@@ -16,9 +16,10 @@ with the command that installs them (``pip install "cnem[plot]"``).
 from .charts import offscreen_pyplot
 from .fields import (FIELD_LABELS, REGION_COLORS, SOLUTION_FIELDS, PlotError, cells_polydata,
                      model, region_color, solution)
+from .scalar import scalar_field
 # the scenes' helpers stay reachable as ``cnem.plot.<name>`` (not in __all__)
 from .fields import (BAR, BAR_TITLE_GAP, INSTALL_HINT, colour_bar_font,  # noqa: F401
                      font_file, nice_length, nodal_field, use_font)
 
 __all__ = ["model", "solution", "cells_polydata", "region_color", "PlotError", "REGION_COLORS",
-           "SOLUTION_FIELDS", "FIELD_LABELS", "offscreen_pyplot"]
+           "SOLUTION_FIELDS", "FIELD_LABELS", "offscreen_pyplot", "scalar_field"]
