@@ -1,5 +1,8 @@
 """Steady heat conduction (`cnem.HeatConduction`) against exact solutions."""
 
+import pathlib
+import runpy
+
 import meshio
 import numpy as np
 import pytest
@@ -133,3 +136,15 @@ def test_file_and_picture(tmp_path):
     pytest.importorskip("pyvista")
     sol.plot(tmp_path / "T.png", title="T (°C)").close()
     assert (tmp_path / "T.png").stat().st_size > 0
+
+
+def test_the_docs_insulated_pipe_matches_its_exact_solution():
+    """docs/examples/heat_pipe.py (two layers, a fixed temperature and convection by
+    boundary names) at a coarse spacing: temperatures, H1 error and the heat lost."""
+    example = runpy.run_path(str(pathlib.Path(__file__).parents[1] / "docs" / "examples"
+                                 / "heat_pipe.py"))
+    out = example["main"](h=0.012, plot=False)
+    assert out["T_error_max"] < 0.005 * (150.0 - 20.0)
+    assert out["h1_error_relative"] < 0.05
+    assert out["Q"] == pytest.approx(out["Q_exact"], rel=5e-3)
+    assert out["T_surface"] == pytest.approx(out["T_surface_exact"], abs=0.5)

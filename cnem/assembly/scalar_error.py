@@ -51,6 +51,10 @@ def h1_error(basis: CellBasis, values: np.ndarray,
     if basis.vector or basis.cells is None:
         raise InputError("h1_error: expected a scalar CellBasis on cells, received "
                          f"{basis!r}; build it as CellBasis(model)")
+    values = check_array("values", values, fix="pass one value per node (e.g. sol.T)")
+    if values.shape != (basis.N,):
+        raise InputError(f"values: expected one value per dof ({basis.N},), received shape "
+                         f"{values.shape}; pass the field's nodal values")
     field = basis.interpolate(values)
     cell, points, weights = cell_quadrature(basis.cells, basis.model.nodes, order,
                                             singular=basis.model.domain.tips)

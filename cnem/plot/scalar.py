@@ -22,7 +22,7 @@ __all__ = ["scalar_field"]
 
 
 def scalar_field(model: Model, values: ArrayLike, path: str | os.PathLike | None = None, *,
-                 title: str = "value", cmap: str = "inferno",
+                 title: str = "value", cmap: str = "coolwarm",
                  bounds: tuple[float, float, float, float] | None = None,
                  window_size: tuple[int, int] = (1200, 1000),
                  length_unit: str | None = None) -> pyvista.Plotter:
