@@ -160,3 +160,20 @@ def test_plot_zooms_to_bounds(tmp_path):
     zoom.close()
     with pytest.raises(cnem.PlotInputError, match="bounds"):
         sol.plot(bounds=(1.0, 0.0, 0.0, 1.0))
+
+
+def test_linear_displacement_in_3d():
+    """The same recovery serves a 3-D model: the patch test at points inside and on
+    faces, Voigt (p, 6)."""
+    model = cnem.discretize(cnem.nodes.irregular(cnem.geometry.box((0, 0, 0), (1, 1, 1)),
+                                                 0.34, seed=0))
+    prob = cnem.Elasticity(model, (1.0, 0.3))
+    grad = np.array([[1e-3, 2e-3, 0.0], [-5e-4, 3e-3, 1e-3], [0.0, 1e-3, -2e-3]])
+    prob.add_dirichlet(model.boundary_nodes(), None, lambda p: p @ grad.T)
+    sol = prob.solve(progress=False)
+    pts = np.random.default_rng(0).uniform(0.05, 0.95, (50, 3))
+    pts = np.vstack([pts, [[0.5, 0.5, 0.0], [1.0, 0.3, 0.6]]])
+    got = sol.stress_at(pts)
+    assert got.shape == (52, 6)
+    np.testing.assert_allclose(got, np.broadcast_to(sol.stress[0], got.shape),
+                               atol=1e-10 * np.abs(sol.stress).max())

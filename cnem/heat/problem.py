@@ -172,7 +172,7 @@ class HeatConduction:
 
     def add_source(self, s: float | Callable[..., np.ndarray]) -> None:
         """Heat source per unit volume (area in 2-D): a number or ``s(x) -> (p,)``."""
-        per_point(s(self.model.nodes) if callable(s) else s, self.model.nodes, 1, "add_source: s")
+        per_point(s, self.model.nodes, 1, "add_source: s")         # checked at the nodes
         self.sources.append(s)
 
     def _check_scalar(self, value, what, edges, normal):
