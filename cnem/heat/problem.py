@@ -27,7 +27,7 @@ from ..solvers.constrained import solve_constrained
 from .solution import HeatSolution
 
 if TYPE_CHECKING:
-    from typing import Callable, Sequence
+    from typing import Callable, Literal, Sequence
     from numpy.typing import ArrayLike
     from ..geometry.model import Model
     from ..solvers.conditions import Where
@@ -243,7 +243,8 @@ class HeatConduction:
             np.add.at(f, edges[:, 1], factor * w * s * length * val)
         return f
 
-    def solve(self, *, method: str = "auto", tol: float = 1e-10) -> HeatSolution:
+    def solve(self, *, method: Literal["auto", "direct", "amg"] = "auto",
+              tol: float = 1e-10) -> HeatSolution:
         """Solve for the nodal temperatures.
 
         Parameters
