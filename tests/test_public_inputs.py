@@ -375,7 +375,7 @@ EXAMPLES = {
                        bounds=(0.0, 0.0, 1.0, 1.0))),
     "cnem.plot.solution": Example(
         lambda f: dict(sol=f.sol, path=f.tmp / "s.png", window_size=(200, 200),
-                       field=f.sol.von_mises),
+                       field=f.sol.von_mises, bounds=(0.2, 0.2, 0.8, 0.8)),
         skip={("field", "nan"): "NaN values are drawn in the colour map's NaN colour"}),
     "cnem.plot.scalar_field": Example(
         lambda f: dict(model=f.model, values=f.model.nodes[:, 0], path=f.tmp / "t.png",
