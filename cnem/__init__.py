@@ -24,7 +24,8 @@ output     ``io``, ``plot``: VTU files and off-screen pictures
 solvers    ``solvers``: conditions, solution base, the constrained linear solve, sparse solvers
 assembly   ``assembly``: SCNI smoothed gradients, bases, forms
 fracture   ``fracture``: Williams fields, SIFs, enrichment, crack growth
-problems   ``elasticity`` (C-NEM), ``fem`` (P1 anchor), ``pd`` (peridynamics)
+problems   ``elasticity`` (C-NEM), ``heat`` (heat conduction), ``fem`` (P1 anchor),
+           ``pd`` (peridynamics)
 front      ``cli``, ``__main__``, the demos
 ========== ==============================================================================
 """
@@ -48,18 +49,19 @@ __version__ = "0.1.0"
 
 #: Submodules and subpackages reachable as attributes of ``cnem`` (loaded on first use).
 _MODULES = frozenset({"assembly", "cli", "config", "elasticity", "errors", "exact", "fem",
-                      "fracture", "geometry", "hyperdual", "io", "material", "nodes", "pd",
+                      "fracture", "geometry", "heat", "hyperdual", "io", "material", "nodes", "pd",
                       "plot", "shape", "solvers", "spatial"})
 
 #: The core workflow names -> the module that defines them.
 _NAMES = {"Domain": "geometry", "Domain3D": "geometry", "NodeCloud": "geometry",
           "Model": "geometry", "discretize": "geometry", "Elasticity": "elasticity",
-          "ElasticSolution": "elasticity", "Hyperelasticity": "elasticity"}
+          "ElasticSolution": "elasticity", "Hyperelasticity": "elasticity",
+          "HeatConduction": "heat"}
 
 __all__ = ["Domain", "Domain3D", "NodeCloud", "Model", "discretize", "Elasticity", "ElasticSolution",
-           "Hyperelasticity",
+           "Hyperelasticity", "HeatConduction",
            "nodes", "geometry", "assembly", "elasticity", "exact", "fracture", "io", "plot", "shape",
-           "spatial", "hyperdual", "pd", "fem", "material",
+           "spatial", "hyperdual", "pd", "fem", "heat", "material",
            "CNEMError", "InputError", "OptionError", "GeometryError", "MaterialError", "FormError",
            "ConditionError", "SpatialError", "FractureError", "GrowthError", "FormatError",
            "HyperDualError", "GrowthWarning", "SIFWarning", "MissingExtraError",

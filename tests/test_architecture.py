@@ -29,7 +29,7 @@ LAYERS = [
     ("solvers", {"solvers"}),
     ("assembly", {"assembly"}),
     ("fracture", {"fracture"}),
-    ("problems", {"elasticity", "fem", "pd"}),
+    ("problems", {"elasticity", "heat", "fem", "pd"}),
     ("front", {"cli", "__main__", "demos"}),
 ]
 RANK = {part: rank for rank, (_, parts) in enumerate(LAYERS) for part in parts}

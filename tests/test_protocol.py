@@ -163,7 +163,7 @@ def test_every_solution_has_the_same_fields(solved, tmp_path):
     where, count = PLACES[name]
     k = count(prob)
     assert isinstance(sol, Solution) and dataclasses.is_dataclass(sol)
-    assert sol.stress_at == where
+    assert sol.stress_places == where
     assert sol.u.shape == (n, 2)
     assert sol.stress.shape == (k, 3) and sol.strain.shape == (k, 3)
     assert sol.von_mises.shape == (k,)

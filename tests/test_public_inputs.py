@@ -62,6 +62,9 @@ NOT_ENTRY_POINTS = {
     "cnem.assembly.condense": "scikit-fem's condense on the user's sparse system",
     "cnem.assembly.solve": "scikit-fem's solve on the user's sparse system",
     "cnem.elasticity.elasticity_form": "a weak form: called by asm with fields",
+    "cnem.heat.conduction_form": "a weak form: called by asm with fields",
+    "cnem.heat.HeatSolution": "a result of HeatConduction.solve",
+    "cnem.heat.HeatSolution.from_temperature": "plumbing: called by HeatConduction.solve",
     "cnem.plot.offscreen_pyplot": "no arguments",
     "cnem.material.Material": "an abstract base class",
     "cnem.material.Hyperelastic": "an abstract base class",
@@ -84,6 +87,8 @@ NOT_ENTRY_POINTS = {
         "cnem.pd.CPD.measure_derivatives", "cnem.pd.Problem.energy_density",
         "cnem.pd.Problem.displacement_gradient", "cnem.pd.Problem.stress_tensor")},
     "cnem.pd.Problem.add_traction": "refuses every call (a PD body has no boundary edges)",
+    "cnem.pd.StaticSolution.stress_at": "refuses every call (the base Solution.stress_at: "
+                                        "no pointwise stress but C-NEM's)",
     # hyper-dual arithmetic: elementwise NumPy semantics on any shape (NaN in, NaN out),
     # inside the energies of the PD and finite-strain materials
     **{f"cnem.hyperdual.{name}": "elementwise hyper-dual math (NumPy semantics)"
@@ -244,6 +249,14 @@ def _pd_problem(f):
     return prob
 
 
+def _heat(f):
+    """A heat-conduction solution on the model of `fx`."""
+    prob = cnem.HeatConduction(f.model, 1.0)
+    prob.add_temperature(lambda p: p[:, 0] < 1e-9, 0.0)
+    prob.add_flux(lambda x, nrm: nrm[:, 0] > 0.5, 1.0)
+    return prob.solve()
+
+
 def _setup(model):
     """The problem of `fx` on a grown model (for `cnem.fracture.grow`)."""
     prob = cnem.Elasticity(model, (1.0, 0.3))
@@ -375,8 +388,18 @@ EXAMPLES = {
                        bounds=(0.0, 0.0, 1.0, 1.0))),
     "cnem.plot.solution": Example(
         lambda f: dict(sol=f.sol, path=f.tmp / "s.png", window_size=(200, 200),
-                       field=f.sol.von_mises),
+                       field=f.sol.von_mises, bounds=(0.2, 0.2, 0.8, 0.8)),
         skip={("field", "nan"): "NaN values are drawn in the colour map's NaN colour"}),
+    "cnem.plot.scalar_field": Example(
+        lambda f: dict(model=f.model, values=f.model.nodes[:, 0], path=f.tmp / "t.png",
+                       window_size=(200, 200), bounds=(0.0, 0.0, 1.0, 1.0)),
+        skip={("values", "nan"): "NaN values are drawn in the colour map's NaN colour"}),
+    "cnem.HeatConduction": Example(lambda f: dict(model=f.model, conductivity=1.0)),
+    "cnem.heat.HeatSolution.temperature": Example(lambda f: dict(self=_heat(f), points=f.inside)),
+    "cnem.heat.HeatSolution.flux_at": Example(lambda f: dict(self=_heat(f), points=f.inside)),
+    "cnem.assembly.h1_error": Example(
+        lambda f: dict(basis=cnem.assembly.CellBasis(f.model), values=f.model.nodes[:, 0],
+                       exact_gradient=lambda x: np.tile([1.0, 0.0], (len(x), 1)))),
     "cnem.plot.cells_polydata": Example(lambda f: dict(model=f.model)),
     "cnem.plot.region_color": Example(lambda f: dict(region=np.array([0, 1]))),
     "cnem.shape.shape_functions": Example(lambda f: dict(model=f.model, points=f.inside,
@@ -486,6 +509,7 @@ EXAMPLES = {
        for cls, attr in _SOLUTIONS.items()},
     "cnem.ElasticSolution.displacement_gradient": Example(
         lambda f: dict(self=f.sol, points=f.inside)),
+    "cnem.ElasticSolution.stress_at": Example(lambda f: dict(self=f.sol, points=f.inside)),
     "cnem.assembly.CellBasis.get_dofs": Example(
         lambda f: dict(self=cnem.assembly.CellBasis(f.model), where=np.array([0, 1])),
         skip={("where", "bool"): _MASK}),

@@ -23,10 +23,11 @@ from ..solvers.conditions import select_nodes
 from .forms import BilinearForm, Functional, LinearForm, asm
 from .edges import cell_edges
 from .gradients import SmoothedGradient, GradientCache, fan_gradient, smoothed_gradient
+from .scalar_error import h1_error
 
 __all__ = ["CellBasis", "BilinearForm", "LinearForm", "Functional", "asm", "condense", "solve",
            "SmoothedGradient", "GradientCache", "smoothed_gradient", "fan_gradient",
-           "cell_edges", "select_nodes"]
+           "cell_edges", "select_nodes", "h1_error"]
 
 #: Old names (one release): see `cnem._aliases`.
 __getattr__ = renamed_attributes(

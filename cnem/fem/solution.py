@@ -48,7 +48,7 @@ class P1Solution(Solution):
     plane: str
     timings: dict
 
-    stress_at = "triangles"
+    stress_places = "triangles"
 
     @classmethod
     def from_dofs(cls, problem: Any, x: np.ndarray,

@@ -100,7 +100,11 @@ def plate_with_hole(width: float = 1.0, height: float = 1.0, radius: float = 0.2
     center : (2,) array_like, optional
         Hole centre, default the plate centre.
     spacing : float, optional
-        Length of the chords of the hole, default ``radius / 8``.
+        Length of the chords of the hole, default ``radius / 16`` (101 chords). Nodes
+        much closer than a chord resolve the polygon (its corners raise the stress,
+        its flat chords lower it): under tension with nodes graded to ``radius / 100``
+        at the hole, the stress concentration reads within 1.2 % of the circle's
+        with 101 chords, 4.5-6 % off with 51 (see docs/elasticity.md).
     """
     w, h, r = _positive("width", width), _positive("height", height), _positive("radius", radius)
     c = check_array("center", [w / 2, h / 2] if center is None else center, shape=(2,),
@@ -108,7 +112,7 @@ def plate_with_hole(width: float = 1.0, height: float = 1.0, radius: float = 0.2
     if (c - r < 0).any() or c[0] + r > w or c[1] + r > h:
         raise GeometryError(f"the hole (centre {c.tolist()}, radius {r}) does not fit inside "
                             f"the plate [0, {w}] x [0, {h}]; make it smaller or move it")
-    ring = arc(c, r, 0.0, 2 * np.pi, spacing or r / 8)[:-1]
+    ring = arc(c, r, 0.0, 2 * np.pi, spacing or r / 16)[:-1]
     shell = [[0, 0], [w, 0], [w, h], [0, h]]
     names = {**_sides(0.0, 0.0, w, h), "hole0": np.concatenate([ring, ring[:1]])}
     return Domain([(shell, [ring[::-1]])], cracks=cracks, boundaries=names)

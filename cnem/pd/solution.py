@@ -36,7 +36,7 @@ class PointSolution(Solution):
         displacement gradient (`cnem.pd.Problem.displacement_gradient`).
     """
 
-    stress_at = "points"
+    stress_places = "points"
 
     def stress_tensor(self) -> np.ndarray:
         """Stress of every point, ``(n, d, d)`` (see `cnem.pd.Problem.stress_tensor`; not

@@ -166,14 +166,7 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
     pv = _pyvista()
     mdl = check_model(model, "cnem.plot.model")
     dom = mdl.domain
-    xmin, ymin, xmax, ymax = dom.bounds
-    if bounds is None:
-        bounds = (xmin, ymin, xmax, ymax)
-    bx0, by0, bx1, by1 = check_array("bounds", bounds, shape=(4,), error=PlotInputError,
-                                     fix="pass (xmin, ymin, xmax, ymax)")
-    if not (bx1 > bx0 and by1 > by0):
-        raise PlotInputError(f"bounds must be (xmin, ymin, xmax, ymax) with xmin < xmax and "
-                             f"ymin < ymax, received {tuple(bounds)}; give a non-empty view")
+    bx0, by0, bx1, by1 = view_bounds(dom.bounds if bounds is None else bounds)
     width, height = window_pixels(window_size)
     lift = 1e-4 * dom.diameter        # draw lines above the cells (parallel view: no shift)
     pl = _plotter(pv, width, height)
@@ -210,6 +203,23 @@ def model(model: Model, path: str | os.PathLike | None = None, *, show_triangles
     _top_view(pl, view, width, height, dom.diameter)
     _scale_bar(pl, pv, view, length_unit, 4 * lift)
     return _save(pl, path, "model")
+
+
+def view_bounds(bounds: Any) -> tuple[float, float, float, float]:
+    """``bounds = (xmin, ymin, xmax, ymax)`` of a view (the order of ``Domain.bounds``),
+    checked.
+
+    Raises
+    ------
+    PlotInputError
+        Not four finite numbers, or an empty view.
+    """
+    bx0, by0, bx1, by1 = check_array("bounds", bounds, shape=(4,), error=PlotInputError,
+                                     fix="pass (xmin, ymin, xmax, ymax)")
+    if not (bx1 > bx0 and by1 > by0):
+        raise PlotInputError(f"bounds must be (xmin, ymin, xmax, ymax) with xmin < xmax and "
+                             f"ymin < ymax, received {tuple(bounds)}; give a non-empty view")
+    return float(bx0), float(by0), float(bx1), float(by1)
 
 
 def window_pixels(window_size: Any) -> tuple[int, int]:
@@ -409,7 +419,7 @@ def nodal_field(sol, field):
             return values
         if values.shape != (k,):
             raise PlotInputError(f"field: expected a name in {SOLUTION_FIELDS}, or values at "
-                                 f"the {n} nodes or the {k} {sol.stress_at}, received shape "
+                                 f"the {n} nodes or the {k} {sol.stress_places}, received shape "
                                  f"{values.shape}; pass {n} or {k} values")
         per_place = values
     elif field not in SOLUTION_FIELDS:
@@ -427,7 +437,8 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *,
              scale: float | None = None, window_size: tuple[int, int] = (1200, 1000),
              show_edges: bool = False, cmap: str = "viridis",
              title: str | None = None, cellwise: bool = True,
-             length_unit: str | None = None) -> pyvista.Plotter:
+             length_unit: str | None = None,
+             bounds: tuple[float, float, float, float] | None = None) -> pyvista.Plotter:
     r"""The body coloured by a field, its deformed and undeformed outlines and a scale
     bar (off-screen).
 
@@ -468,12 +479,17 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *,
         the nodes (`nodal_field`) and draws it on the deformed triangles.
     length_unit : str, optional
         The unit of the coordinates, written on the scale bar (e.g. ``"mm"``).
+    bounds : (4,) float, optional
+        ``(xmin, ymin, xmax, ymax)`` to show (a zoom, in the order of
+        ``Domain.bounds``, as `model`); default the whole body, deformed and
+        undeformed.
 
     Returns
     -------
     pyvista.Plotter
     """
     pv = _pyvista()
+    zoom = None if bounds is None else view_bounds(bounds)
     per_cell = _cell_values(sol, field) if cellwise else None
     name = field if isinstance(field, str) else "field"
     label = title or FIELD_LABELS.get(name, name)
@@ -529,6 +545,9 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *,
     hi = np.maximum(nodes[:, :2].max(axis=0), moved[:, :2].max(axis=0))
     pad = 0.06 * (hi - lo).max()
     view = (lo[0] - pad, lo[1] - 2.5 * pad, hi[0] + pad, hi[1] + 2.5 * pad)
+    if zoom is not None:
+        pad = 0.06 * (zoom[3] - zoom[1])
+        view = (zoom[0], zoom[1] - 2.5 * pad, zoom[2], zoom[3] + 2.5 * pad)
     _top_view(pl, view, width, height, diameter, right=0.2)
     _scale_bar(pl, pv, view, length_unit, 2 * lift)
     return _save(pl, path, "solution")
@@ -546,7 +565,7 @@ def _cell_values(sol, field):
     displacement, another kind of solution, or values at the nodes)."""
     cells = getattr(sol, "cells", None)
     model = getattr(sol, "model", None)
-    if getattr(sol, "stress_at", None) != "cells" or cells is None or model is None \
+    if getattr(sol, "stress_places", None) != "cells" or cells is None or model is None \
             or len(sol.stress) != len(model.cells):
         return None
     if isinstance(field, str):

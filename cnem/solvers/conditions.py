@@ -375,22 +375,48 @@ class Conditions:
         t = vector_constant(t, d, "add_traction: t",
                             f"give the traction vector, e.g. [{example}], or a pressure p "
                             f"along the outward normal as lambda x, nrm: -p * nrm")
+        index, edges, normal = self.select_facets(where, "add_traction")
+        self.tractions.append(Traction(index, edges, normal, t))
+
+    def select_facets(self, where: Where, what: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The boundary edges (3-D: triangles) of ``boundary_edges()`` that ``where``
+        picks: a boundary name, a predicate of their midpoints (centroids) and outward
+        unit normals, or an ``(e,)`` bool mask.
+
+        Parameters
+        ----------
+        where : str, callable ``(x, nrm) -> (e,) bool``, or an ``(e,)`` bool mask
+        what : str
+            The method named in the errors.
+
+        Returns
+        -------
+        index : (k,) int64 ndarray
+            Their rows in ``boundary_edges()``.
+        edges : (k, 2) or (k, 3) int64 ndarray
+        normal : (k, d) ndarray
+
+        Raises
+        ------
+        ConditionError
+            A predicate that returns no bool per edge, or selects none.
+        """
         edges, normal = self.boundary_edges()
-        mid = x[edges].mean(axis=1)          # edge midpoints; triangle centroids in 3-D
+        mid = self.condition_points[edges].mean(axis=1)   # edge midpoints; triangle centroids in 3-D
         if isinstance(where, str):
             pick = self.named_facets(where)
         else:
             pick = np.asarray(_call_where(where, mid, normal)) if callable(where) else \
                 np.asarray(where)
         if pick.shape != (len(edges),) or pick.dtype != bool:
-            raise ConditionError(f"add_traction: where(x, nrm) must return a ({len(edges)},) bool "
+            raise ConditionError(f"{what}: where(x, nrm) must return a ({len(edges)},) bool "
                                  f"array, received dtype {pick.dtype} shape {pick.shape}")
         if not pick.any():
-            raise ConditionError(f"add_traction: `where` selects no {self.edges_name}; check the "
+            raise ConditionError(f"{what}: `where` selects no {self.edges_name}; check the "
                              "predicate against the midpoints and outward normals of "
                              "boundary_edges()")
         index = np.flatnonzero(pick)
-        self.tractions.append(Traction(index, edges[index], normal[index], t))
+        return index, edges[index], normal[index]
 
     def add_body_force(self, b: ArrayLike | Callable[..., np.ndarray]) -> None:
         """Body force per unit area (2-D) or volume: ``b(x) -> (p, d)``, a constant ``(d,)``,

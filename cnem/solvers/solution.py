@@ -10,7 +10,8 @@ for the same meanings:
                        ``k`` integration places: the SCNI cells (C-NEM, ``k = m``),
                        the triangles (P1) or the points (PD, ``k = n``)
 ``strain``             the same places and order, engineering shears (``2 exy``)
-``stress_at``          ``"cells"``, ``"triangles"`` or ``"points"``: where they live
+``stress_places``      ``"cells"``, ``"triangles"`` or ``"points"``: where they live
+``stress_at(p)``       ``(p, s)`` stress at any points of the body (C-NEM: a patch recovery)
 ``von_mises``          ``(k,)``
 ``displacement(p)``    ``(p, d)`` at any points of the body
 ``write(path)``        ``.vtu`` for ParaView (`paraview_fields`): ``displacement``
@@ -30,7 +31,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..errors import InputError, check_array
+from ..errors import InputError, UnsupportedError, check_array
 
 __all__ = ["Solution", "von_mises", "engineering_strain", "voigt", "energy_error_density"]
 
@@ -177,7 +178,7 @@ class Solution:
     """Base of every solution (see the module docstring for the shared names).
 
     A subclass declares ``stress`` and ``strain`` (fields, or properties where they
-    are computed on demand), sets ``stress_at``, and implements `displacement`,
+    are computed on demand), sets ``stress_places``, and implements `displacement`,
     `nodal_average` (its per-place values at the nodes, for pictures),
     `plot_mesh` and `write_fields`.
 
@@ -193,11 +194,11 @@ class Solution:
     u: np.ndarray
 
     #: Where ``stress`` and ``strain`` live: "cells", "triangles" or "points".
-    stress_at = "points"
+    stress_places = "points"
 
     def __repr__(self):
         return (f"<{type(self).__name__} {len(self.u)} nodes, {len(self.stress)} "
-                f"{self.stress_at}, max |u| {np.abs(self.u).max():.3e}, "
+                f"{self.stress_places}, max |u| {np.abs(self.u).max():.3e}, "
                 f"max von Mises {self.von_mises.max():.3e}>")
 
     @property
@@ -218,6 +219,19 @@ class Solution:
         """
         raise NotImplementedError
 
+    def stress_at(self, points: np.ndarray) -> np.ndarray:
+        """Voigt stress ``(p, s)`` at points ``(p, d)`` of the body (see the C-NEM
+        solutions' `cnem.elasticity.solution.CellSolution.stress_at`).
+
+        Raises
+        ------
+        UnsupportedError
+            For a solution that has no pointwise stress (here: any but C-NEM's).
+        """
+        raise UnsupportedError(f"{type(self).__name__} has no stress_at(points): its stress "
+                               f"lives at its {self.stress_places} (sol.stress); use those "
+                               f"values, or solve the problem with cnem.Elasticity")
+
     def nodal_average(self, values: np.ndarray) -> np.ndarray:
         """Values ``(k, ...)`` at the places of ``stress`` as ``(n, ...)`` at the nodes."""
         raise NotImplementedError
@@ -226,11 +240,11 @@ class Solution:
         """``values`` ``(k, ...)``, one row per place of ``stress``, as float64: refused
         with an `InputError` when complex, boolean, not numbers or of another row count
         (NaN entries stay: they average to NaN)."""
-        count = len(self.u) if self.stress_at == "points" else len(self.stress)
+        count = len(self.u) if self.stress_places == "points" else len(self.stress)
         arr = check_array("values", values, finite=False,
-                          fix=f"pass one value (or row) per {self.stress_at[:-1]}")
+                          fix=f"pass one value (or row) per {self.stress_places[:-1]}")
         if arr.ndim == 0 or len(arr) != count:
-            raise InputError(f"values: expected one row per {self.stress_at[:-1]} ({count} "
+            raise InputError(f"values: expected one row per {self.stress_places[:-1]} ({count} "
                              f"rows), received shape {arr.shape}")
         return arr
 
@@ -251,7 +265,7 @@ class Solution:
         """
         point_data = {"u": self.u}
         cell_data = {"stress": self.stress, "strain": self.strain, "von_mises": self.von_mises}
-        if self.stress_at == "points":
+        if self.stress_places == "points":
             return {**point_data, **cell_data}, {}
         return point_data, cell_data
 
