@@ -11,26 +11,13 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 from test_dimension import _tetrahedral_patch
+from test_hyperelasticity import F2, MATERIALS, _homogeneous, holed  # noqa: F401 (fixture)
 
 import cnem
 from cnem.assembly import CellBasis
 from cnem.elasticity.fbar import FbarOperator, patch_average
 from cnem.elasticity.finite_strain import FiniteStrainOperator
-from cnem.material import NeoHookean, SaintVenantKirchhoff
-
-F2 = np.array([[1.6, 0.3], [0.1, 0.8]])
-MATERIALS = [NeoHookean(1.0, 3.0), SaintVenantKirchhoff(2.0, 0.3)]
-
-
-@pytest.fixture(scope="module")
-def holed():
-    dom = cnem.geometry.plate_with_hole(1.0, 1.0, 0.2, spacing=0.05)
-    return cnem.discretize(cnem.nodes.irregular(dom, 0.06, seed=11))
-
-
-def _homogeneous(F):
-    return lambda p: p @ (F - np.eye(len(F))).T
-
+from cnem.material import NeoHookean
 
 def _check_tangent(op, u, rng, h=1e-6):
     """Central differences of the forces and energy along a random direction (their
