@@ -874,3 +874,70 @@ def sibson_reference_3d(nodes, x):
             continue
         w[i] = scipy.spatial.ConvexHull(verts).volume
     return w / w.sum()
+
+
+def cook_membrane_fem(material, load, *, divisions, order=2, steps=8, tol=1e-10):
+    """Cook's membrane in plane strain by scikit-fem's P``order`` triangles (Newton,
+    the same `cnem.material.Hyperelastic` law at every quadrature point): the slow
+    reference of the finite-strain C-NEM cases.
+
+    The tapered panel with corners (0, 0), (48, 44), (48, 60), (0, 44), clamped at
+    x = 0, a dead shear traction ``load / 16`` (total ``load``) in +y on x = 48; a
+    ``divisions x divisions`` grid of quadrilaterals, each cut in two triangles.
+
+    Returns
+    -------
+    float
+        The vertical displacement of the corner (48, 60).
+    """
+    from skfem import (Basis, BilinearForm, ElementTriP2, ElementTriP3, ElementTriP4,
+                       ElementVector, FacetBasis, LinearForm, MeshTri, asm, condense, solve)
+    from skfem.helpers import grad
+
+    unit = MeshTri.init_tensor(np.linspace(0, 1, divisions + 1), np.linspace(0, 1, divisions + 1))
+    xi, eta = unit.p
+    mesh = MeshTri(np.array([48 * xi, 44 * xi + eta * (44 + 16 * xi - 44 * xi)]), unit.t)
+    element = ElementVector({2: ElementTriP2, 3: ElementTriP3, 4: ElementTriP4}[order]())
+    basis = Basis(mesh, element, intorder=2 * order)
+    right = FacetBasis(mesh, element, facets=mesh.facets_satisfying(lambda x: x[0] > 48 - 1e-9),
+                       intorder=2 * order)
+
+    def law(w, tangent):
+        F = grad(w["prev"]) + np.eye(2)[:, :, None, None]
+        shape = F.shape[2:]
+        _, P, A = material.evaluate(np.moveaxis(F, (0, 1), (-2, -1)).reshape(-1, 2, 2),
+                                    tangent=tangent)
+        return np.moveaxis(P.reshape(*shape, 2, 2), (-2, -1), (0, 1)), \
+            None if A is None else np.moveaxis(A.reshape(*shape, 2, 2, 2, 2), (2, 3, 4, 5), (0, 1, 2, 3))
+
+    @LinearForm
+    def internal(v, w):
+        P, _ = law(w, False)
+        return np.einsum("ij...,ij...->...", P, grad(v))
+
+    @BilinearForm
+    def stiffness(u, v, w):
+        _, A = law(w, True)
+        return np.einsum("ijkl...,ij...,kl...->...", A, grad(v), grad(u))
+
+    @LinearForm
+    def shear(v, w):
+        return load / 16.0 * v.value[1]
+
+    fixed = basis.get_dofs(lambda x: x[0] < 1e-9).all()
+    f_ext = asm(shear, right)
+    x = np.zeros(basis.N)
+    for step in range(1, steps + 1):
+        f = step / steps * f_ext
+        for _ in range(30):
+            prev = basis.interpolate(x)
+            r = asm(internal, basis, prev=prev) - f
+            r[fixed] = 0.0
+            if np.linalg.norm(r) <= tol * np.linalg.norm(f):
+                break
+            K = asm(stiffness, basis, prev=prev)
+            x += solve(*condense(K, -r, D=fixed))
+        else:
+            raise RuntimeError(f"cook_membrane_fem: step {step} did not converge")
+    corner = np.flatnonzero((np.abs(mesh.p[0] - 48) < 1e-9) & (np.abs(mesh.p[1] - 60) < 1e-9))[0]
+    return float(x[basis.nodal_dofs[1, corner]])

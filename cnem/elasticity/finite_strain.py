@@ -91,6 +91,11 @@ class FiniteStrainOperator:
         grad = np.stack([op @ u for op in self._gradient_ops], axis=1)
         return grad.reshape(-1, d, d) + np.eye(d)
 
+    def constitutive_gradient(self, u: np.ndarray) -> np.ndarray:
+        """The ``F`` at which each cell's law is evaluated, ``(m, d, d)``: ``F~`` here
+        (`cnem.elasticity.fbar.FbarOperator` changes its volume)."""
+        return self.deformation_gradient(u)
+
     def laws(self, F: np.ndarray, *, tangent: bool = True
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
         """Energy density ``(m,)``, stress ``P (m, d, d)`` and tangent ``A (m, d, d, d, d)``

@@ -26,13 +26,14 @@ class HyperelasticSolution(CellSolution):
         The smoothed ``F~ = I + grad~ u`` per cell (in-plane block in plane strain,
         ``F33 = 1``).
     stress : (m, 3) or (m, 6) ndarray
-        Cauchy stress ``P F^T / J`` per cell, Voigt ``[sxx, syy, sxy]`` (in-plane
+        Cauchy stress ``P F^T / J`` per cell (at the F-bar gradient with
+        ``volumetric="fbar"``), Voigt ``[sxx, syy, sxy]`` (in-plane
         components in plane strain) or ``[sxx, syy, szz, syz, sxz, sxy]``.
     strain : (m, 3) or (m, 6) ndarray
         Green-Lagrange strain ``(F^T F - I) / 2`` per cell, Voigt with engineering
         shears (``2 E12``).
     first_piola : (m, d, d) ndarray
-        First Piola-Kirchhoff stress ``P`` per cell.
+        First Piola-Kirchhoff stress ``P`` per cell (of the law's ``F``, see ``stress``).
     residual_history : list of list of float
         Newton's residual norms, one list per load step.
     steps : list of (float, (d n,) ndarray)
@@ -70,9 +71,10 @@ class HyperelasticSolution(CellSolution):
         Newton's residual ``history`` and the load ``steps`` (``(factor, dofs)``)."""
         operator = problem.operator
         F = operator.deformation_gradient(dofs)
-        W, P, _ = operator.laws(F, tangent=False)
-        J = np.linalg.det(F)
-        cauchy = P @ np.swapaxes(F, 1, 2) / J[:, None, None]
+        F_law = operator.constitutive_gradient(dofs)          # F~, or F-bar's
+        W, P, _ = operator.laws(F_law, tangent=False)
+        J = np.linalg.det(F_law)
+        cauchy = P @ np.swapaxes(F_law, 1, 2) / J[:, None, None]
         d = F.shape[1]
         green = 0.5 * (np.swapaxes(F, 1, 2) @ F - np.eye(d))
         strain = voigt(green)

@@ -13,6 +13,7 @@ from ..assembly import CellBasis
 from ..errors import InputError, MaterialError, OptionError
 from ..material import Hyperelastic, NeoHookean, check_plane, parse_materials
 from ..solvers.newton import newton
+from .fbar import FbarOperator, patch_average
 from .finite_strain import EnergySum, FiniteStrainOperator
 from .hyperelastic_solution import HyperelasticSolution
 from .model_problem import ModelProblem
@@ -65,6 +66,10 @@ class Hyperelasticity(ModelProblem):
     gradients : GradientCache, optional
         The model's smoothed gradients at ``gauss``, shared with other problems
         on the model (an `Elasticity` on the same model, say).
+    volumetric : {"fbar", None}
+        ``"fbar"``: every cell's volume change is averaged over a patch of about
+        four cells (`cnem.elasticity.fbar`), which removes volumetric locking as the
+        material becomes incompressible; None: plain SCNI, one volume change per cell.
 
     Attributes
     ----------
@@ -90,7 +95,8 @@ class Hyperelasticity(ModelProblem):
 
     def __init__(self, model: Model, materials: Hyperelastic | Sequence[Hyperelastic], *,
                  plane: Literal["strain"] | None = None, gauss: int = 2,
-                 stabilization: float = 0.0, gradients: GradientCache | None = None):
+                 stabilization: float = 0.0, gradients: GradientCache | None = None,
+                 volumetric: Literal["fbar"] | None = None):
         super().__init__(model, gauss=gauss, gradients=gradients, caller="Hyperelasticity")
         if self.dim == 2 and plane is None:
             plane = "strain"
@@ -110,6 +116,9 @@ class Hyperelasticity(ModelProblem):
         self.stabilization = float(stabilization)
         if not (np.isfinite(self.stabilization) and self.stabilization >= 0):
             raise InputError(f"stabilization: expected a number >= 0, received {stabilization!r}")
+        if volumetric not in ("fbar", None):
+            raise OptionError(f"volumetric: expected 'fbar' or None, received {volumetric!r}")
+        self.volumetric = volumetric
         self._operator = None
         self._system = None
 
@@ -124,13 +133,17 @@ class Hyperelasticity(ModelProblem):
         return self.operator.basis
 
     @property
-    def operator(self) -> FiniteStrainOperator:
+    def operator(self) -> FiniteStrainOperator | FbarOperator:
         """Energy, internal forces and tangent of the cells (built on first use)."""
         if self._operator is None:
             basis = CellBasis(self.model, vector=True, cells=self.cells,
                               gradient=self.gradients.cells())
-            self._operator = FiniteStrainOperator(basis, self.region_materials,
-                                                  self.cells.region)
+            region = self.cells.region
+            if self.volumetric == "fbar":
+                self._operator = FbarOperator(basis, self.region_materials, region,
+                                              patch_average(basis, self.cells.node, region))
+            else:
+                self._operator = FiniteStrainOperator(basis, self.region_materials, region)
         return self._operator
 
     @property
