@@ -49,7 +49,8 @@ DEMOS = _named("bimaterial_cylinder", "inclined_crack", "mode1_crack", "pd_vs_cn
                "growth_pd_vs_cnem", "growth_dcb", "kalthoff_winkler")
 
 #: ``cnem pd <name>`` -> module of `cnem.demos` (add a PD demo here).
-PD_DEMOS = _named("pd_vs_cnem_crack", "pd_crack_branching", "cpd_examples", "kalthoff_winkler")
+PD_DEMOS = _named("pd_vs_cnem_crack", "pd_crack_branching", "pd_vs_cnem_3d", "cpd_examples",
+                  "kalthoff_winkler")
 
 #: Subcommand -> its table of demos.
 _TABLES = {"demo": DEMOS, "pd": PD_DEMOS}

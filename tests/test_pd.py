@@ -193,3 +193,23 @@ def test_errors():
         prob.solve_static()
     with pytest.raises(ValueError, match="dt"):
         prob.run_dynamic(-1.0, 10)
+
+
+def test_body_from_a_3d_cloud():
+    """The nodes of the 3-D model, each with its cells' volume (an interface node sums its
+    cells): the volumes tile the body, and the horizon is 3 cbrt(V / n)."""
+    lo, mid, hi = np.zeros(3), np.array([0.5, 1.0, 1.0]), np.array([1.0, 1.0, 1.0])
+    from cnem.geometry.shapes3d import box_surface
+    dom = cnem.Domain3D([box_surface(lo, mid), box_surface([0.5, 0.0, 0.0], hi)])
+    cloud = cnem.nodes.irregular(dom, 0.25, seed=1)
+    body = pd.Body.from_cloud(cloud, 3.0)
+    model = body.model
+    assert body.dim == 3 and len(body.points) == len(model.nodes)
+    np.testing.assert_allclose(body.volumes.sum(), 1.0, rtol=1e-12)
+    on_interface = np.bincount(model.cells.node, minlength=len(model.nodes)) == 2
+    assert on_interface.any()
+    i = int(np.flatnonzero(on_interface)[0])
+    np.testing.assert_allclose(body.volumes[i], model.cells.volume[model.cells.node == i].sum())
+    np.testing.assert_allclose(body.horizon, 3.0 * (1.0 / len(model.nodes)) ** (1 / 3))
+    with pytest.raises(cnem.InputError, match="thickness"):
+        pd.Body.from_cloud(cloud, 3.0, thickness=2.0)

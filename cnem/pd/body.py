@@ -175,12 +175,19 @@ class Body:
         Parameters
         ----------
         cloud : cnem.NodeCloud
+            On a `cnem.Domain` (2-D) or a `cnem.Domain3D` (3-D: the nodes of
+            `cnem.discretize`, including any boundary nodes the tetrahedrisation added,
+            with their constrained Voronoi cells' volumes).
         horizon_factor : float
-            Horizon in units of the mean node spacing (``sqrt(area / n)``).
+            Horizon in units of the mean node spacing (``sqrt(area / n)``, in 3-D
+            ``cbrt(volume / n)``).
         thickness : float
+            2-D only (a 3-D cloud refuses any other value than 1).
         """
         from ..geometry import discretize
         model = discretize(cloud, progress=False)
+        if cloud.dim == 3:
+            return cls._from_model_3d(model, horizon_factor, thickness)
         area = np.bincount(model.cells.node, weights=model.cells.area, minlength=len(model.nodes))
         h = np.sqrt(model.domain.area / len(np.unique(model.node_of_point)))
         copies = np.bincount(model.node_of_point)[model.node_of_point] > 1
@@ -196,6 +203,20 @@ class Body:
                    cracks=[frame.to_local(_past_the_mouths(c, model.domain.tips, horizon,
                                                            model.domain.tolerance))
                            for c in model.domain.cracks], crossing_points=nudged)
+        body.model = model
+        return body
+
+    @classmethod
+    def _from_model_3d(cls, model, horizon_factor, thickness):
+        """`from_cloud` for a 3-D model: the nodes with their cells' volumes (a node on a
+        material interface sums its cells), horizon in units of ``cbrt(volume / n)``."""
+        if thickness != 1.0:
+            raise InputError(f"thickness: a 3-D cloud has volumes of its own; expected the "
+                             f"default 1.0, received {thickness}")
+        n = len(model.nodes)
+        volume = np.bincount(model.cells.node, weights=model.cells.volume, minlength=n)
+        h = float(volume.sum() / n) ** (1.0 / 3.0)
+        body = cls(model.nodes, volume, horizon_factor * h)
         body.model = model
         return body
 
