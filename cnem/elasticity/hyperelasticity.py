@@ -52,8 +52,10 @@ class Hyperelasticity(ModelProblem):
     gauss : int
         Gauss points per cell-edge piece in the smoothed gradients.
     stabilization : float
-        Weight ``a`` of an energy-based sub-cell stabilisation (0, the default:
-        plain SCNI). The energy becomes
+        Weight ``a`` of an energy-based sub-cell stabilisation (default 1, as
+        `cnem.Elasticity`; 0 is plain SCNI, whose Newton iterations may invert cells or
+        end on an indefinite tangent: Cook's membrane, `docs/finite_strain.md`). The
+        energy becomes
         ``sum_k V_k W(F~_k) + a [sum_s V_s W_mu(F~_s) - sum_k V_k W_mu(F~_k)]`` over
         the fan sub-cells ``s`` of the cells ``k``, ``W_mu`` the neo-Hookean law of the
         region's shear modulus alone (``lam = 0``). The sub-cells' gradients average
@@ -95,7 +97,7 @@ class Hyperelasticity(ModelProblem):
 
     def __init__(self, model: Model, materials: Hyperelastic | Sequence[Hyperelastic], *,
                  plane: Literal["strain"] | None = None, gauss: int = 2,
-                 stabilization: float = 0.0, gradients: GradientCache | None = None,
+                 stabilization: float = 1.0, gradients: GradientCache | None = None,
                  volumetric: Literal["fbar"] | None = None):
         super().__init__(model, gauss=gauss, gradients=gradients, caller="Hyperelasticity")
         if self.dim == 2 and plane is None:
