@@ -152,6 +152,8 @@ class _TieRecovery:
         self.points, self.scale = points, scale
         self.tets = [tuple(t) for t in tets.tolist()]
         self.alive = [True] * len(self.tets)
+        #: which tetrahedra are not flat (known when they are made, never recomputed)
+        self.solid = _solid(points, tets).tolist()
         self.watched = {int(v) for v in watched}
         #: flat tetrahedra that flips made (`remove_flat` with ``solid_only=False``)
         self.made_flat: list[int] = []
@@ -171,10 +173,11 @@ class _TieRecovery:
             self._stars[v] = s
         return s
 
-    def _add(self, tet):
+    def _add(self, tet, solid):
         k = len(self.tets)
         self.tets.append(tet)
         self.alive.append(True)
+        self.solid.append(solid)
         for v in tet:
             self._added.setdefault(v, set()).add(k)
             if v in self._stars:
@@ -191,9 +194,9 @@ class _TieRecovery:
         """Faces (as frozensets) of the tetrahedra at ``a`` that contain ``a``."""
         out = set()
         for k in self.star(a):
-            t = self.tets[k]
-            if not _solid(self.points, np.array([t]))[0]:
+            if not self.solid[k]:
                 continue
+            t = self.tets[k]
             rest = [v for v in t if v != a]
             for i in range(3):
                 out.add(frozenset((a, rest[i], rest[(i + 1) % 3])))
@@ -253,7 +256,7 @@ class _TieRecovery:
         p, quad = self.points, set(self.tets[k])
         for f in combinations(sorted(quad), 3):
             nb = [j for j in set.intersection(*(self.star(v) for v in f)) if j != k]
-            if len(nb) != 1 or not _solid(p, np.array([self.tets[nb[0]]]))[0]:
+            if len(nb) != 1 or not self.solid[nb[0]]:
                 continue
             x = p[list(self.tets[nb[0]])]
             m = x[1:] - x[0]
@@ -380,7 +383,7 @@ class _TieRecovery:
         for t, f in zip(new.tolist(), flat.tolist()):
             if f:
                 self.made_flat.append(len(self.tets))
-            self._add(tuple(t))
+            self._add(tuple(t), not f)
 
     def result(self):
         return np.array([t for t, ok in zip(self.tets, self.alive) if ok], dtype=np.int64)
