@@ -29,6 +29,7 @@ interfaces too; each piece goes to the sub-cell of its facet.
 
 from __future__ import annotations
 
+from itertools import chain
 from typing import Any, Callable
 
 import numpy as np
@@ -405,20 +406,25 @@ def boundary_points_3d(model: Any, interface: InterfacePieces | None = None
 
 
 def _face_holding(points, area_normal, corners, normal, size):
-    """The boundary triangle (of the same outward normal) holding each point, -1 if none."""
+    """The boundary triangle (of the same outward normal) holding each point, -1 if none.
+
+    Candidates are the triangles whose bounding sphere about their centroid (the
+    largest one's radius) reaches the point; each (point, candidate) pair is tested
+    at once, and a point takes its first candidate that holds it."""
     centre = corners.mean(axis=1)
     reach = np.linalg.norm(corners - centre[:, None], axis=2).max(axis=1)
     tree = cKDTree(centre)
     out = np.full(len(points), -1, dtype=np.int64)
     candidates = tree.query_ball_point(points, r=float(reach.max()) * (1.0 + 1e-9))
+    count = np.fromiter(map(len, candidates), dtype=np.int64, count=len(points))
+    face = np.fromiter(chain.from_iterable(candidates), dtype=np.int64, count=int(count.sum()))
+    point = np.repeat(np.arange(len(points), dtype=np.int64), count)
     unit = area_normal / np.linalg.norm(area_normal, axis=1)[:, None]
-    for i, cand in enumerate(candidates):
-        cand = np.asarray(cand, dtype=np.int64)
-        cand = cand[np.einsum("ij,j->i", normal[cand], unit[i]) > 1.0 - 1e-6]
-        if len(cand) == 0:
-            continue
-        inside = on_triangles(np.broadcast_to(points[i], (len(cand), 3)), corners[cand],
-                              PAIR_RTOL * 1e3, PAIR_RTOL * size)
-        if inside.any():
-            out[i] = cand[np.flatnonzero(inside)[0]]
+    facing = np.einsum("ij,ij->i", normal[face], unit[point]) > 1.0 - 1e-6
+    face, point = face[facing], point[facing]
+    inside = on_triangles(points[point], corners[face], PAIR_RTOL * 1e3, PAIR_RTOL * size)
+    face, point = face[inside], point[inside]
+    # the first hit of each point (pairs are in candidate order, grouped by point)
+    first = np.flatnonzero(np.r_[True, point[1:] != point[:-1]]) if len(point) else point
+    out[point[first]] = face[first]
     return out
