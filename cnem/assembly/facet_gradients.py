@@ -81,11 +81,11 @@ def facet_points(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_norm
     return _grouped_facet_points(facet_triangles, facet_cell, facet_normal)[1:]
 
 
-def _grouped_facet_points(facet_triangles, facet_cell, facet_normal):
-    """`facet_points`, after the facet of every triangle."""
+def _grouped_facet_points(facet_triangles, facet_cell, facet_normal, on_interface=None):
+    """`facet_points`, after the facet of every triangle (`_facet_groups`)."""
     tri = facet_triangles
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    group, first = _facet_groups(facet_cell, facet_normal)
+    group, first = _facet_groups(facet_cell, facet_normal, on_interface)
     total = np.bincount(group, weights=area, minlength=len(first))
     centre = tri.mean(axis=1)
     point = np.column_stack([np.bincount(group, weights=area * centre[:, i], minlength=len(first))
@@ -95,10 +95,15 @@ def _grouped_facet_points(facet_triangles, facet_cell, facet_normal):
     return group, facet_cell[first], point, normal
 
 
-def _facet_groups(facet_cell, facet_normal):
+def _facet_groups(facet_cell, facet_normal, on_interface=None):
     """The facet (cell, normal) of each triangle, numbered in the order of the cells,
-    and a triangle of each facet."""
-    key = np.column_stack([facet_cell, np.round(facet_normal * PLANE_RESOLUTION)]).astype(np.int64)
+    and a triangle of each facet. With ``on_interface`` (f,) bool, a cell's triangles on
+    interface faces and those off them in the same plane (a shadow of the interface's
+    plane beyond its border) are two facets: only the first are cut into pieces."""
+    columns = [facet_cell, np.round(facet_normal * PLANE_RESOLUTION)]
+    if on_interface is not None:
+        columns.append(on_interface)
+    key = np.column_stack(columns).astype(np.int64)
     _, first, group = np.unique(key, axis=0, return_index=True, return_inverse=True)
     return group.reshape(-1), first
 
@@ -141,7 +146,9 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
         bad = np.flatnonzero(~(volume > 0))[:5]
         raise GeometryError(f"expected cells of positive volume, received volumes "
                             f"{volume[bad].tolist()} at cells {bad.tolist()}")
-    group, cell, points, flux = _grouped_facet_points(facet_triangles, facet_cell, facet_normal)
+    group, cell, points, flux = _grouped_facet_points(
+        facet_triangles, facet_cell, facet_normal,
+        None if interface is None else interface.on_interface)
     two_sided = [] if spokes is None else [(spokes[0], spokes[1], -spokes[1], *spokes[2:])]
     if interface is not None and len(interface.tri_a):
         whole = np.ones(len(points), dtype=bool)
@@ -339,7 +346,10 @@ def sub_cell_gradient_3d(model: Any, interface: InterfacePieces | None = None
 
 
 def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
-    """`interface_pieces` of a 3-D model's cells on its interface faces.
+    """`interface_pieces` of a 3-D model's cells on its interface faces and on their
+    shadow facets (in the plane of a boundary or interface face beyond its border,
+    where the cells of the two sides cut the plane differently: their facet points
+    find no partner and lie on no boundary face).
 
     Parameters
     ----------
@@ -350,11 +360,27 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
     -------
     InterfacePieces
     """
-    group, _ = _facet_groups(cells.facet_cell, cells.facet_normal)
-    between = model.boundary_face_regions[:, 1] >= 0
+    group, _, point, area_normal = _grouped_facet_points(cells.facet_triangles, cells.facet_cell,
+                                                         cells.facet_normal)
     size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
+    # shadow facets: unpaired, and on no boundary face
+    lone = np.flatnonzero(~_paired(point, area_normal, size))
+    faces, normal = model.boundary_with_normals()
+    outer = _face_holding(point[lone], area_normal[lone], model.nodes[faces], normal, size) >= 0
+    between = model.boundary_face_regions[:, 1] >= 0
     return interface_pieces(cells.facet_triangles, cells.facet_normal, group,
-                            model.nodes[model.boundary_faces[between]], size)
+                            model.nodes[model.boundary_faces[between]], size,
+                            also=np.isin(group, lone[~outer]))
+
+
+def _paired(point, area_normal, size):
+    """Whether each facet point ``(k, 3)`` has another at it (to ``PAIR_RTOL size``)
+    with an opposite area-normal: the two sides of one facet."""
+    pairs = cKDTree(point).query_pairs(PAIR_RTOL * size, output_type="ndarray")
+    opposite = np.einsum("ij,ij->i", area_normal[pairs[:, 0]], area_normal[pairs[:, 1]]) < 0
+    shared = np.zeros(len(point), dtype=bool)
+    shared[pairs[opposite].ravel()] = True
+    return shared
 
 
 def boundary_points_3d(model: Any, interface: InterfacePieces | None = None
@@ -383,16 +409,12 @@ def boundary_points_3d(model: Any, interface: InterfacePieces | None = None
         The row of ``model.boundary_with_normals()`` the point lies on.
     """
     cells = model.cells
-    group, _, point, area_normal = _grouped_facet_points(cells.facet_triangles, cells.facet_cell,
-                                                         cells.facet_normal)
-    size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
-    tree = cKDTree(point)
-    pairs = tree.query_pairs(PAIR_RTOL * size, output_type="ndarray")
-    opposite = np.einsum("ij,ij->i", area_normal[pairs[:, 0]], area_normal[pairs[:, 1]]) < 0
-    shared = np.zeros(len(point), dtype=bool)
-    shared[pairs[opposite].ravel()] = True
     if interface is None:
         interface = model_interface_pieces(model, cells)
+    group, _, point, area_normal = _grouped_facet_points(cells.facet_triangles, cells.facet_cell,
+                                                         cells.facet_normal, interface.on_interface)
+    size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
+    shared = _paired(point, area_normal, size)
     shared[group[interface.on_interface]] = True
     outer = np.flatnonzero(~shared)
     faces, normal = model.boundary_with_normals()
