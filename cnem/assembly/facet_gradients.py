@@ -207,9 +207,11 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
         The sub-cell of each facet triangle.
     volume : (s,) ndarray
     spokes : (centroid (e, 3), area-normal (e, 3), sub_a (e,), sub_b (e,))
-        The spoke faces between two sub-cells, oriented out of ``sub_a``; ``sub_b``
-        is -1 for a spoke whose edge the neighbouring facet cut otherwise (each side
-        then closes its own sub-cell).
+        The spoke faces between two sub-cells, oriented out of ``sub_a``. Where the
+        neighbouring facet cut the edge otherwise (a T-junction), the spokes are the
+        pieces of the common refinement of the collinear edges; ``sub_b`` is -1 only
+        for an edge no other edge of the cell runs along (each side then closes its
+        own sub-cell).
 
     Raises
     ------
@@ -233,8 +235,8 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     outline = ~_has_reverse(edge_group, p, q)
     p, q, edge_group, edge_cell = p[outline], q[outline], edge_group[outline], edge_cell[outline]
     # an edge's twin is the same edge the other way in a neighbouring facet; a facet
-    # cut differently on the two sides of an edge leaves it without (its spoke is then
-    # one-sided, see facet_gradient)
+    # cut differently on the two sides of an edge leaves it without (its spokes are then
+    # cut at the T-junction, `_t_junction_pieces`)
     twin = _reverse_in(edge_cell, p, q)
     paired = twin >= 0
     # flat facets join the largest neighbouring pyramid (through flat neighbours, a
@@ -258,17 +260,63 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     triangle_sub = sub_of_owner[group]
     edge_sub = sub_of_owner[owner[edge_group]]
     other = np.where(paired, edge_sub[np.maximum(twin, 0)], -1)
-    between = (paired & (edge_sub != other) & (np.arange(len(p)) < twin)) | ~paired
-    apex_of = node_xyz[edge_cell[between]]
-    pb, qb = p[between], q[between]
+    # a T-junction (one facet cut the edge where its neighbour did not): the spokes
+    # are cut at the common refinement of the collinear edges, in pairs
+    lone = np.flatnonzero(~paired)
+    pa, pb_, pieces = _t_junction_pieces(p[lone], q[lone], edge_cell[lone], scale[edge_group[lone]])
+    alone = np.ones(len(lone), dtype=bool)
+    alone[pa] = False
+    alone[pb_] = False
+    between = (paired & (edge_sub != other) & (np.arange(len(p)) < twin))
+    between[lone[alone]] = True
+    start, end = [np.concatenate([x[between], y]) for x, y in ((p, pieces[0]), (q, pieces[1]))]
+    sub_a = np.concatenate([edge_sub[between], edge_sub[lone[pa]]])
+    sub_b = np.concatenate([other[between], edge_sub[lone[pb_]]])
+    apex_of = node_xyz[np.concatenate([edge_cell[between], edge_cell[lone[pa]]])]
     # seen from its sub-cell the spoke (apex, q, p) has the outward normal (q - apex) x (p - apex)
-    area_normal = 0.5 * np.cross(qb - apex_of, pb - apex_of)
-    centroid = (apex_of + pb + qb) / 3.0
+    area_normal = 0.5 * np.cross(end - apex_of, start - apex_of)
+    centroid = (apex_of + start + end) / 3.0
+    inner = sub_a != sub_b
     sub_volume = np.bincount(triangle_sub, weights=six_v, minlength=len(kept)) / 6.0
     parent = np.zeros(len(kept), dtype=np.int64)
     parent[triangle_sub] = facet_cell
-    return parent, triangle_sub, sub_volume, (centroid, area_normal, edge_sub[between],
-                                             other[between])
+    return parent, triangle_sub, sub_volume, (centroid[inner], area_normal[inner], sub_a[inner],
+                                             sub_b[inner])
+
+
+def _t_junction_pieces(p, q, cell, size):
+    """The common refinement of the edges ``p -> q`` ``(e, 3)`` of each cell that run
+    along each other the opposite way (collinear to ``1e-9 size``).
+
+    Returns
+    -------
+    a, b : (k,) int64 ndarray
+        The overlapping pairs (each once): a piece of edge ``a`` (its direction) and
+        of edge ``b`` (the other way).
+    pieces : (start (k, 3), end (k, 3))
+        Each piece along ``a``'s direction.
+    """
+    order = np.argsort(cell, kind="stable")
+    bounds = np.searchsorted(cell[order], np.unique(cell), side="left")
+    count = np.diff(np.append(bounds, len(order)))
+    # all pairs of edges within a cell
+    first = np.repeat(bounds, count * count)
+    within = np.arange(int((count * count).sum())) - np.repeat(np.cumsum(count * count)
+                                                              - count * count, count * count)
+    k = np.repeat(count, count * count)
+    i, j = order[first + within // k], order[first + within % k]
+    d = q[i] - p[i]
+    dd = np.einsum("ij,ij->i", d, d)
+    tol = 1e-9 * size[i]
+    t_start = np.einsum("ij,ij->i", q[j] - p[i], d) / dd
+    t_end = np.einsum("ij,ij->i", p[j] - p[i], d) / dd
+    off = np.maximum(np.linalg.norm(np.cross(q[j] - p[i], d), axis=1),
+                     np.linalg.norm(np.cross(p[j] - p[i], d), axis=1)) / np.sqrt(dd)
+    lo, hi = np.maximum(t_start, 0.0), np.minimum(t_end, 1.0)
+    keep = (i < j) & (off <= tol) & ((hi - lo) * np.sqrt(dd) > tol) & \
+        (np.einsum("ij,ij->i", q[j] - p[j], d) < 0)
+    i, j, lo, hi, d = i[keep], j[keep], lo[keep], hi[keep], d[keep]
+    return i, j, (p[i] + lo[:, None] * d, p[i] + hi[:, None] * d)
 
 
 def _has_reverse(owner, p, q):
