@@ -97,9 +97,9 @@ def _grouped_facet_points(facet_triangles, facet_cell, facet_normal, on_interfac
 
 def _facet_groups(facet_cell, facet_normal, on_interface=None):
     """The facet (cell, normal) of each triangle, numbered in the order of the cells,
-    and a triangle of each facet. With ``on_interface`` (f,) bool, a cell's triangles on
-    interface faces and those off them in the same plane (a shadow of the interface's
-    plane beyond its border) are two facets: only the first are cut into pieces."""
+    and a triangle of each facet. With ``on_interface`` (f,) bool (the triangles cut
+    into interface pieces), a cell's triangles cut and not cut in one plane are two
+    facets."""
     columns = [facet_cell, np.round(facet_normal * PLANE_RESOLUTION)]
     if on_interface is not None:
         columns.append(on_interface)
@@ -263,15 +263,15 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     # a T-junction (one facet cut the edge where its neighbour did not): the spokes
     # are cut at the common refinement of the collinear edges, in pairs
     lone = np.flatnonzero(~paired)
-    pa, pb_, pieces = _t_junction_pieces(p[lone], q[lone], edge_cell[lone], scale[edge_group[lone]])
+    pa, pb, pieces = _t_junction_pieces(p[lone], q[lone], edge_cell[lone], scale[edge_group[lone]])
     alone = np.ones(len(lone), dtype=bool)
     alone[pa] = False
-    alone[pb_] = False
+    alone[pb] = False
     between = (paired & (edge_sub != other) & (np.arange(len(p)) < twin))
     between[lone[alone]] = True
     start, end = [np.concatenate([x[between], y]) for x, y in ((p, pieces[0]), (q, pieces[1]))]
     sub_a = np.concatenate([edge_sub[between], edge_sub[lone[pa]]])
-    sub_b = np.concatenate([other[between], edge_sub[lone[pb_]]])
+    sub_b = np.concatenate([other[between], edge_sub[lone[pb]]])
     apex_of = node_xyz[np.concatenate([edge_cell[between], edge_cell[lone[pa]]])]
     # seen from its sub-cell the spoke (apex, q, p) has the outward normal (q - apex) x (p - apex)
     area_normal = 0.5 * np.cross(end - apex_of, start - apex_of)
@@ -285,8 +285,16 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
 
 
 def _t_junction_pieces(p, q, cell, size):
-    """The common refinement of the edges ``p -> q`` ``(e, 3)`` of each cell that run
-    along each other the opposite way (collinear to ``1e-9 size``).
+    """The common refinement of the edges ``p -> q`` of each cell that run along each
+    other the opposite way (collinear to ``1e-9 size``).
+
+    Parameters
+    ----------
+    p, q : (e, 3) ndarray
+        The edges' ends.
+    cell : (e,) int64 ndarray
+    size : (e,) ndarray
+        The size of each edge's facet.
 
     Returns
     -------
@@ -303,8 +311,8 @@ def _t_junction_pieces(p, q, cell, size):
     first = np.repeat(bounds, count * count)
     within = np.arange(int((count * count).sum())) - np.repeat(np.cumsum(count * count)
                                                               - count * count, count * count)
-    k = np.repeat(count, count * count)
-    i, j = order[first + within // k], order[first + within % k]
+    per_cell = np.repeat(count, count * count)
+    i, j = order[first + within // per_cell], order[first + within % per_cell]
     d = q[i] - p[i]
     dd = np.einsum("ij,ij->i", d, d)
     tol = 1e-9 * size[i]

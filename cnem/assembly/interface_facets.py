@@ -62,7 +62,7 @@ class InterfacePieces(NamedTuple):
 def interface_pieces(facet_triangles: np.ndarray, facet_normal: np.ndarray,
                      facet_group: np.ndarray, face_corners: np.ndarray, size: float,
                      also: np.ndarray | None = None) -> InterfacePieces:
-    """The common refinement of the cells' facets on interface faces.
+    """The common refinement of the cells' facets on interface faces (and of ``also``).
 
     Parameters
     ----------
@@ -96,8 +96,8 @@ def interface_pieces(facet_triangles: np.ndarray, facet_normal: np.ndarray,
         none = np.zeros(0, dtype=np.int64)
         return InterfacePieces(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)), none, none,
                                on)
-    # a facet's triangles on the interface apart from those in its plane beyond the
-    # interface's border (a shadow facet), which the other side does not cover
+    # a facet's triangles to cut (on an interface, or ``also``) apart from its others in
+    # the same plane, which the other side's pieces do not cover
     facet_group = np.unique(np.column_stack([facet_group, on]), axis=0,
                             return_inverse=True)[1].reshape(-1)
     tri_idx = np.flatnonzero(on)
