@@ -29,6 +29,7 @@ interfaces too; each piece goes to the sub-cell of its facet.
 
 from __future__ import annotations
 
+from itertools import chain
 from typing import Any, Callable
 
 import numpy as np
@@ -80,11 +81,11 @@ def facet_points(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_norm
     return _grouped_facet_points(facet_triangles, facet_cell, facet_normal)[1:]
 
 
-def _grouped_facet_points(facet_triangles, facet_cell, facet_normal):
-    """`facet_points`, after the facet of every triangle."""
+def _grouped_facet_points(facet_triangles, facet_cell, facet_normal, on_interface=None):
+    """`facet_points`, after the facet of every triangle (`_facet_groups`)."""
     tri = facet_triangles
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    group, first = _facet_groups(facet_cell, facet_normal)
+    group, first = _facet_groups(facet_cell, facet_normal, on_interface)
     total = np.bincount(group, weights=area, minlength=len(first))
     centre = tri.mean(axis=1)
     point = np.column_stack([np.bincount(group, weights=area * centre[:, i], minlength=len(first))
@@ -94,10 +95,15 @@ def _grouped_facet_points(facet_triangles, facet_cell, facet_normal):
     return group, facet_cell[first], point, normal
 
 
-def _facet_groups(facet_cell, facet_normal):
+def _facet_groups(facet_cell, facet_normal, on_interface=None):
     """The facet (cell, normal) of each triangle, numbered in the order of the cells,
-    and a triangle of each facet."""
-    key = np.column_stack([facet_cell, np.round(facet_normal * PLANE_RESOLUTION)]).astype(np.int64)
+    and a triangle of each facet. With ``on_interface`` (f,) bool (the triangles cut
+    into interface pieces), a cell's triangles cut and not cut in one plane are two
+    facets."""
+    columns = [facet_cell, np.round(facet_normal * PLANE_RESOLUTION)]
+    if on_interface is not None:
+        columns.append(on_interface)
+    key = np.column_stack(columns).astype(np.int64)
     _, first, group = np.unique(key, axis=0, return_index=True, return_inverse=True)
     return group.reshape(-1), first
 
@@ -140,7 +146,9 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
         bad = np.flatnonzero(~(volume > 0))[:5]
         raise GeometryError(f"expected cells of positive volume, received volumes "
                             f"{volume[bad].tolist()} at cells {bad.tolist()}")
-    group, cell, points, flux = _grouped_facet_points(facet_triangles, facet_cell, facet_normal)
+    group, cell, points, flux = _grouped_facet_points(
+        facet_triangles, facet_cell, facet_normal,
+        None if interface is None else interface.on_interface)
     two_sided = [] if spokes is None else [(spokes[0], spokes[1], -spokes[1], *spokes[2:])]
     if interface is not None and len(interface.tri_a):
         whole = np.ones(len(points), dtype=bool)
@@ -199,9 +207,11 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
         The sub-cell of each facet triangle.
     volume : (s,) ndarray
     spokes : (centroid (e, 3), area-normal (e, 3), sub_a (e,), sub_b (e,))
-        The spoke faces between two sub-cells, oriented out of ``sub_a``; ``sub_b``
-        is -1 for a spoke whose edge the neighbouring facet cut otherwise (each side
-        then closes its own sub-cell).
+        The spoke faces between two sub-cells, oriented out of ``sub_a``. Where the
+        neighbouring facet cut the edge otherwise (a T-junction), the spokes are the
+        pieces of the common refinement of the collinear edges; ``sub_b`` is -1 only
+        for an edge no other edge of the cell runs along (each side then closes its
+        own sub-cell).
 
     Raises
     ------
@@ -225,8 +235,8 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     outline = ~_has_reverse(edge_group, p, q)
     p, q, edge_group, edge_cell = p[outline], q[outline], edge_group[outline], edge_cell[outline]
     # an edge's twin is the same edge the other way in a neighbouring facet; a facet
-    # cut differently on the two sides of an edge leaves it without (its spoke is then
-    # one-sided, see facet_gradient)
+    # cut differently on the two sides of an edge leaves it without (its spokes are then
+    # cut at the T-junction, `_t_junction_pieces`)
     twin = _reverse_in(edge_cell, p, q)
     paired = twin >= 0
     # flat facets join the largest neighbouring pyramid (through flat neighbours, a
@@ -250,17 +260,71 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     triangle_sub = sub_of_owner[group]
     edge_sub = sub_of_owner[owner[edge_group]]
     other = np.where(paired, edge_sub[np.maximum(twin, 0)], -1)
-    between = (paired & (edge_sub != other) & (np.arange(len(p)) < twin)) | ~paired
-    apex_of = node_xyz[edge_cell[between]]
-    pb, qb = p[between], q[between]
+    # a T-junction (one facet cut the edge where its neighbour did not): the spokes
+    # are cut at the common refinement of the collinear edges, in pairs
+    lone = np.flatnonzero(~paired)
+    pa, pb, pieces = _t_junction_pieces(p[lone], q[lone], edge_cell[lone], scale[edge_group[lone]])
+    alone = np.ones(len(lone), dtype=bool)
+    alone[pa] = False
+    alone[pb] = False
+    between = (paired & (edge_sub != other) & (np.arange(len(p)) < twin))
+    between[lone[alone]] = True
+    start, end = [np.concatenate([x[between], y]) for x, y in ((p, pieces[0]), (q, pieces[1]))]
+    sub_a = np.concatenate([edge_sub[between], edge_sub[lone[pa]]])
+    sub_b = np.concatenate([other[between], edge_sub[lone[pb]]])
+    apex_of = node_xyz[np.concatenate([edge_cell[between], edge_cell[lone[pa]]])]
     # seen from its sub-cell the spoke (apex, q, p) has the outward normal (q - apex) x (p - apex)
-    area_normal = 0.5 * np.cross(qb - apex_of, pb - apex_of)
-    centroid = (apex_of + pb + qb) / 3.0
+    area_normal = 0.5 * np.cross(end - apex_of, start - apex_of)
+    centroid = (apex_of + start + end) / 3.0
+    inner = sub_a != sub_b
     sub_volume = np.bincount(triangle_sub, weights=six_v, minlength=len(kept)) / 6.0
     parent = np.zeros(len(kept), dtype=np.int64)
     parent[triangle_sub] = facet_cell
-    return parent, triangle_sub, sub_volume, (centroid, area_normal, edge_sub[between],
-                                             other[between])
+    return parent, triangle_sub, sub_volume, (centroid[inner], area_normal[inner], sub_a[inner],
+                                             sub_b[inner])
+
+
+def _t_junction_pieces(p, q, cell, size):
+    """The common refinement of the edges ``p -> q`` of each cell that run along each
+    other the opposite way (collinear to ``1e-9 size``).
+
+    Parameters
+    ----------
+    p, q : (e, 3) ndarray
+        The edges' ends.
+    cell : (e,) int64 ndarray
+    size : (e,) ndarray
+        The size of each edge's facet.
+
+    Returns
+    -------
+    a, b : (k,) int64 ndarray
+        The overlapping pairs (each once): a piece of edge ``a`` (its direction) and
+        of edge ``b`` (the other way).
+    pieces : (start (k, 3), end (k, 3))
+        Each piece along ``a``'s direction.
+    """
+    order = np.argsort(cell, kind="stable")
+    bounds = np.searchsorted(cell[order], np.unique(cell), side="left")
+    count = np.diff(np.append(bounds, len(order)))
+    # all pairs of edges within a cell
+    first = np.repeat(bounds, count * count)
+    within = np.arange(int((count * count).sum())) - np.repeat(np.cumsum(count * count)
+                                                              - count * count, count * count)
+    per_cell = np.repeat(count, count * count)
+    i, j = order[first + within // per_cell], order[first + within % per_cell]
+    d = q[i] - p[i]
+    dd = np.einsum("ij,ij->i", d, d)
+    tol = 1e-9 * size[i]
+    t_start = np.einsum("ij,ij->i", q[j] - p[i], d) / dd
+    t_end = np.einsum("ij,ij->i", p[j] - p[i], d) / dd
+    off = np.maximum(np.linalg.norm(np.cross(q[j] - p[i], d), axis=1),
+                     np.linalg.norm(np.cross(p[j] - p[i], d), axis=1)) / np.sqrt(dd)
+    lo, hi = np.maximum(t_start, 0.0), np.minimum(t_end, 1.0)
+    keep = (i < j) & (off <= tol) & ((hi - lo) * np.sqrt(dd) > tol) & \
+        (np.einsum("ij,ij->i", q[j] - p[j], d) < 0)
+    i, j, lo, hi, d = i[keep], j[keep], lo[keep], hi[keep], d[keep]
+    return i, j, (p[i] + lo[:, None] * d, p[i] + hi[:, None] * d)
 
 
 def _has_reverse(owner, p, q):
@@ -338,7 +402,10 @@ def sub_cell_gradient_3d(model: Any, interface: InterfacePieces | None = None
 
 
 def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
-    """`interface_pieces` of a 3-D model's cells on its interface faces.
+    """`interface_pieces` of a 3-D model's cells on its interface faces and on their
+    shadow facets (in the plane of a boundary or interface face beyond its border,
+    where the cells of the two sides cut the plane differently: their facet points
+    find no partner and lie on no boundary face).
 
     Parameters
     ----------
@@ -349,11 +416,27 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
     -------
     InterfacePieces
     """
-    group, _ = _facet_groups(cells.facet_cell, cells.facet_normal)
-    between = model.boundary_face_regions[:, 1] >= 0
+    group, _, point, area_normal = _grouped_facet_points(cells.facet_triangles, cells.facet_cell,
+                                                         cells.facet_normal)
     size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
+    # shadow facets: unpaired, and on no boundary face
+    lone = np.flatnonzero(~_paired(point, area_normal, size))
+    faces, normal = model.boundary_with_normals()
+    outer = _face_holding(point[lone], area_normal[lone], model.nodes[faces], normal, size) >= 0
+    between = model.boundary_face_regions[:, 1] >= 0
     return interface_pieces(cells.facet_triangles, cells.facet_normal, group,
-                            model.nodes[model.boundary_faces[between]], size)
+                            model.nodes[model.boundary_faces[between]], size,
+                            also=np.isin(group, lone[~outer]))
+
+
+def _paired(point, area_normal, size):
+    """Whether each facet point ``(k, 3)`` has another at it (to ``PAIR_RTOL size``)
+    with an opposite area-normal: the two sides of one facet."""
+    pairs = cKDTree(point).query_pairs(PAIR_RTOL * size, output_type="ndarray")
+    opposite = np.einsum("ij,ij->i", area_normal[pairs[:, 0]], area_normal[pairs[:, 1]]) < 0
+    shared = np.zeros(len(point), dtype=bool)
+    shared[pairs[opposite].ravel()] = True
+    return shared
 
 
 def boundary_points_3d(model: Any, interface: InterfacePieces | None = None
@@ -382,16 +465,12 @@ def boundary_points_3d(model: Any, interface: InterfacePieces | None = None
         The row of ``model.boundary_with_normals()`` the point lies on.
     """
     cells = model.cells
-    group, _, point, area_normal = _grouped_facet_points(cells.facet_triangles, cells.facet_cell,
-                                                         cells.facet_normal)
-    size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
-    tree = cKDTree(point)
-    pairs = tree.query_pairs(PAIR_RTOL * size, output_type="ndarray")
-    opposite = np.einsum("ij,ij->i", area_normal[pairs[:, 0]], area_normal[pairs[:, 1]]) < 0
-    shared = np.zeros(len(point), dtype=bool)
-    shared[pairs[opposite].ravel()] = True
     if interface is None:
         interface = model_interface_pieces(model, cells)
+    group, _, point, area_normal = _grouped_facet_points(cells.facet_triangles, cells.facet_cell,
+                                                         cells.facet_normal, interface.on_interface)
+    size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
+    shared = _paired(point, area_normal, size)
     shared[group[interface.on_interface]] = True
     outer = np.flatnonzero(~shared)
     faces, normal = model.boundary_with_normals()
@@ -405,20 +484,25 @@ def boundary_points_3d(model: Any, interface: InterfacePieces | None = None
 
 
 def _face_holding(points, area_normal, corners, normal, size):
-    """The boundary triangle (of the same outward normal) holding each point, -1 if none."""
+    """The boundary triangle (of the same outward normal) holding each point, -1 if none.
+
+    Candidates are the triangles whose bounding sphere about their centroid (the
+    largest one's radius) reaches the point; each (point, candidate) pair is tested
+    at once, and a point takes its first candidate that holds it."""
     centre = corners.mean(axis=1)
     reach = np.linalg.norm(corners - centre[:, None], axis=2).max(axis=1)
     tree = cKDTree(centre)
     out = np.full(len(points), -1, dtype=np.int64)
     candidates = tree.query_ball_point(points, r=float(reach.max()) * (1.0 + 1e-9))
+    count = np.fromiter(map(len, candidates), dtype=np.int64, count=len(points))
+    face = np.fromiter(chain.from_iterable(candidates), dtype=np.int64, count=int(count.sum()))
+    point = np.repeat(np.arange(len(points), dtype=np.int64), count)
     unit = area_normal / np.linalg.norm(area_normal, axis=1)[:, None]
-    for i, cand in enumerate(candidates):
-        cand = np.asarray(cand, dtype=np.int64)
-        cand = cand[np.einsum("ij,j->i", normal[cand], unit[i]) > 1.0 - 1e-6]
-        if len(cand) == 0:
-            continue
-        inside = on_triangles(np.broadcast_to(points[i], (len(cand), 3)), corners[cand],
-                              PAIR_RTOL * 1e3, PAIR_RTOL * size)
-        if inside.any():
-            out[i] = cand[np.flatnonzero(inside)[0]]
+    facing = np.einsum("ij,ij->i", normal[face], unit[point]) > 1.0 - 1e-6
+    face, point = face[facing], point[facing]
+    inside = on_triangles(points[point], corners[face], PAIR_RTOL * 1e3, PAIR_RTOL * size)
+    face, point = face[inside], point[inside]
+    # the first hit of each point (pairs are in candidate order, grouped by point)
+    first = np.flatnonzero(np.r_[True, point[1:] != point[:-1]]) if len(point) else point
+    out[point[first]] = face[first]
     return out

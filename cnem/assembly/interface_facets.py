@@ -60,9 +60,9 @@ class InterfacePieces(NamedTuple):
 
 
 def interface_pieces(facet_triangles: np.ndarray, facet_normal: np.ndarray,
-                     facet_group: np.ndarray, face_corners: np.ndarray, size: float
-                     ) -> InterfacePieces:
-    """The common refinement of the cells' facets on interface faces.
+                     facet_group: np.ndarray, face_corners: np.ndarray, size: float,
+                     also: np.ndarray | None = None) -> InterfacePieces:
+    """The common refinement of the cells' facets on interface faces (and of ``also``).
 
     Parameters
     ----------
@@ -76,6 +76,9 @@ def interface_pieces(facet_triangles: np.ndarray, facet_normal: np.ndarray,
         The interface faces (between two regions).
     size : float
         The model's size (tolerances are relative to it).
+    also : (f,) bool ndarray, optional
+        Further triangles to cut into pieces with the other side's (facets that two
+        cells cut differently off the interfaces: shadows of a face's plane).
 
     Returns
     -------
@@ -87,12 +90,16 @@ def interface_pieces(facet_triangles: np.ndarray, facet_normal: np.ndarray,
         An interface facet the other side's facets do not cover.
     """
     on = _on_faces(facet_triangles, facet_normal, face_corners, size)
+    if also is not None:
+        on |= also
     if not on.any():
         none = np.zeros(0, dtype=np.int64)
         return InterfacePieces(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)), none, none,
                                on)
-    # the whole facet of any triangle on an interface
-    on = np.isin(facet_group, facet_group[on])
+    # a facet's triangles to cut (on an interface, or ``also``) apart from its others in
+    # the same plane, which the other side's pieces do not cover
+    facet_group = np.unique(np.column_stack([facet_group, on]), axis=0,
+                            return_inverse=True)[1].reshape(-1)
     tri_idx = np.flatnonzero(on)
     ta, tb = _overlapping(facet_triangles, facet_normal, tri_idx, size)
     # the pair's triangles in the 2-D frame of ta's plane, about ta's centre

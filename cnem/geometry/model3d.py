@@ -34,7 +34,7 @@ __all__ = ["Model3D", "discretize_3d"]
 
 #: A cell's facet triangle whose sides are below this fraction of the model's size (its
 #: area below the square) is flat: round-off of coincident circumcentres.
-FLAT_FACET_RTOL = 1e-10
+FLAT_FACET_RTOL = 1e-7
 
 log = logging.getLogger(__name__)
 

@@ -7,10 +7,10 @@ Every boundary (and interface) triangle becomes a face of the tetrahedrisation:
    square triangulated the other way) is recovered by re-triangulating the
    tetrahedra around the crossing diagonal (a cone from the face's far vertex;
    accepted only when it tiles the same volume with empty circumspheres);
-3. a face still missing is split at its circumcentre (or at the midpoint of its
-   longest edge when the circumcentre falls outside it): the new nodes are boundary
-   nodes, returned after the input points, and the faces are refined. Qhull runs
-   again, at most ``max_rounds`` times. No interior Steiner point is ever added;
+3. a face still missing is split (`face_refinement.refine_faces`: at its circumcentre,
+   or at an edge's midpoint; its planar patch flipped back to Delaunay): the new nodes
+   are boundary nodes, returned after the input points. Qhull runs again, at most
+   ``max_rounds`` times. No interior Steiner point is ever added;
 4. a flat sliver (four coplanar, cocircular nodes: Qhull's tie on a lattice square)
    holds both diagonals of its quadrilateral, one towards each side. The tetrahedra
    around one diagonal are re-coned from an end of the other (step 2's flip), so that
@@ -34,6 +34,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay
 
 from ..errors import GeometryError
+from .face_refinement import refine_faces
 
 __all__ = ["Tetrahedrisation", "conforming_tetrahedra", "signed_volumes", "region_volumes",
            "tet_neighbors"]
@@ -151,6 +152,8 @@ class _TieRecovery:
         self.points, self.scale = points, scale
         self.tets = [tuple(t) for t in tets.tolist()]
         self.alive = [True] * len(self.tets)
+        #: which tetrahedra are not flat (known when they are made, never recomputed)
+        self.solid = _solid(points, tets).tolist()
         self.watched = {int(v) for v in watched}
         #: flat tetrahedra that flips made (`remove_flat` with ``solid_only=False``)
         self.made_flat: list[int] = []
@@ -170,10 +173,11 @@ class _TieRecovery:
             self._stars[v] = s
         return s
 
-    def _add(self, tet):
+    def _add(self, tet, solid):
         k = len(self.tets)
         self.tets.append(tet)
         self.alive.append(True)
+        self.solid.append(solid)
         for v in tet:
             self._added.setdefault(v, set()).add(k)
             if v in self._stars:
@@ -190,9 +194,9 @@ class _TieRecovery:
         """Faces (as frozensets) of the tetrahedra at ``a`` that contain ``a``."""
         out = set()
         for k in self.star(a):
-            t = self.tets[k]
-            if not _solid(self.points, np.array([t]))[0]:
+            if not self.solid[k]:
                 continue
+            t = self.tets[k]
             rest = [v for v in t if v != a]
             for i in range(3):
                 out.add(frozenset((a, rest[i], rest[(i + 1) % 3])))
@@ -252,7 +256,7 @@ class _TieRecovery:
         p, quad = self.points, set(self.tets[k])
         for f in combinations(sorted(quad), 3):
             nb = [j for j in set.intersection(*(self.star(v) for v in f)) if j != k]
-            if len(nb) != 1 or not _solid(p, np.array([self.tets[nb[0]]]))[0]:
+            if len(nb) != 1 or not self.solid[nb[0]]:
                 continue
             x = p[list(self.tets[nb[0]])]
             m = x[1:] - x[0]
@@ -379,7 +383,7 @@ class _TieRecovery:
         for t, f in zip(new.tolist(), flat.tolist()):
             if f:
                 self.made_flat.append(len(self.tets))
-            self._add(tuple(t))
+            self._add(tuple(t), not f)
 
     def result(self):
         return np.array([t for t, ok in zip(self.tets, self.alive) if ok], dtype=np.int64)
@@ -438,51 +442,6 @@ def _remove_flats(points, tets, faces, scale):
         todo = [k for k in todo + fixer.made_flat if fixer.alive[k]]
         fixer.made_flat.clear()
     return fixer.result()
-
-
-def _split(points, faces, face_regions, missing):
-    """Split the ``missing`` faces (indices into ``faces``); return the refined arrays."""
-    pts = list(points)
-    fl = [tuple(f) for f in faces.tolist()]
-    rl = [tuple(r) for r in face_regions.tolist()]
-    for f in missing.tolist():
-        tri = fl[f]
-        if tri is None:
-            continue
-        x = np.array([pts[v] for v in tri])
-        e1, e2 = x[1] - x[0], x[2] - x[0]
-        nrm = np.cross(e1, e2)
-        n2 = nrm @ nrm
-        centre = x[0] + (np.cross(nrm, e1) * (e2 @ e2) + np.cross(e2, nrm) * (e1 @ e1)) / (2 * n2)
-        bary = np.linalg.lstsq(np.column_stack([e1, e2]), centre - x[0], rcond=None)[0]
-        inside = bary.min() > 0.05 and bary.sum() < 0.95
-        k = len(pts)
-        if inside:
-            pts.append(centre)
-            fl[f] = None
-            for i in range(3):
-                fl.append((tri[i], tri[(i + 1) % 3], k))
-                rl.append(rl[f])
-            continue
-        lengths = [np.sum((x[(i + 1) % 3] - x[i]) ** 2) for i in range(3)]
-        i = int(np.argmax(lengths))
-        u, v = tri[i], tri[(i + 1) % 3]
-        pts.append(0.5 * (x[i] + x[(i + 1) % 3]))
-        for g, other in enumerate(fl):
-            if other is None or u not in other or v not in other:
-                continue
-            j = other.index(u)
-            w = other[(j + 2) % 3]
-            if other[(j + 1) % 3] != v:        # the face runs v -> u
-                u2, v2, w = v, u, other[(other.index(v) + 2) % 3]
-            else:
-                u2, v2 = u, v
-            fl[g] = None
-            fl.extend([(u2, k, w), (k, v2, w)])
-            rl.extend([rl[g], rl[g]])
-    keep = [i for i, f in enumerate(fl) if f is not None]
-    return (np.array(pts, dtype=np.float64), np.array([fl[i] for i in keep], dtype=np.int64),
-            np.array([rl[i] for i in keep], dtype=np.int64))
 
 
 def _delaunay(points, centre, scale):
@@ -635,7 +594,7 @@ def conforming_tetrahedra(points: ArrayLike, boundary_faces: ArrayLike,
                 break
         if len(missing) == 0:
             break
-        points, faces, face_regions = _split(points, faces, face_regions, np.asarray(missing))
+        points, faces, face_regions = refine_faces(points, faces, face_regions, missing)
     else:
         raise GeometryError(
             f"{len(missing)} boundary faces are still not faces of the Delaunay tetrahedrisation "
@@ -648,7 +607,7 @@ def conforming_tetrahedra(points: ArrayLike, boundary_faces: ArrayLike,
     vol = signed_volumes(points, tets)
     flip = vol < 0
     tets[flip] = tets[flip][:, [0, 1, 3, 2]]
-    n_reg = int(face_regions[:, 0].max()) + 1
+    n_reg = int(face_regions.max()) + 1
     want = region_volumes(points, faces, face_regions, n_reg)
     got = np.bincount(region, weights=np.abs(vol), minlength=n_reg)
     if np.abs(got - want).max() > 1e-9 * np.abs(want).sum():
