@@ -874,3 +874,68 @@ def sibson_reference_3d(nodes, x):
             continue
         w[i] = scipy.spatial.ConvexHull(verts).volume
     return w / w.sum()
+
+
+def cantilever_p2(length, width, material, load, cells_across):
+    """Tip deflection of the clamped square-section cantilever by scikit-fem P2 tetrahedra.
+
+    The box ``[0, length] x [0, width] x [0, width]``, clamped (u = 0) on x = 0, loaded
+    by the uniform shear traction ``(0, 0, -load)`` on x = length, meshed by
+    ``cells_across`` cubes a side across the section (``round(cells_across * length /
+    width)`` along it), each cut into 6 tetrahedra; quadratic displacements, an
+    exact quadrature of the stiffness, a direct solve (SuperLU: ``cells_across`` = 8, 70k
+    dofs, takes minutes).
+
+    Parameters
+    ----------
+    length, width : float
+    material : (E, nu)
+    load : float
+        Traction per unit area on the end face (total force ``load * width**2``).
+    cells_across : int
+
+    Returns
+    -------
+    tip : float
+        The mean deflection ``u_z`` over the loaded end face (its integral over the
+        face divided by ``width**2``).
+    displacement : callable ``(p, 3) -> (p, 3)``
+        The P2 displacement at points of the box.
+    dofs : int
+    """
+    import scipy.sparse.linalg as spla
+    from skfem import Basis, ElementTetP2, ElementVector, FacetBasis, Functional, LinearForm, MeshTet
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    along = int(round(cells_across * length / width))
+    mesh = MeshTet.init_tensor(np.linspace(0.0, length, along + 1),
+                               np.linspace(0.0, width, cells_across + 1),
+                               np.linspace(0.0, width, cells_across + 1))
+    mesh = mesh.with_boundaries({"clamp": lambda x: x[0] < 1e-9 * length,
+                                 "tip": lambda x: x[0] > (1.0 - 1e-9) * length})
+    element = ElementVector(ElementTetP2())
+    basis = Basis(mesh, element, intorder=2)
+    K = linear_elasticity(*lame_parameters(*material)).assemble(basis)
+
+    @LinearForm
+    def shear(v, w):
+        return -load * v[2]
+
+    f = shear.assemble(FacetBasis(mesh, element, facets=mesh.boundaries["tip"], intorder=2))
+    free = np.setdiff1d(np.arange(basis.N), basis.get_dofs("clamp").all())
+    u = np.zeros(basis.N)
+    u[free] = spla.spsolve(K[free][:, free].tocsc(), f[free])
+
+    @Functional
+    def deflection(w):
+        return w["uz"]
+
+    uz, uz_basis = basis.split(u)[2]
+    end = FacetBasis(mesh, uz_basis.elem, facets=mesh.boundaries["tip"], intorder=2)
+    mean = deflection.assemble(end, uz=end.interpolate(uz)) / width ** 2
+
+    def displacement(points):
+        probes = basis.probes(np.ascontiguousarray(np.asarray(points, dtype=float).T))
+        return (probes @ u).reshape(3, -1).T
+
+    return float(mean), displacement, basis.N
