@@ -79,16 +79,17 @@ class P1Solution(Solution):
     def energy_error(self, exact_stress: Callable[..., np.ndarray], *, order: int = 4) -> float:
         """Error in the energy norm against an exact stress field.
 
-        ``sqrt(sum_T ∫_T (σh - σ)ᵀ C⁻¹ (σh - σ) dΩ)`` with a triangle rule of
-        degree ``order`` on every triangle, collapsed at the crack tips (see
-        `cnem.assembly.quadrature.triangle_quadrature`) like the C-NEM error.
+        ``sqrt(sum_T ∫_T (σh - σ)ᵀ C⁻¹ (σh - σ) dΩ)`` with a rule of degree
+        ``order`` on every element: on triangles collapsed at the crack tips (see
+        `cnem.assembly.quadrature.triangle_quadrature`) like the C-NEM error, on
+        tetrahedra scikit-fem's rule.
 
         Parameters
         ----------
-        exact_stress : callable ``(q, 2) -> (q, 3)`` or ``(q, 2), (q,) -> (q, 3)``
-            ``[sxx, syy, sxy]`` at points; a function of two arguments also
-            receives the region of the triangle holding each point (for
-            fields discontinuous across material interfaces).
+        exact_stress : callable ``(q, d) -> (q, s)`` or ``(q, d), (q,) -> (q, s)``
+            Voigt stresses at points (``s`` = 3 in 2-D, 6 in 3-D); a function of
+            two arguments also receives the region of the element holding each
+            point (for fields discontinuous across material interfaces).
         order : int
             Degree of the quadrature rule.
 
@@ -96,12 +97,15 @@ class P1Solution(Solution):
         -------
         float
         """
-        corners = self.mesh.p.T[self.mesh.t.T]                      # (t, 3, 2)
-        e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
-        clockwise = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] < 0
-        corners[clockwise] = corners[clockwise][:, ::-1]
-        owner, points, weights = triangle_quadrature(corners, order,
-                                                     singular=self.problem.domain.tips)
+        corners = self.mesh.p.T[self.mesh.t.T]                      # (t, d + 1, d)
+        if corners.shape[2] == 3:
+            owner, points, weights = _tetrahedron_quadrature(corners, order)
+        else:
+            e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
+            clockwise = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] < 0
+            corners[clockwise] = corners[clockwise][:, ::-1]
+            owner, points, weights = triangle_quadrature(corners, order,
+                                                         singular=self.problem.domain.tips)
         density = energy_error_density(points, self.region[owner], self.stress[owner],
                                        self.C[owner], exact_stress)
         return float(np.sqrt(weights @ density))
