@@ -939,3 +939,25 @@ def cantilever_p2(length, width, material, load, cells_across):
         return (probes @ u).reshape(3, -1).T
 
     return float(mean), displacement, basis.N
+
+
+def end_face_mean(model, values):
+    """Mean of nodal ``values (n,)`` over the boundary faces of a 3-D model whose outward
+    normal is +x (the loaded end of a cantilever): exact for fields linear between the
+    three nodes of each boundary triangle (P1 hats, and C-NEM's shape functions on a
+    boundary face)."""
+    faces, normal = model.boundary_with_normals()
+    end = faces[normal[:, 0] > 0.5]
+    corners = model.nodes[end]
+    area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
+                                         corners[:, 2] - corners[:, 0]), axis=1)
+    return float(area @ np.asarray(values)[end].mean(axis=1)) / area.sum()
+
+
+def beam_tip(length, width, material, force):
+    """Timoshenko's tip deflection (positive) of a square-section cantilever under an
+    end force, Cowper's shear coefficient of a square ``10 (1 + nu) / (12 + 11 nu)``."""
+    E, nu = material
+    inertia = width ** 4 / 12.0
+    shear = E / (2.0 * (1.0 + nu)) * 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu) * width ** 2
+    return force * length ** 3 / (3.0 * E * inertia) + force * length / shear

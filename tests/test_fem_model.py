@@ -15,7 +15,7 @@ import cnem
 from cnem import fem
 from cnem.geometry.shapes3d import box_surface
 from cnem.material import lame, stiffness_matrix
-from reference import cantilever_p2
+from reference import beam_tip, cantilever_p2, end_face_mean
 from test_fem import PATCH, SOFT, STIFF, linear_field
 
 
@@ -161,19 +161,6 @@ def test_3d_errors(two_box_model):
 LENGTH, WIDTH, LOAD, STEEL = 5.0, 1.0, 1.0, (1000.0, 0.3)
 
 
-def tip_deflection(model, u):
-    """Mean ``u_z`` over the end face x = LENGTH: both methods are linear between the
-    three nodes of each boundary triangle there (C-NEM's shape functions on a
-    boundary face, P1 hats), so the face integral is exact for both."""
-    faces, normal = model.boundary_with_normals()
-    end = faces[normal[:, 0] > 0.5]
-    corners = model.nodes[end]
-    area = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0],
-                                         corners[:, 2] - corners[:, 0]), axis=1)
-    assert np.isclose(area.sum(), WIDTH ** 2, rtol=1e-12)
-    return float(area @ u[end, 2].mean(axis=1)) / WIDTH ** 2
-
-
 def cantilever(h, seed=0):
     """C-NEM and P1 tip deflections on one irregular cloud of spacing ``h``."""
     dom = cnem.geometry.box((0.0, 0.0, 0.0), (LENGTH, WIDTH, WIDTH))
@@ -183,8 +170,8 @@ def cantilever(h, seed=0):
         prob.add_dirichlet(lambda p: p[:, 0] < 1e-9 * LENGTH, None)
         prob.add_traction(lambda x, n: n[:, 0] > 0.5, [0.0, 0.0, -LOAD])
         sol = prob.solve()
-        tips.append(tip_deflection(model, sol.u))
-    return model, tips
+        tips.append(end_face_mean(model, sol.u[:, 2]))
+    return tips
 
 
 def test_cantilever_tip_deflection():
@@ -194,21 +181,13 @@ def test_cantilever_tip_deflection():
     10 %: the tip deflection is the compliance, which a method converging at first
     order in the energy norm misses by O((h/a)^2) = 11 % at h/a = 1/3. The P2
     reference with 4 cubes across (10k dofs) is within 0.25 % of its converged value
-    (0.1 % between 6 and 8 cubes across; see benchmarks/three_d.py --cantilever).
+    (0.05 % between 6 and 8 cubes across; see benchmarks/three_d.py --cantilever).
     """
     reference, _, _ = cantilever_p2(LENGTH, WIDTH, STEEL, LOAD, 4)
-    model, (scni, p1) = cantilever(WIDTH / 3.0)
+    scni, p1 = cantilever(WIDTH / 3.0)
     scni_error, p1_error = abs(scni / reference - 1.0), abs(p1 / reference - 1.0)
     assert scni_error < 0.10, (scni, p1, reference)
     assert scni_error < p1_error, (scni, p1, reference)
-    beam = beam_tip(LENGTH, WIDTH, STEEL, LOAD)
+    beam = -beam_tip(LENGTH, WIDTH, STEEL, LOAD * WIDTH ** 2)
     assert abs(reference / beam - 1.0) < 0.03                          # the right problem
 
-
-def beam_tip(length, width, material, load):
-    """Timoshenko's tip deflection of the cantilever (shear coefficient of a square,
-    Cowper's ``10 (1 + nu) / (12 + 11 nu)``), signed like ``u_z``."""
-    E, nu = material
-    force, inertia = load * width ** 2, width ** 4 / 12.0
-    shear = E / (2.0 * (1.0 + nu)) * 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu) * width ** 2
-    return -(force * length ** 3 / (3.0 * E * inertia) + force * length / shear)
