@@ -48,9 +48,9 @@ How to run
 ----------
 ::
 
-    python benchmarks/three_d.py                        # 10k nodes (~2 minutes)
+    python benchmarks/three_d.py                        # 10k nodes (~4 min, busy 2 cores)
     python benchmarks/three_d.py --sizes 10000 100000 1000000
-    python benchmarks/three_d.py --cantilever           # the tip-deflection table (~6 min)
+    python benchmarks/three_d.py --cantilever           # the tip-deflection table (~3 min)
 """
 import argparse
 import os
