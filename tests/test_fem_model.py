@@ -8,6 +8,8 @@ reference (`reference.cantilever_p2`).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -55,6 +57,16 @@ def test_same_conditions_as_cnem_on_the_model():
     assert key(edges_p1) == key(edges_cnem)                         # same orientation too
     np.testing.assert_allclose(p1.load().reshape(-1, 2).sum(axis=0), [0.0, -1.0], rtol=1e-12)
     assert p1.solve().u[:, 1].min() < 0
+
+
+def test_node_in_no_triangle_is_refused():
+    model = cnem.discretize(cnem.nodes.regular(cnem.geometry.rectangle(), 0.25))
+    corner = np.flatnonzero(np.hypot(*model.nodes.T) < 1e-9)[0]
+    keep = ~(model.triangles == corner).any(axis=1)
+    broken = dataclasses.replace(model, triangles=model.triangles[keep],
+                                 triangle_region=model.triangle_region[keep])
+    with pytest.raises(cnem.GeometryError, match="1 nodes in none"):
+        fem.P1Elasticity.from_model(broken, SOFT)
 
 
 # --------------------------------------------------------------------------------- 3-D

@@ -88,13 +88,9 @@ class P1Elasticity(Conditions):
                  plane: str = "stress", nodes: int | None = None,
                  max_area: float | None = None, quality: float = 30.0):
         if not isinstance(domain, Domain):
-            on_model = hasattr(domain, "nodes") and hasattr(domain, "cells")
             raise InputError(f"P1Elasticity meshes a 2-D cnem.Domain, received "
-                             f"{type(domain).__name__}; "
-                             + ("for P1 on a model's own nodes call "
-                                "P1Elasticity.from_model(model, materials)" if on_model else
-                                "build a model with cnem.discretize and call "
-                                "P1Elasticity.from_model(model, materials)"))
+                             f"{type(domain).__name__}; for P1 on the nodes of a model (2-D or "
+                             f"3-D) call P1Elasticity.from_model(model, materials)")
         self._set_problem(domain, materials, 2, plane)
         t0 = time.perf_counter()
         points, tri, region = mesh_domain(domain, nodes=nodes, max_area=max_area,
