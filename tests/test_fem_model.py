@@ -117,7 +117,7 @@ def test_regions_of_the_tetrahedra(two_box_model):
     np.testing.assert_allclose(volume.sum(), 2.0 * 1.0 * 0.8, rtol=1e-12)
 
 
-def test_linear_patch_on_a_3d_model_with_two_materials(two_box_model):
+def test_linear_patch_on_a_3d_model_with_two_materials(two_box_model, tmp_path):
     model = two_box_model
     field, stresses = two_material_field()
     prob = fem.P1Elasticity.from_model(model, [SOFT3, STIFF3])
@@ -135,6 +135,8 @@ def test_linear_patch_on_a_3d_model_with_two_materials(two_box_model):
     assert error < 1e-10 * np.sqrt(sol.energy())
     wrong = sol.energy_error(lambda x, region: 1.1 * stresses[region])
     np.testing.assert_allclose(wrong, 0.1 * np.sqrt(2.0 * sol.energy()), rtol=1e-9)  # exact volumes
+    with pytest.raises(cnem.CNEMError, match="tetrahedra cannot be written"):
+        sol.write(str(tmp_path / "p1.vtu"))
 
 
 def test_3d_patch_by_tractions(two_box_model):
