@@ -153,21 +153,9 @@ class P1Solution(Solution):
 
 def _tetrahedron_quadrature(corners: np.ndarray, order: int
                             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """scikit-fem's rule of degree ``order`` on every tetrahedron.
-
-    Parameters
-    ----------
-    corners : (t, 4, 3) ndarray
-    order : int
-
-    Returns
-    -------
-    owner : (q,) int64 ndarray
-        The tetrahedron of each point.
-    points : (q, 3) ndarray
-    weights : (q,) ndarray
-        ``sum(weights[owner == k])`` is the volume of tetrahedron ``k``.
-    """
+    """scikit-fem's rule of degree ``order`` on the tetrahedra ``corners (t, 4, 3)``: the
+    tetrahedron ``(q,)`` of each point, the points ``(q, 3)`` and their weights ``(q,)``,
+    which sum to each tetrahedron's volume."""
     ref, ref_weights = get_quadrature(RefTet, order)             # (3, r), (r,): volume 1/6
     jac = np.moveaxis(corners[:, 1:] - corners[:, :1], 1, 2)     # (t, 3, 3): columns edges
     points = corners[:, :1] + np.einsum("tij,jr->tri", jac, ref)
