@@ -451,6 +451,8 @@ EXAMPLES = {
     "cnem.pd.Problem": Example(lambda f: dict(body=f.body, material=cnem.pd.BondBased(1.0))),
     "cnem.fem.P1Elasticity": Example(
         lambda f: dict(domain=cnem.Domain(f.square), materials=(1.0, 0.3), nodes=20)),
+    "cnem.fem.P1Elasticity.from_model": Example(
+        lambda f: dict(model=f.model, materials=(1.0, 0.3))),
     "cnem.fem.mesh_domain": Example(lambda f: dict(domain=cnem.Domain(f.square), nodes=20)),
     "cnem.material.LinearElastic": Example(lambda f: dict(E=1.0, nu=0.3)),
     "cnem.material.parse_materials": Example(
