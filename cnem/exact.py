@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike
 from .errors import InputError, MaterialError, check_array, check_points
 from .material import effective_modulus, lame
 
-__all__ = ["LayeredCylinder", "CentralCrack", "rayleigh_speed"]
+__all__ = ["LayeredCylinder", "ThickSphere", "CentralCrack", "rayleigh_speed"]
 
 
 class LayeredCylinder:
@@ -125,6 +125,74 @@ class LayeredCylinder:
         srr, stt = lm - dev, lm + dev
         return np.column_stack([srr * c * c + stt * s * s, srr * s * s + stt * c * c,
                                 (srr - stt) * s * c])
+
+
+class ThickSphere:
+    """Hollow sphere under internal pressure (Lamé), linear elastic, in 3-D.
+
+    ``u_r = A r + B / r²``, ``σ_rr = (3 λ + 2 μ) A - 4 μ B / r³``,
+    ``σ_θθ = σ_φφ = (3 λ + 2 μ) A + 2 μ B / r³``, with ``A, B`` from ``σ_rr(a) = -p``
+    and ``σ_rr(b) = 0``.
+
+    Parameters
+    ----------
+    inner, outer : float
+        Radii ``a < b``.
+    E, nu : float
+    pressure : float
+        ``p`` on the inner surface.
+    center : (3,) array_like
+    """
+
+    def __init__(self, inner: float, outer: float, E: float, nu: float, *, pressure: float = 1.0,
+                 center: ArrayLike = (0.0, 0.0, 0.0)) -> None:
+        a, b = (float(check_array(name, v, shape=())) for name, v in (("inner", inner),
+                                                                      ("outer", outer)))
+        if not 0.0 < a < b:
+            raise InputError(f"inner, outer: expected radii 0 < inner < outer, received "
+                             f"{a!r}, {b!r}")
+        E, nu = (float(check_array(name, v, shape=(), error=MaterialError))
+                 for name, v in (("E", E), ("nu", nu)))
+        if not (E > 0.0 and -1.0 < nu < 0.5):
+            raise MaterialError(f"E, nu: expected E > 0 and -1 < nu < 1/2, received {E!r}, {nu!r}")
+        self.inner, self.outer = a, b
+        self.lam, self.mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+        p = float(check_array("pressure", pressure, shape=()))
+        self.center = check_array("center", center, shape=(3,), fix="pass one point (x, y, z)")
+        self.B = p / (4.0 * self.mu * (a ** -3 - b ** -3))
+        self.A = 4.0 * self.mu * self.B / (b ** 3 * (3.0 * self.lam + 2.0 * self.mu))
+
+    def radial_displacement(self, r: ArrayLike) -> np.ndarray:
+        r = _distances("r", r)
+        return self.A * r + self.B / r ** 2
+
+    def radial_stress(self, r: ArrayLike) -> np.ndarray:
+        r = _distances("r", r)
+        return (3.0 * self.lam + 2.0 * self.mu) * self.A - 4.0 * self.mu * self.B / r ** 3
+
+    def hoop_stress(self, r: ArrayLike) -> np.ndarray:
+        r = _distances("r", r)
+        return (3.0 * self.lam + 2.0 * self.mu) * self.A + 2.0 * self.mu * self.B / r ** 3
+
+    def _radial(self, points):
+        rel = check_points("points", points, dims=(3,)) - self.center
+        r = np.linalg.norm(rel, axis=1)
+        return r, rel / r[:, None]
+
+    def displacement(self, points: ArrayLike) -> np.ndarray:
+        """``(p, 3)`` Cartesian displacements."""
+        r, n = self._radial(points)
+        return self.radial_displacement(r)[:, None] * n
+
+    def stress(self, points: ArrayLike) -> np.ndarray:
+        """``(p, 6)`` Voigt ``[sxx, syy, szz, syz, sxz, sxy]``:
+        ``σ = σ_θθ I + (σ_rr - σ_θθ) n ⊗ n``."""
+        r, n = self._radial(points)
+        srr, stt = self.radial_stress(r), self.hoop_stress(r)
+        d = (srr - stt)[:, None]
+        return np.column_stack([stt + d[:, 0] * n[:, 0] ** 2, stt + d[:, 0] * n[:, 1] ** 2,
+                                stt + d[:, 0] * n[:, 2] ** 2, d[:, 0] * n[:, 1] * n[:, 2],
+                                d[:, 0] * n[:, 0] * n[:, 2], d[:, 0] * n[:, 0] * n[:, 1]])
 
 
 def _distances(name: str, value: ArrayLike) -> np.ndarray:

@@ -341,6 +341,8 @@ EXAMPLES = {
     "cnem.exact.LayeredCylinder": Example(
         lambda f: dict(radii=np.array([1.0, 2.0]), materials=np.array([[1.0, 0.3]]),
                        center=np.array([0.0, 0.0]))),
+    "cnem.exact.ThickSphere": Example(
+        lambda f: dict(inner=0.5, outer=1.0, E=1.0, nu=0.3, center=np.zeros(3))),
     "cnem.exact.CentralCrack": Example(lambda f: dict(half_length=1.0)),
     "cnem.exact.rayleigh_speed": Example(lambda f: dict(E=1.0, nu=0.3, density=1.0)),
     "cnem.fracture.sif": Example(lambda f: dict(sol=f.sol, tip=f.tip)),
@@ -522,6 +524,14 @@ EXAMPLES = {
                        r=np.array([1.2, 1.5])),
         skip={"shape": _ELEMENTWISE, "scalar": _ELEMENTWISE})
        for method in ("hoop_stress", "layer", "radial_displacement", "radial_stress")},
+    **{f"cnem.exact.ThickSphere.{method}": Example(
+        lambda f: dict(self=cnem.exact.ThickSphere(0.5, 1.0, 1.0, 0.3), r=np.array([0.6, 0.9])),
+        skip={"shape": _ELEMENTWISE, "scalar": _ELEMENTWISE})
+       for method in ("hoop_stress", "radial_displacement", "radial_stress")},
+    **{f"cnem.exact.ThickSphere.{method}": Example(
+        lambda f: dict(self=cnem.exact.ThickSphere(0.5, 1.0, 1.0, 0.3),
+                       points=np.array([[0.6, 0.0, 0.0], [0.0, 0.5, 0.5]])))
+       for method in ("displacement", "stress")},
     "cnem.exact.LayeredCylinder.displacement": Example(
         lambda f: dict(self=cnem.exact.LayeredCylinder([1.0, 2.0], [[1.0, 0.3]]),
                        points=np.array([[1.2, 0.0], [0.0, 1.5]]))),
