@@ -5,6 +5,7 @@ import pytest
 
 import cnem
 
+
 @pytest.fixture
 def sphere():
     return cnem.exact.ThickSphere(0.5, 1.25, 3.0, 0.3, pressure=2.0, center=(1.0, -2.0, 0.5))
