@@ -327,6 +327,23 @@ def check_growth_two_holes(demo, res, outdir):
     assert np.all(np.diff(tips[:, 0, 0]) > 0) and np.all(np.diff(tips[:, 1, 0]) < 0)
     # the plate is point-symmetric about its centre: so are the two paths (to the cloud's asymmetry)
     assert np.abs(tips[:, 0] + tips[:, 1] - [20.0, 10.0]).max() < 0.15
+    clamped = res["runs"].get("clamped")
+    if clamped is None:
+        return
+    # clamped grips (u_x = 0 along top and bottom): the same symmetry, a smaller first kink
+    # and a path farther below the hole at (3, 7) than with free grips; the left tips at
+    # 3, 4, 6, 8 mm of growth near the independent P2 check's (outside this project)
+    ct = clamped["tips"]
+    assert np.abs(ct[:, 0] + ct[:, 1] - [20.0, 10.0]).max() < 0.15
+    free = res["runs"]["free"]
+    assert 0 < clamped["kink"] < free["kink"] - 4.0
+    assert clamped["hole_gap"] > free["hole_gap"] + 0.8
+    check = demo.INDEPENDENT["clamped"]
+    grown = np.isfinite(clamped["at_growth"][:, 0])
+    assert grown.sum() >= 2
+    assert np.hypot(*(clamped["at_growth"] - check["at_growth"])[grown].T).max() < 0.15
+    assert abs(clamped["kink"] - check["kink"]) < 1.5
+    assert [row[0] for row in res["comparison"]][-1] == "published XFEM (MSolve)"
 
 
 def check_growth_pd_vs_cnem(demo, res, outdir):

@@ -105,9 +105,8 @@ def test_an_ambiguous_constant_load_is_refused(kind, bad):
     prob = _problems()[kind]
     with pytest.raises(cnem.ConditionError, match="vector of 2 components"):
         prob.add_body_force(bad)
-    if kind != "pd":                       # PD takes no tractions at all
-        with pytest.raises(cnem.ConditionError, match="pressure p along the outward normal"):
-            prob.add_traction(lambda x, nrm: x[:, 0] > 1.0 - 1e-9, bad)
+    with pytest.raises(cnem.ConditionError, match="pressure p along the outward normal"):
+        prob.add_traction(lambda x, nrm: x[:, 0] > 1.0 - 1e-9, bad)
 
 
 @pytest.mark.parametrize("kind", ["cnem", "p1", "pd"])

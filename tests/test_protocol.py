@@ -94,8 +94,14 @@ def test_every_problem_offers_the_conditions_and_solve(name):
     with pytest.raises(ConditionError, match=r"conflicting values on 1 dof.*0\.5 and 1"):
         prob.prescribed()
     if name == "PD":
-        with pytest.raises(NotImplementedError, match="add_body_force"):
-            prob.add_traction(lambda x, n: n[:, 0] > 0.5, [1.0, 0.0])
+        # a lattice knows no boundary edges: it takes a traction on points with the area
+        # each carries (`cnem.pd.tractions`), and refuses one without it
+        with pytest.raises(NotImplementedError, match="plain Body has no boundary edges"):
+            prob.boundary_edges()
+        with pytest.raises(ConditionError, match="exactly one of area= .* or spacing="):
+            prob.add_traction(lambda x: x[:, 0] > 1.0 - 1e-9, [1.0, 0.0])
+        prob.add_traction(lambda x: x[:, 0] > 1.0 - 1e-9, [1.0, 0.0], spacing=H)
+        assert len(prob.tractions) == 1
         return
     edges, normal = prob.boundary_edges()
     assert edges.shape[1] == 2 and normal.shape == (len(edges), 2)

@@ -86,7 +86,6 @@ NOT_ENTRY_POINTS = {
         "cnem.fracture.Enrichment.values", "cnem.spatial.RTree.from_points_in",
         "cnem.pd.CPD.measure_derivatives", "cnem.pd.Problem.energy_density",
         "cnem.pd.Problem.displacement_gradient", "cnem.pd.Problem.stress_tensor")},
-    "cnem.pd.Problem.add_traction": "refuses every call (a PD body has no boundary edges)",
     "cnem.pd.StaticSolution.stress_at": "refuses every call (the base Solution.stress_at: "
                                         "no pointwise stress but C-NEM's)",
     # hyper-dual arithmetic: elementwise NumPy semantics on any shape (NaN in, NaN out),
@@ -568,6 +567,10 @@ EXAMPLES = {
        for name in ("stack", "concatenate")},
     "cnem.pd.Problem.add_velocity": Example(
         lambda f: dict(self=_pd_problem(f), where=np.array([24]), component=0, value=1.0)),
+    "cnem.pd.Problem.add_traction": Example(
+        lambda f: dict(self=_pd_problem(f), where=np.arange(20, 25),         # the row x = 1
+                       t=np.array([1.0, 0.0]), area=np.full(5, 0.25), normal=np.array([1.0, 0.0])),
+        skip={("area", "scalar"): "a number is valid (the same area at every loaded point)"}),
     "cnem.pd.Problem.run_dynamic": Example(
         lambda f: dict(self=_pd_problem(f), dt=1e-3, steps=2,
                        velocity=np.zeros((len(f.lattice), 2)), progress=False)),

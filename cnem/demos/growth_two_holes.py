@@ -19,7 +19,7 @@ the same plate, holes, cracks, material, plane strain and load, with
 
 * supports: u_y = 0 along the bottom, u_y = 0.1 mm along the top, u_x = 0 at
   the top-left *and* the bottom-right corners (ours: u_x = 0 at one corner
-  only; `study` runs both);
+  only; `study` runs both; see also "Clamped grips" below);
 * Q4 XFEM on one unstructured mesh of 4272 dofs (element size about 0.3 mm),
   Heaviside and tip enrichment (tip enrichment area 0.5), the J (interaction)
   integral over a radius of 2 element sizes, maximum circumferential tensile
@@ -66,13 +66,38 @@ published supports (u_x = 0 at two corners) move our tips by less than
 0.01 mm over the first 4 steps (h = 0.25, no rings): they are not the cause.
 We tuned nothing to close that gap.
 
+Clamped grips (``--grips clamped``; ``--grips both`` runs the two)
+-----------------------------------------------------------------
+An independent check (a P2 finite-element code with remeshing and its own
+interaction integral, written outside this project) reproduces our path under
+the demo's conditions: first kink 16.90 degrees, left tip at 3 mm of growth
+(3.414, 4.545) converged in the increment (ours: the limit (3.42, 4.54) above),
+entry into the hole at (3, 7) near (3.84-3.88, 5.18-5.20). It finds the
+published shape only with *clamped grips*, u_x = 0 along the whole top and
+bottom edges as well (the grips of a testing machine): left tip at 3, 4, 6, 8 mm
+of growth (3.89, 3.60), (4.88, 3.47), (6.87, 3.30), (8.87, 3.37) against the
+published (3.81, 3.90), (4.77, 3.62), (6.71, 3.28), (8.70, 3.21), though with a
+first kink of 10.4 degrees instead of 19.2. Clamping the edges holds back the
+shear that turns the cracks towards the holes: the first kink drops from about
+17 to about 10 degrees, the left crack runs 1.5 mm below the hole at (3, 7) and
+on towards the other hole, as the published one does. With clamped grips
+(h = 0.25, 1 mm increments) our left tip at 3, 4, 6, 8 mm of growth is
+(3.90, 3.60), (4.90, 3.58), (6.88, 3.34), (8.88, 3.39), first kink 10.2
+degrees: within 0.12 mm and 0.3 degrees of the independent check. The
+published path is then matched in shape; its first kink (19.2) is not.
+
 Expected result
 ---------------
 * Both paths curve and stay point-symmetric about the plate's centre; the
   table gives the tip positions at every step beside the published ones at
-  the same crack length, and their distance.
+  the same crack length, and their distance; with ``--grips both`` the last
+  table sets the left crack's tips at 3, 4, 6, 8 mm of growth and its first
+  kink, for both grips, beside the independent check's and the published ones.
 * ``two_holes_paths.png``: the paths over the von Mises field, the published
-  path dashed; ``two_holes_sif.png``: K_I, K_II against crack length.
+  path dashed; ``two_holes_sif.png``: K_I, K_II against crack length (with
+  clamped grips ``two_holes_paths_clamped.png``, ``two_holes_sif_clamped.png``);
+  ``two_holes_grips.png``: the left crack's paths for the grips run, the
+  independent check's points and the published path.
 """
 
 from __future__ import annotations
@@ -86,12 +111,13 @@ import shapely
 
 import cnem
 from cnem.cli import demo_parser, positive_float, positive_int
+from cnem.errors import check_choice
 from cnem.geometry import arc
 
 if TYPE_CHECKING:
     from typing import Sequence
 
-__all__ = ["main", "cli", "study"]
+__all__ = ["main", "cli", "study", "grown", "compare_grips"]
 
 L, B, R = 20.0, 10.0, 2.0
 HOLES = ((3.0, 7.0), (17.0, 3.0))
@@ -107,6 +133,25 @@ PUBLISHED_PATHS = np.array([
      [10.3089, 6.6554], [9.3177, 6.5233], [8.3514, 6.2659]]])
 #: published end points (left crack, right crack)
 PUBLISHED = PUBLISHED_PATHS[:, -1]
+#: Growth (mm from the initial tip) at which the left crack's tips are compared.
+GROWTH = np.array([3.0, 4.0, 6.0, 8.0])
+#: The boundary conditions of `main` (``grips``), as the output names them.
+GRIPS = {"free": "u_y = 0 along the bottom, u_y = 0.1 mm along the top, u_x = 0 at the "
+                 "bottom-left corner",
+         "clamped": "u_y = 0 along the bottom, u_y = 0.1 mm along the top, u_x = 0 along "
+                    "both",
+         "both": "the two runs"}
+#: The independent check (a P2 finite-element code with remeshing and its own interaction
+#: integral, written outside this project; issue 39): the left crack's tip at `GROWTH` mm
+#: of growth (NaN: not given), its first kink (degrees), where it meets the hole at (3, 7),
+#: the decimals given.
+INDEPENDENT = {
+    "free": dict(at_growth=np.array([[3.414, 4.545]] + [[np.nan, np.nan]] * 3), kink=16.90,
+                 entry=np.array([3.86, 5.19]), digits=3, kink_digits=2,
+                 hole="(converged in the increment) enters it near (3.84-3.88, 5.18-5.20)"),
+    "clamped": dict(at_growth=np.array([[3.89, 3.60], [4.88, 3.47], [6.87, 3.30], [8.87, 3.37]]),
+                    kink=10.4, digits=2, kink_digits=1, hole="passes below it"),
+}
 
 
 def domain(h):
@@ -116,12 +161,15 @@ def domain(h):
     return cnem.Domain([(shell, holes)], cracks=cracks)
 
 
-def setup(model, corners=False):
+def setup(model, corners=False, clamped=False):
     """Elasticity with the supports and the pull; ``corners``: u_x = 0 at the top-left and
-    bottom-right corners (the published run) instead of at the bottom-left one."""
+    bottom-right corners (the published run) instead of at the bottom-left one;
+    ``clamped``: clamped grips, u_x = 0 on the whole top and bottom edges as well."""
     tol = 1e-9 * L
     prob = cnem.Elasticity(model, (E, NU), plane="strain")
     prob.add_dirichlet(lambda p: np.abs(p[:, 1]) < tol, 1)
+    if clamped:
+        prob.add_dirichlet(lambda p: (np.abs(p[:, 1]) < tol) | (np.abs(p[:, 1] - B) < tol), 0)
     pins = [(0.0, B), (L, 0.0)] if corners else [(0.0, 0.0)]
     for x, y in pins:
         prob.add_dirichlet(lambda p, x=x, y=y: np.hypot(p[:, 0] - x, p[:, 1] - y) < tol, 0)
@@ -130,16 +178,17 @@ def setup(model, corners=False):
 
 
 def run(h=0.25, increment=1.0, steps=None, refine="auto", corners=False, progress=True,
-        scheme="explicit"):
+        scheme="explicit", clamped=False):
     """`cnem.fracture.grow` on the plate; ``steps`` default: 12 mm of growth per crack;
     ``refine``: ``"auto"`` (grow's default), None (no rings) or the ring tip spacing in
-    background spacings; ``scheme``: the increment of `cnem.fracture.grow`. A run whose
+    background spacings; ``scheme``: the increment of `cnem.fracture.grow`; ``clamped``:
+    clamped grips (`setup`). A run whose
     cracks cut the plate in two returns the path up to there (the event ``"split"`` says so)."""
     dom = domain(h)
     steps = int(round(12.0 / increment)) if steps is None else steps
     rings = refine if refine is None or refine == "auto" else refine * h
     try:
-        return cnem.fracture.grow(dom, h, lambda m: setup(m, corners), increment=increment,
+        return cnem.fracture.grow(dom, h, lambda m: setup(m, corners, clamped), increment=increment,
                                   steps=steps, refine=rings, scheme=scheme, progress=progress)
     except cnem.GeometryError as err:
         if getattr(err, "history", None) is None:
@@ -176,33 +225,17 @@ def hausdorff(a, b):
     return float(shapely.hausdorff_distance(shapely.LineString(a), shapely.LineString(b), densify=0.01))
 
 
-def main(h: float = 0.25, *, increment: float = 1.0, steps: int = 12,
-         refine: float | str | None = "auto",
-         outdir: str = "results/growth_two_holes", plot: bool = True,
-         progress: bool = True) -> dict:
-    """Grow both cracks; print the tips at every step beside the published ones.
-
-    Returns
-    -------
-    dict
-        ``tips (steps + 1, 2, 2)`` (tip 0 the left crack), ``final (2, 2)``,
-        ``distance (2,)`` of the last tips to the published end points,
-        ``published (steps + 1, 2, 2)`` (the published tips at the same crack
-        lengths, NaN beyond 13 mm), ``lengths (steps + 1, 2)`` the crack lengths,
-        ``hausdorff (2,)`` to the published paths,
-        ``events``, ``files``.
-    """
-    out = pathlib.Path(outdir)
-    out.mkdir(parents=True, exist_ok=True)
-    hist = run(h, increment, steps, refine, progress=progress)
+def _left_first(hist):
+    """``(tips (k, 2, 2), angles (k, 2) degrees, lengths (k, 2))`` of a run, the left crack
+    first."""
     tips = hist.paths()
-    left = int(np.argmin(tips[0, :, 0]))
-    order = [left, 1 - left]
-    tips = tips[:, order]
-    angles = np.degrees(hist.array("angle"))[:, order]
-    lengths = hist.array("crack_length")[:, order]
-    published = np.stack([at_lengths(p, a) for p, a in zip(PUBLISHED_PATHS, lengths.T)], axis=1)
-    gap = np.hypot(*(tips - published).transpose(2, 0, 1))
+    order = [int(np.argmin(tips[0, :, 0])), 1 - int(np.argmin(tips[0, :, 0]))]
+    return (tips[:, order], np.degrees(hist.array("angle"))[:, order],
+            hist.array("crack_length")[:, order])
+
+
+def _print_steps(tips, angles, lengths, published, gap):
+    """The tips at every step beside the published ones at the same crack length."""
     print(f"{'step':>4} {'a':>5} | {'left x':>7} {'left y':>7} {'kink':>7} {'publ.':>13} "
           f"{'dist':>5} | {'right x':>7} {'right y':>7} {'kink':>7} {'publ.':>13} {'dist':>5}")
     for k in range(len(tips)):
@@ -211,6 +244,30 @@ def main(h: float = 0.25, *, increment: float = 1.0, steps: int = 12,
             row += (f" | {tips[k, i, 0]:>7.3f} {tips[k, i, 1]:>7.3f} {angles[k, i]:>7.2f} "
                     f"({published[k, i, 0]:>5.2f},{published[k, i, 1]:>5.2f}) {gap[k, i]:>5.2f}")
         print(row)
+
+
+def grown(h: float = 0.25, increment: float = 1.0, steps: int = 12,
+          refine: float | str | None = "auto", clamped: bool = False,
+          progress: bool = True) -> dict:
+    """One run (`run`) with its tips beside the published ones, printed.
+
+    Returns
+    -------
+    dict
+        ``tips (steps + 1, 2, 2)`` (tip 0 the left crack), ``final (2, 2)``, ``distance (2,)``
+        of the last tips to the published end points, ``published (steps + 1, 2, 2)`` (the
+        published tips at the same crack lengths, NaN beyond 13 mm), ``lengths (steps + 1, 2)``
+        the crack lengths, ``hausdorff (2,)`` to the published paths, ``kink`` (the left
+        crack's first kink, degrees), ``at_growth (4, 2)`` (its tip at `GROWTH` mm of growth,
+        NaN beyond its end), ``hole (2,)`` (the point of its path nearest the hole at (3, 7))
+        and ``hole_gap`` (its distance to the hole, 0: it enters), ``paths``, ``events``,
+        ``history``.
+    """
+    hist = run(h, increment, steps, refine, progress=progress, clamped=clamped)
+    tips, angles, lengths = _left_first(hist)
+    published = np.stack([at_lengths(p, a) for p, a in zip(PUBLISHED_PATHS, lengths.T)], axis=1)
+    gap = np.hypot(*(tips - published).transpose(2, 0, 1))
+    _print_steps(tips, angles, lengths, published, gap)
     distance = np.hypot(*(tips[-1] - PUBLISHED).T)
     paths = mouth_paths(hist)
     haus = np.array([hausdorff(p, q) for p, q in zip(paths, PUBLISHED_PATHS)])
@@ -220,22 +277,139 @@ def main(h: float = 0.25, *, increment: float = 1.0, steps: int = 12,
     print(f"{len(hist.model.nodes)} nodes at the end")
     for e in hist.events:
         print(e)
+    line, centre = shapely.LineString(paths[0]), shapely.Point(HOLES[0])
+    hole_gap = max(0.0, float(line.distance(centre)) - R)
+    hole = shapely.get_coordinates(shapely.shortest_line(line, centre))[0] if hole_gap > 0 else \
+        shapely.get_coordinates(line.intersection(centre.buffer(R, quad_segs=256).boundary))[0]
+    return dict(tips=tips, final=tips[-1], distance=distance, published=published,
+                lengths=lengths, hausdorff=haus, kink=float(angles[0, 0]),
+                at_growth=at_lengths(paths[0], 1.0 + GROWTH), hole=hole,
+                hole_gap=hole_gap, paths=paths,
+                events=[str(e) for e in hist.events], history=hist)
+
+
+def compare_grips(runs: dict) -> list:
+    """Print the left crack's tip at `GROWTH` mm of growth and its first kink, for each
+    run (``runs``: grips -> `grown` result) beside the independent check and the
+    published XFEM path.
+
+    Returns
+    -------
+    list of tuple
+        ``(label, points (4, 2), kink, digits, kink digits)`` rows as printed (NaN: not
+        given; the references with the digits they were given with).
+    """
+    def cell(p, digits):
+        return f"({p[0]:6.{digits}f}, {p[1]:6.{digits}f})" if np.isfinite(p).all() else \
+            f"{'-':^16}"
+
+    published_kink = float(np.degrees(np.arctan2(*np.diff(PUBLISHED_PATHS[0, 1:3], axis=0)[0, ::-1])))
+    rows = []
+    for grips, res in runs.items():
+        rows.append((f"cnem, {grips} grips", res["at_growth"], res["kink"], 3, 2))
+        check = INDEPENDENT[grips]
+        rows.append((f"independent check, {grips}", check["at_growth"], check["kink"],
+                     check["digits"], check["kink_digits"]))
+    rows.append(("published XFEM (MSolve)", PUBLISHED_PATHS[0, 1 + GROWTH.astype(int)],
+                 published_kink, 2, 1))
+    print(f"left crack: tip (x, y) in mm at {', '.join(f'{g:g}' for g in GROWTH)} mm of growth "
+          f"and first kink (degrees)")
+    head = " ".join(f"{f'{g:g} mm':^16}" for g in GROWTH)
+    print(f"{'':<28} {head} {'kink':>6}")
+    for label, points, kink, digits, kink_digits in rows:
+        print(f"{label:<28} {' '.join(cell(p, digits) for p in points)} "
+              f"{kink:>6.{kink_digits}f}")
+    for grips, res in runs.items():
+        where = "enters it at" if res["hole_gap"] == 0 else \
+            f"passes {res['hole_gap']:.2f} mm from it, nearest at"
+        print(f"hole at (3, 7), cnem, {grips} grips: the left path {where} "
+              f"({res['hole'][0]:.3f}, {res['hole'][1]:.3f}); the independent check's "
+              f"{INDEPENDENT[grips]['hole']}")
+    return rows
+
+
+def main(h: float = 0.25, *, increment: float = 1.0, steps: int = 12,
+         refine: float | str | None = "auto", grips: str = "free",
+         outdir: str = "results/growth_two_holes", plot: bool = True,
+         progress: bool = True) -> dict:
+    """Grow both cracks; print the tips at every step beside the published ones, and the
+    left crack's tips at 3, 4, 6 and 8 mm of growth beside the independent check's and
+    the published ones.
+
+    Parameters
+    ----------
+    grips : {"free", "clamped", "both"}
+        The demo's conditions (u_x free along the top and bottom edges), clamped grips
+        (u_x = 0 there too), or both runs.
+
+    Returns
+    -------
+    dict
+        The `grown` result of the first run (``"free"`` when both ran) with ``files``,
+        ``runs`` (grips -> `grown` result) and ``comparison`` (`compare_grips`).
+    """
+    check_choice("grips", grips, GRIPS)
+    out = pathlib.Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    runs = {}
+    for variant in ("free", "clamped") if grips == "both" else (grips,):
+        print(f"-- {variant} grips: {GRIPS[variant]}")
+        runs[variant] = grown(h, increment, steps, refine, variant == "clamped", progress)
+    comparison = compare_grips(runs)
     files = []
     if plot:
-        fig = hist.plot(None, kind="paths", length_unit="mm", stress_unit="MPa",
-                        title=f"Two holes, two edge cracks: {len(hist.steps)} increments of "
-                              f"{increment:g} mm, h = {h:g} mm")
-        for k, p in enumerate(PUBLISHED_PATHS):
-            fig.axes[0].plot(*p.T, "--x", color="tab:orange", lw=1.2, ms=4,
-                             label="published XFEM path" if k == 0 else None)
-        fig.axes[0].legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=4, fontsize=8)
-        fig.savefig(out / "two_holes_paths.png", dpi=130, bbox_inches="tight")
-        hist.plot(out / "two_holes_sif.png", kind="sif", length_unit="mm",
-                  sif_unit=r"MPa$\sqrt{\mathrm{mm}}$")
-        files = [out / "two_holes_paths.png", out / "two_holes_sif.png"]
-    return dict(tips=tips, final=tips[-1], distance=distance, published=published, lengths=lengths,
-                hausdorff=haus,
-                events=[str(e) for e in hist.events], files=[str(f) for f in files], history=hist)
+        for variant, res in runs.items():
+            files += _pictures(res["history"], variant, h, increment, out)
+        files.append(_grips_picture(runs, out / "two_holes_grips.png"))
+    first = runs[next(iter(runs))]
+    return dict(first, files=[str(f) for f in files], runs=runs, comparison=comparison)
+
+
+def _pictures(hist, grips, h, increment, out):
+    """The paths over the von Mises field and the SIF curves of one run."""
+    suffix = "" if grips == "free" else f"_{grips}"
+    fig = hist.plot(None, kind="paths", length_unit="mm", stress_unit="MPa",
+                    title=f"Two holes, two edge cracks, {grips} grips: {len(hist.steps)} "
+                          f"increments of {increment:g} mm, h = {h:g} mm")
+    for k, p in enumerate(PUBLISHED_PATHS):
+        fig.axes[0].plot(*p.T, "--x", color="tab:orange", lw=1.2, ms=4,
+                         label="published XFEM path" if k == 0 else None)
+    fig.axes[0].legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=4, fontsize=8)
+    fig.savefig(out / f"two_holes_paths{suffix}.png", dpi=130, bbox_inches="tight")
+    hist.plot(out / f"two_holes_sif{suffix}.png", kind="sif", length_unit="mm",
+              sif_unit=r"MPa$\sqrt{\mathrm{mm}}$")
+    return [out / f"two_holes_paths{suffix}.png", out / f"two_holes_sif{suffix}.png"]
+
+
+def _grips_picture(runs, path):
+    """The left crack's paths of the runs, the independent check's points and the
+    published path, near the hole at (3, 7)."""
+    from cnem.plot.charts import offscreen_pyplot
+    plt = offscreen_pyplot()
+    fig, ax = plt.subplots(figsize=(9, 5.5))
+    ax.add_patch(plt.Circle(HOLES[0], R, fill=False, color="black"))
+    ax.plot([0, 0], [0, B], color="black", lw=1)
+    colours = {"free": "tab:red", "clamped": "tab:blue"}
+    for grips, res in runs.items():
+        ax.plot(*res["paths"][0].T, "o-", ms=3, lw=1.5, color=colours[grips],
+                label=f"cnem, {grips} grips")
+    ax.plot(*PUBLISHED_PATHS[0].T, "--x", color="black", lw=1, ms=5, label="published XFEM")
+    ax.plot(*INDEPENDENT["clamped"]["at_growth"].T, "s", ms=8, mfc="none", color="tab:blue",
+            label="independent check, clamped grips (3, 4, 6, 8 mm)")
+    ax.plot(*INDEPENDENT["free"]["at_growth"][0], "^", ms=8, mfc="none", color="tab:red",
+            label="independent check, free grips (3 mm, converged)")
+    ax.plot(*INDEPENDENT["free"]["entry"], "v", ms=8, mfc="none", color="tab:red",
+            label="independent check, free grips: entry into the hole")
+    ax.set_xlim(0.0, 10.0)
+    ax.set_ylim(2.0, 7.5)
+    ax.set_aspect("equal")
+    ax.set_xlabel(r"$x$ (mm)")
+    ax.set_ylabel(r"$y$ (mm)")
+    ax.set_title("Left crack: free against clamped grips (hole at (3, 7) drawn)")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2)
+    fig.savefig(path, dpi=130, bbox_inches="tight")
+    plt.close(fig)
+    return path
 
 
 #: The runs of `study`: (h, increment, ring tip spacing in spacings or None, published supports).
@@ -327,12 +501,17 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     parser.add_argument("--increment", type=positive_float, default=1.0, help="crack increment (mm)")
     parser.add_argument("--steps", type=positive_int, default=12, help="growth increments")
     parser.add_argument("--no-rings", action="store_true", help="no refinement following the tips")
+    parser.add_argument("--grips", choices=("free", "clamped", "both"), default="free",
+                        help="u_x along the top and bottom edges: free (the demo's conditions), "
+                             "clamped (u_x = 0, the conditions the published path matches) or "
+                             "both runs side by side")
     parser.add_argument("--study", action="store_true",
                         help="also the convergence study: spacing/2, increment/2 and /4, the "
                              "published supports (several minutes)")
     args = parser.parse_args(argv)
     res = main(args.h, increment=args.increment, steps=args.steps,
-               refine=None if args.no_rings else "auto", outdir=args.out, plot=not args.no_plot)
+               refine=None if args.no_rings else "auto", grips=args.grips, outdir=args.out,
+               plot=not args.no_plot)
     if args.study:
         study(outdir=args.out)
     return res

@@ -14,10 +14,10 @@ then held. Bond-based PMB (`cnem.pd.BondBased`, nu = 1/3), critical stretch
 at 0.8 times the Silling-Askari stable time step.
 
 Discretisation: one point at the centre of each h x h cell of a regular grid
-(no point on the crack line), horizon delta = m h. The tractions are body
-forces ``sigma / h`` per unit volume on the outermost row of points of each
-loaded edge (force sigma h per point and unit thickness). The pre-crack drops
-the bonds crossing it (`cnem.pd.Body(cracks=...)`), so the damage shows only
+(no point on the crack line), horizon delta = m h. The tractions act on the
+outermost row of points of each loaded edge (``add_traction(..., spacing=h)``:
+force sigma h per point and unit thickness). The pre-crack drops the bonds
+crossing it (`cnem.pd.Body(cracks=...)`), so the damage shows only
 the bonds broken during the run.
 
 Materials (``--material``)
@@ -184,10 +184,9 @@ def build(h: float, m: float, material: str = "soda-lime",
                    cracks=[[[-horizon, 0.0], [NOTCH, 0.0]]])
     problem = pd.Problem(body, pd.BondBased(mat["E"], fracture_energy=mat["G0"],
                                             density=mat["density"]), plane="stress")
-    edge = np.abs(points[:, 1]) > 0.5 * HEIGHT - h            # the outermost row at each edge
-    load = np.zeros_like(points)
-    load[edge, 1] = np.sign(points[edge, 1]) * stress / h
-    problem.add_body_force(load)
+    edge = 0.5 * HEIGHT - h                                  # the outermost row at each edge
+    problem.add_traction(lambda p: p[:, 1] > edge, [0.0, stress], spacing=h)
+    problem.add_traction(lambda p: p[:, 1] < -edge, [0.0, -stress], spacing=h)
     return problem, shape
 
 

@@ -24,8 +24,8 @@ from ..assembly.facet_gradients import boundary_points_3d
 from ..assembly.gradients import GradientCache
 from ..errors import GeometryError
 from ..geometry.model import check_model
-from ..geometry.topology import constraint_edges
 from ..solvers.conditions import Conditions, traction_at
+from ..solvers.facet_loads import facet_loads
 
 if TYPE_CHECKING:
     from ..geometry.domain import Domain
@@ -94,13 +94,7 @@ class ModelProblem(Conditions):
         """The model's boundary pieces with the body on one side and their outward unit
         normals (see `Conditions.boundary_edges`): constraint edges ``(e, 2)`` in 2-D,
         boundary triangles ``(e, 3)`` in 3-D."""
-        if self.dim == 3:
-            return self.model.boundary_with_normals()
-        tri = self.model.triangles
-        edges, _ = constraint_edges(tri, self.model.neighbors(across_regions=True))
-        d = self.model.nodes[edges[:, 1]] - self.model.nodes[edges[:, 0]]
-        normal = np.column_stack([d[:, 1], -d[:, 0]]) / np.linalg.norm(d, axis=1)[:, None]
-        return edges, normal
+        return self.model.boundary_with_normals()
 
     def nodal_load(self) -> np.ndarray:
         """The nodes' share of the tractions (3-point Gauss rule on each edge, exact up
@@ -114,21 +108,12 @@ class ModelProblem(Conditions):
         """
         n, d = self.model.nodes.shape
         f = np.zeros((n, d))
-        g, w = np.polynomial.legendre.leggauss(3)
-        s, w = 0.5 * (g + 1.0), 0.5 * w
         x = self.model.nodes
         for traction in self.tractions:
-            edges, normal, t = traction.edges, traction.normal, traction.value
             if d == 3:
-                f += self._facet_loads(traction.index, t)
-                continue
-            a, b = x[edges[:, 0]], x[edges[:, 1]]
-            length = np.linalg.norm(b - a, axis=1)
-            for sk, wk in zip(s, w):
-                pts = a + sk * (b - a)
-                tr = traction_at(t, pts, normal)
-                np.add.at(f, edges[:, 0], (wk * (1.0 - sk) * length)[:, None] * tr)
-                np.add.at(f, edges[:, 1], (wk * sk * length)[:, None] * tr)
+                f += self._facet_loads(traction.index, traction.value)
+            else:
+                f += facet_loads(x, traction.edges, traction.normal, traction.value)
         cells = self.cells
         for b in self.body_forces_at(x[cells.node]):
             np.add.at(f, cells.node, cells.measure[:, None] * b)

@@ -21,8 +21,8 @@ from .pslg import SegmentKind
 from .selection import boundary_subset
 from ..shape import shape_functions
 from ..spatial.rtree import RTree
-from .topology import (circumcenters, cut_between_regions, triangle_neighbors,
-                       vertex_triangles)
+from .topology import (circumcenters, constraint_edges, cut_between_regions,
+                       triangle_neighbors, vertex_triangles)
 
 from .triangulation import constrained_delaunay
 
@@ -205,6 +205,20 @@ class Model:
         if name not in self._derived:
             self._derived[name] = build()
         return self._derived[name]
+
+    def boundary_with_normals(self) -> tuple[np.ndarray, np.ndarray]:
+        """The edges of the body's boundary (outer boundary, holes and crack faces;
+        interfaces between regions are not) and their outward unit normals.
+
+        Returns
+        -------
+        edges : (e, 2) int64 ndarray
+            Node pairs, the body on the left (counter-clockwise).
+        normal : (e, 2) ndarray
+        """
+        edges, _ = constraint_edges(self.triangles, self.neighbors(across_regions=True))
+        d = self.nodes[edges[:, 1]] - self.nodes[edges[:, 0]]
+        return edges, np.column_stack([d[:, 1], -d[:, 0]]) / np.linalg.norm(d, axis=1)[:, None]
 
     def boundary_nodes(self, name_or_predicate: str | Callable | None = None) -> np.ndarray:
         """Indices of the nodes on the boundary, on a named boundary, or on the boundary

@@ -18,6 +18,7 @@ from .dynamics import Dynamics
 from .moments import moment_tensors, live_inverse
 from ..material import PLANES
 from .solution import StaticSolution
+from .tractions import BodyTractions
 from .velocity import VelocityConditions
 
 if TYPE_CHECKING:
@@ -36,7 +37,7 @@ __all__ = ["Problem"]
 log = logging.getLogger(__name__)
 
 
-class Problem(Conditions, VelocityConditions, Dynamics):
+class Problem(BodyTractions, Conditions, VelocityConditions, Dynamics):
     """A peridynamic body with a material, loads and displacement conditions.
 
     Parameters
@@ -269,7 +270,7 @@ class Problem(Conditions, VelocityConditions, Dynamics):
         self._linear_only("stress_tensor")
         return self.behaviour.stress_tensor(u)
 
-    # -- conditions (`Conditions`: add_dirichlet, add_body_force) ----------------------
+    # -- conditions (`Conditions`: add_dirichlet, add_body_force; `BodyTractions`) ------
     points_name = "body.points"
 
     @property
@@ -287,25 +288,10 @@ class Problem(Conditions, VelocityConditions, Dynamics):
         model = getattr(self.body, "model", None)
         return None if model is None else model.domain
 
-    def add_traction(self, where: Callable[..., np.ndarray] | ArrayLike,
-                     t: ArrayLike | Callable[..., np.ndarray]) -> None:
-        """Not for peridynamics: a nonlocal body has no boundary edges to load.
-
-        Raises
-        ------
-        UnsupportedError
-            Always (a `NotImplementedError`): give the loads as body forces (`add_body_force`, force per unit
-            volume; a traction ``t`` on an edge becomes about ``t / dx`` on the
-            layer of points along it, ``dx`` the spacing).
-        """
-        raise UnsupportedError(
-            "add_traction: peridynamics takes no tractions (a nonlocal body has no "
-            "boundary edges); give the load as a body force with add_body_force, e.g. "
-            "t / dx on the layer of points along the edge (dx the point spacing)")
-
     def load(self) -> np.ndarray:
-        """External forces ``(d n,)``: body forces times volumes."""
-        f = np.zeros((len(self.body), self.dim))
+        """External forces ``(d n,)``: body forces times volumes, and the point forces of
+        the tractions (`traction_forces`)."""
+        f = self.traction_forces()
         for b in self.body_forces_at(self.body.points):
             f += self.body.volumes[:, None] * b
         return f.reshape(-1)

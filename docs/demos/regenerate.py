@@ -39,7 +39,7 @@ PAGES = {
     "kalthoff_winkler": ("pd", "kalthoff-winkler", "--quick"),
     "growth_sent": ("demo", "growth-sent"),
     "growth_kink": ("demo", "growth-kink", "--angles", "30", "60"),
-    "growth_two_holes": ("demo", "growth-two-holes", "--h", "0.5", "--steps", "4"),
+    "growth_two_holes": ("demo", "growth-two-holes", "--grips", "both", "--h", "0.5", "--steps", "8"),
 }
 #: The pages whose runs are short enough for the test suite (8-30 s each with a warm numba
 #: cache on the shared 2-core machine; growth_sent, 20361 nodes, took 310 s there).
