@@ -1,0 +1,110 @@
+"""Convergence study: Lamé's hollow sphere by 3-D C-NEM and by P1 tetrahedra on the same nodes.
+
+Workload
+--------
+The hollow sphere ``inner = 0.5 <= r <= outer = 1`` (``cnem.geometry.hollow_sphere``, its
+surfaces as icospheres of ``--subdivisions`` levels, by default the fewest whose edges on
+the cavity are at most ``h``), E = 1, nu = 0.3, an internal pressure
+p = 1 (the traction ``-p n`` on the cavity) and the exact displacement of
+`cnem.exact.ThickSphere` held on the outer surface, so that the discrete problem has no rigid
+motion and its exact solution is Lamé's. For each spacing ``h`` one irregular cloud
+``cnem.nodes.irregular(dom, h, seed=0)``, one model, and on it:
+
+* **C-NEM**: ``cnem.Elasticity(model, (E, nu))`` (default stabilisation);
+* **P1**: ``cnem.fem.P1Elasticity.from_model(model, (E, nu))`` on the model's tetrahedra.
+
+What is measured
+----------------
+The energy-norm error ``sol.energy_error(exact.stress)`` (relative, as `energy_error`
+defines it) of each side, its rate against ``h`` between successive rows
+(``log(e1/e2) / log(h1/h2)``), the discretisation and solve times.
+
+The surfaces are polyhedral: the body is the icosphere shell, not the sphere, so the error
+measured against the smooth solution would stop falling if the facets stayed fixed while
+``h`` shrinks; by default they shrink with ``h`` (every surface vertex is a node).
+
+How to run
+----------
+::
+
+    python benchmarks/hollow_sphere.py                      # h = 0.25 0.2 0.15 0.1
+    python benchmarks/hollow_sphere.py --h 0.3 0.2 --subdivisions 3
+"""
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+import cnem  # noqa: E402
+from cnem.exact import ThickSphere  # noqa: E402
+
+INNER, OUTER, E, NU, P = 0.5, 1.0, 1.0, 0.3, 1.0
+
+
+def conditions(prob, exact, tol):
+    """Exact displacement on the outer surface, the pressure on the cavity."""
+    r = lambda x: np.linalg.norm(x, axis=1)                       # noqa: E731
+    for k in range(3):
+        prob.add_dirichlet(lambda x: r(x) > OUTER - tol, k,
+                           lambda x, k=k: exact.displacement(x)[:, k])
+    prob.add_traction(lambda x, n: r(x) < INNER + tol, lambda x, n: -P * n)
+
+
+def one(h, subdivisions, seed=0):
+    dom = cnem.geometry.hollow_sphere(INNER, OUTER, subdivisions=subdivisions)
+    exact = ThickSphere(INNER, OUTER, E, NU, pressure=P)
+    tol = 0.05 * h
+    t0 = time.perf_counter()
+    model = cnem.discretize(cnem.nodes.irregular(dom, h, seed=seed))
+    t1 = time.perf_counter()
+    row = dict(h=h, levels=subdivisions, nodes=len(model.nodes), discretize=t1 - t0)
+    for name, prob in (("cnem", cnem.Elasticity(model, (E, NU))),
+                       ("p1", cnem.fem.P1Elasticity.from_model(model, (E, NU)))):
+        conditions(prob, exact, tol)
+        t = time.perf_counter()
+        sol = prob.solve()
+        row[name + "_time"] = time.perf_counter() - t
+        row[name] = sol.energy_error(exact.stress)
+    return row
+
+
+def table(rows):
+    lines = [f"{'h':>6} {'nodes':>7} {'discretize s':>12} | {'C-NEM error':>11} {'rate':>5} "
+             f"{'solve s':>8} | {'P1 error':>9} {'rate':>5} {'solve s':>8} | {'P1/C-NEM':>8}"]
+    for i, r in enumerate(rows):
+        rate = {k: (np.log(rows[i - 1][k] / r[k]) / np.log(rows[i - 1]["h"] / r["h"])
+                    if i else np.nan) for k in ("cnem", "p1")}
+        fmt = {k: (f"{rate[k]:5.2f}" if i else f"{'-':>5}") for k in rate}
+        lines.append(f"{r['h']:6.3f} {r['nodes']:7d} {r['discretize']:12.1f} | {r['cnem']:11.3e} "
+                     f"{fmt['cnem']} {r['cnem_time']:8.1f} | {r['p1']:9.3e} {fmt['p1']} "
+                     f"{r['p1_time']:8.1f} | {r['p1'] / r['cnem']:8.2f}")
+    lines.append("errors: energy_error against Lamé (relative energy norm); rates against h")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--h", type=float, nargs="+", default=[0.25, 0.2, 0.15, 0.1],
+                        help="node spacings (default: %(default)s)")
+    parser.add_argument("--subdivisions", type=int, default=None,
+                        help="icosphere levels of the two surfaces (default: per h, the fewest "
+                             "whose edges on the cavity are at most h)")
+    args = parser.parse_args(argv)
+    print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores", flush=True)
+    rows = []
+    for h in args.h:
+        levels = args.subdivisions
+        if levels is None:              # an icosphere's edge is about 1.05 radius / 2^levels
+            levels = max(1, int(np.ceil(np.log2(1.05 * INNER / h))))
+        rows.append(one(h, levels))
+        print(table(rows).splitlines()[-2], flush=True)
+    print(table(rows))
+    return rows
+
+
+if __name__ == "__main__":
+    main()
