@@ -144,7 +144,7 @@ def tension(h: float, factors: Sequence[float], steps: int, cloud: str) -> dict:
 
 
 def cantilever(h: float, factors: Sequence[float], steps: int, cloud: str,
-               load: float = 0.012) -> dict:
+               load: float = 0.008) -> dict:
     """Example 2: the runs, the tip-deflection table and the linear limit."""
     length, height, law = 5.0, 1.0, BondContinuum(1.0, exponent=2.0)
     tol = 1e-9 * length

@@ -24,6 +24,10 @@ __all__ = ["bulk_factor", "cpd_material", "run_cnem", "run_cpd", "Run"]
 
 #: Relative residual of every Newton solve.
 TOL = 1e-9
+#: Newton corrections allowed per load step of CPD (its bent one-neighbour beams at the
+#: largest horizon wander for 10-60 iterations in a step before the quadratic phase; a
+#: line search makes that worse: it stalls on tiny steps).
+MAX_ITERATIONS = 60
 
 
 class Run(dict):
@@ -108,7 +112,8 @@ def run_cpd(cloud: cnem.NodeCloud, horizon_factor: float, law: BondContinuum,
     states = []
     start = time.perf_counter()
     _, history = newton(evaluate, prob.load(), D, values, points=body.points, pattern=pattern,
-                        tol=TOL, steps=steps, on_step=lambda k, u: states.append((k / steps, u)))
+                        tol=TOL, steps=steps, max_iterations=MAX_ITERATIONS,
+                        on_step=lambda k, u: states.append((k / steps, u)))
     seconds = time.perf_counter() - start
     n = len(body)
     return Run(u=np.array([u.reshape(n, 2) for _, u in states]),
