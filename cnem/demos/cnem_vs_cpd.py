@@ -92,11 +92,14 @@ def _cloud(domain, h, kind):
 
 
 def _interior(length, height):
-    """``inside(points, horizon)``: points a horizon away from every edge (on a body too
-    thin for any, the points farthest from the edges)."""
-    def inside(p, d):
+    """``inside(body)``: the points whose bonds, partial ones included (they reach half a
+    spacing past the horizon), all end at interior points (on a body too thin for any,
+    the points farthest from the edges)."""
+    def inside(body):
+        p = body.points
         depth = np.minimum.reduce([p[:, 0], length - p[:, 0], p[:, 1], height - p[:, 1]])
-        return depth >= min(d, depth.max() * (1 - 1e-9))
+        reach = body.horizon + 0.5 * np.sqrt(np.median(body.volumes) / body.thickness)
+        return depth > min(reach, depth.max() * (1 - 1e-9))
     return inside
 
 

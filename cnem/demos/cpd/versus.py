@@ -34,7 +34,8 @@ class Run(dict):
     """One method's result: ``u`` (s, n, 2) after each load step, ``factor`` (s,),
     ``force`` (s, n, 2) internal forces, ``history`` (Newton residuals per step),
     ``iterations`` (Newton corrections in all), ``seconds`` (Newton), ``evaluate_seconds``
-    (one residual plus tangent) and, for CPD, ``C1``, ``bulk``, ``horizon``."""
+    (one residual plus tangent) and, for CPD, ``setup_seconds`` (body and interactions),
+    ``C1``, ``bulk``, ``horizon``."""
 
     __getattr__ = dict.__getitem__
 
@@ -93,20 +94,22 @@ def run_cnem(model: cnem.Model, law: BondContinuum, dirichlet: list[tuple],
 
 
 def run_cpd(cloud: cnem.NodeCloud, horizon_factor: float, law: BondContinuum,
-            inside: Callable[[np.ndarray, float], np.ndarray], dirichlet: list[tuple],
+            inside: Callable[[pd.Body], np.ndarray], dirichlet: list[tuple],
             point_forces: np.ndarray | None, steps: int) -> Run:
     """CPD on the nodes of ``cloud`` (`cnem.pd.Body.from_cloud`, horizon
     ``horizon_factor`` spacings), calibrated by `cpd_material` on the points
-    ``inside(points, horizon)`` selects, with ``dirichlet`` and optional nodal forces
+    ``inside(body)`` selects, with ``dirichlet`` and optional nodal forces
     ``point_forces (n, 2)`` (the whole load), in ``steps`` load steps."""
+    start = time.perf_counter()
     body = pd.Body.from_cloud(cloud, horizon_factor)
-    material, bulk = cpd_material(body, law, inside(body.points, body.horizon))
+    material, bulk = cpd_material(body, law, inside(body))
     prob = pd.Problem(body, material)
     for where, component, value in dirichlet:
         prob.add_dirichlet(where, component, value)
     if point_forces is not None:
         prob.add_body_force(point_forces / body.volumes[:, None])
     evaluate, pattern = prob.behaviour.static_system()
+    setup_seconds = time.perf_counter() - start
     evaluate_seconds = _timed_evaluate(evaluate, body.points.size)
     D, values = prob.prescribed()
     states = []
@@ -120,5 +123,5 @@ def run_cpd(cloud: cnem.NodeCloud, horizon_factor: float, law: BondContinuum,
                factor=np.array([f for f, _ in states]),
                force=np.array([evaluate(u, False)[0].reshape(n, 2) for _, u in states]),
                history=history, seconds=seconds, iterations=sum(len(h) - 1 for h in history),
-               evaluate_seconds=evaluate_seconds, C1=material.C1, bulk=bulk,
+               evaluate_seconds=evaluate_seconds, setup_seconds=setup_seconds, C1=material.C1, bulk=bulk,
                horizon=body.horizon)
