@@ -39,21 +39,10 @@ import time
 
 import numpy as np
 
-from _harness import MachineLoad, load_text, median
+from _harness import MachineLoad, load_text, warm_median
 
 SIZES = {"small": 0.05, "large": 0.02}
 LENGTH, HEIGHT, LOAD, STEPS, HORIZON = 5.0, 1.0, 0.008, 4, 3.0
-
-
-def timed(fn, repeat=3):
-    """``fn()`` once as a warm-up, then the median seconds of ``repeat`` calls."""
-    fn()
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return median(times)
 
 
 def run(h):
@@ -73,7 +62,7 @@ def run(h):
     prob.system
     setup = time.perf_counter() - t0
     zero = np.zeros(model.nodes.size)
-    evaluate = timed(lambda: prob.system.evaluate(zero, True))
+    evaluate, _ = warm_median(lambda: prob.system.evaluate(zero, True), 3)
     sol = prob.solve(steps=STEPS, tol=1e-9, progress=False)
     its = sum(len(r) - 1 for r in sol.residual_history)
     rows = {"C-NEM": dict(n=len(model.nodes), setup=setup, evaluate=evaluate,
