@@ -50,7 +50,7 @@ DEMOS = _named("bimaterial_cylinder", "inclined_crack", "mode1_crack", "pd_vs_cn
 
 #: ``cnem pd <name>`` -> module of `cnem.demos` (add a PD demo here).
 PD_DEMOS = _named("pd_vs_cnem_crack", "pd_crack_branching", "pd_vs_cnem_3d", "cpd_examples",
-                  "kalthoff_winkler")
+                  "kalthoff_winkler", "cnem_vs_cpd")
 
 #: Subcommand -> its table of demos.
 _TABLES = {"demo": DEMOS, "pd": PD_DEMOS}

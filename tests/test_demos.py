@@ -161,6 +161,27 @@ def check_pd_vs_cnem_3d(demo, out, outdir):
         assert row["pd_error"] > 10 * row["cnem_error"]
 
 
+def check_cnem_vs_cpd(demo, out, outdir):
+    """C-NEM on the strip is the homogeneous closed form at every stretch (the
+    finite-strain patch test); CPD on the same nodes is softer in tension and in bending
+    (its surface effect: missing bonds within a horizon of the free edges), more so at
+    the larger horizon; the cantilever's first load step is in the linear range and the
+    large deflection stiffens."""
+    tension, beam = out["tension"], out["cantilever"]
+    np.testing.assert_allclose(tension["force"]["C-NEM"], tension["exact"], rtol=1e-8)
+    cpd = [k for k in tension["runs"] if k != "C-NEM"]
+    for k in cpd:
+        assert (0 < tension["force"][k]).all() and (tension["force"][k] < tension["exact"]).all()
+        assert (beam["deflection"][k] > beam["deflection"]["C-NEM"]).all()
+    assert tension["force"][cpd[1]][-1] < tension["force"][cpd[0]][-1]
+    linear = beam["linear_per_load"] * beam["loads"]
+    assert abs(beam["deflection"]["C-NEM"][0] / linear[0] - 1) < 0.03
+    assert beam["deflection"]["C-NEM"][-1] < 0.95 * linear[-1]
+    assert np.all(np.diff(beam["deflection"]["C-NEM"]) > 0)
+    for path in out["files"]:
+        assert pathlib.Path(path).stat().st_size > 10_000
+
+
 def check_pd_vs_cnem_crack(demo, out, outdir):
     """On the same nodes, C-NEM and state-based PD open the crack like Griffith's
     ellipse (within the finite-plate excess) and agree with each other."""
@@ -404,6 +425,8 @@ CASES = [
     Case("pd-vs-cnem-crack", "pd_vs_cnem_crack", check_pd_vs_cnem_crack,
          page="pd_vs_cnem_crack"),
     Case("pd-vs-cnem-3d", "pd_vs_cnem_3d", check_pd_vs_cnem_3d, args=((0.25, 0.125),)),
+    Case("cnem-vs-cpd", "cnem_vs_cpd", check_cnem_vs_cpd, args=(0.25, (2.0, 3.0)),
+         sizes=dict(steps=4), plot=True),
     Case("pd-crack-branching", "pd_crack_branching", check_pd_crack_branching,
          page="pd_crack_branching"),
     Case("kalthoff-winkler", "kalthoff_winkler", check_kalthoff_winkler, page="kalthoff_winkler"),

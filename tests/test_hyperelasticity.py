@@ -187,6 +187,20 @@ def test_uniaxial_tension_to_twice_the_length():
     np.testing.assert_allclose(sol.stress[:, 0], nominal * stretch / (stretch * b), rtol=1e-9)
 
 
+def test_progress_bar_counts_the_load_steps(capsys):
+    """``progress=True`` shows a tqdm bar on stderr that reaches the number of load steps;
+    ``progress=False`` prints nothing."""
+    model = cnem.discretize(cnem.nodes.regular(cnem.geometry.rectangle(1.0, 1.0), 0.25))
+    prob = cnem.Hyperelasticity(model, NeoHookean(1.0, 2.0))
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+    prob.add_dirichlet(lambda p: p[:, 0] > 1.0 - 1e-9, 0, 0.3)
+    prob.solve(steps=3, progress=True)
+    err = capsys.readouterr().err
+    assert "hyperelasticity load steps" in err and "3/3" in err
+    prob.solve(steps=3, progress=False)
+    assert capsys.readouterr().err == ""
+
+
 # -- failures and inputs -----------------------------------------------------------------
 def test_non_convergence_raises_with_the_history(holed):
     mat = NeoHookean(1.0, 3.0)

@@ -4,10 +4,12 @@ Newton with load steps)."""
 from __future__ import annotations
 
 import logging
+import sys
 import time
 from typing import TYPE_CHECKING
 
 import numpy as np
+from tqdm.auto import tqdm
 
 from ..assembly import CellBasis
 from ..errors import InputError, MaterialError, OptionError
@@ -172,7 +174,7 @@ class Hyperelasticity(ModelProblem):
         return self.nodal_load().reshape(-1)
 
     def solve(self, *, steps: int = 1, tol: float = 1e-10, max_iterations: int = 20,
-              line_search: bool = False) -> HyperelasticSolution:
+              line_search: bool = False, progress: bool | None = None) -> HyperelasticSolution:
         """Newton's method (`cnem.solvers.newton.newton`, exact tangent) over ``steps``
         equal load steps.
 
@@ -186,6 +188,9 @@ class Hyperelasticity(ModelProblem):
             Newton corrections allowed per load step.
         line_search : bool
             Backtrack along each correction until the residual decreases.
+        progress : bool, optional
+            A tqdm bar over the load steps on stderr (default: when stderr is a
+            terminal).
 
         Returns
         -------
@@ -207,10 +212,20 @@ class Hyperelasticity(ModelProblem):
         t1 = time.perf_counter()
         D, values = self.prescribed()
         states = []
-        u, history = newton(system.evaluate, self.load(), D, values, points=self.model.nodes,
-                            tol=tol, steps=steps, max_iterations=max_iterations,
-                            line_search=line_search,
-                            on_step=lambda step, dofs: states.append((step / steps, dofs)))
+        show = sys.stderr.isatty() if progress is None else progress
+        bar = tqdm(total=steps, desc="hyperelasticity load steps", unit="step",
+                   disable=not show, leave=False, mininterval=0.0)
+
+        def on_step(step, dofs):
+            states.append((step / steps, dofs))
+            bar.update()
+
+        try:
+            u, history = newton(system.evaluate, self.load(), D, values, points=self.model.nodes,
+                                tol=tol, steps=steps, max_iterations=max_iterations,
+                                line_search=line_search, on_step=on_step)
+        finally:
+            bar.close()
         t2 = time.perf_counter()
         timings = dict(gradients=t1 - t0, newton=t2 - t1)
         log.info("hyperelasticity: %d load steps, %d Newton iterations, %s", len(history),

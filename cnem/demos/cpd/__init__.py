@@ -1,7 +1,8 @@
 """The CPD examples of Javili et al. §6, run by `cnem.demos.cpd_examples`
-(``cnem pd cpd-examples``)."""
+(``cnem pd cpd-examples``), and the pieces of `cnem.demos.cnem_vs_cpd` (C-NEM against
+CPD at finite strain: `bond_law`, `versus`, `pictures`)."""
 
 
-from . import common, stretch, structures
+from . import bond_law, common, pictures, stretch, structures, versus
 
-__all__ = ["common", "stretch", "structures"]
+__all__ = ["bond_law", "common", "pictures", "stretch", "structures", "versus"]

@@ -1,0 +1,261 @@
+"""Finite-strain C-NEM against CPD on the same nodes: uniaxial tension to 100 % stretch
+and a bent cantilever (issue 38 item 4; the seed paper's §6.1-6.2 examples).
+
+The problems
+------------
+One node cloud (`cnem.nodes.regular`, or ``irregular``) is solved twice:
+
+* by C-NEM, `cnem.Hyperelasticity` (total Lagrangian SCNI, sub-cell stabilisation 1), and
+* by CPD, `cnem.pd.CPD` on `cnem.pd.Body.from_cloud` of the same cloud (the nodes with
+  their cell areas as volumes), at horizons of 2, 3 and 4 node spacings,
+
+with the same energy: CPD's one-neighbour Seth-Hill energy ``C1 |Xi| S_n(lam)^2 / 2``
+(C2 = 0) integrated over a full horizon is the continuum law
+`cnem.demos.cpd.bond_law.BondContinuum` ``W(F) = 4 mu / pi int p_n(|F M|) dtheta``
+(a Cauchy solid, lam = mu; for n = 2 exactly Saint Venant-Kirchhoff with nu = 1/4), which
+C-NEM solves. C1 is calibrated per horizon so that CPD's *interior* points have that
+``mu``: C1 = mu / (f pi delta^3 / 24), ``f`` the lattice sum of the interior bonds against
+its continuum value (`cnem.demos.cpd.versus.bulk_factor`, printed; 0.67-0.94 here).
+Everything is in units of ``mu = 1`` and the length of the model; thickness 1.
+
+1. **Tension** (n = 1, the paper's Figure 5 law): a 2 x 1 strip between rollers (left
+   edge ``u_x = 0``, its lower corner ``u_y = 0``, right edge ``u_x = L (lambda - 1)``),
+   lateral edges free, to ``lambda = 2`` in 8 load steps. Force-stretch: the reaction of
+   the right grip against the closed form of the homogeneous state
+   (``P22(lambda, b) = 0`` for the lateral stretch b, force ``P11 H``).
+2. **Cantilever** (n = 2, the paper's Figure 7 law): a 5 x 1 beam clamped on its left
+   edge, a downward load P on its right edge (C-NEM: a dead traction P/H; CPD: P shared
+   by the edge's points), to P = 0.008 in 8 load steps (tip deflection about 0.3 of the
+   length). Tip deflection (mean over the right edge) against load, with the small-load
+   linear limit: `cnem.Elasticity` on the same model with the linearised law.
+
+Horizons are in `cnem.pd.Body.from_cloud`'s spacings ``sqrt(area / n)`` (0.093 and
+0.094 here: the regular cloud's boundary nodes count).
+
+Expected result (``h = 0.1``, regular cloud; 231 and 561 nodes; about a minute)
+-------------------------------------------------------------------------------
+* Tension: C-NEM is the closed form to round-off at every stretch (SCNI passes the
+  finite-strain patch test): 0.71548, 1.50749, 3.23888 at stretch 1.25, 1.5, 2. CPD is
+  softer, by -20 %/-15 % (2 spacings, at 1.25/2), -25 % (3) and -41 % (4): a fraction
+  that grows with the horizon and hardly with the stretch. With the same energy the
+  finite-strain kinematics agree; the difference is CPD's *surface effect*: points
+  within a horizon of the free lateral edges miss bonds, so a skin a horizon thick on
+  each side of the strip is softer, and the strip contracts less (lateral stretch 0.70-
+  0.74 against 0.683). The difference field peaks next to the grips, where the
+  prescribed columns meet points with few bonds.
+* Cantilever: C-NEM starts on the linear answer (0.9986 of it at the first load) and
+  stiffens as the beam turns (1.427 against 1.546 at P = 0.008). CPD bends more: +39 %,
+  +57 %, +79 % at the smallest load, as bending loads the soft skin; at 4 spacings its
+  curve jumps between P = 0.006 and 0.007 when the bonds next to the clamp's lower corner
+  collapse (smallest bond stretch 0.07; the SVK bond energy does not resist it). The
+  difference field grows from the clamp to the tip. The CPD curves approach C-NEM's as
+  the horizon shrinks. (The tables and the reasons: ``docs/finite_strain.md``.)
+* Pictures ``tension.png``, ``cantilever.png``: the deformed C-NEM and CPD (3 spacings)
+  bodies over the undeformed outline, the difference ``|u_CPD - u_C-NEM|`` on the
+  deformed C-NEM body, and the curves of every horizon.
+
+Run ``python demos/cnem_vs_cpd.py --help`` or ``cnem pd cnem-vs-cpd --help``.
+"""
+
+from __future__ import annotations
+
+import pathlib
+from typing import TYPE_CHECKING
+
+import numpy as np
+from scipy.optimize import brentq
+
+import cnem
+from cnem.cli import demo_parser, positive_float, positive_int
+from cnem.errors import OptionError
+from cnem.demos.cpd.bond_law import BondContinuum
+from cnem.demos.cpd.pictures import compare_picture
+from cnem.demos.cpd.versus import run_cnem, run_cpd
+
+if TYPE_CHECKING:
+    from typing import Sequence
+
+__all__ = ["main", "cli", "tension_closed_form", "CLOUDS"]
+
+#: Node clouds the demo can use.
+CLOUDS = ("regular", "irregular")
+#: Stretches of the force table.
+TABLE_STRETCHES = (1.25, 1.5, 2.0)
+
+
+def tension_closed_form(law: BondContinuum, stretch: float) -> tuple[float, float]:
+    """Lateral stretch ``b`` and nominal stress ``P11`` of the homogeneous uniaxial state
+    ``F = diag(stretch, b)`` of ``law`` with ``P22 = 0`` (one root in ``(0.05, 1]``)."""
+    def lateral(b):
+        return law.evaluate(np.diag([stretch, b])[None], tangent=False)[1][0, 1, 1]
+    b = brentq(lateral, 0.05, 1.0, xtol=1e-14) if stretch != 1 else 1.0
+    return b, float(law.evaluate(np.diag([stretch, b])[None], tangent=False)[1][0, 0, 0])
+
+
+def _cloud(domain, h, kind):
+    return cnem.nodes.regular(domain, h) if kind == "regular" else \
+        cnem.nodes.irregular(domain, h, seed=1)
+
+
+def _interior(length, height):
+    """``inside(body)``: the points whose bonds, partial ones included (they reach half a
+    spacing past the horizon), all end at interior points (on a body too thin for any,
+    the points farthest from the edges)."""
+    def inside(body):
+        p = body.points
+        depth = np.minimum.reduce([p[:, 0], length - p[:, 0], p[:, 1], height - p[:, 1]])
+        reach = body.horizon + 0.5 * np.sqrt(np.median(body.volumes) / body.thickness)
+        return depth > min(reach, depth.max() * (1 - 1e-9))
+    return inside
+
+
+def tension(h: float, factors: Sequence[float], steps: int, cloud: str) -> dict:
+    """Example 1: the runs, the force table and the closed form."""
+    length, height, law = 2.0, 1.0, BondContinuum(1.0, exponent=1.0)
+    tol = 1e-9 * length
+    nodes = _cloud(cnem.geometry.rectangle(length, height), h, cloud)
+    model = cnem.discretize(nodes, progress=False)
+    left = lambda p: p[:, 0] < tol                                       # noqa: E731
+    right = lambda p: p[:, 0] > length - tol                             # noqa: E731
+    dirichlet = [(left, 0, 0.0), (lambda p: left(p) & (p[:, 1] < tol), 1, 0.0),
+                 (right, 0, length)]                                     # to stretch 2
+    runs = {"C-NEM": run_cnem(model, law, dirichlet, None, steps)}
+    for m in factors:
+        runs[f"CPD {m:g}h"] = run_cpd(nodes, m, law, _interior(length, height), dirichlet,
+                                      None, steps)
+    grip = right(model.nodes)
+    stretch = 1.0 + runs["C-NEM"].factor
+    curves = {name: run.force[:, grip, 0].sum(axis=1) for name, run in runs.items()}
+    exact = np.array([tension_closed_form(law, s)[1] * height for s in stretch])
+    fine = np.linspace(1.0, 2.0, 41)
+    closed = np.array([tension_closed_form(law, s)[1] * height for s in fine])
+    b_exact = tension_closed_form(law, 2.0)[0]
+    middle = np.abs(model.nodes[:, 0] - length / 2) < 0.5 * h
+    top, bottom = middle & (model.nodes[:, 1] > height - tol), middle & (model.nodes[:, 1] < tol)
+    width = {name: (height + run.u[-1][top, 1].mean() - run.u[-1][bottom, 1].mean()) / height
+             for name, run in runs.items()}
+    lines = [f"Tension of a {length:g} x {height:g} strip, {len(model.nodes)} nodes ({cloud}, "
+             f"h = {h:g}), BondContinuum n = 1, mu = 1: grip force",
+             f"{'stretch':>8}{'closed form':>13}" + "".join(f"{k:>12}" for k in runs)]
+    for s in TABLE_STRETCHES:
+        k = int(np.argmin(np.abs(stretch - s)))
+        lines.append(f"{stretch[k]:>8.3f}{exact[k]:>13.5f}"
+                     + "".join(f"{c[k]:>12.5f}" for c in curves.values()))
+    lines.append(f"{'rel. diff':>8}{'at 2':>13}" + "".join(
+        f"{c[-1] / exact[-1] - 1:>+12.2%}" for c in curves.values()))
+    lines.append(f"lateral stretch at mid-length, stretch 2: closed form {b_exact:.4f}; "
+                 + ", ".join(f"{k} {v:.4f}" for k, v in width.items()))
+    lines.append("CPD C1 (bulk factor f): " + ", ".join(
+        f"{k} {r.C1:.4g} ({r.bulk:.3f})" for k, r in runs.items() if k != "C-NEM"))
+    return dict(model=model, runs=runs, stretch=stretch, force=curves, exact=exact,
+                closed=(fine, closed), width=width, lateral=b_exact, lines=lines,
+                x=stretch, xlabel="stretch $\\lambda$", ylabel="grip force $F$ ($\\mu H$)")
+
+
+def cantilever(h: float, factors: Sequence[float], steps: int, cloud: str,
+               load: float = 0.008) -> dict:
+    """Example 2: the runs, the tip-deflection table and the linear limit."""
+    length, height, law = 5.0, 1.0, BondContinuum(1.0, exponent=2.0)
+    tol = 1e-9 * length
+    nodes = _cloud(cnem.geometry.rectangle(length, height), h, cloud)
+    model = cnem.discretize(nodes, progress=False)
+    clamp = lambda p: p[:, 0] < tol                                      # noqa: E731
+    tip = model.nodes[:, 0] > length - tol
+    dirichlet = [(clamp, None, 0.0)]
+    traction = (lambda x, n: x[:, 0] > length - tol, np.array([0.0, -load / height]))
+    forces = np.zeros((len(model.nodes), 2))
+    forces[tip, 1] = -load / tip.sum()
+    runs = {"C-NEM": run_cnem(model, law, dirichlet, traction, steps)}
+    for m in factors:
+        runs[f"CPD {m:g}h"] = run_cpd(nodes, m, law, _interior(length, height), dirichlet,
+                                      forces, steps)
+    linear = cnem.Elasticity(model, law.linearized(), plane="strain")
+    linear.add_dirichlet(clamp, None, 0.0)
+    linear.add_traction(*traction)
+    per_load = -linear.solve(progress=False).u[tip, 1].mean() / load
+    loads = load * runs["C-NEM"].factor
+    deflection = {name: -run.u[:, tip, 1].mean(axis=1) for name, run in runs.items()}
+    lines = [f"Cantilever {length:g} x {height:g}, {len(model.nodes)} nodes ({cloud}, h = {h:g}),"
+             f" BondContinuum n = 2 (SVK, nu = 1/4), mu = 1: tip deflection",
+             f"{'load':>8}{'linear':>10}" + "".join(f"{k:>12}" for k in runs)]
+    for k in sorted({0, len(loads) // 2 - 1, len(loads) - 1}):
+        lines.append(f"{loads[k]:>8.4f}{per_load * loads[k]:>10.4f}"
+                     + "".join(f"{d[k]:>12.4f}" for d in deflection.values()))
+    lines.append(f"{'rel. diff':>8}{'last':>10}" + "".join(
+        f"{d[-1] / deflection['C-NEM'][-1] - 1:>+12.2%}" for d in deflection.values()))
+    lines.append(f"C-NEM at the first load / linear: "
+                 f"{deflection['C-NEM'][0] / (per_load * loads[0]):.4f}; CPD C1 (bulk factor "
+                 f"f): " + ", ".join(f"{k} {r.C1:.4g} ({r.bulk:.3f})" for k, r in runs.items()
+                                     if k != "C-NEM"))
+    return dict(model=model, runs=runs, loads=loads, deflection=deflection,
+                linear_per_load=per_load, lines=lines, force=deflection, x=loads,
+                closed=(np.array([0.0, loads[-1]]), per_load * np.array([0.0, loads[-1]])),
+                xlabel="load $P$ ($\\mu H$)", ylabel="tip deflection ($H$)")
+
+
+EXAMPLES = {"tension": tension, "cantilever": cantilever}
+
+
+def main(h: float = 0.1, factors: Sequence[float] = (2.0, 3.0, 4.0), *, steps: int = 8,
+         cloud: str = "regular", examples: Sequence[str] = tuple(EXAMPLES),
+         outdir: str = "results/cnem_vs_cpd", plot: bool = True) -> dict:
+    """Run the examples, print their tables and Newton counts, write their pictures.
+
+    Parameters
+    ----------
+    h : float
+        Node spacing (the strip is 2 x 1, the beam 5 x 1).
+    factors : sequence of float
+        CPD horizons in node spacings.
+    steps : int
+        Load steps of every run.
+    cloud : {"regular", "irregular"}
+    examples : sequence of {"tension", "cantilever"}
+
+    Returns
+    -------
+    dict
+        Example name -> its numbers (``runs``: C-NEM and each CPD, see
+        `cnem.demos.cpd.versus.Run`; ``force`` per run per load step, ...) and
+        ``files``.
+    """
+    if cloud not in CLOUDS:
+        raise OptionError(f"cloud: expected one of {CLOUDS}, received {cloud!r}")
+    unknown = [e for e in examples if e not in EXAMPLES]
+    if unknown:
+        raise OptionError(f"examples: expected names from {tuple(EXAMPLES)}, received {unknown}")
+    out, files = {}, []
+    for name in examples:
+        res = EXAMPLES[name](h, factors, steps, cloud)
+        print("\n".join(res["lines"]))
+        print("Newton iterations (seconds): " + ", ".join(
+            f"{k} {r.iterations} ({r.seconds:.2f} s)" for k, r in res["runs"].items()) + "\n")
+        if plot:
+            path = pathlib.Path(outdir) / f"{name}.png"
+            path.parent.mkdir(parents=True, exist_ok=True)
+            middle = [k for k in res["runs"] if k != "C-NEM"][len(factors) // 2]
+            files.append(compare_picture(str(path), res, middle, name))
+            print(f"wrote {files[-1]}")
+        out[name] = res
+    out["files"] = files
+    return out
+
+
+def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> dict:
+    """Command line: ``python demos/cnem_vs_cpd.py --help`` or ``cnem pd cnem-vs-cpd``."""
+    parser = demo_parser(__file__, __doc__, prog)
+    parser.add_argument("--h", type=positive_float, default=0.1, help="node spacing")
+    parser.add_argument("--factors", type=positive_float, nargs="+", default=[2.0, 3.0, 4.0],
+                        help="CPD horizons in node spacings")
+    parser.add_argument("--steps", type=positive_int, default=8, help="load steps")
+    parser.add_argument("--cloud", choices=CLOUDS, default="regular", help="node cloud")
+    parser.add_argument("--example", choices=tuple(EXAMPLES) + ("all",), default="all",
+                        help="the example to run (all: both)")
+    args = parser.parse_args(argv)
+    examples = tuple(EXAMPLES) if args.example == "all" else (args.example,)
+    return main(args.h, tuple(args.factors), steps=args.steps, cloud=args.cloud,
+                examples=examples, outdir=args.out, plot=not args.no_plot)
+
+
+if __name__ == "__main__":
+    cli()
