@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import cases3d
+import cnem
 from cnem.errors import GeometryError
 from cnem.geometry.tetrahedra import _FACES, conforming_tetrahedra, signed_volumes
 
@@ -99,3 +100,14 @@ def test_open_surface_and_duplicates_are_named():
         conforming_tetrahedra(np.vstack([p, p[5]]), f, r)
     with pytest.raises(GeometryError, match=r"\(n, 3\)"):
         conforming_tetrahedra(p[:, :2], f, r)
+
+
+def test_flat_slivers_in_a_faceted_surface_do_not_vote():
+    """Four coplanar nodes of one icosphere facet make a flat sliver lying in the surface;
+    its two sides of a boundary face carry no region (it used to make the classification
+    refuse a valid hollow sphere)."""
+    dom = cnem.geometry.hollow_sphere(0.5, 1.0, subdivisions=1)
+    cloud = cnem.nodes.irregular(dom, 0.3, seed=0)
+    tets = conforming_tetrahedra(cloud.points, cloud.boundary_faces, cloud.boundary_face_regions)
+    volume = np.abs(signed_volumes(tets.points, tets.tetrahedra)).sum()
+    np.testing.assert_allclose(volume, dom.volume, rtol=1e-12)

@@ -503,6 +503,8 @@ def _classify(points, tets, faces, face_regions):
         votes_f.append(np.flatnonzero(hit))
         votes_s.append(order[at[hit]])
     vf, vs = np.concatenate(votes_f), np.concatenate(votes_s)
+    solid_vote = ~flat[vs // 4]         # a flat sliver's side of a face means nothing
+    vf, vs = vf[solid_vote], vs[solid_vote]
     tet, far = vs // 4, tets[vs // 4, vs % 4]
     x = points[faces[vf]]
     side = np.einsum("ij,ij->i", np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]),
