@@ -88,3 +88,24 @@ def test_boundary_nodes_of_a_3d_model(box_model):
                                   on[nodes[on, 2] > 0.5])
     with pytest.raises(cnem.ConditionError, match="no named boundaries"):
         box_model.boundary_nodes("top")
+
+
+def test_cell_quadrature_and_energy_error_in_3d(box_model):
+    """The cones over the facets integrate each cell's volume, and the energy-norm error of
+    the patch test's solution is zero against its stress and ``sqrt(V e C^-1 e)`` against a
+    stress off by ``e``."""
+    from cnem.assembly.quadrature import cell_quadrature
+    model = box_model
+    cell, _, weights = cell_quadrature(model.cells, model.nodes, 2)
+    np.testing.assert_allclose(np.bincount(cell, weights=weights, minlength=len(model.cells)),
+                               model.cells.volume, atol=1e-14)
+    prob = cnem.Elasticity(model, (E, NU))
+    prob.add_dirichlet(lambda p: np.ones(len(p), dtype=bool), None, lambda p: p @ A.T + B)
+    sol = prob.solve(progress=False)
+    exact = _exact_stress()
+    assert sol.energy_error(lambda x: np.tile(exact, (len(x), 1))) < 1e-12 * np.abs(exact).max()
+    off = 0.1 * exact
+    C = LinearElastic(E, NU).elasticity_matrix(3)
+    want = np.sqrt(0.48 * off @ np.linalg.solve(C, off))
+    np.testing.assert_allclose(sol.energy_error(lambda x: np.tile(exact + off, (len(x), 1))),
+                               want, rtol=1e-10)

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from skfem.quadrature import get_quadrature
-from skfem.refdom import RefTri
+from skfem.refdom import RefTet, RefTri
 
 from .._aliases import renamed_attributes
 from ..errors import InputError, check_count
@@ -15,7 +15,7 @@ from .subdivision import cell_triangles
 if TYPE_CHECKING:
     from ..geometry.model import Cells
 
-__all__ = ["triangle_quadrature", "cell_quadrature"]
+__all__ = ["triangle_quadrature", "tetrahedron_quadrature", "cell_quadrature"]
 
 #: Old names (one release): see `cnem._aliases`.
 __getattr__ = renamed_attributes(__name__, {
@@ -141,15 +141,42 @@ def triangle_quadrature(corners: np.ndarray, order: int = 4, *,
     return np.concatenate(owners), np.concatenate(points), np.concatenate(weights)
 
 
-def cell_quadrature(cells: Cells, nodes: np.ndarray, order: int = 4, *,
-                    singular: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Quadrature points and weights on every cell polygon.
+def tetrahedron_quadrature(corners: np.ndarray, order: int = 4
+                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """scikit-fem's rule of degree ``order`` on tetrahedra.
 
     Parameters
     ----------
-    cells : Cells
+    corners : (t, 4, 3) ndarray
+        Tetrahedra (negatively oriented ones get negative weights).
+    order : int
+        Polynomial degree integrated exactly on each tetrahedron.
+
+    Returns
+    -------
+    tet : (q,) int64 ndarray
+        The tetrahedron of each point.
+    points : (q, 3) ndarray
+    weights : (q,) ndarray
+        Summing to each tetrahedron's signed volume.
+    """
+    ref, ref_weights = get_quadrature(RefTet, order)             # (3, r), (r,): volume 1/6
+    jac = np.moveaxis(corners[:, 1:] - corners[:, :1], 1, 2)     # (t, 3, 3): columns edges
+    points = corners[:, :1] + np.einsum("tij,jr->tri", jac, ref)
+    weights = np.linalg.det(jac)[:, None] * ref_weights[None, :]
+    owner = np.repeat(np.arange(len(corners)), len(ref_weights))
+    return owner, points.reshape(-1, 3), weights.reshape(-1)
+
+
+def cell_quadrature(cells: Cells, nodes: np.ndarray, order: int = 4, *,
+                    singular: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Quadrature points and weights on every cell polygon (3-D: polyhedron).
+
+    Parameters
+    ----------
+    cells : Cells or Cells3D
         ``m`` cells.
-    nodes : (n, 2) ndarray
+    nodes : (n, 2) or (n, 3) ndarray
         The model's nodes.
     order : int
         Polynomial degree integrated exactly on each triangle of the cells.
@@ -162,8 +189,16 @@ def cell_quadrature(cells: Cells, nodes: np.ndarray, order: int = 4, *,
         The cell of each point.
     points : (q, 2) ndarray
     weights : (q,) ndarray
-        ``sum(weights[cell == k]) == cells.area[k]``.
+        ``sum(weights[cell == k]) == cells.measure[k]``.
     """
+    if nodes.shape[1] == 3:
+        # the cones from each cell's apex (else its node) over its facet triangles, signed:
+        # they make the cell however its facets are shaped
+        tri = cells.facet_triangles
+        apex = (cells.apex if cells.apex is not None else nodes[cells.node])[cells.facet_cell]
+        corners = np.concatenate([apex[:, None], tri], axis=1)
+        tet, points, weights = tetrahedron_quadrature(corners, order)
+        return cells.facet_cell[tet], points, weights
     owner, corners = cell_triangles(cells, nodes)
     triangle, points, weights = triangle_quadrature(corners, order, singular=singular)
     return owner[triangle], points, weights

@@ -205,12 +205,14 @@ class ElasticSolution(CellSolution):
         Parameters
         ----------
         exact_stress : callable ``(q, 2) -> (q, 3)``, or ``(q, 2), (q,) -> (q, 3)``
-            ``[sxx, syy, sxy]`` at points; given a second parameter it also
+            ``[sxx, syy, sxy]`` at points (3-D: ``(q, 3) -> (q, 6)``, Voigt
+            ``[sxx, syy, szz, syz, sxz, sxy]``); given a second parameter it also
             receives the region of the cell holding each point (for fields
             that jump across a material interface: the polygonal interface
             of the model need not be the exact one).
         order : int
-            Degree of the triangle rule on the triangles of each cell.
+            Degree of the triangle rule on the triangles of each cell (3-D: of the
+            tetrahedron rule on the cones from each cell's node over its facets).
         strain : {"smoothed", "pointwise"}
 
         Returns
@@ -218,8 +220,9 @@ class ElasticSolution(CellSolution):
         float
         """
         check_choice("strain", strain, ("smoothed", "pointwise"))
+        tips = self.model.domain.tips if self.model.nodes.shape[1] == 2 else None
         cell, points, weights = cell_quadrature(self.cells, self.model.nodes, order,
-                                                singular=self.model.domain.tips)
+                                                singular=tips)
         if strain == "smoothed":
             stress = self.stress[cell]
         else:

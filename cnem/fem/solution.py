@@ -7,10 +7,8 @@ from typing import Any, Callable
 
 import numpy as np
 from skfem.helpers import grad
-from skfem.quadrature import get_quadrature
-from skfem.refdom import RefTet
 
-from ..assembly.quadrature import triangle_quadrature
+from ..assembly.quadrature import tetrahedron_quadrature, triangle_quadrature
 from ..material import stiffness_matrix
 from ..errors import GeometryError, UnsupportedError, check_points
 from ..solvers.solution import Solution, energy_error_density, engineering_strain
@@ -99,7 +97,7 @@ class P1Solution(Solution):
         """
         corners = self.mesh.p.T[self.mesh.t.T]                      # (t, d + 1, d)
         if corners.shape[2] == 3:
-            owner, points, weights = _tetrahedron_quadrature(corners, order)
+            owner, points, weights = tetrahedron_quadrature(corners, order)
         else:
             e1, e2 = corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]
             clockwise = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] < 0
@@ -149,16 +147,3 @@ class P1Solution(Solution):
         from .. import io
         io.write_points(self.mesh.p.T, path, triangles=self.mesh.t.T, point_data=point_data,
                         cell_data=cell_data)
-
-
-def _tetrahedron_quadrature(corners: np.ndarray, order: int
-                            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """scikit-fem's rule of degree ``order`` on the tetrahedra ``corners (t, 4, 3)``: the
-    tetrahedron ``(q,)`` of each point, the points ``(q, 3)`` and their weights ``(q,)``,
-    which sum to each tetrahedron's volume."""
-    ref, ref_weights = get_quadrature(RefTet, order)             # (3, r), (r,): volume 1/6
-    jac = np.moveaxis(corners[:, 1:] - corners[:, :1], 1, 2)     # (t, 3, 3): columns edges
-    points = corners[:, :1] + np.einsum("tij,jr->tri", jac, ref)
-    weights = np.abs(np.linalg.det(jac))[:, None] * ref_weights[None, :]
-    owner = np.repeat(np.arange(len(corners)), len(ref_weights))
-    return owner, points.reshape(-1, 3), weights.reshape(-1)
