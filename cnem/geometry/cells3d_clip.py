@@ -196,10 +196,16 @@ class GeneralCells:
                 poly = poly.clip(Plane(fn[k], float(offset[k]), ("f", int(fid[k]))))
                 if poly is None:
                     return [], None
-        for k in range(len(dist)):
-            if 0.5 * dist[k] >= poly.radius() * (1 + 1e-12):
+        u, half_dist = y / dist[:, None], 0.5 * dist
+        todo = np.arange(len(dist))
+        for _ in range(len(dist)):          # the bisectors that cut the polytope, nearest first
+            cuts = (poly.vertices @ u[todo].T - half_dist[todo]).max(axis=0, initial=-1.0) > _ON
+            todo = todo[cuts]
+            if len(todo) == 0:
                 break
-            poly = poly.clip(Plane(y[k] / dist[k], 0.5 * dist[k], ("b", int(near[k]))))
+            k = int(todo[0])
+            poly = poly.clip(Plane(u[k], float(half_dist[k]), ("b", int(near[k]))))
+            todo = todo[1:]
         if convex:
             return [poly], None
         centre = poly.vertices.mean(axis=0)

@@ -86,30 +86,30 @@ class RegionTets:
             the pieces on their faces).
         """
         x = (self.points[self.tets[ids]] - x0) / s                       # (k, 4, 3)
-        a, b, c = (x[:, _FACES[:, q]] for q in range(3))                   # (k, 4, 3)
-        normal = np.cross(b - a, c - a)
         six_v = np.einsum("kj,kj->k", x[:, 1] - x[:, 0],
                           np.cross(x[:, 2] - x[:, 0], x[:, 3] - x[:, 0]))
         flat = np.abs(six_v) <= _FLAT
-        normal = np.where((six_v < 0)[:, None, None], -normal, normal)     # outward
+        # the tetrahedra's outward planes, and poly's
+        a, b, c = (x[:, _FACES[:, q]] for q in range(3))                   # (k, 4, 3)
+        normal = np.cross(b - a, c - a)
+        normal = np.where((six_v < 0)[:, None, None], -normal, normal)
         normal /= np.maximum(np.linalg.norm(normal, axis=2), 1e-300)[..., None]
         offset = np.einsum("kfj,kfj->kf", normal, a)
+        planes = [pl for _, pl in poly.faces]
+        pn = np.array([pl.normal for pl in planes]).reshape(-1, 3)
+        po = np.array([pl.offset for pl in planes])
+        beyond = np.einsum("kvj,fj->kfv", x, pn) - po[:, None]             # (k, f, 4)
+        apart = (beyond >= -_ON).all(axis=2).any(axis=1)                   # a plane of poly
         side = np.einsum("vj,kfj->kfv", poly.vertices, normal) - offset[..., None]
-        apart = (side.min(axis=2) >= -_ON).any(axis=1)            # a tetrahedron's plane separates
-        if len(poly.faces):                                         # ... or one of poly's planes
-            pn = np.array([pl.normal for _, pl in poly.faces])
-            po = np.array([pl.offset for _, pl in poly.faces])
-            apart |= (np.einsum("kvj,fj->kfv", x, pn) - po[:, None] >= -_ON).all(axis=2).any(axis=1)
+        apart |= (side.min(axis=2) >= -_ON).any(axis=1)                    # a tetrahedron's
         pieces = []
         for k in np.flatnonzero(~apart & ~flat).tolist():
-            piece = poly
             t = int(ids[k])
-            for f in range(4):
-                if side[k, f].max() <= _ON:
-                    continue                                                # poly inside
-                bnd = int(self.boundary[t, f])
-                tag = ("f", bnd) if bnd >= 0 else ("t", int(self.face_key[t, f]))
-                piece = piece.clip(Plane(normal[k, f], float(offset[k, f]), tag))
+            tags = [("f", int(self.boundary[t, f])) if self.boundary[t, f] >= 0
+                    else ("t", int(self.face_key[t, f])) for f in range(4)]
+            piece = Polytope.tetrahedron(x[k], tags)
+            for f in np.flatnonzero(beyond[k].max(axis=1) > _ON).tolist():
+                piece = piece.clip(planes[f])
                 if piece is None:
                     break
             if piece is not None:
