@@ -103,3 +103,34 @@ def test_cavity_cells_are_invariant(shift, scale):
     tol = 1e-8 if shift else 1e-11
     np.testing.assert_allclose(moved.volume / scale ** 3, ref.volume, rtol=tol,
                                atol=tol * ref.volume.max())
+
+
+def test_pieces_join_only_through_shared_internal_faces():
+    """Two tetrahedra sharing a face make one cell; moved apart (sharing nothing), two;
+    a flat tetrahedron between them joins them again."""
+    from cnem.geometry.polytope import Polytope
+    from cnem.geometry.tet_pieces import connected
+    base = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    up = Polytope.tetrahedron(np.vstack([base, [0, 0, 1]]), [("f", 0), ("f", 1), ("f", 2),
+                                                              ("t", 7)])
+    down = Polytope.tetrahedron(np.vstack([base, [0, 0, -1]]), [("f", 3), ("f", 4), ("f", 5),
+                                                                ("t", 7)])
+    apart = Polytope.tetrahedron(np.vstack([base, [0, 0, -1]]) + 5.0,
+                                 [("f", 3), ("f", 4), ("f", 5), ("t", 8)])
+    none = np.zeros((0, 4), dtype=np.int64)
+    assert connected([up, down], none)
+    assert not connected([up, apart], none)
+    assert connected([up, apart], np.array([[7, 8, 9, 10]]))
+
+
+def test_a_cell_split_by_the_region_is_refused(monkeypatch):
+    """Were the pieces of a cell not to meet inside the region, the error names the node
+    and asks for a finer cloud."""
+    import cnem.geometry.cells3d_clip as clip
+    monkeypatch.setattr(clip, "connected", lambda pieces, joins: False)
+    dom, h = _domain("tube")
+    cloud = cnem.nodes.irregular(dom, h, seed=1)
+    tet = conforming_tetrahedra(cloud.points, cloud.boundary_faces, cloud.boundary_face_regions)
+    with pytest.raises(GeometryError, match="refine the cloud near"):
+        constrained_voronoi_cells(tet.points, tet.tetrahedra, tet.tet_region,
+                                  tet.boundary_faces, tet.boundary_face_regions)

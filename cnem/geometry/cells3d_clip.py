@@ -5,21 +5,29 @@ the origin, lengths in units of its longest Delaunay edge) inside a cube of
 half-side ``a`` (doubled, a bounded number of times, until the cell does not touch
 it):
 
-* when the region's faces within reach are in convex position (no vertex of one
-  beyond another's plane: a box, its edges and corners, a flat interface), the
-  cell is one convex polytope: the cube clipped by those faces' planes and by the
-  bisectors with the region's nodes, nearest first, until the next bisector lies
-  beyond the cell;
-* otherwise (a re-entrant edge, a slot, a cavity nearby) visibility matters. The
-  region's tetrahedra in reach are the convex pieces; from them the shadows of the
-  faces seen from ``i`` are removed (the shadow of a triangle is convex: beyond its
-  plane and inside the three planes through ``i`` and its edges), and each nearer
-  node ``j`` removes the part of the pieces nearer to ``j`` that ``j`` sees (its
-  bisector half-space minus ``j``'s shadows). Every set operation leaves disjoint
-  convex pieces, so the volume is exact. The faces between two pieces of the cell
-  (on a tetrahedron face, a shadow plane, a bisector) cancel: per plane, the
-  polygons of one side minus those of the other are the cell's boundary there
-  (shapely in the plane), so no facet lies inside the cell.
+Only the faces of *blocking* patches (`.smooth_patches`: patches with a sharp
+re-entrant edge) hide points; the faceted facets of a curved cavity or hole do not.
+
+* when no blocking face with region beyond its plane is in reach, the cell is the
+  Voronoi polytope of ``i`` among the region's nodes, within the region: if the
+  faces within reach are in convex position (no vertex of one beyond another's
+  plane: a box, its edges and corners, a flat interface), one convex polytope, the
+  cube clipped by those faces' planes and by the bisectors that cut it, nearest
+  first; else (a curved re-entrant surface nearby) the polytope cut by each of the
+  region's tetrahedra it meets (`.tet_pieces`), the faces between tetrahedra
+  dropped (they cancel exactly);
+* otherwise (a notch, a slot, a cubic cavity nearby) visibility matters. The
+  convex pieces are the cube cut to the region's side of ``i`` (or the region's
+  tetrahedra in reach, when smooth re-entrant faces are near too); from them the
+  shadows of the blocking faces seen from ``i`` are removed (the shadow of a
+  triangle is convex: beyond its plane and inside the three planes through ``i``
+  and its edges), and each nearer node ``j`` removes the part of the pieces nearer
+  to ``j`` that ``j`` sees (its bisector half-space minus ``j``'s shadows). Every
+  set operation leaves disjoint convex pieces, so the volume is exact. The faces
+  between two pieces of the cell (on a tetrahedron face, a shadow plane, a
+  bisector) cancel: per plane, the polygons of one side minus those of the other
+  are the cell's boundary there (shapely in the plane), so no facet lies inside
+  the cell.
 """
 
 from __future__ import annotations
