@@ -187,3 +187,13 @@ def nearest_visible(x, points, faces, candidates=24):
         out[rows[seen]] = idx[rows[seen], k]
         todo[rows[seen]] = False
     return out
+
+
+def facet_flux(cells):
+    """Per cell: the sum of its facets' area vectors ``(m, 3)`` (zero for a closed cell) and
+    its surface area ``(m,)``."""
+    area = cells.facet_areas()
+    m = len(cells.node)
+    flux = np.stack([np.bincount(cells.facet_cell, weights=cells.facet_normal[:, k] * area,
+                                 minlength=m) for k in range(3)], axis=1)
+    return flux, np.bincount(cells.facet_cell, weights=area, minlength=m)

@@ -60,9 +60,7 @@ def test_cells_partition_the_body_and_are_closed(name):
     assert cells.volume.min() > 0
     area = cells.facet_areas()
     m = len(cells.node)
-    flux = np.stack([np.bincount(cells.facet_cell, weights=cells.facet_normal[:, k] * area,
-                                 minlength=m) for k in range(3)], axis=1)
-    surface = np.bincount(cells.facet_cell, weights=area, minlength=m)
+    flux, surface = cases3d.facet_flux(cells)
     assert (np.abs(flux).max(axis=1) <= 1e-10 * surface).all()
     # divergence theorem: the facets enclose the volume
     rel = cells.facet_triangles.mean(axis=1) - tet.points[cells.node[cells.facet_cell]]
@@ -134,3 +132,35 @@ def test_a_cell_split_by_the_region_is_refused(monkeypatch):
     with pytest.raises(GeometryError, match="refine the cloud near"):
         constrained_voronoi_cells(tet.points, tet.tetrahedra, tet.tet_region,
                                   tet.boundary_faces, tet.boundary_face_regions)
+
+
+@pytest.mark.slow
+def test_blocking_and_smooth_cavities_side_by_side():
+    """A box with a cubic cavity (blocking: sharp re-entrant edges) beside a faceted
+    spherical one (not blocking): the cells partition the body and each sample lies in the
+    cell of its nearest node seen past the blocking faces only."""
+    from cnem.geometry.shapes3d import box_surface, sphere_surface
+    dom = cnem.Domain3D((box_surface((0, 0, 0), (2, 1, 1)),
+                         [box_surface((0.35, 0.35, 0.35), (0.65, 0.65, 0.65)),
+                          sphere_surface(0.2, center=(1.1, 0.5, 0.5), subdivisions=1)]))
+    cloud = cnem.nodes.irregular(dom, 0.2, seed=1)
+    tet = conforming_tetrahedra(cloud.points, cloud.boundary_faces, cloud.boundary_face_regions)
+    cells = constrained_voronoi_cells(tet.points, tet.tetrahedra, tet.tet_region,
+                                      tet.boundary_faces, tet.boundary_face_regions)
+    np.testing.assert_allclose(cells.volume.sum(), dom.volume, rtol=1e-10)
+    blocking, _ = blocking_sides(tet.points, tet.boundary_faces, tet.boundary_face_regions)
+    cube = np.abs(tet.points[tet.boundary_faces] - 0.5).max(axis=(1, 2)) <= 0.15 + 1e-9
+    np.testing.assert_array_equal(blocking[:, 0], cube)          # exactly the cubic cavity
+    rng = np.random.default_rng(3)
+    x = rng.uniform(dom.bounds[0], dom.bounds[1], (1500, 3))
+    x = x[dom.contains(x)][:300]
+    owner = cases3d.nearest_visible(x, tet.points, tet.boundary_faces[blocking[:, 0]])
+    assert (owner >= 0).all()
+    order = np.argsort(cells.facet_cell, kind="stable")
+    start = np.searchsorted(cells.facet_cell[order], np.arange(len(cells.node) + 1))
+    cell_of = np.full(len(tet.points), -1)
+    cell_of[cells.node] = np.arange(len(cells.node))
+    inside = [_winding(p[None], cells.facet_triangles[order[start[cell_of[i]]:
+                                                             start[cell_of[i] + 1]]])[0]
+              for p, i in zip(x, owner.tolist())]
+    np.testing.assert_allclose(inside, 1.0, atol=1e-6)

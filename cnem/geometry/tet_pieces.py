@@ -18,12 +18,10 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .polytope import _ON, Plane, Polytope
-from .tetrahedra import tet_neighbors
+from .tetrahedra import _FACES, tet_neighbors
 
 __all__ = ["RegionTets", "open_facets", "connected"]
 
-#: Opposite vertex of each face ``k`` of a tetrahedron is ``k``; its three vertices.
-_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 #: A tetrahedron whose ``|6 V|`` (local unit) is below this is flat: no piece, but it
 #: joins the pieces around it.
 _FLAT = 1e-10
