@@ -105,7 +105,9 @@ class RegionTets:
             t = int(ids[k])
             tags = [("f", int(self.boundary[t, f])) if self.boundary[t, f] >= 0
                     else ("t", int(self.face_key[t, f])) for f in range(4)]
-            piece = Polytope.tetrahedron(x[k], tags)
+            turn = _FACES if six_v[k] > 0 else _FACES[:, ::-1]   # counter-clockwise outside
+            piece = Polytope(x[k], [(turn[f], Plane(normal[k, f], float(offset[k, f]), tags[f]))
+                                    for f in range(4)])
             for f in np.flatnonzero(beyond[k].max(axis=1) > _ON).tolist():
                 piece = piece.clip(planes[f])
                 if piece is None:
