@@ -18,6 +18,8 @@ from cnem.geometry.tetrahedra import conforming_tetrahedra, signed_volumes
 def _domain(name):
     if name == "hollow_sphere":
         return cnem.geometry.hollow_sphere(0.5, 1.0, subdivisions=2), 0.35
+    if name == "hollow_sphere_fine":
+        return cnem.geometry.hollow_sphere(0.5, 1.0), 0.15
     return cnem.Domain3D(cases3d.tube_surface(0.4, 1.0, 1.0, 16)), 0.25
 
 
@@ -51,7 +53,10 @@ def test_curved_boundaries_hide_nothing(name):
     assert reentrant.any()                  # the cavity's or hole's facets are re-entrant
 
 
-@pytest.mark.parametrize("name", ["hollow_sphere", "tube"])
+FINE = pytest.param("hollow_sphere_fine", marks=pytest.mark.slow)
+
+
+@pytest.mark.parametrize("name", ["hollow_sphere", "tube", FINE])
 def test_cells_partition_the_body_and_are_closed(name):
     dom, tet, cells = _cells(name)
     np.testing.assert_allclose(cells.volume.sum(), dom.volume, rtol=1e-10)
@@ -69,7 +74,7 @@ def test_cells_partition_the_body_and_are_closed(name):
     np.testing.assert_allclose(div, cells.volume, rtol=1e-9, atol=1e-14)
 
 
-@pytest.mark.parametrize("name", ["hollow_sphere", "tube"])
+@pytest.mark.parametrize("name", ["hollow_sphere", "tube", FINE])
 def test_each_point_lies_in_the_cell_of_its_nearest_node(name):
     """Brute force: with no blocking face the owner of a point is its nearest node
     (visibility cut by the empty set of blocking faces); the point must lie inside that
