@@ -24,7 +24,7 @@ __all__ = ["SNAP_TOL", "OVERLAP_TOL", "MERGE_TOL", "GRID_TOL", "SHAPE_TOL", "ROU
            "DT_LIMIT", "COORDINATE_LIMIT", "DIRECT_MEMORY", "DIRECT_FILL",
            "CG_MAXITER", "SIF_DISCS", "SIF_REACH", "SIF_INNER", "SIF_STRAIGHTNESS",
            "SIF_BEND_SPACINGS", "SIF_SPREAD", "SIF_SPACINGS", "PARALLEL_MIN", "PLOT_MAX_PIXELS",
-           "CHORD_TOLERANCE", "ARC_MIN_PIECES"]
+           "CHORD_TOLERANCE", "ARC_MIN_PIECES", "SMOOTH_ANGLE"]
 
 # ---------------------------------------------------------------- geometry tolerances
 #: Coordinates (and their extent) must stay below this in magnitude: squared distances
@@ -42,6 +42,14 @@ CHORD_TOLERANCE = 1e-3
 
 #: ... and a full turn of an arc has at least this many chords (small holes stay round).
 ARC_MIN_PIECES = 16
+
+#: Two boundary faces of a 3-D region meeting at an edge whose dihedral angle, measured
+#: inside the region, differs from 180 degrees by less than this (degrees) belong to one
+#: smooth patch (a faceted sphere, cylinder or fillet). A patch hides points from the
+#: nodes (cuts visibility in the 3-D cells) only when one of its edges is a sharp
+#: re-entrant edge, whose angle in the region exceeds ``180 + SMOOTH_ANGLE`` (a notch,
+#: a slot, a cubic cavity); `cnem.geometry.smooth_patches`.
+SMOOTH_ANGLE = 30.0
 
 #: Relative area below which an overlap of two regions is considered round-off.
 OVERLAP_TOL = 1e-12

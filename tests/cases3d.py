@@ -144,10 +144,35 @@ def segments_blocked(a, b, tri):
     return hit.any(axis=1)
 
 
+def tube_surface(inner, outer, height, segments=24):
+    """A thick-walled tube along z (a cylinder with a coaxial hole), as triangles: the
+    regular ``segments``-gons inscribed in the circles of radii ``inner < outer``.
+
+    Returns ``(vertices (4 segments, 3), faces (8 segments, 3))``, faces pointing out of
+    the wall (into the hole on the inner side).
+    """
+    t = 2.0 * np.pi * np.arange(segments) / segments
+    ring = np.column_stack([np.cos(t), np.sin(t), np.zeros(segments)])
+    up = np.array([0.0, 0.0, height])
+    vertices = np.concatenate([outer * ring, outer * ring + up, inner * ring, inner * ring + up])
+    i, j = np.arange(segments), (np.arange(segments) + 1) % segments
+    ob, ot, ib, it = i, segments + i, 2 * segments + i, 3 * segments + i
+    obj, otj, ibj, itj = j, segments + j, 2 * segments + j, 3 * segments + j
+    faces = np.concatenate([
+        np.column_stack([ob, obj, otj]), np.column_stack([ob, otj, ot]),      # outer wall
+        np.column_stack([ib, it, itj]), np.column_stack([ib, itj, ibj]),      # inner wall
+        np.column_stack([ot, otj, itj]), np.column_stack([ot, itj, it]),      # top
+        np.column_stack([ob, ib, ibj]), np.column_stack([ob, ibj, obj])])     # bottom
+    return vertices, faces
+
+
 def nearest_visible(x, points, faces, candidates=24):
     """Index of the nearest node visible from each sample ``x (s, 3)`` (brute force).
 
-    Returns -1 where none of the ``candidates`` nearest nodes is visible.
+    ``faces`` are the triangles that cut visibility: all boundary faces, or a subset
+    (the blocking ones, `cnem.geometry.smooth_patches`; an empty ``(0, 3)`` array makes
+    this the plain nearest node). Returns -1 where none of the ``candidates`` nearest
+    nodes is visible.
     """
     from scipy.spatial import cKDTree
     tri = points[faces]
@@ -162,3 +187,13 @@ def nearest_visible(x, points, faces, candidates=24):
         out[rows[seen]] = idx[rows[seen], k]
         todo[rows[seen]] = False
     return out
+
+
+def facet_flux(cells):
+    """Per cell: the sum of its facets' area vectors ``(m, 3)`` (zero for a closed cell) and
+    its surface area ``(m,)``."""
+    area = cells.facet_areas()
+    m = len(cells.node)
+    flux = np.stack([np.bincount(cells.facet_cell, weights=cells.facet_normal[:, k] * area,
+                                 minlength=m) for k in range(3)], axis=1)
+    return flux, np.bincount(cells.facet_cell, weights=area, minlength=m)

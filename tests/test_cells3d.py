@@ -37,9 +37,7 @@ def test_cells_partition_each_region_and_are_closed(name, jitter):
     area = cells.facet_areas()
     m = len(cells.node)
     # closed: the normals times the areas sum to zero over each cell
-    flux = np.stack([np.bincount(cells.facet_cell, weights=cells.facet_normal[:, k] * area,
-                                 minlength=m) for k in range(3)], axis=1)
-    scale = np.bincount(cells.facet_cell, weights=area, minlength=m)
+    flux, scale = cases3d.facet_flux(cells)
     assert np.abs(flux).max(axis=1).max() <= 1e-12 * scale.max()
     # divergence theorem: the volume is (1/3) sum (x - x_i) . n A over the facets
     rel = cells.facet_triangles.mean(axis=1) - tet.points[cells.node[cells.facet_cell]]

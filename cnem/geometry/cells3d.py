@@ -1,8 +1,10 @@
 """Constrained Voronoi integration cells in 3-D, with their boundaries as triangles.
 
 A point ``x`` of region ``r`` belongs to the cell of node ``i`` when ``i`` is visible
-from ``x`` (the segment between them crosses no boundary or interface face) and no
-node visible from ``x`` is nearer. A node on an interface owns one cell per region.
+from ``x`` (the segment between them crosses no blocking boundary or interface face:
+one of a patch with a sharp re-entrant edge, `.smooth_patches`; the facets of a
+curved cavity or hole hide nothing) and no node visible from ``x`` is nearer. A
+node on an interface owns one cell per region.
 
 Two paths compute the cells:
 
@@ -12,8 +14,8 @@ Two paths compute the cells:
   of a Delaunay edge, the circumcentres of the tetrahedra around the edge ordered by
   angle and fan-triangulated; the volume is ``sum(A d) / 6`` over the facets;
 * the *general path* (`.cells3d_clip`), for every other node: exact clipping of
-  convex polytopes by bisectors, boundary planes and the shadows of the boundary
-  faces (see there).
+  convex polytopes by bisectors, boundary planes or the region's tetrahedra, and
+  the shadows of the blocking faces (see there).
 
 The cells partition each region: their volumes sum to the region's volume to
 round-off.

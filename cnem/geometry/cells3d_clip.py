@@ -5,21 +5,29 @@ the origin, lengths in units of its longest Delaunay edge) inside a cube of
 half-side ``a`` (doubled, a bounded number of times, until the cell does not touch
 it):
 
-* when the region's faces within reach are in convex position (no vertex of one
-  beyond another's plane: a box, its edges and corners, a flat interface), the
-  cell is one convex polytope: the cube clipped by those faces' planes and by the
-  bisectors with the region's nodes, nearest first, until the next bisector lies
-  beyond the cell;
-* otherwise (a re-entrant edge, a slot, a cavity nearby) visibility matters. The
-  region's tetrahedra in reach are the convex pieces; from them the shadows of the
-  faces seen from ``i`` are removed (the shadow of a triangle is convex: beyond its
-  plane and inside the three planes through ``i`` and its edges), and each nearer
-  node ``j`` removes the part of the pieces nearer to ``j`` that ``j`` sees (its
-  bisector half-space minus ``j``'s shadows). Every set operation leaves disjoint
-  convex pieces, so the volume is exact. The faces between two pieces of the cell
-  (on a tetrahedron face, a shadow plane, a bisector) cancel: per plane, the
-  polygons of one side minus those of the other are the cell's boundary there
-  (shapely in the plane), so no facet lies inside the cell.
+Only the faces of *blocking* patches (`.smooth_patches`: patches with a sharp
+re-entrant edge) hide points; the faceted facets of a curved cavity or hole do not.
+
+* when no blocking face with region beyond its plane is in reach, the cell is the
+  Voronoi polytope of ``i`` among the region's nodes, within the region: if the
+  faces within reach are in convex position (no vertex of one beyond another's
+  plane: a box, its edges and corners, a flat interface), one convex polytope, the
+  cube clipped by those faces' planes and by the bisectors that cut it, nearest
+  first; else (a curved re-entrant surface nearby) the polytope cut by each of the
+  region's tetrahedra it meets (`.tet_pieces`), the faces between tetrahedra
+  dropped (they cancel exactly);
+* otherwise (a notch, a slot, a cubic cavity nearby) visibility matters. The
+  convex pieces are the cube cut to the region's side of ``i`` (or the region's
+  tetrahedra in reach, when smooth re-entrant faces are near too); from them the
+  shadows of the blocking faces seen from ``i`` are removed (the shadow of a
+  triangle is convex: beyond its plane and inside the three planes through ``i``
+  and its edges), and each nearer node ``j`` removes the part of the pieces nearer
+  to ``j`` that ``j`` sees (its bisector half-space minus ``j``'s shadows). Every
+  set operation leaves disjoint convex pieces, so the volume is exact. The faces
+  between two pieces of the cell (on a tetrahedron face, a shadow plane, a
+  bisector) cancel: per plane, the polygons of one side minus those of the other
+  are the cell's boundary there (shapely in the plane), so no facet lies inside
+  the cell.
 """
 
 from __future__ import annotations
@@ -30,6 +38,8 @@ from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
 from .polytope import _ON, Plane, Polytope, cut, subtract
+from .smooth_patches import blocking_sides
+from .tet_pieces import RegionTets, connected, open_facets
 
 __all__ = ["GeneralCells"]
 
@@ -65,21 +75,21 @@ class GeneralCells:
         centroid = x.mean(axis=1)
         radius = np.linalg.norm(x - centroid[:, None], axis=2).max(axis=1)
         self.face_radius = float(radius.max())
-        # per region: its faces with outward normals, its nodes, its tetrahedra
-        self.region_faces, self.region_nodes, self.region_tets = [], [], []
+        blocking, reentrant = blocking_sides(points, faces, face_regions)
+        # per region: its faces with outward normals, whether they block and whether they
+        # have a re-entrant edge, its nodes
+        self.region_faces, self.region_nodes = [], []
         tet_x = points[tets]
-        tet_c = tet_x.mean(axis=1)
-        tet_r = np.linalg.norm(tet_x - tet_c[:, None], axis=2).max(axis=1)
-        self.tet_radius = float(tet_r.max()) if len(tet_r) else 0.0
         for r in range(n_reg):
             inner, outer = face_regions[:, 0] == r, face_regions[:, 1] == r
             idx = np.flatnonzero(inner | outer)
             sign = np.where(inner[idx], 1.0, -1.0)
-            self.region_faces.append((idx, sign[:, None] * normal[idx], cKDTree(centroid[idx])))
-            ts = np.flatnonzero(tet_region == r)
-            nodes = np.unique(tets[ts])
+            mine = np.where(inner[idx], 0, 1)
+            self.region_faces.append((idx, sign[:, None] * normal[idx], cKDTree(centroid[idx]),
+                                      blocking[idx, mine], reentrant[idx, mine]))
+            nodes = np.unique(tets[tet_region == r])
             self.region_nodes.append((nodes, cKDTree(points[nodes])))
-            self.region_tets.append((ts, cKDTree(tet_c[ts])))
+        self.region_tets = RegionTets(points, tets, tet_region, faces)
         edge_len = np.zeros(len(points))
         for a, b in ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)):
             d = np.linalg.norm(tet_x[:, a] - tet_x[:, b], axis=1)
@@ -97,7 +107,7 @@ class GeneralCells:
         half = 1.0
         for _ in range(_GROW):
             reach = np.sqrt(3.0) * half
-            pieces = self._pieces(i, r, x0, s, half, reach)
+            pieces, joins = self._pieces(i, r, x0, s, half, reach)
             if not any(pl.tag[0] == "box" for p in pieces for _, pl in p.faces):
                 break
             half *= 2.0
@@ -109,24 +119,31 @@ class GeneralCells:
         if not pieces:
             raise GeometryError(f"node {i} at {x0.tolist()} has an empty cell in region {r}; "
                                 f"it is not visible from any point of its region")
-        tri, normal = _boundary(pieces)
+        if joins is None:
+            tri, normal = _boundary(pieces)
+        elif connected(pieces, joins):
+            tri, normal = open_facets(pieces)
+        else:
+            raise GeometryError(
+                f"the cell of node {i} at {x0.tolist()} in region {r} falls apart into pieces "
+                f"that do not meet inside the region: its Voronoi cell reaches across a hole, "
+                f"gap or wall thinner than the node spacing there; refine the cloud near "
+                f"{x0.tolist()} (spacing below the gap's width)")
         volume = sum(p.volume() for p in pieces) * s ** 3
         return tri * s + x0, normal, volume
 
     def _near_faces(self, r, x0, s, reach):
-        idx, normal, tree = self.region_faces[r]
+        idx, normal, tree, block, bent = self.region_faces[r]
         near = np.array(tree.query_ball_point(x0, reach * s + self.face_radius), dtype=np.int64)
-        if len(near) == 0:
-            return np.zeros((0, 3, 3)), np.zeros((0, 3)), near
         x = (self.points[self.faces[idx[near]]] - x0) / s
-        return x, normal[near], idx[near]
+        return x.reshape(-1, 3, 3), normal[near], idx[near], block[near], bent[near]
 
     def _pieces(self, i, r, x0, s, half, reach):
-        fx, fn, fid = self._near_faces(r, x0, s, 3.0 * reach)
+        """The cell's convex pieces in the local frame, and the flat tetrahedra's face keys
+        (`RegionTets.cut`) when they are pieces of the region's tetrahedra clipped only by
+        bisectors (else None: their shared faces need cancelling by `_boundary`)."""
+        fx, fn, fid, block, bent = self._near_faces(r, x0, s, 3.0 * reach)
         offset = np.einsum("ij,ij->i", fn, fx[:, 0])
-        planes = _distinct_planes(fx, fn, offset, np.inf)
-        beyond = fx.reshape(-1, 3) @ fn[planes].T - offset[planes]
-        convex = beyond.max(initial=-np.inf) <= _REFLEX
         nodes, tree = self.region_nodes[r]
         near = nodes[tree.query_ball_point(x0, 2.0 * reach * s)]
         near = near[near != i]
@@ -134,39 +151,75 @@ class GeneralCells:
         dist = np.linalg.norm(y, axis=1)
         order = np.argsort(dist, kind="stable")
         box = Polytope.box(half)
-        if convex:
-            poly = box
-            for k in _distinct_planes(fx, fn, offset, reach):
-                poly = poly.clip(Plane(fn[k], float(offset[k]), ("f", int(fid[k]))))
-                if poly is None:
-                    return []
-            pieces = [poly]
+        # only faces with some of the region beyond their plane can hide points, and of
+        # those only the faces of blocking patches do (`smooth_patches`)
+        corners = np.concatenate([y, fx.reshape(-1, 3)])
+        hides = np.flatnonzero(block)
+        hides = hides[(corners @ fn[hides].T - offset[hides] > _REFLEX).any(axis=0)]
+        within = _within(fx, reach)
+        if len(hides) == 0:
+            return self._unblocked(r, x0, s, box, y[order], dist[order], near[order],
+                                   fx[within], fn[within], offset[within], fid[within],
+                                   bent[within].any())
+        behind = (corners @ fn[within].T - offset[within] > _REFLEX).any(axis=0)
+        if (behind & ~block[within]).any():
+            # smooth re-entrant faces too: the region's tetrahedra clip it exactly
+            pieces, _ = self.region_tets.cut(box, self.region_tets.near(r, x0, reach * s), x0, s)
         else:
             pieces = self._wedge(i, r, x0, s, box, fx, fn, offset, fid)
-            # only faces with some of the region beyond their plane cast shadows that matter
-            corners = np.concatenate([y, fx.reshape(-1, 3)])
-            behind = (corners @ fn.T - offset > _REFLEX).any(axis=0)
             # the others bound the region: their half-spaces clip like a convex neighbourhood's
-            support = np.flatnonzero(~behind)
+            support = within[~behind]
             for k in _distinct_planes(fx[support], fn[support], offset[support], reach):
                 k = support[k]
                 plane = Plane(fn[k], float(offset[k]), ("f", int(fid[k])))
                 pieces = [q for q in (p.clip(plane) for p in pieces) if q is not None]
-            fx, fn, offset, fid = fx[behind], fn[behind], offset[behind], fid[behind]
-            if pieces:
-                corners = np.concatenate([p.vertices for p in pieces])
-                for shadow in _shadows(np.zeros(3), fx, fn, offset, fid, ("i", i), corners):
-                    pieces = subtract(pieces, shadow)
+        fx, fn, offset, fid = fx[hides], fn[hides], offset[hides], fid[hides]
+        if pieces:
+            corners = np.concatenate([p.vertices for p in pieces])
+            for shadow in _shadows(np.zeros(3), fx, fn, offset, fid, ("i", i), corners):
+                pieces = subtract(pieces, shadow)
         for k in order.tolist():
             if not pieces or 0.5 * dist[k] >= max(p.radius() for p in pieces) * (1 + 1e-12):
                 break
-            u = y[k] / dist[k]
-            nearer_i = Plane(u, 0.5 * dist[k], ("b", int(near[k])))
-            if convex:
-                pieces = [p for p in (pieces[0].clip(nearer_i),) if p is not None]
-                continue
+            nearer_i = Plane(y[k] / dist[k], 0.5 * dist[k], ("b", int(near[k])))
             pieces = _claim(pieces, nearer_i, y[k], (fx, fn, offset, fid), ("j", int(near[k])))
-        return pieces
+        return pieces, None
+
+    def _unblocked(self, r, x0, s, box, y, dist, near, fx, fn, offset, fid, bent):
+        """The cell when no face in reach hides points: the node's Voronoi polytope among its
+        region's nodes (``y (k, 3)`` at ``dist (k,)``, nearest first) within the region.
+
+        When the faces ``fx`` meeting the ``box``'s ball are in convex position (no vertex
+        of one beyond another's plane: a box, its edges and corners, a flat interface), that
+        is the box clipped by their planes and by the bisectors: one piece; else the
+        polytope is cut by the region's tetrahedra (`RegionTets.cut`), and the flat
+        tetrahedra's face keys come back too. ``bent``: a face among them has a re-entrant
+        edge (so they are not in convex position)."""
+        planes = [] if bent else _distinct_planes(fx, fn, offset, np.inf)
+        beyond = fx.reshape(-1, 3) @ fn[planes].T - offset[planes]
+        convex = not bent and beyond.max(initial=-np.inf) <= _REFLEX
+        poly = box
+        if convex:
+            for k in planes:
+                poly = poly.clip(Plane(fn[k], float(offset[k]), ("f", int(fid[k]))))
+                if poly is None:
+                    return [], None
+        u, half_dist = y / dist[:, None], 0.5 * dist
+        todo = np.arange(len(dist))
+        for _ in range(len(dist)):          # the bisectors that cut the polytope, nearest first
+            cuts = (poly.vertices @ u[todo].T - half_dist[todo]).max(axis=0, initial=-1.0) > _ON
+            todo = todo[cuts]
+            if len(todo) == 0:
+                break
+            k = int(todo[0])
+            poly = poly.clip(Plane(u[k], float(half_dist[k]), ("b", int(near[k]))))
+            todo = todo[1:]
+        if convex:
+            return [poly], None
+        centre = poly.vertices.mean(axis=0)
+        ball = float(np.linalg.norm(poly.vertices - centre, axis=1).max())
+        ids = self.region_tets.near(r, x0 + s * centre, s * ball)
+        return self.region_tets.cut(poly, ids, x0, s)
 
     def _wedge(self, i, r, x0, s, box, fx, fn, offset, fid):
         """The cube cut to the region's side of node ``i``: by the planes of its faces when
@@ -215,14 +268,19 @@ class GeneralCells:
         return pieces
 
 
+def _within(fx, reach):
+    """Indices of the faces ``fx (f, 3, 3)`` whose bounding spheres meet the ball of radius
+    ``reach`` about the origin."""
+    centre = fx.mean(axis=1)
+    radius = np.linalg.norm(fx - centre[:, None], axis=2).max(axis=1, initial=0.0)
+    return np.flatnonzero(np.linalg.norm(centre, axis=1) <= reach + radius)
+
+
 def _distinct_planes(fx, fn, offset, reach):
     """Indices of the faces within ``reach`` of the origin, one per distinct plane."""
     if len(fn) == 0:
         return []
-    a, b, c = fx[:, 0], fx[:, 1], fx[:, 2]
-    centre = (a + b + c) / 3.0
-    radius = np.linalg.norm(fx - centre[:, None], axis=2).max(axis=1)
-    within = np.flatnonzero(np.linalg.norm(centre, axis=1) <= reach + radius)
+    within = _within(fx, reach)
     key = np.round(np.column_stack([fn[within], offset[within]]) * 1e9)
     return within[np.unique(key, axis=0, return_index=True)[1]].tolist()
 

@@ -141,13 +141,13 @@ class Polytope:
 
     def volume(self) -> float:
         """Volume by the divergence theorem over the faces' fans (about the centroid)."""
-        c = self.vertices.mean(axis=0)
-        total = 0.0
-        for idx, _ in self.faces:
-            x = self.vertices[idx] - c
-            total += np.einsum("ij,ij->i", x[0][None, :].repeat(len(idx) - 2, 0),
-                               np.cross(x[1:-1], x[2:])).sum()
-        return total / 6.0
+        x = self.vertices - self.vertices.mean(axis=0)
+        fan = np.concatenate([np.column_stack([np.full(len(idx) - 2, idx[0]), idx[1:-1], idx[2:]])
+                              for idx, _ in self.faces])
+        a, b, c = x[fan[:, 0]], x[fan[:, 1]], x[fan[:, 2]]
+        return float((a[:, 0] * (b[:, 1] * c[:, 2] - b[:, 2] * c[:, 1])
+                      + a[:, 1] * (b[:, 2] * c[:, 0] - b[:, 0] * c[:, 2])
+                      + a[:, 2] * (b[:, 0] * c[:, 1] - b[:, 1] * c[:, 0])).sum()) / 6.0
 
     def radius(self) -> float:
         """Largest distance of a vertex from the origin."""
