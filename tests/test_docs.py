@@ -34,7 +34,42 @@ def test_site_builds_strict(tmp_path):
     assert api
     for page in api:              # a bare doctest in a docstring is code, not nested quotes
         assert "<blockquote>" not in page.read_text(), page
-    assert 'class="arithmatex"' in (site / "fracture" / "index.html").read_text()
+    fracture = (site / "fracture" / "index.html").read_text()
+    assert 'class="arithmatex"' in fracture
+    # formulas are MathML from the build, with no script or CDN to draw them
+    assert '<math xmlns="http://www.w3.org/1998/Math/MathML" display="block">' in fracture
+    assert "<mi>&#x003C3;</mi>" in fracture                     # sigma
+    assert "\\frac" not in fracture and "\\sigma" not in fracture
+    for page in site.rglob("*.html"):
+        text = page.read_text()
+        assert not re.search(r"<script[^>]+(mathjax|katex)", text, re.I), page
+        assert not re.search(r"https?://[^\"']*(mathjax|katex|unpkg|jsdelivr|cdnjs)", text,
+                             re.I), page
+    # long code lines wrap, printed output and tables scroll (docs/stylesheets/extra.css)
+    assert 'href="../stylesheets/extra.css"' in fracture
+    assert '<div class="language-text highlight">' in (site / "tutorial" / "index.html").read_text()
+
+
+@pytest.mark.skipif(importlib.util.find_spec("latex2mathml") is None,
+                    reason='the docs extra is not installed (pip install -e ".[docs]")')
+def test_formulas_become_mathml():
+    """docs/mathml_hook.py turns arithmatex's inline and display TeX into MathML (its
+    HTML escapes read back), leaves other HTML alone and names the page of a formula it
+    cannot read."""
+    render = runpy.run_path(str(ROOT / "docs" / "mathml_hook.py"))["render_formulas"]
+    page = ('<p>If <span class="arithmatex">\\(a &lt; b_i\\)</span> then</p>\n'
+            '<div class="arithmatex">\\[\n\\frac{1}{2}\n\\]</div><p>$5 and \\(x\\)</p>')
+    out = render(page, "x.md")
+    assert out.count("<math") == 2 and "\\frac" not in out and "&lt; b_i" not in out
+    assert '<span class="arithmatex"><math xmlns="http://www.w3.org/1998/Math/MathML" ' \
+           'display="inline">' in out
+    bare = out.replace("<mrow>", "").replace("</mrow>", "")
+    assert 'display="block"><mfrac><mn>1</mn><mn>2</mn></mfrac></math></div>' in bare
+    assert "<mi>a</mi><mo>&#x0003C;</mo><msub><mi>b</mi><mi>i</mi></msub>" in bare
+    assert out.endswith("<p>$5 and \\(x\\)</p>")       # not marked by arithmatex: kept
+    for broken in ("x^", "\\sigma + \\unknowncommand"):   # unreadable; unknown to latex2mathml
+        with pytest.raises(ValueError, match="x.md"):
+            render(f'<span class="arithmatex">\\({broken}\\)</span>', "x.md")
 
 
 @pytest.mark.skipif(importlib.util.find_spec("griffe") is None,
