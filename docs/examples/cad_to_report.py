@@ -60,7 +60,8 @@ out.mkdir(parents=True, exist_ok=True)
 with open(out / "forces.csv", "w", newline="") as f:
     writer = csv.writer(f)
     writer.writerow(["boundary", "kind", "force_x_N", "force_y_N"])
-    writer.writerows([(name, kind, f"{fx:.6g}", f"{fy:.6g}") for name, kind, fx, fy in rows])
+    for name, kind, *force in rows:             # to 1 mN (+ 0.0: no "-0.000")
+        writer.writerow([name, kind, *(f"{round(value, 3) + 0.0:.3f}" for value in force)])
 print(f"wrote {out / 'forces.csv'}:")
 print((out / "forces.csv").read_text().strip())
 
