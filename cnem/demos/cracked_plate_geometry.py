@@ -126,6 +126,8 @@ def main(h: float = 0.1, h_min: float = 0.01, gamma_deg: float = 30.0, growth: f
         cnem.plot.model(model, files["tip"], window_size=window_size,
                         bounds=(tip[0] - half, tip[1] - half, tip[0] + half, tip[1] + half)
                         ).close()
+    for path in files.values():
+        print(f"wrote {path}")
     return {
         "n_points": len(cloud.points),
         "n_nodes": len(model.nodes),
@@ -160,8 +162,6 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
           f"in {res['seconds']:.2f} s")
     print(f"sum of cell areas {res['cell_area']:.15g} vs plate area {res['exact_area']:g} "
           f"(relative error {res['area_error']:.1e})")
-    for path in res["files"].values():
-        print(f"wrote {path}")
     return res
 
 
