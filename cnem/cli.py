@@ -116,7 +116,12 @@ def _positive(kind: type) -> Callable[[str], int | float]:
 positive_int, positive_float = _positive(int), _positive(float)
 
 
-def demo_parser(module_file: str, doc: str, prog: str | None = None) -> argparse.ArgumentParser:
+#: What a demo's ``--help`` calls its run time at the defaults (`demo_parser`).
+RUN_TIME_LABEL = "Expected run time at the defaults"
+
+
+def demo_parser(module_file: str, doc: str, prog: str | None = None, *,
+                run_time: str) -> argparse.ArgumentParser:
     """The command line every demo starts from (the one place of the demos' output rule).
 
     Parameters
@@ -128,6 +133,10 @@ def demo_parser(module_file: str, doc: str, prog: str | None = None) -> argparse
     prog : str, optional
         The command shown in the usage line (`main` passes the one it was called as), by
         default the demo's ``cnem`` command (`demo_command`).
+    run_time : str
+        How long the demo runs at its defaults on a 2-core machine with the numba
+        kernels compiled (the demo's ``RUN_TIME``, measured, e.g. ``"about 10 s"``);
+        the description says it after the docstring's first line.
 
     Returns
     -------
@@ -136,9 +145,11 @@ def demo_parser(module_file: str, doc: str, prog: str | None = None) -> argparse
         ``--no-plot``; the demo adds its own options. Compiling kernels is announced on the
         terminal (`show_compile_notice`).
     """
+    first_line = doc.strip().split("\n")[0]
+    description = (f"{first_line}\n\n{RUN_TIME_LABEL}: {run_time}\n(a shared 2-core "
+                   "machine, kernels compiled; a first run compiles them first)")
     parser = argparse.ArgumentParser(prog=prog or demo_command(module_file),
-                                     description=doc.strip().split("\n")[0],
-                                     formatter_class=HelpFormatter)
+                                     description=description, formatter_class=HelpFormatter)
     parser.add_argument("--out", default=output_folder(module_file),
                         help="folder for the files and pictures")
     parser.add_argument("--no-plot", action="store_true", help="skip the pictures")

@@ -7,6 +7,7 @@ import importlib
 import inspect
 import os
 import pathlib
+import re
 import subprocess
 import sys
 import textwrap
@@ -192,6 +193,17 @@ def test_every_demo_shows_its_defaults_and_follows_the_output_rule(command, name
     assert out.default == f"results/{module}"
     main = importlib.import_module(f"cnem.demos.{module}").main
     assert inspect.signature(main).parameters["outdir"].default == out.default
+
+
+@pytest.mark.parametrize("command, name", [(c, n) for c, t in cli._TABLES.items() for n in t])
+def test_every_demo_states_its_run_time(command, name, capsys):
+    """``--help`` of every demo says how long it runs at its defaults (its ``RUN_TIME``: a
+    duration in s, min or h)."""
+    run_time = importlib.import_module(f"cnem.demos.{cli._TABLES[command][name]}").RUN_TIME
+    assert re.search(r"\d+(\.\d+)?(-\d+(\.\d+)?)? (s|min|h)\b", run_time), run_time
+    code, out = _run([command, name, "--help"], capsys)
+    assert code == 0
+    assert f"{cli.RUN_TIME_LABEL}: {run_time}" in " ".join(out.split())
 
 
 def test_undefined_pd_k_is_explained_with_the_right_threshold():

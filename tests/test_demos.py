@@ -13,6 +13,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import pathlib
+import re
 import runpy
 from dataclasses import dataclass, field
 from typing import Callable
@@ -463,3 +464,14 @@ def test_demo(case):
         run = demo_runs.run_main(case.module, *args, **sizes, plot=case.plot)
     extra = (run.stdout,) if case.stdout else ()
     case.check(demo, run.result, run.outdir, *extra)
+    assert_every_file_announced(run.stdout, run.outdir)
+
+
+def assert_every_file_announced(stdout, outdir):
+    """Each file a demo wrote is named by a ``wrote <file>`` line of what it printed; the
+    frames of a series count as named when its ``.pvd`` (in their folder) is."""
+    announced = {pathlib.Path(p) for p in re.findall(r"^wrote (\S+)", stdout, re.M)}
+    for path in (p for p in outdir.rglob("*") if p.is_file()):
+        series = {p for p in path.parent.glob("*.pvd")} & announced
+        assert path in announced or (path.suffix in (".vtu", ".pvtu") and series), (
+            f"{path} was written but not announced with a 'wrote' line")

@@ -312,3 +312,24 @@ def test_default_stabilisation_does_not_lock():
         assert coarse[0] < 1e-3 and fine[0] < 1e-3, (nu, coarse, fine)
         assert coarse[1] < 0.3 and fine[1] < 0.1, (nu, coarse, fine)
         assert fine[1] < 0.55 * coarse[1], (nu, coarse, fine)
+
+
+def test_reaction_balances_the_loads_and_takes_any_where():
+    """``sol.reaction(where)``: the clamp's force balances the body's weight and an end
+    traction exactly (equilibrium of K u = f, to the solver's tolerance), the same by name,
+    predicate, mask and indices; a boundary with no support carries none; an empty
+    selection is refused."""
+    dom = cnem.geometry.rectangle(3.0, 1.0, origin=(10.0, -5.0))
+    prob = cnem.Elasticity(cnem.discretize(cnem.nodes.irregular(dom, 0.2, seed=1)), (100.0, 0.25))
+    prob.add_dirichlet("left", None)
+    prob.add_body_force([0.5, -2.0])                       # (1.5, -6) over the area 3
+    prob.add_traction("right", [1.0, 3.0])                  # (1, 3) over the edge of length 1
+    sol = prob.solve()
+    expected = -np.array([1.5 + 1.0, -6.0 + 3.0])
+    np.testing.assert_allclose(sol.reaction("left"), expected, atol=1e-8)
+    left = np.abs(prob.model.nodes[:, 0] - 10.0) < 1e-9
+    for where in (lambda x: np.abs(x[:, 0] - 10.0) < 1e-9, left, np.flatnonzero(left)):
+        np.testing.assert_allclose(sol.reaction(where), expected, atol=1e-8)
+    np.testing.assert_allclose(sol.reaction("right"), 0.0, atol=1e-8)
+    with pytest.raises(cnem.errors.ConditionError, match="selects no node"):
+        sol.reaction(lambda x: x[:, 0] > 100.0)

@@ -13,12 +13,15 @@ for every entry of `cnem.cli.DEMOS` and `cnem.cli.PD_DEMOS`):
    plot: bool = True) -> dict``, a launcher ``demos/<module>.py``, a row in
    ``tests/test_demos.py``'s ``CASES``, its name in `MODULES` below, an entry in
    `cnem.cli.DEMOS` (or `cnem.cli.PD_DEMOS`).
-2. Its command line starts from the shared parser, which shows every default and
+2. Its command line starts from the shared parser, which shows every default,
    holds the output rule (``--out``, default ``results/<module>/``, and
-   ``--no-plot``)::
+   ``--no-plot``) and states the run time at the defaults on 2 cores (the module's
+   ``RUN_TIME``, measured)::
+
+       RUN_TIME = "about 10 s"
 
        def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
-           parser = demo_parser(__file__, __doc__, prog)     # from cnem.cli
+           parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)  # cnem.cli
            parser.add_argument("--h", type=float, default=0.1, help="node spacing")
            args = parser.parse_args(argv)
            return main(args.h, outdir=args.out, plot=not args.no_plot)

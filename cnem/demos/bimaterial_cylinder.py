@@ -70,6 +70,10 @@ ASPECT = 0.75
 TOL = 1e-9
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 10 s"
+
+
 def grid_for(nodes):
     """The polar lattice ``(radii, angles)`` for about ``nodes`` nodes: an odd number
     of radii (so that a ring of nodes lies on the interface, midway), the angles
@@ -336,7 +340,7 @@ def main(grids: tuple = GRIDS, *, irregular: tuple = (False, True), fem: bool = 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/bimaterial_cylinder.py --help`` or
     ``cnem demo bimaterial-cylinder``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--nodes", type=positive_int, nargs="+",
                         help="node counts (default the paper's 147 315 687 1863)")
     kind = parser.add_mutually_exclusive_group()

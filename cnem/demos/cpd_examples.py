@@ -91,6 +91,10 @@ QUICK = {
 }
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 4 min"
+
+
 def main(examples: tuple = EXAMPLES, *, quick: bool = False, outdir: str = "results/cpd_examples",
          plot: bool = True) -> dict:
     """Run the examples (names from `EXAMPLES`), print their tables, write their pictures.
@@ -108,7 +112,7 @@ def main(examples: tuple = EXAMPLES, *, quick: bool = False, outdir: str = "resu
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/cpd_examples.py --help`` or ``cnem pd cpd-examples``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--example", choices=EXAMPLES + ("all",), default="all",
                         help="the example to run (all: the five)")
     parser.add_argument("--quick", action="store_true", help="tiny versions (seconds)")

@@ -88,6 +88,10 @@ ANGLES = tuple(float(np.degrees(np.arctan(s))) for s in (0.025, 0.05, 0.1))
 ROOT = 0.64
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 100 s"
+
+
 def domain(theta_deg):
     """The beam with a crack along y = 0 ending in a kink of ``theta_deg`` degrees."""
     t = np.radians(theta_deg)
@@ -285,12 +289,14 @@ def main(h: float = 0.05, *, increment: float = 0.1, steps: int = 30, angles: tu
         _paths_figure(runs, out / "dcb_paths.png")
         _load_figure(runs[-1], out / "dcb_load.png")
         files = [out / "dcb_paths.png", out / "dcb_load.png"]
+    for f in files:
+        print(f"wrote {f}")
     return dict(runs=runs, convergence=conv, files=[str(f) for f in files])
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_dcb --help`` or ``cnem demo growth-dcb``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--h", type=positive_float, default=0.05, help="node spacing (units of H)")
     parser.add_argument("--increment", type=positive_float, default=0.1, help="crack increment (units of H)")
     parser.add_argument("--steps", type=positive_int, default=30, help="growth increments")

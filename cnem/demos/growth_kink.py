@@ -45,6 +45,10 @@ ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0)
 CLOUD = (0.4, 0.0025, 0.15)
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 25 s"
+
+
 def exact(gamma_deg):
     """Exact K_I, K_II and the maximum hoop stress angle (radians)."""
     g = np.deg2rad(gamma_deg)
@@ -134,13 +138,15 @@ def main(angles: tuple = ANGLES, *, cloud: tuple = CLOUD, outdir: str = "results
             fig.savefig(out / "kink_path.png", dpi=130)
             plt.close(fig)
             files.append(out / "kink_path.png")
+    for f in files:
+        print(f"wrote {f}")
     return dict(rows=rows, max_error_deg=max(r["error_deg"] for r in rows),
                 files=[str(f) for f in files])
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_kink --help`` or ``cnem demo growth-kink``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--angles", type=float, nargs="+", default=list(ANGLES),
                         help="crack angles in degrees")
     args = parser.parse_args(argv)

@@ -119,6 +119,10 @@ TIPS = np.array([[1.0, 2.85], [plate.L - 1.0, 7.15]])
 DIRECTIONS = np.array([[1.0, 0.0], [-1.0, 0.0]])
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 2 min"
+
+
 def _cnem(dom, cloud, increment, steps):
     try:
         hist = cnem.fracture.grow(dom, cloud, plate.setup, increment=increment, steps=steps,
@@ -483,6 +487,7 @@ def main(spacings: Sequence[float] = (0.25,), *, model: str = "bond", steps: int
         text = breaks_table(rows)
         print(text)
         (out / "breaks.txt").write_text(text + "\n")
+        print(f"wrote {out / 'breaks.txt'}")
         return dict(results=rows, table=text, files=[])
     results = []
     for h in spacings:
@@ -492,6 +497,7 @@ def main(spacings: Sequence[float] = (0.25,), *, model: str = "bond", steps: int
                   snapshot=out / f"pd_damage_h{h:g}.npz")
         np.savez(out / f"pd_damage_h{h:g}.npz", points=r["points"], damage=r["damage"],
                  factor=r["pd_last_factor"])
+        print(f"wrote {out / f'pd_damage_h{h:g}.npz'}")
         print(f"h = {h:g}: C-NEM {r['seconds'][0]:.0f} s, PD {r['seconds'][1]:.0f} s "
               f"({r['pd_steps']} load steps, {r['pd_broken']} bonds broken, "
               f"{r['pd_incomplete']} steps cut at max_rounds, stopped: {r['pd_stopped']}; "
@@ -505,13 +511,15 @@ def main(spacings: Sequence[float] = (0.25,), *, model: str = "bond", steps: int
         files.append(out / "pd_cnem_paths.png")
         _plot(results, files[-1])
     (out / "table.txt").write_text(text + "\n")
+    for f in [*files, out / "table.txt"]:
+        print(f"wrote {f}")
     return dict(results=results, table=text, files=[str(f) for f in files])
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> dict:
     """Command line: ``python -m cnem.demos.growth_pd_vs_cnem --help`` or
     ``cnem demo growth-pd-vs-cnem``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--h", type=positive_float, nargs="+", default=[0.25], help="node spacings (mm)")
     parser.add_argument("--model", choices=("bond", "state"), default="bond",
                         help="the PD material model")

@@ -51,6 +51,10 @@ __all__ = ["main", "cli"]
 W, H, E, NU, SIGMA = 1.0, 2.0, 1.0, 0.3, 1.0
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 3 min"
+
+
 def handbook(a):
     """K_I of the SENT specimen (Brown & Srawley), ``a`` crack length."""
     r = np.asarray(a) / W
@@ -117,6 +121,8 @@ def main(h: float = 0.01, *, a0: float = 0.2, a1: float = 0.6, increment: float 
                   reference=(aa, handbook(aa)),
                   title=r"SENT: $K_\mathrm{I}$ during growth vs the handbook")
         files = [out / "sent_path.png", out / "sent_sif.png"]
+    for f in files:
+        print(f"wrote {f}")
     return dict(rows=rows, max_error=max(abs(r["error"]) for r in rows),
                 max_kink_deg=max(abs(r["kink_deg"]) for r in rows),
                 nodes=len(hist.model.nodes), files=[str(f) for f in files], history=hist,
@@ -125,7 +131,7 @@ def main(h: float = 0.01, *, a0: float = 0.2, a1: float = 0.6, increment: float 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_sent --help`` or ``cnem demo growth-sent``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--h", type=positive_float, default=0.01, help="node spacing (fraction of W)")
     parser.add_argument("--increment", type=positive_float, default=0.02, help="crack increment / W")
     parser.add_argument("--full", action="store_true",

@@ -154,6 +154,10 @@ INDEPENDENT = {
 }
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 12 s"
+
+
 def domain(h):
     shell = [[0.0, 0.0], [L, 0.0], [L, B], [0.0, B]]
     holes = [arc(c, R, 0.0, 2 * np.pi, h)[:-1][::-1] for c in HOLES]
@@ -361,6 +365,8 @@ def main(h: float = 0.25, *, increment: float = 1.0, steps: int = 12,
         for variant, res in runs.items():
             files += _pictures(res["history"], variant, h, increment, out)
         files.append(_grips_picture(runs, out / "two_holes_grips.png"))
+    for f in files:
+        print(f"wrote {f}")
     first = runs[next(iter(runs))]
     return dict(first, files=[str(f) for f in files], runs=runs, comparison=comparison)
 
@@ -491,12 +497,13 @@ def study(runs: Sequence[tuple] = STUDY, outdir: str = "results/growth_two_holes
     fig.tight_layout()
     fig.savefig(out / "two_holes_study.png", dpi=130)
     plt.close(fig)
+    print(f"wrote {out / 'two_holes_study.png'}")
     return rows
 
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python -m cnem.demos.growth_two_holes --help`` or ``cnem demo growth-two-holes``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--h", type=positive_float, default=0.25, help="background node spacing (mm)")
     parser.add_argument("--increment", type=positive_float, default=1.0, help="crack increment (mm)")
     parser.add_argument("--steps", type=positive_int, default=12, help="growth increments")

@@ -60,6 +60,10 @@ SIF_CLOUD = (4.0, 0.4, 0.0025, 0.15)
 ANGLES = (0.0, 15.0, 30.0, 45.0, 60.0, 75.0)
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 35 s"
+
+
 def build(gamma_deg, cloud=SIF_CLOUD, seed=0):
     """The plate, its graded cloud and the model. Returns ``(model, tip_right)``."""
     W, h, h_min, growth = cloud
@@ -216,7 +220,7 @@ def main(angles: tuple = ANGLES, *, sif_cloud: tuple = SIF_CLOUD, paper_cloud: t
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/inclined_crack.py --help`` or ``cnem demo inclined-crack``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--angles", type=float, nargs="+", default=list(ANGLES),
                         help="crack angles in degrees")
     parser.add_argument("--h-min", type=positive_float, default=SIF_CLOUD[2], help="spacing at the tips")

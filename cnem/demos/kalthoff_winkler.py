@@ -109,6 +109,10 @@ WINDOW = 20e-3                        # length of the crack fitted, beyond 2 del
 QUICK = dict(h=(2.5e-3,), m=3.0, t_end=50e-6)
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 70 s"
+
+
 def plate(h: float) -> np.ndarray:
     """Cell-centred grid points of the plate without the notch slots.
 
@@ -368,8 +372,11 @@ def main(h: Sequence[float] = (1e-3, 0.5e-3), m: float = 4.0, t_end: float = 50e
         print(text)
         for f in (f for r in rows for f in r["files"] if not f.endswith((".vtu", ".pvtu"))):
             print(f"wrote {f}")
-        frames = sum(f.endswith((".vtu", ".pvtu")) for f in rows[0]["files"])
-        print(f"damage frames: {outdir}/frames_h*mm/ ({frames} per run)")
+        for r in rows:                      # the frames: one .pvd series per run
+            frames = [f for f in r["files"] if f.endswith((".vtu", ".pvtu"))]
+            if frames:
+                print(f"wrote {pathlib.Path(frames[0]).with_name('kw.pvd')} "
+                      f"({len(frames)} damage frames beside it)")
     return dict(rows=rows, table=text)
 
 
@@ -403,7 +410,7 @@ def table(rows: list, t_end: float) -> str:
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> dict:
     """Command line: ``python -m cnem.demos.kalthoff_winkler --help`` or
     ``cnem demo kalthoff-winkler``; under ``mpiexec -n N`` it runs on the N ranks."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.epilog = ("Distributed: mpiexec -n 2 python -m cnem.demos.kalthoff_winkler [options] "
                      "(the same run on 2 MPI ranks; needs cnem[mpi]).")
     parser.add_argument("--h", type=positive_float, nargs="+", default=[1.0, 0.5],

@@ -64,6 +64,10 @@ ENRICH = dict(radius=0.25, functions="branch")
 TOL = 1e-9
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 45 s"
+
+
 def domain():
     return cnem.geometry.rectangle(L, L, cracks=[[[0.0, 0.5 * L], TIP]])
 
@@ -210,7 +214,7 @@ def main(spacings: tuple = SPACINGS, *, methods: tuple = ("cnem", "enriched", "f
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/mode1_crack.py --help`` or ``cnem demo mode1-crack``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--n", type=positive_int, nargs="+", default=[8, 16, 32, 64],
                         help="nodes per side of the regular clouds (h = 1 / n)")
     parser.add_argument("--no-fem", action="store_true", help="skip the scikit-fem P1 anchor")

@@ -108,6 +108,10 @@ ANGLE_WINDOW = 5e-3                 # length of the branches fitted for the angl
 QUICK = dict(h=0.5e-3, m=4.0, t_end=30e-6)
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 90 s"
+
+
 def plate(h: float) -> tuple[np.ndarray, np.ndarray]:
     """Cell-centred grid points of the plate.
 
@@ -401,7 +405,7 @@ def report(r, h, horizon, material, mat):
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/pd_crack_branching.py --help`` or
     ``cnem pd pd-crack-branching``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--h", type=positive_float, default=0.25, help="grid spacing in mm")
     parser.add_argument("--m", type=positive_float, default=4.0, help="horizon / spacing")
     parser.add_argument("--time", type=positive_float, default=46.0, help="simulated time in µs")

@@ -53,6 +53,10 @@ L, E, NU, SIGMA = 2.0, 1.0, 0.25, 1.0
 SPACINGS = (0.25, 0.125)
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 40 s"
+
+
 def exact(x):
     """The uniaxial-stress displacement ``(p, 3)`` at points ``x (p, 3)``."""
     return SIGMA / E * x * [1.0, -NU, -NU]
@@ -162,7 +166,7 @@ def main(spacings: tuple = SPACINGS, *, outdir: str = "results/pd_vs_cnem_3d",
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/pd_vs_cnem_3d.py --help`` or ``cnem pd pd-vs-cnem-3d``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--h", type=float, nargs="+", default=list(SPACINGS),
                         help="node spacings")
     args = parser.parse_args(argv)

@@ -57,6 +57,10 @@ SPACINGS = (1 / 16, 1 / 32, 1 / 64)
 TOL = 1e-9
 
 
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 1 min"
+
+
 def domain():
     return cnem.geometry.rectangle(2 * W, 2 * W, origin=(-W, -W), cracks=[[[-A, 0.0], [A, 0.0]]])
 
@@ -203,7 +207,7 @@ def main(spacings: tuple = SPACINGS, *, outdir: str = "results/pd_vs_cnem_crack"
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     """Command line: ``python demos/pd_vs_cnem_crack.py --help`` or
     ``cnem demo pd-vs-cnem-crack``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--n", type=positive_int, nargs="+", default=[16, 32, 64],
                         help="nodes per unit length (h = 1 / n)")
     args = parser.parse_args(argv)

@@ -13,7 +13,8 @@ from .. import config
 from ..assembly.recovery import NodalValues, recover_at_nodes, values_at
 from ..solvers.solution import (Solution, energy_error_density, engineering_strain, vector3,
                                 von_mises)
-from ..errors import GeometryError, check_choice, check_points
+from ..solvers.conditions import Where, select_nodes
+from ..errors import ConditionError, GeometryError, check_choice, check_points
 
 __all__ = ["CellSolution", "ElasticSolution", "von_mises", "energy_error_density"]
 
@@ -235,3 +236,41 @@ class ElasticSolution(CellSolution):
     def energy(self) -> float:
         """Strain energy ``1/2 sum_k A_k σ_k · ε_k``."""
         return 0.5 * float(self.cells.measure @ (self.stress * self.strain).sum(axis=1))
+
+    def reaction(self, where: Where) -> np.ndarray:
+        """The resultant force the supports exert on the body at the nodes ``where`` picks:
+        the sum of ``K u - f`` over those nodes' dofs (zero to the solver's tolerance
+        where nothing is prescribed).
+
+        Parameters
+        ----------
+        where : str, callable ``(n, d) -> (n,) bool``, or a boolean mask / index array over
+            the nodes
+            As in `cnem.Elasticity.add_dirichlet`: a boundary name (``"clamp"``) picks
+            the nodes on that boundary.
+
+        Returns
+        -------
+        (d,) ndarray
+            Force per unit thickness in 2-D (force in 3-D), in the units of the
+            tractions times length; with the body's loads it sums to zero.
+
+        Examples
+        --------
+        >>> import cnem
+        >>> dom = cnem.geometry.rectangle(2.0, 1.0)
+        >>> prob = cnem.Elasticity(cnem.discretize(cnem.nodes.regular(dom, 0.25)), (1.0, 0.3))
+        >>> prob.add_dirichlet("left", None)
+        >>> prob.add_traction("right", [0.0, -1.0])       # 1 per unit length, edge length 1
+        >>> sol = prob.solve()
+        >>> [round(float(r), 9) + 0.0 for r in sol.reaction("left")]
+        [0.0, 1.0]
+        """
+        problem = self.problem
+        nodes = select_nodes(problem.condition_points, where, named=problem.named_nodes)
+        if nodes.size == 0:
+            raise ConditionError("reaction: `where` selects no node; check it against the "
+                                 "nodes (boundary nodes lie exactly on the boundary)")
+        d = self.u.shape[1]
+        residual = problem.stiffness() @ self.dofs - problem.load()
+        return residual[:d * len(self.u)].reshape(-1, d)[nodes].sum(axis=0)
