@@ -81,6 +81,8 @@ __all__ = ["main", "cli", "tension_closed_form", "CLOUDS"]
 CLOUDS = ("regular", "irregular")
 #: Stretches of the force table.
 TABLE_STRETCHES = (1.25, 1.5, 2.0)
+#: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
+RUN_TIME = "about 20 s"
 
 
 def tension_closed_form(law: BondContinuum, stretch: float) -> tuple[float, float]:
@@ -243,7 +245,7 @@ def main(h: float = 0.1, factors: Sequence[float] = (2.0, 3.0, 4.0), *, steps: i
 
 def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> dict:
     """Command line: ``python demos/cnem_vs_cpd.py --help`` or ``cnem pd cnem-vs-cpd``."""
-    parser = demo_parser(__file__, __doc__, prog)
+    parser = demo_parser(__file__, __doc__, prog, run_time=RUN_TIME)
     parser.add_argument("--h", type=positive_float, default=0.1, help="node spacing")
     parser.add_argument("--factors", type=positive_float, nargs="+", default=[2.0, 3.0, 4.0],
                         help="CPD horizons in node spacings")
