@@ -132,6 +132,62 @@ def test_vtu_reads_in_pyvista_and_warps(case, request, tmp_path):
         np.testing.assert_allclose(grid.cell_data["volume"], model.cells.volume[order])
 
 
+PAIRS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "yz": (1, 2), "xz": (0, 2), "xy": (0, 1)}
+
+
+@pytest.mark.parametrize("case", ["plane", "solid"])
+def test_tensor_components_and_nodal_stress_of_a_patch(case, request, tmp_path):
+    """Beside each tensor, ``<name>_xx`` ... hold its entries (tensor shears); the
+    nodal stress is the patch test's constant stress at the nodes and the cell vertices."""
+    sol = request.getfixturevalue(case)
+    dim, n = sol.u.shape[1], len(sol.model.nodes)
+    path = sol.write(tmp_path / f"{case}.vtu")
+    mesh, grid = meshio.read(path), pv.read(path)
+    for name in ("stress", "strain"):
+        full = _cells_in_order(mesh, name).reshape(-1, 3, 3)
+        for suffix, (i, j) in PAIRS.items():
+            np.testing.assert_array_equal(_cells_in_order(mesh, f"{name}_{suffix}"), full[:, i, j])
+            assert grid.cell_data[f"{name}_{suffix}"].shape == (grid.n_cells,)
+    np.testing.assert_allclose(_cells_in_order(mesh, "strain_xy"), 0.5 * sol.strain[:, -1],
+                               rtol=1e-12)
+    nodal = mesh.point_data["stress_nodal"].reshape(-1, 3, 3)
+    for suffix, (i, j) in PAIRS.items():
+        np.testing.assert_array_equal(mesh.point_data[f"stress_nodal_{suffix}"], nodal[:, i, j])
+    exact, _ = _full_tensor(A2 if dim == 2 else A3, dim)
+    np.testing.assert_allclose(nodal, np.broadcast_to(exact, nodal.shape),
+                               rtol=0, atol=1e-8 * np.abs(exact).max())
+    assert grid.point_data["stress_nodal"].shape == (grid.n_points, 9)
+    assert n < grid.n_points
+
+
+def test_nodal_stress_is_the_mean_of_the_cells_of_each_node(tmp_path):
+    """Two materials, a non-uniform stress: ``stress_nodal`` at a node is the
+    area-weighted mean of the stresses of its cells (two or more on the interface),
+    computed here node by node; at the cell vertices it interpolates the nodal values."""
+    dom = cnem.Domain([[[0, 0], [1, 0], [1, 1], [0, 1]], [[1, 0], [2, 0], [2, 1], [1, 1]]])
+    model = cnem.discretize(cnem.nodes.irregular(dom, 0.2, seed=1))
+    prob = cnem.Elasticity(model, [(1.0, 0.3), (4.0, 0.25)], plane="strain")
+    prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+    prob.add_traction(lambda x, n: x[:, 0] > 2 - 1e-9, [0.3, 1.0])
+    sol = prob.solve(progress=False)
+    n, cells = len(model.nodes), model.cells
+    assert np.bincount(cells.node, minlength=n).max() > 1           # interface nodes
+    mesh = meshio.read(sol.write(tmp_path / "two.vtu"))
+    stress = _cells_in_order(mesh, "stress").reshape(-1, 3, 3)
+    assert np.ptp(stress[:, 0, 1]) > 0.1 * np.abs(stress).max()     # not a constant field
+    hand = np.empty((n, 3, 3))
+    for node in range(n):
+        mine = cells.node == node
+        hand[node] = np.tensordot(cells.area[mine], stress[mine], axes=1) / cells.area[mine].sum()
+    nodal = mesh.point_data["stress_nodal"].reshape(-1, 3, 3)
+    np.testing.assert_allclose(nodal[:n], hand, rtol=1e-12, atol=1e-14 * np.abs(hand).max())
+    vertices, cell = cnem.io.cell_points(model)
+    inside = vertices + config.VERTEX_NUDGE * (model.nodes[cells.node[cell]] - vertices)
+    interpolated = model.shape_functions(inside) @ hand.reshape(n, 9)
+    np.testing.assert_allclose(nodal[n:].reshape(-1, 9), interpolated, rtol=1e-12,
+                               atol=1e-14 * np.abs(hand).max())
+
+
 def test_cracked_cells_warp_with_their_own_side(tmp_path):
     """In a cracked model every polygon has its own vertices, each with the displacement
     inside that polygon, so the crack faces part in ParaView's Warp By Vector (shared

@@ -94,22 +94,36 @@ class CellSolution(Solution):
     def write_fields(self, path: str, point_data: dict[str, np.ndarray],
                      cell_data: dict[str, np.ndarray]) -> None:
         """Nodes and integration cells with the fields (`cnem.io.write`); the
-        ``displacement`` also at the cells' vertices (interpolated just inside each
-        vertex's cell, `cnem.config.VERTEX_NUDGE`), so that the cells warp with it."""
+        ``displacement`` and the other nodal values (``stress_nodal``) also at the
+        cells' vertices (interpolated just inside each vertex's cell,
+        `cnem.config.VERTEX_NUDGE`), so that the cells warp with the body and show the
+        nodal values."""
         from .. import io
-        if "displacement" in point_data:
-            point_data = {**point_data, "displacement": np.concatenate(
-                [point_data["displacement"], vector3(self.vertex_displacement())])}
-        io.write(self.model, path, point_data=point_data, cell_data=cell_data)
+        inside = self._inside_vertices()
+        phi = self.model.shape_functions(inside)
+        n, extended = len(self.model.nodes), {}
+        for name, value in point_data.items():
+            if name == "displacement":
+                extended[name] = np.concatenate([value, vector3(self.displacement(inside))])
+            elif len(value) == n and np.issubdtype(np.asarray(value).dtype, np.floating):
+                extended[name] = np.concatenate([value, phi @ value])
+            else:
+                extended[name] = value
+        io.write(self.model, path, point_data=extended, cell_data=cell_data)
 
     def vertex_displacement(self) -> np.ndarray:
         """Displacements ``(q, d)`` at the cell vertices of `cnem.io.cell_points`, each
         interpolated just inside a cell it bounds (`cnem.config.VERTEX_NUDGE` of the way
         to the cell's node), so that a vertex on a crack face takes that cell's side."""
+        return self.displacement(self._inside_vertices())
+
+    def _inside_vertices(self) -> np.ndarray:
+        """The cell vertices of `cnem.io.cell_points` moved `cnem.config.VERTEX_NUDGE`
+        of the way to their cell's node, ``(q, d)``."""
         from .. import io
         vertices, cell = io.cell_points(self.model)
         node = self.model.nodes[self.model.cells.node[cell]]
-        return self.displacement(vertices + config.VERTEX_NUDGE * (node - vertices))
+        return vertices + config.VERTEX_NUDGE * (node - vertices)
 
 
 @dataclass(eq=False, repr=False)

@@ -15,8 +15,10 @@ for the same meanings:
 ``von_mises``          ``(k,)``
 ``displacement(p)``    ``(p, d)`` at any points of the body
 ``write(path)``        ``.vtu`` for ParaView (`paraview_fields`): ``displacement``
-                       ``(n, 3)``, ``stress`` and ``strain`` as ``(k, 9)`` tensors,
-                       ``von_mises``; ``.pvd``: the `series` of states
+                       ``(n, 3)``, ``stress`` and ``strain`` as ``(k, 9)`` tensors and
+                       their components ``stress_xx`` ..., ``stress_nodal`` (the
+                       `nodal_average` of ``stress``), ``von_mises``; ``.pvd``: the
+                       `series` of states
 ``plot(path=None)``    off-screen picture of the deformed body (`cnem.plot.solution`)
 =====================  ===================================================================
 """
@@ -43,7 +45,10 @@ VOIGT = {2: ((0, 0), (1, 1), (0, 1)),
 VECTORS = {"u": "displacement", "velocity": "velocity"}
 
 #: Voigt fields written as tensors, and whether their shears are engineering ones (2 e_xy).
-TENSORS = {"stress": False, "strain": True}
+TENSORS = {"stress": False, "strain": True, "stress_nodal": False}
+
+#: The component arrays written beside each tensor: suffix -> entry of the 3 x 3 tensor.
+COMPONENTS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "yz": (1, 2), "xz": (0, 2), "xy": (0, 1)}
 
 
 def vector3(values: np.ndarray) -> np.ndarray:
@@ -81,7 +86,9 @@ def paraview_fields(point_data: dict[str, np.ndarray],
         The vectors of `VECTORS` renamed and ``(n, 3)``; the Voigt fields of
         `TENSORS` ``(k, 9)`` (in 2-D the in-plane components, ``zz``, ``xz`` and
         ``yz`` 0: the out-of-plane stress of plane strain is not part of the 2-D
-        solution); every other array as given.
+        solution), each followed by its components ``<name>_xx``, ``_yy``, ``_zz``,
+        ``_yz``, ``_xz``, ``_xy`` ``(k,)`` (tensor shears, `COMPONENTS`); every other
+        array as given.
     """
     def convert(data):
         out = {}
@@ -89,7 +96,10 @@ def paraview_fields(point_data: dict[str, np.ndarray],
             if name in VECTORS:
                 out[VECTORS[name]] = vector3(value)
             elif name in TENSORS:
-                out[name] = tensor9(value, engineering=TENSORS[name])
+                full = tensor9(value, engineering=TENSORS[name])
+                out[name] = full
+                for suffix, (i, j) in COMPONENTS.items():
+                    out[f"{name}_{suffix}"] = full[:, 3 * i + j]
             else:
                 out[name] = value
         return out
@@ -261,12 +271,14 @@ class Solution:
         point_data : dict of str -> (n, ...) ndarray
         cell_data : dict of str -> (k, ...) ndarray
             Values at the places of ``stress`` (merged into ``point_data`` when they
-            are the points).
+            are the points; otherwise ``point_data`` also holds ``stress_nodal``, their
+            `nodal_average`).
         """
         point_data = {"u": self.u}
         cell_data = {"stress": self.stress, "strain": self.strain, "von_mises": self.von_mises}
         if self.stress_places == "points":
             return {**point_data, **cell_data}, {}
+        point_data["stress_nodal"] = self.nodal_average(self.stress)
         return point_data, cell_data
 
     def write_fields(self, path: str, point_data: dict[str, np.ndarray],
@@ -279,8 +291,10 @@ class Solution:
 
         A ``.vtu`` path gets the nodes (points) and the fields of `paraview_fields`:
         point vectors ``displacement`` ``(n, 3)`` (``z = 0`` in 2-D), the tensors
-        ``stress`` and ``strain`` ``(k, 9)``, ``von_mises`` and the solution's other
-        scalars (see `cnem.io`). A ``.pvd`` path gets one ``.vtu`` per state of
+        ``stress`` and ``strain`` ``(k, 9)`` and their components ``stress_xx`` ...,
+        the point tensor ``stress_nodal`` (`nodal_average` of ``stress``, when it lives
+        on cells or triangles), ``von_mises`` and the solution's other scalars (see
+        `cnem.io`). A ``.pvd`` path gets one ``.vtu`` per state of
         `series` beside it, ``<stem>_<i>.vtu``, and the collection with their times.
 
         Returns
