@@ -186,6 +186,33 @@ def test_history_writes_one_frame_per_state_and_its_pictures(sent_run, tmp_path)
         sent_run.plot(kind="map")
 
 
+def test_history_writes_its_k_table_as_csv_and_json(sent_run, tmp_path):
+    """``sif.csv`` and ``sif.json`` read back with the standard library hold, per state
+    and tip, the history's own arrays (NaN as ``nan`` in the CSV, ``null`` in the JSON)."""
+    import csv
+    import json
+    sent_run.write(tmp_path)
+    with open(tmp_path / "sif.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    data = json.loads((tmp_path / "sif.json").read_text())
+    assert data["criterion"] == sent_run.criterion
+    assert len(rows) == len(data["records"]) == 3                 # 3 states, 1 tip
+    for name, column in (("tips", ["x", "y"]), ("K", ["K_I", "K_II"]), ("K_eq", ["K_eq"]),
+                         ("crack_length", ["crack_length"]), ("load_factor", ["load_factor"]),
+                         ("increment", ["increment"])):
+        expected = sent_run.array(name)[:, 0].reshape(3, -1)
+        from_csv = np.array([[float(r[c]) for c in column] for r in rows])
+        from_json = np.array([[r[c] for c in column] for r in data["records"]], dtype=float)
+        np.testing.assert_array_equal(from_csv, expected, err_msg=name)
+        np.testing.assert_array_equal(from_json, expected, err_msg=name)
+    np.testing.assert_array_equal([float(r["angle_deg"]) for r in rows],
+                                  np.degrees(sent_run.array("angle")[:, 0]))
+    assert [int(r["step"]) for r in rows] == [0, 1, 2] and {r["tip"] for r in rows} == {"0"}
+    assert all(np.isnan(float(r["cycles"])) for r in rows)            # no Paris law
+    assert all(r["cycles"] is None for r in data["records"])
+    assert list(rows[0]) == list(sent_run.COLUMNS)
+
+
 def test_tip_into_the_far_edge_splits_the_body_with_the_pieces_named():
     dom = cnem.geometry.rectangle(1.0, 2.0, cracks=[[[0.0, 1.0], [0.88, 1.0]]])
     with pytest.raises(GeometryError, match="2 pieces") as info, \

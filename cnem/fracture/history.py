@@ -7,6 +7,8 @@ Every tip of the initial domain keeps its row ``i`` in every step's arrays
 
 from __future__ import annotations
 
+import csv
+import json
 import pathlib
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -189,27 +191,46 @@ class GrowthHistory:
             return np.full(len(c) + 1, np.nan)
         return np.concatenate([[0.0], np.cumsum(c)])
 
+    #: The columns of `records` (and of ``sif.csv``), in order.
+    COLUMNS = ("step", "tip", "active", "x", "y", "crack_length", "K_I", "K_II", "K_eq",
+               "angle_deg", "increment", "load_factor", "cycles")
+
+    def records(self) -> list[dict]:
+        """One dict per state and tip with the `COLUMNS`: step, tip, whether it was
+        active, its position, crack length, K_I, K_II, K_eq, kink angle (degrees),
+        increment, load factor and cumulative cycles (NaN where a value is absent)."""
+        cycles, rows = self.cycles, []
+        for k, s in enumerate(self._all()):
+            for i in range(len(s.tips)):
+                rows.append(dict(zip(self.COLUMNS, (
+                    k, i, bool(s.active[i]), float(s.tips[i, 0]), float(s.tips[i, 1]),
+                    float(s.crack_length[i]), float(s.K[i, 0]), float(s.K[i, 1]),
+                    float(s.K_eq[i]), float(np.degrees(s.angle[i])), float(s.increment[i]),
+                    float(s.load_factor[i]), float(cycles[k])))))
+        return rows
+
     def table(self) -> str:
         """Text table: per state and tip, position, K_I, K_II, K_eq, angle (degrees),
         load factor, cumulative cycles."""
         lines = [f"{'step':>4} {'tip':>3} {'x':>10} {'y':>10} {'length':>9} {'K_I':>10} "
                  f"{'K_II':>10} {'K_eq':>10} {'angle':>8} {'load':>9} {'cycles':>10}"]
-        cycles = self.cycles
-        for k, s in enumerate(self._all()):
-            for i in range(len(s.tips)):
-                lines.append(f"{k:>4d} {i:>3d} {s.tips[i, 0]:>10.5g} {s.tips[i, 1]:>10.5g} "
-                             f"{s.crack_length[i]:>9.5g} {s.K[i, 0]:>10.4g} {s.K[i, 1]:>10.4g} "
-                             f"{s.K_eq[i]:>10.4g} {np.degrees(s.angle[i]):>8.3f} "
-                             f"{s.load_factor[i]:>9.4g} {cycles[k]:>10.4g}")
+        for r in self.records():
+            lines.append(f"{r['step']:>4d} {r['tip']:>3d} {r['x']:>10.5g} {r['y']:>10.5g} "
+                         f"{r['crack_length']:>9.5g} {r['K_I']:>10.4g} {r['K_II']:>10.4g} "
+                         f"{r['K_eq']:>10.4g} {r['angle_deg']:>8.3f} "
+                         f"{r['load_factor']:>9.4g} {r['cycles']:>10.4g}")
         for e in self.events:
             lines.append(str(e))
         return "\n".join(lines)
 
     def write(self, folder: str | os.PathLike) -> list:
-        """One VTU per state, ``step_000.vtu`` ... (displacement, stress, strain, von
-        Mises; see `cnem.solvers.solution.Solution.write`), written from the solutions
-        kept with ``keep=True``, and ``steps.pvd``, their collection over the growth step
-        (time ``k`` for ``step_k``), which ParaView opens as one series.
+        """The run's files in ``folder``: the K table, ``sif.csv`` (one row per state and
+        tip, the `COLUMNS` of `records`; NaN written ``nan``) and ``sif.json`` (``criterion``,
+        ``records`` as in `records`, NaN as ``null``, and ``events`` as text); one VTU per
+        state, ``step_000.vtu`` ... (displacement, stress, strain, von Mises; see
+        `cnem.solvers.solution.Solution.write`), written from the solutions kept with
+        ``keep=True``, and ``steps.pvd``, their collection over the growth step (time
+        ``k`` for ``step_k``), which ParaView opens as one series.
 
         Returns
         -------
@@ -218,6 +239,7 @@ class GrowthHistory:
         """
         out = pathlib.Path(folder)
         out.mkdir(parents=True, exist_ok=True)
+        self._write_sif(out)
         files, steps = [], []
         for k, s in enumerate(self._all()):
             if s.solution is None:
@@ -227,6 +249,19 @@ class GrowthHistory:
         if files:
             write_pvd(out / "steps.pvd", list(zip(steps, files)))
         return files
+
+    def _write_sif(self, out: pathlib.Path) -> None:
+        """``sif.csv`` and ``sif.json`` in ``out`` (see `write`)."""
+        records = self.records()
+        with open(out / "sif.csv", "w", newline="") as f:
+            writer = csv.DictWriter(f, fieldnames=self.COLUMNS)
+            writer.writeheader()
+            writer.writerows(records)
+        nulls = [{k: None if isinstance(v, float) and not np.isfinite(v) else v
+                  for k, v in r.items()} for r in records]
+        with open(out / "sif.json", "w") as f:
+            json.dump({"criterion": self.criterion, "records": nulls,
+                       "events": [str(e) for e in self.events]}, f, indent=1, allow_nan=False)
 
     def plot(self, path: str | None = None, *, kind: Literal["paths", "sif", "load"] = "paths",
              **kwargs: Any) -> Figure:
