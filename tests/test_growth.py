@@ -211,6 +211,10 @@ def test_history_writes_its_k_table_as_csv_and_json(sent_run, tmp_path):
     assert all(np.isnan(float(r["cycles"])) for r in rows)            # no Paris law
     assert all(r["cycles"] is None for r in data["records"])
     assert list(rows[0]) == list(sent_run.COLUMNS)
+    table = sent_run.table().splitlines()                           # the same rows as text
+    assert len(table) == 1 + 3 + len(sent_run.events)
+    assert [float(line.split()[5]) for line in table[1:4]] == \
+        pytest.approx(sent_run.array("K")[:, 0, 0], rel=1e-3)
 
 
 def test_tip_into_the_far_edge_splits_the_body_with_the_pieces_named():
