@@ -18,7 +18,7 @@ from .._parallel import parallel_kernel
 
 #: Row kinds (``FALLBACK``: barycentric in the tetrahedron, where the cavity's
 #: coordinates are not a partition into non-negative weights, see `_kernels3d._bad_row`).
-CAVITY, AT_NODE, ON_FACE, ON_EDGE, FAILED, FALLBACK = 0, 1, 2, 3, 4, 5
+CAVITY, AT_NODE, ON_FACE, ON_EDGE, FALLBACK = 0, 1, 2, 3, 4
 
 #: Largest cavity (tetrahedra); its boundary has at most twice as many faces.
 MAX_CAVITY = 1024

@@ -35,7 +35,7 @@ import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from .._parallel import parallel_kernel
-from ._cavity3d import (AT_NODE, CAVITY, FACES, FAILED, FALLBACK, MAX_CAVITY, ON_EDGE, ON_FACE,
+from ._cavity3d import (AT_NODE, CAVITY, FACES, FALLBACK, MAX_CAVITY, ON_EDGE, ON_FACE,
                         PAIRS, _cavity, _cross, _face_side, _rel, _special)
 
 #: A weight below ``-NEGATIVE_RTOL`` times the largest makes a row `FALLBACK`.
@@ -386,7 +386,9 @@ def natural(nodes, tet, nb, cedges, features, points, tet_of, tol, nch, laplace,
     grads : (p * slots, 3) float64
         Empty unless ``gradient``.
     kinds : (p,) int8
-        ``CAVITY``, ``AT_NODE``, ``ON_FACE``, ``ON_EDGE``, ``FAILED`` or ``FALLBACK``.
+        ``CAVITY``, ``AT_NODE``, ``ON_FACE``, ``ON_EDGE`` or ``FALLBACK`` (a cavity whose
+        weights are not non-negative shares, or that round-off broke: barycentric; on a
+        face such a point takes the face's linear interpolation and stays ``ON_FACE``).
     full : bool
         Some chunk ran out of room (the result is incomplete).
     """
@@ -458,14 +460,16 @@ def natural(nodes, tet, nb, cedges, features, points, tet_of, tol, nch, laplace,
                     c = _natural_row(nodes, tet, nb, foot, cav, csize, stamp, mark, pos,
                                      node_mark, node_slot, fq, fs, fv, bf, twin, hkeys, hval, cc,
                                      acc, cols, laplace, gradient and not limit, nu, limit)
-                if csize <= 0 or c <= 0:
-                    kind, c = FAILED, 0
-                else:
+                ok = csize > 0 and c > 0
+                if ok:
                     for e in range(c):
                         for d in range(3):
                             acc[e, 11 + d] = nodes[cols[e], d] - foot[d]
-                    if not _normalise(acc, c, laplace, gradient and not limit, vals, grads):
-                        kind, c = (FAILED, 0) if limit else (FALLBACK, 0)
+                    ok = _normalise(acc, c, laplace, gradient and not limit, vals, grads)
+                if not ok and limit:        # the face's own linear interpolation (API.md)
+                    c = _barycentric_row(nodes, tet, tet_of[s], x, cols, vals, grads)
+                elif not ok:                # a cavity broke on round-off: barycentric below
+                    kind, c = FALLBACK, 0
                 if not limit and (kind == FALLBACK or (kind == CAVITY and _bad_row(vals, c))):
                     kind = FALLBACK
                     c = _barycentric_row(nodes, tet, tet_of[s], x, cols, vals, grads)

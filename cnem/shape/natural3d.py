@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 from .. import config
 from .._parallel import work_chunks
 from .._predicates import Frame, local_frame
-from ..errors import CNEMError, GeometryError, check_array, check_choice
+from ..errors import GeometryError, check_array, check_choice
 from . import _cavity3d as C
 from . import _kernels3d as K
 from .natural import KINDS, ShapeGradients
@@ -295,16 +295,12 @@ def shape_functions_3d(mesh: TetMesh, points: ArrayLike, *,
         if not full:
             break
         slots *= 2
-    failed = np.sort(order[kinds == C.FAILED])
-    if failed.size:
-        raise CNEMError(f"the natural-neighbour cavity of {failed.size} points was inconsistent "
-                        f"(round-off on a circumsphere), first {pts[failed[:3]].tolist()}; "
-                        "please report this case")
     fallback = np.sort(order[kinds == C.FALLBACK])
     if fallback.size:
         _log.warning("%d of %d points lie where the constrained %s coordinates are not "
                      "non-negative shares (beside a re-entrant edge, near the plane of a "
-                     "boundary face); they interpolate linearly in their tetrahedron, first %s",
+                     "boundary face) or where their cavity broke on a circumsphere's round-off; "
+                     "they interpolate linearly in their tetrahedron, first %s",
                      fallback.size, len(pts), kind, pts[fallback[:3]].tolist())
     offsets, cols, vals, grads = K.permute_rows(start, size, cols, vals, grads, order)
     phi = sp.csr_matrix((vals, cols, offsets), shape=(len(pts), n))
