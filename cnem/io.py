@@ -12,7 +12,8 @@
 * cell data ``region``, ``node`` (owner node), ``area`` and ``cell`` (index of
   the integration cell in ``model.cells``; ``-1`` on the vertex cells), plus
   the caller's arrays;
-* point data ``node_of_point`` plus the caller's per-node arrays.
+* point data ``node_of_point``, in a cracked 2-D model ``crack_face``
+  (`crack_face_ids`), plus the caller's per-node arrays.
 
 Arrays are written in binary, so `read` gives back the cells bit for bit.
 
@@ -50,8 +51,8 @@ if TYPE_CHECKING:
     from .geometry.model import Model
     from .geometry.model3d import Model3D
 
-__all__ = ["write", "cell_points", "write_nodes", "write_points", "read", "CellMesh", "FormatError",
-           "SUFFIXES"]
+__all__ = ["write", "cell_points", "crack_face_ids", "write_nodes", "write_points", "read", "CellMesh",
+           "FormatError", "SUFFIXES"]
 
 log = logging.getLogger(__name__)
 
@@ -154,6 +155,42 @@ def _cracked(model):
     return len(getattr(getattr(model, "domain", None), "cracks", ())) > 0
 
 
+def crack_face_ids(model: Model) -> np.ndarray:
+    """Which crack face each node of a cracked 2-D model lies on.
+
+    Parameters
+    ----------
+    model : Model
+        From `cnem.discretize`; its crack-face nodes are the points of the cloud
+        with two nodes (``model.node_of_point``).
+
+    Returns
+    -------
+    (n,) int64 ndarray
+        0 off the cracks; ``k + 1`` on the face of crack ``k`` (of
+        ``model.domain.cracks``, the nearest polyline) that the crack's normal points
+        to, ``-(k + 1)`` on the other. The normal of a crack segment ``a -> b`` is
+        ``b - a`` turned counter-clockwise; a node's side is that of its cell
+        (`Model.node_sides`).
+    """
+    nodes = np.asarray(model.nodes, np.float64)
+    ids = np.zeros(len(nodes), np.int64)
+    copies = np.flatnonzero(np.bincount(model.node_of_point)[model.node_of_point] > 1)
+    cracks = model.domain.cracks
+    if not len(copies) or not cracks:
+        return ids
+    a = np.concatenate([c[:-1] for c in cracks])
+    b = np.concatenate([c[1:] for c in cracks])
+    crack = np.concatenate([np.full(len(c) - 1, k) for k, c in enumerate(cracks)])
+    x = nodes[copies][:, None]                                        # (c, 1, 2)
+    t = np.clip(np.einsum("csj,sj->cs", x - a, b - a) / np.einsum("sj,sj->s", b - a, b - a), 0, 1)
+    nearest = np.argmin(np.linalg.norm(x - (a + t[..., None] * (b - a)), axis=2), axis=1)
+    normal = (b - a)[nearest] @ np.array([[0.0, 1.0], [-1.0, 0.0]])   # turned counter-clockwise
+    side = np.einsum("cj,cj->c", model.node_sides()[copies] - nodes[copies], normal)
+    ids[copies] = np.where(side > 0, 1, -1) * (crack[nearest] + 1)
+    return ids
+
+
 def _polyhedral(cells):
     """Whether ``cells`` are 3-D cells bounded by facet triangles (`cnem.geometry.Cells3D`)."""
     return hasattr(cells, "facet_triangles")
@@ -233,7 +270,9 @@ def write(model: Model | Model3D, path: str | os.PathLike, *,
     point_data : dict of str -> (n,) or (n, c), or (n + q,) or (n + q, c) array_like, optional
         Values at the nodes (displacements, say), or at every point of the file
         (the nodes, then the ``q`` cell vertices of `cell_points`). With ``n`` rows
-        the cell vertices get NaN (``-1`` for integer arrays).
+        the cell vertices get NaN (``-1`` for integer arrays). The names
+        ``node_of_point`` and ``crack_face`` (written for a cracked 2-D model,
+        `crack_face_ids`) are reserved.
     cell_data : dict of str -> (m,) or (m, c) array_like, optional
         Values on the integration cells (stresses, say); the node vertex
         cells get NaN (``-1``). The names ``region``, ``node``, ``area``
@@ -287,9 +326,12 @@ def write(model: Model | Model3D, path: str | os.PathLike, *,
 
     pdata = {"node_of_point": np.concatenate(
         [np.asarray(model.node_of_point, np.int64), np.full(len(vpoints), -1, np.int64)])}
+    if _cracked(model) and not _polyhedral(cells):
+        pdata["crack_face"] = np.concatenate([crack_face_ids(model),
+                                              np.zeros(len(vpoints), np.int64)])
     for name, value in (point_data or {}).items():
-        if name == "node_of_point":
-            raise FormatError("point_data name 'node_of_point' is reserved by cnem.io; rename it")
+        if name in ("node_of_point", "crack_face"):
+            raise FormatError(f"point_data name {name!r} is reserved by cnem.io; rename it")
         rows = len(points) if np.ndim(value) and len(value) == len(points) else n
         arr, fill = _checked(value, rows, f"point_data[{name!r}]")
         full = np.full((len(points),) + arr.shape[1:], fill, dtype=arr.dtype)

@@ -287,3 +287,42 @@ def test_3d_picture(solid, tmp_path):
         sol.plot(tmp_path / "bad.png", clip="w")
     with pytest.raises(PlotInputError, match="field"):
         sol.plot(tmp_path / "bad.png", field="gxy")
+
+
+def test_crack_face_ids_pair_the_copies_by_the_crack_normal(tmp_path):
+    """``crack_face`` is +-(k + 1) on the two copies of each crack-face node of crack k,
+    + on the side its normal (``b - a`` turned counter-clockwise) points to: crack 0
+    runs left to right (normal up), crack 1 right to left (normal down)."""
+    cracks = [[[0.3, 0.6], [0.7, 0.6]], [[0.7, 0.3], [0.3, 0.3]]]
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=cracks)
+    model = cnem.discretize(cnem.nodes.irregular(dom, 0.1, seed=2))
+    prob = cnem.Elasticity(model, (E, NU), plane="strain")
+    prob.add_dirichlet(lambda p: p[:, 1] < 1e-9, None)
+    prob.add_traction(lambda x, n: x[:, 1] > 1 - 1e-9, [0.0, 1.0])
+    sol = prob.solve(progress=False)
+    mesh = meshio.read(sol.write(tmp_path / "faces.vtu"))
+    n = len(model.nodes)
+    face = mesh.point_data["crack_face"]
+    assert face.shape == (len(mesh.points),) and np.issubdtype(face.dtype, np.integer)
+    assert not face[n:].any()
+    copies = np.bincount(model.node_of_point)[model.node_of_point] > 1
+    assert np.array_equal(face[:n] != 0, copies)
+    owner = np.concatenate(mesh.cell_data["node"][1:])
+    corners = [block.data for block in mesh.cells[1:]]
+    for k, y in enumerate((0.6, 0.3)):
+        plus, minus = np.flatnonzero(face == k + 1), np.flatnonzero(face == -(k + 1))
+        assert len(plus) == len(minus) >= 3
+        order_p = np.lexsort(mesh.points[plus, :2].T)
+        order_m = np.lexsort(mesh.points[minus, :2].T)
+        np.testing.assert_array_equal(mesh.points[plus[order_p]], mesh.points[minus[order_m]])
+        np.testing.assert_allclose(mesh.points[plus, 1], y, atol=1e-12)
+        up = 1.0 if k == 0 else -1.0                       # the crack's normal, y component
+        opening = up * (sol.u[plus[order_p], 1] - sol.u[minus[order_m], 1])
+        assert opening.min() > 0                           # the + face is the one pulled along n
+        for node, sign in [(i, 1.0) for i in plus] + [(i, -1.0) for i in minus]:
+            polygons, start = [], 0
+            for block in corners:                          # the cells of this node, from the file
+                mine = owner[start:start + len(block)] == node
+                polygons += list(mesh.points[block[mine].reshape(-1), 1])
+                start += len(block)
+            assert polygons and (sign * up * (np.array(polygons) - y)).min() >= -1e-9

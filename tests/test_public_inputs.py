@@ -381,6 +381,7 @@ EXAMPLES = {
         skip={**_FIELDS, ("points", "shape"): _THREE_D}),
     "cnem.io.read": Example(lambda f: dict(path=cnem.io.write(f.model, f.tmp / "r.vtu"))),
     "cnem.io.cell_points": Example(lambda f: dict(model=f.model)),
+    "cnem.io.crack_face_ids": Example(lambda f: dict(model=f.model)),
     "cnem.plot.solution3d": Example(
         lambda f: dict(sol=_solid_solution(), path=f.tmp / "s3.png", window_size=(200, 150),
                        clip=(0.0, -1.0, 0.0), origin=(0.5, 0.5, 0.5))),

@@ -17,7 +17,8 @@ for the same meanings:
 ``write(path)``        ``.vtu`` for ParaView (`paraview_fields`): ``displacement``
                        ``(n, 3)``, ``stress`` and ``strain`` as ``(k, 9)`` tensors and
                        their components ``stress_xx`` ..., ``stress_nodal`` (the
-                       `nodal_average` of ``stress``), ``von_mises``; ``.pvd``: the
+                       `nodal_average` of ``stress``), ``von_mises`` (and, from
+                       `cnem.io.write`, ``crack_face`` of a cracked model); ``.pvd``: the
                        `series` of states
 ``plot(path=None)``    off-screen picture of the deformed body (`cnem.plot.solution`)
 =====================  ===================================================================
