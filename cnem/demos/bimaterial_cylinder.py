@@ -17,7 +17,8 @@ boundaries have their vertices at the boundary nodes.
 
 For the fairness anchor the same cylinder is solved with scikit-fem P1
 triangles on a quality mesh from `triangle` with (about) the same node count
-(`cnem.fem`).
+(`cnem.fem`, "FEM"), and with P1 on each C-NEM model's own nodes and constrained
+Delaunay triangles (`cnem.fem.P1Elasticity.from_model`, "P1 same nodes").
 
 Expected result
 ---------------
@@ -158,6 +159,12 @@ def solve_fem(domain, nodes):
     return sol, time.perf_counter() - t0
 
 
+def solve_fem_same(model):
+    """scikit-fem P1 on the nodes and constrained Delaunay triangles of a C-NEM model."""
+    from cnem import fem
+    return pose(fem.P1Elasticity.from_model(model, MATERIALS, plane="stress")).solve()
+
+
 def rate(nodes: np.ndarray, errors: np.ndarray) -> float:
     """Fitted convergence rate of ``errors`` against h ~ nodes^(-1/2)."""
     return np.polyfit(-0.5 * np.log(nodes), np.log(errors), 1)[0]
@@ -170,7 +177,8 @@ def run(grids: tuple = GRIDS, irregular: tuple = (False, True), fem: bool = True
     Returns
     -------
     list of dict
-        ``kind, nodes, h, error, paper, fem_nodes, fem_error, time, fem_time``.
+        ``kind, nodes, h, error, paper, fem_nodes, fem_error, time, fem_time``, and
+        ``fem_same_error`` (P1 on the C-NEM nodes) when ``fem``.
     """
     exact = exact_solution()
     stress = exact_stress(exact)
@@ -187,6 +195,8 @@ def run(grids: tuple = GRIDS, irregular: tuple = (False, True), fem: bool = True
         if out is not None:
             fsol, fsec = out
             row.update(fem_nodes=len(fsol.u), fem_error=fsol.energy_error(stress), fem_time=fsec)
+        if fem:
+            row.update(fem_same_error=solve_fem_same(sol.model).energy_error(stress))
         rows.append(row)
     return rows
 
@@ -200,16 +210,18 @@ def _paper(n, irregular):
 
 
 def table(rows):
-    """The error table as text (ours, ours / sqrt 2 beside Table I, FEM)."""
+    """The error table as text (ours, ours / sqrt 2 beside Table I, FEM, P1 on our nodes)."""
     lines = [f"{'cloud':>9} {'nodes':>6} {'h':>7} {'C-NEM e':>10} {'e/sqrt2':>10} "
-             f"{'Table I':>10} {'ratio':>6} {'time s':>7} | {'FEM nodes':>9} {'FEM e':>10} {'time s':>7}"]
+             f"{'Table I':>10} {'ratio':>6} {'time s':>7} | {'FEM nodes':>9} {'FEM e':>10} {'time s':>7}"
+             f" | {'P1 same e':>10}"]
     for r in rows:
         half = r["error"] / np.sqrt(2.0)
         fem = (f"{r['fem_nodes']:>9d} {r['fem_error']:>10.3e} {r['fem_time']:>7.2f}"
                if "fem_error" in r else f"{'-':>9} {'-':>10} {'-':>7}")
+        same = f"{r['fem_same_error']:>10.3e}" if "fem_same_error" in r else f"{'-':>10}"
         lines.append(f"{r['kind']:>9} {r['nodes']:>6d} {r['h']:>7.4f} {r['error']:>10.3e} "
                      f"{half:>10.3e} {r['paper']:>10.3e} {half / r['paper']:>6.2f} "
-                     f"{r['time']:>7.2f} | {fem}")
+                     f"{r['time']:>7.2f} | {fem} | {same}")
     for kind in ("regular", "irregular"):
         sel = [r for r in rows if r["kind"] == kind]
         if len(sel) > 1:
@@ -220,6 +232,8 @@ def table(rows):
                 line += f", paper {rate(n, paper):.3f}"
             if all("fem_error" in r for r in sel):
                 line += f", FEM {rate([r['fem_nodes'] for r in sel], [r['fem_error'] for r in sel]):.3f}"
+            if all("fem_same_error" in r for r in sel):
+                line += f", P1 same nodes {rate(n, [r['fem_same_error'] for r in sel]):.3f}"
             lines.append(line)
     return "\n".join(lines)
 
@@ -243,6 +257,10 @@ def plot_convergence(rows, path):
             nf = np.array([r["fem_nodes"] for r in sel])
             ef = np.array([r["fem_error"] for r in sel]) / np.sqrt(2.0)
             ax.loglog(1 / np.sqrt(nf), ef, "^:", label=f"FEM P1 (rate {rate(nf, ef):.2f})")
+        if all("fem_same_error" in r for r in sel):
+            es = np.array([r["fem_same_error"] for r in sel]) / np.sqrt(2.0)
+            ax.loglog(1 / np.sqrt(n), es, marker + ":", mfc="none",
+                      label=f"P1 on the C-NEM {kind} nodes (rate {rate(n, es):.2f})")
     ax.set_xlabel(r"$1/\sqrt{\mathrm{nodes}}$  ($\propto h$)")
     ax.set_ylabel(r"$\sqrt{\frac{1}{2}\int \mathbf{e}\cdot\mathbf{C}^{-1}\mathbf{e}\;"
                   r"\mathrm{d}A}$  (energy-norm error)")
@@ -346,7 +364,8 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     kind = parser.add_mutually_exclusive_group()
     kind.add_argument("--irregular", action="store_true", help="irregular clouds only")
     kind.add_argument("--regular", action="store_true", help="regular clouds only")
-    parser.add_argument("--no-fem", action="store_true", help="skip the scikit-fem P1 anchor")
+    parser.add_argument("--no-fem", action="store_true",
+                        help="skip the scikit-fem P1 anchors (quality mesh and C-NEM nodes)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the irregular clouds")
     args = parser.parse_args(argv)
     grids = GRIDS if not args.nodes else tuple(grid_for(n) for n in args.nodes)
