@@ -94,6 +94,8 @@ def check_cylinder_files(demo, out, outdir, stdout):
     assert fem_rows
     for row in fem_rows:
         assert row["error"] < row["fem_error"], row
+    for row in out["rows"]:                            # and P1 on the very same nodes
+        assert row["error"] < row["fem_same_error"], row
     read = cnem.io.read(outdir / "cylinder.vtu")
     assert read is not None
     assert f"wrote {outdir / 'cylinder.vtu'}" in stdout
@@ -145,6 +147,10 @@ def check_mode1_crack(demo, out, outdir):
     finest = [r for r in out["rows"] if r["method"] == "cnem"][-1]
     assert abs(finest["KI"] - 1.0) < 0.05
     assert "nan" not in demo.table(out["rows"])[0]      # FEM has no K_I: "-" and a note
+    assert 0.35 < out["rates"]["fem_same"] < 0.65, out["rates"]    # P1 on the C-NEM nodes
+    same = [r for r in out["rows"] if r["method"] == "fem_same"]
+    plain = [r for r in out["rows"] if r["method"] == "cnem"]
+    assert [r["nodes"] for r in same] == [r["nodes"] for r in plain]
 
 
 def check_cpd_output(demo, results, outdir, stdout):
