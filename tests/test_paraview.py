@@ -188,16 +188,22 @@ def test_nodal_stress_is_the_mean_of_the_cells_of_each_node(tmp_path):
                                atol=1e-14 * np.abs(hand).max())
 
 
+def _pulled_cracked_plate(cracks, seed):
+    """A unit square with ``cracks``, clamped at the bottom and pulled up at the top."""
+    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=cracks)
+    model = cnem.discretize(cnem.nodes.irregular(dom, 0.1, seed=seed))
+    prob = cnem.Elasticity(model, (E, NU), plane="strain")
+    prob.add_dirichlet(lambda p: p[:, 1] < 1e-9, None)
+    prob.add_traction(lambda x, n: x[:, 1] > 1 - 1e-9, [0.0, 1.0])
+    return prob.solve(progress=False)
+
+
 def test_cracked_cells_warp_with_their_own_side(tmp_path):
     """In a cracked model every polygon has its own vertices, each with the displacement
     inside that polygon, so the crack faces part in ParaView's Warp By Vector (shared
     vertices took one face's displacement for both)."""
-    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=[[[0.0, 0.5], [0.5, 0.5]]])
-    model = cnem.discretize(cnem.nodes.irregular(dom, 0.1, seed=1))
-    prob = cnem.Elasticity(model, (E, NU), plane="strain")
-    prob.add_dirichlet(lambda p: p[:, 1] < 1e-9, None)
-    prob.add_traction(lambda x, n: x[:, 1] > 1 - 1e-9, [0.0, 1.0])
-    sol = prob.solve(progress=False)
+    sol = _pulled_cracked_plate([[[0.0, 0.5], [0.5, 0.5]]], seed=1)
+    model = sol.model
     mesh = meshio.read(sol.write(tmp_path / "crack.vtu"))
     u = mesh.point_data["displacement"][:, :2]
     n, cells = len(model.nodes), model.cells
@@ -294,12 +300,8 @@ def test_crack_face_ids_pair_the_copies_by_the_crack_normal(tmp_path):
     + on the side its normal (``b - a`` turned counter-clockwise) points to: crack 0
     runs left to right (normal up), crack 1 right to left (normal down)."""
     cracks = [[[0.3, 0.6], [0.7, 0.6]], [[0.7, 0.3], [0.3, 0.3]]]
-    dom = cnem.geometry.rectangle(1.0, 1.0, cracks=cracks)
-    model = cnem.discretize(cnem.nodes.irregular(dom, 0.1, seed=2))
-    prob = cnem.Elasticity(model, (E, NU), plane="strain")
-    prob.add_dirichlet(lambda p: p[:, 1] < 1e-9, None)
-    prob.add_traction(lambda x, n: x[:, 1] > 1 - 1e-9, [0.0, 1.0])
-    sol = prob.solve(progress=False)
+    sol = _pulled_cracked_plate(cracks, seed=2)
+    model = sol.model
     mesh = meshio.read(sol.write(tmp_path / "faces.vtu"))
     n = len(model.nodes)
     face = mesh.point_data["crack_face"]
