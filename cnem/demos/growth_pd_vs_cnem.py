@@ -400,18 +400,32 @@ def breaks_table(rows: list) -> str:
     return "\n".join(lines)
 
 
+def _cell(value: float, spec: str, width: int) -> str:
+    """``value`` formatted, or ``-`` where it could not be computed (NaN)."""
+    return f"{value:>{width}{spec}}" if np.isfinite(value) else f"{'-':>{width}}"
+
+
 def table(results: list) -> str:
     lines = [f"{'h':>5} {'delta':>6} {'nodes':>6} {'crack':>5} | {'Hausdorff':>9} {'over':>5} | "
              f"{'kink C-NEM':>10} {'PD':>7} | {'reaches C-NEM':>18} {'PD':>18} | "
              f"{'start factor C-NEM':>18} {'PD':>6}"]
+    missing = []
     for r in results:
         for name, row in zip(("left", "right"), r["rows"]):
-            c = f"{row['reach_cnem']:.2f} {row['meets_cnem']}"
-            p = f"{row['reach_pd']:.2f} {row['meets_pd']}"
+            c = f"{_cell(row['reach_cnem'], '.2f', 0)} {row['meets_cnem']}"
+            p = f"{_cell(row['reach_pd'], '.2f', 0)} {row['meets_pd']}"
             lines.append(f"{r['h']:>5.3f} {r['horizon']:>6.3f} {r['nodes']:>6d} {name:>5} | "
-                         f"{row['hausdorff']:>9.3f} {row['compared_length']:>5.1f} | "
-                         f"{row['kink_cnem']:>10.2f} {row['kink_pd']:>7.2f} | {c:>18} {p:>18} | "
-                         f"{r['cnem_factor']:>18.4f} {r['pd_started']:>6.4f}")
+                         f"{_cell(row['hausdorff'], '.3f', 9)} {row['compared_length']:>5.1f} | "
+                         f"{_cell(row['kink_cnem'], '.2f', 10)} {_cell(row['kink_pd'], '.2f', 7)} | "
+                         f"{c:>18} {p:>18} | "
+                         f"{_cell(r['cnem_factor'], '.4f', 18)} {_cell(r['pd_started'], '.4f', 6)}")
+            if not np.isfinite(row["kink_pd"]):
+                missing.append(f"{name} at h = {r['h']:g}")
+    if missing:
+        lines.append("-: no PD crack path grew from the notch (" + ", ".join(missing) + "): the "
+                     "damage did not link up into a path at this spacing, so there is no PD kink, "
+                     "Hausdorff distance or reach; refine (e.g. --h 0.125 or 0.0625) to compare "
+                     "the paths")
     for r in results:
         for c in r.get("pd_other", []):
             lines.append(f"h = {r['h']:g}: a PD crack not from a notch, from the {c['start']} at "
