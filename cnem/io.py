@@ -389,10 +389,10 @@ def write_nodes(model: Model, path: str | os.PathLike, *,
     return path
 
 
-def write_points(points: ArrayLike, path: str | os.PathLike, *, triangles: ArrayLike | None = None,
+def write_points(points: ArrayLike, path: str | os.PathLike, *, cells: ArrayLike | None = None,
                  point_data: Mapping[str, ArrayLike] | None = None,
                  cell_data: Mapping[str, ArrayLike] | None = None) -> pathlib.Path:
-    """Write points (2-D or 3-D), as ``vertex`` cells or with triangles on them.
+    """Write points (2-D or 3-D), as ``vertex`` cells or with triangles or tetrahedra on them.
 
     Parameters
     ----------
@@ -400,11 +400,12 @@ def write_points(points: ArrayLike, path: str | os.PathLike, *, triangles: Array
         Written with ``z = 0`` in 2-D.
     path : str or os.PathLike
         Suffix ``.vtu``.
-    triangles : (t, 3) int array_like, optional
-        Cells; without them every point is a ``vertex`` cell.
+    cells : (t, 3) or (t, 4) int array_like, optional
+        Triangles (3 columns) or, on 3-D points, tetrahedra (4 columns), as indices into
+        ``points``; without them every point is a ``vertex`` cell.
     point_data : dict of str -> (n,) or (n, c) array_like, optional
     cell_data : dict of str -> (t,) or (t, c) array_like, optional
-        Values on the triangles (or on the vertex cells: one per point).
+        Values on the cells (or on the vertex cells: one per point).
 
     Returns
     -------
@@ -413,23 +414,28 @@ def write_points(points: ArrayLike, path: str | os.PathLike, *, triangles: Array
     Raises
     ------
     FormatError
-        Unsupported suffix or arrays of the wrong length.
+        Unsupported suffix, cells that are not triangles or tetrahedra of the points, or
+        arrays of the wrong length.
     """
     path, fmt = _format(path)
     pts = check_points("points", points, error=FormatError)
     full = np.zeros((len(pts), 3))
     full[:, :pts.shape[1]] = pts
-    if triangles is None:
+    if cells is None:
         block = meshio.CellBlock("vertex", np.arange(len(pts), dtype=np.int64)[:, None])
     else:
-        tri = np.asarray(triangles)
-        if tri.ndim != 2 or tri.shape[1] != 3 or tri.dtype.kind not in "iu" or \
-                (tri.size and (tri.min() < 0 or tri.max() >= len(pts))):
-            raise FormatError(f"triangles: expected a (t, 3) array of point indices in "
-                              f"[0, {len(pts)}), received shape {tri.shape}, dtype {tri.dtype}"
-                              + (f", indices {tri.min()}..{tri.max()}" if tri.size else "")
+        cell = np.asarray(cells)
+        corners = (3, 4) if pts.shape[1] == 3 else (3,)
+        if cell.ndim != 2 or cell.shape[1] not in corners or cell.dtype.kind not in "iu" or \
+                (cell.size and (cell.min() < 0 or cell.max() >= len(pts))):
+            kinds = " or (t, 4) tetrahedra" if pts.shape[1] == 3 else ""
+            raise FormatError(f"cells: expected a (t, 3) array of triangles{kinds}, as point "
+                              f"indices in [0, {len(pts)}), received shape {cell.shape}, "
+                              f"dtype {cell.dtype}"
+                              + (f", indices {cell.min()}..{cell.max()}" if cell.size else "")
                               + "; index the points given")
-        block = meshio.CellBlock("triangle", tri.astype(np.int64))
+        kind = "triangle" if cell.shape[1] == 3 else "tetra"
+        block = meshio.CellBlock(kind, cell.astype(np.int64))
     pdata = {name: _checked(value, len(pts), f"point_data[{name!r}]")[0]
              for name, value in (point_data or {}).items()}
     cdata = {name: [_checked(value, len(block.data), f"cell_data[{name!r}]")[0]]

@@ -113,6 +113,6 @@ def test_a_file_meshio_cannot_parse_is_a_format_error(tmp_path):
 def test_triangles_that_index_past_the_points_are_refused(tmp_path):
     pts = np.random.default_rng(0).random((5, 2))
     with pytest.raises(cnem.FormatError, match=r"indices in \[0, 5\), .* indices 0..9"):
-        cnem.io.write_points(pts, tmp_path / "p.vtu", triangles=[[0, 1, 9]])
+        cnem.io.write_points(pts, tmp_path / "p.vtu", cells=[[0, 1, 9]])
     with pytest.raises(cnem.FormatError, match="received shape"):
-        cnem.io.write_points(pts, tmp_path / "p.vtu", triangles=[[0.0, 1.0, 2.0]])
+        cnem.io.write_points(pts, tmp_path / "p.vtu", cells=[[0.0, 1.0, 2.0]])

@@ -376,7 +376,7 @@ EXAMPLES = {
         skip=_FIELDS),
     "cnem.io.write_points": Example(
         lambda f: dict(points=f.lattice, path=f.tmp / "p.vtu",
-                       triangles=np.array([[0, 1, 5]]),
+                       cells=np.array([[0, 1, 5]]),
                        point_data=dict(u=f.lattice), cell_data=dict(a=np.ones(1))),
         skip={**_FIELDS, ("points", "shape"): _THREE_D}),
     "cnem.io.read": Example(lambda f: dict(path=cnem.io.write(f.model, f.tmp / "r.vtu"))),

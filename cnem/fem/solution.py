@@ -10,7 +10,7 @@ from skfem.helpers import grad
 
 from ..assembly.quadrature import tetrahedron_quadrature, triangle_quadrature
 from ..material import stiffness_matrix
-from ..errors import GeometryError, UnsupportedError, check_points
+from ..errors import GeometryError, check_points
 from ..solvers.solution import Solution, energy_error_density, engineering_strain
 
 __all__ = ["P1Solution"]
@@ -133,17 +133,7 @@ class P1Solution(Solution):
 
     def write_fields(self, path: str, point_data: dict[str, np.ndarray],
                      cell_data: dict[str, np.ndarray]) -> None:
-        """The mesh with the fields (`cnem.io.write_points` with its triangles; 2-D only).
-
-        Raises
-        ------
-        UnsupportedError
-            On tetrahedra (`cnem.io.write_points` writes triangles).
-        """
-        if self.u.shape[1] == 3:
-            raise UnsupportedError("P1Solution.write: tetrahedra cannot be written yet; write "
-                                   "the nodal values with cnem.io.write_points(sol.mesh.p.T, "
-                                   "path, point_data={'u': sol.u})")
+        """The mesh (triangles or tetrahedra) with the fields (`cnem.io.write_points`)."""
         from .. import io
-        io.write_points(self.mesh.p.T, path, triangles=self.mesh.t.T, point_data=point_data,
+        io.write_points(self.mesh.p.T, path, cells=self.mesh.t.T, point_data=point_data,
                         cell_data=cell_data)
