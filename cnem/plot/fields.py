@@ -531,15 +531,15 @@ def solution(sol: Any, path: str | os.PathLike | None = None, *,
         if per_cell is not None:
             pl.add_mesh(_lines(pv, moved, segments, lift), color=grey,
                         line_width=max(1.5, 1.5 * width / 1200), lighting=False)
-            entries = [(f"deformed outline ×{scale:.3g}; colours on the undeformed cells",
-                        grey)]
+            outline = f"deformed outline ×{scale:.3g}" if scale else "outline (undeformed)"
+            entries = [(f"{outline}; colours on the undeformed cells", grey)]
         else:
             pl.add_mesh(_lines(pv, model.nodes, segments, lift), color="black",
                         line_width=max(1.0, width / 1200), lighting=False)
-            entries = [(f"undeformed outline; colours on the body deformed ×{scale:.3g}",
-                        "black")]
+            body = f"the body deformed ×{scale:.3g}" if scale else "the undeformed body"
+            entries = [(f"undeformed outline; colours on {body}", "black")]
     else:
-        entries = [(f"points moved ×{scale:.3g}", "black")]
+        entries = [(f"points moved ×{scale:.3g}" if scale else "points (undeformed)", "black")]
     _legend(pl, entries)
     lo = np.minimum(nodes[:, :2].min(axis=0), moved[:, :2].min(axis=0))
     hi = np.maximum(nodes[:, :2].max(axis=0), moved[:, :2].max(axis=0))
