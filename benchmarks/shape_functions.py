@@ -59,7 +59,7 @@ table's ``rep`` column gives the runs done.
 **CGAL** (the compiled anchor, square domain only) -- when g++ and CGAL's headers are found
 (Debian: ``apt-get install libcgal-dev``; a benchmark-time tool, not a cnem dependency), the
 driver ``tests/cgal_sibson.cpp`` is compiled once into a cache folder
-(``~/.cache/cnem-benchmarks``, see ``tests/cgal_sibson.py``) and run as its own process on the
+(``~/.cache/cnem-benchmarks``, see ``tests/cgal_coordinates.py``) and run as its own process on the
 cnem model's nodes and the same query points (raw float64 files).  It builds a
 ``Delaunay_triangulation_2`` (timed apart, not counted), then ``--repeat`` times, single
 threaded: ``CGAL::hilbert_sort`` of the query indices (counted), ``locate`` from the
@@ -119,7 +119,7 @@ from _harness import (MachineLoad, fmt_n, in_child, load_text, median, peak_rss_
 
 # the CGAL driver lives with the test that checks cnem's Sibson values against it
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "tests"))
-import cgal_sibson  # noqa: E402
+import cgal_coordinates  # noqa: E402
 
 DOMAINS = {
     "square": dict(),
@@ -288,7 +288,7 @@ def cgal_vs_cnem(exe, nodes_file, phi_file, queries, repeat, tmp):
     import scipy.sparse
 
     pts = query_points(queries)
-    out = cgal_sibson.run(exe, np.load(nodes_file), pts, repeat, tmp)
+    out = cgal_coordinates.run(exe, np.load(nodes_file), pts, repeat, tmp)
     if "error" in out:
         return out
     phi = out.pop("phi")
@@ -632,7 +632,7 @@ def main(argv=None):
           f"{[fmt_n(n) for n in sizes]}, {fmt_n(queries)} queries, repeat {repeat}; "
           f"python {sys.version.split()[0]}, numpy {np.__version__}, scipy {scipy.__version__}, "
           f"{os.cpu_count()} CPUs")
-    cgal = cgal_sibson.build() if "square" in domains and not args.no_cgal else \
+    cgal = cgal_coordinates.build() if "square" in domains and not args.no_cgal else \
         dict(skipped="CGAL column not requested (--no-cgal or no square domain)")
     if "exe" in cgal:
         print(f"CGAL {cgal['cgal']} driver: {cgal['exe']} ("

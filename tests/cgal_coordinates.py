@@ -1,6 +1,7 @@
-"""CGAL's Sibson coordinates: an independent reference for cnem's
-(``tests/test_cgal_reference.py``) and the compiled anchor of
-``benchmarks/shape_functions.py``. `build` compiles ``cgal_sibson.cpp``, `run` runs it.
+"""CGAL's natural-neighbour coordinates: an independent reference for cnem's
+(``tests/test_cgal_reference.py``) and the compiled anchor of the benchmarks. Two drivers:
+``cgal_sibson.cpp`` (2-D Sibson, ``benchmarks/shape_functions.py``) and ``cgal_laplace3.cpp``
+(3-D Laplace, ``benchmarks/laplace_3d.py``). `build` compiles one, `run` runs it.
 
 CGAL is a test- and benchmark-time tool only, never a dependency of cnem: where g++ or CGAL's
 headers (Debian: ``apt-get install libcgal-dev``) are missing, `build` says why, the test
@@ -16,7 +17,10 @@ import time
 
 import numpy as np
 
-SOURCE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "cgal_sibson.cpp")
+HERE = os.path.dirname(os.path.abspath(__file__))
+SIBSON_2D = os.path.join(HERE, "cgal_sibson.cpp")
+LAPLACE_3D = os.path.join(HERE, "cgal_laplace3.cpp")
+SHARED = os.path.join(HERE, "cgal_driver.h")          # included by both drivers
 FLAGS = ["-O3", "-march=native", "-DNDEBUG", "-DCGAL_NDEBUG", "-std=c++17"]
 LIBS = ["-lgmp", "-lmpfr"]
 INSTALL_HINT = "apt-get install libcgal-dev"
@@ -28,8 +32,15 @@ def cache_dir():
     return os.path.join(base, "cnem-benchmarks")
 
 
-def build(cxx=None):
-    """Compile the driver (or reuse the cached build).
+def build(cxx=None, source=SIBSON_2D):
+    """Compile a driver (or reuse the cached build).
+
+    Parameters
+    ----------
+    cxx : str, optional
+        The compiler (default ``$CXX`` or g++).
+    source : str
+        `SIBSON_2D` or `LAPLACE_3D`.
 
     Returns
     -------
@@ -41,9 +52,10 @@ def build(cxx=None):
     if shutil.which(cxx) is None:
         return dict(skipped=f"no C++ compiler ({cxx!r} not on PATH): CGAL column skipped")
     version = subprocess.run([cxx, "--version"], capture_output=True, text=True).stdout
-    with open(SOURCE, "rb") as f:
-        key = hashlib.sha256(f.read() + " ".join(FLAGS + LIBS + [version]).encode()).hexdigest()
-    exe = os.path.join(cache_dir(), f"cgal_sibson_{key[:16]}")
+    text = b"".join(open(path, "rb").read() for path in (source, SHARED))
+    key = hashlib.sha256(text + " ".join(FLAGS + LIBS + [version]).encode()).hexdigest()
+    name = os.path.splitext(os.path.basename(source))[0]
+    exe = os.path.join(cache_dir(), f"{name}_{key[:16]}")
     cgal = cgal_version(cxx)
     if cgal is None:
         return dict(skipped=f"CGAL headers not found by {cxx} ({INSTALL_HINT}): "
@@ -53,7 +65,7 @@ def build(cxx=None):
     os.makedirs(cache_dir(), exist_ok=True)
     tmp = f"{exe}.tmp{os.getpid()}"
     t0 = time.perf_counter()
-    done = subprocess.run([cxx, *FLAGS, SOURCE, "-o", tmp, *LIBS], capture_output=True,
+    done = subprocess.run([cxx, *FLAGS, source, "-o", tmp, *LIBS], capture_output=True,
                           text=True)
     if done.returncode != 0:
         return dict(skipped="compiling the CGAL driver failed: CGAL column skipped\n"
@@ -73,13 +85,15 @@ def cgal_version(cxx):
 
 
 def run(exe, nodes, points, repeat, tmp):
-    """Run the driver on ``nodes`` (n, 2) and ``points`` (q, 2) in a fresh process.
+    """Run a driver on ``nodes`` (n, d) and ``points`` (q, d) in a fresh process (d = 2
+    for `SIBSON_2D`, 3 for `LAPLACE_3D`).
 
     Returns
     -------
     dict
         ``build`` (Delaunay seconds), ``runs`` (wall seconds per timed run: Hilbert sort +
-        coordinates + CSR), ``cpu_runs`` (the runs' CPU seconds), ``outside``, ``rss``
+        coordinates + CSR), ``cpu_runs`` (the runs' CPU seconds), ``outside`` (points the
+        driver gave no coordinates: outside the hull, or in 3-D with an unbounded cell), ``rss``
         (peak bytes), ``phi`` (the last run's ``scipy.sparse.csr_matrix``, shape (q, n));
         ``error`` when the driver failed.
     """
