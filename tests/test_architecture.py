@@ -21,7 +21,7 @@ ROOT = pathlib.Path(cnem.__file__).resolve().parent
 #: The layers, lowest first: the first part of a module's name below ``cnem`` -> rank.
 LAYERS = [
     ("core", {"errors", "config", "_compile", "_parallel", "_memory", "_machine_load", "_predicates",
-              "hyperdual", "material", "exact", "_aliases"}),
+              "_sets", "hyperdual", "material", "exact", "_aliases"}),
     ("spatial", {"spatial"}),
     ("shape", {"shape"}),
     ("geometry", {"geometry"}),

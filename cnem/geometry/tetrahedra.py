@@ -33,6 +33,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay
 
+from .._sets import isin
 from ..errors import GeometryError
 from .face_refinement import refine_faces
 
@@ -41,6 +42,7 @@ __all__ = ["Tetrahedrisation", "conforming_tetrahedra", "signed_volumes", "regio
 
 #: The faces of a tetrahedron (a, b, c, d), each opposite one vertex.
 _FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
+_EDGES = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])
 #: Relative tolerance of the tie tests (cospherical, coplanar), in units of the model's size.
 _TIE = 1e-8
 
@@ -455,19 +457,23 @@ def _delaunay(points, centre, scale):
     return np.ascontiguousarray(tri.simplices, dtype=np.int64)
 
 
+def _longest_edges(points, tets):
+    """The longest edge ``(t,)`` of each tetrahedron."""
+    edge = points[tets[:, _EDGES[:, 0]]] - points[tets[:, _EDGES[:, 1]]]
+    return np.sqrt(np.einsum("tek,tek->te", edge, edge).max(axis=1))
+
+
 def _solid(points, tets):
     """Which tetrahedra ``(t,)`` are not flat slivers (four coplanar nodes)."""
-    x = points[tets]
-    length = np.linalg.norm(x[:, None] - x[:, :, None], axis=3).max(axis=(1, 2))
-    return np.abs(signed_volumes(points, tets)) > _TIE * length ** 3
+    return np.abs(signed_volumes(points, tets)) > _TIE * _longest_edges(points, tets) ** 3
 
 
 def _missing_faces(points, tets, faces):
     """Faces that no solid tetrahedron has (a face of flat slivers only does not separate)."""
     n = len(points)
     tets = tets[_solid(points, tets)]
-    keys = np.unique(_face_keys(tets[:, _FACES].reshape(-1, 3), n))
-    return np.flatnonzero(~np.isin(_face_keys(faces, n), keys))
+    keys = _face_keys(tets[:, _FACES].reshape(-1, 3), n)
+    return np.flatnonzero(~isin(_face_keys(faces, n), keys))
 
 
 def _classify(points, tets, faces, face_regions):
@@ -479,13 +485,11 @@ def _classify(points, tets, faces, face_regions):
     sk = keys[order]
     bkeys = _face_keys(faces, n)
     pair = np.flatnonzero(sk[1:] == sk[:-1])
-    inner = ~np.isin(sk[pair], bkeys)
+    inner = ~isin(sk[pair], bkeys)
     i0, i1 = order[pair[inner]] // 4, order[pair[inner] + 1] // 4
     # a flat sliver (four coplanar nodes) of boundary nodes may lie in an interface plane,
     # on both sides at once: it does not connect
-    x = points[tets]
-    length = np.linalg.norm(x[:, None] - x[:, :, None], axis=3).max(axis=(1, 2))
-    flat = np.abs(signed_volumes(points, tets)) <= _TIE * length ** 3
+    flat = ~_solid(points, tets)
     on_boundary = np.zeros(n, dtype=bool)
     on_boundary[faces.ravel()] = True
     flat &= on_boundary[tets].all(axis=1)
