@@ -951,7 +951,7 @@ def cook_membrane_fem(material, load, *, divisions, order=2, steps=8, tol=1e-10)
 
     @LinearForm
     def shear(v, w):
-        return load / 16.0 * v.value[1]
+        return load / 16.0 * v[1]
 
     fixed = basis.get_dofs(lambda x: x[0] < 1e-9).all()
     f_ext = asm(shear, right)
