@@ -876,14 +876,50 @@ def sibson_reference_3d(nodes, x):
     return w / w.sum()
 
 
+def cook_mesh(divisions, graded=False):
+    """Cook's membrane, the tapered panel with corners (0, 0), (48, 44), (48, 60),
+    (0, 44): a ``divisions x divisions`` mapped grid of quadrilaterals, each cut in two
+    triangles (`skfem.MeshTri`).
+
+    ``graded``: the grid lines crowd cosine-wise towards the clamped edge
+    (``xi -> 1 - cos(pi xi / 2)``) and towards the top and bottom edges
+    (``eta -> (1 - cos(pi eta)) / 2``), so the cells at the clamp's two corners,
+    where the stresses are singular, are ~``1 / divisions^2`` across.
+    """
+    from skfem import MeshTri
+
+    s = np.linspace(0, 1, divisions + 1)
+    along, across = (1 - np.cos(np.pi * s / 2), (1 - np.cos(np.pi * s)) / 2) if graded else (s, s)
+    unit = MeshTri.init_tensor(along, across)
+    xi, eta = unit.p
+    return MeshTri(np.array([48 * xi, 44 * xi + eta * (44 + 16 * xi - 44 * xi)]), unit.t)
+
+
+def _cook_corner_uy(mesh, basis, x):
+    """The vertical displacement of the corner (48, 60) from the dofs ``x`` of the
+    vector ``basis``."""
+    corner = np.flatnonzero((np.abs(mesh.p[0] - 48) < 1e-9) & (np.abs(mesh.p[1] - 60) < 1e-9))[0]
+    return float(x[basis.nodal_dofs[1, corner]])
+
+
+def _skfem_law(material, F, tangent):
+    """``material.evaluate`` at scikit-fem's ``F (2, 2, elements, points)``: ``P`` in
+    the same layout and ``A (2, 2, 2, 2, elements, points)`` (None without ``tangent``)."""
+    shape = F.shape[2:]
+    _, P, A = material.evaluate(np.moveaxis(F, (0, 1), (-2, -1)).reshape(-1, 2, 2),
+                                tangent=tangent)
+    return np.moveaxis(P.reshape(*shape, 2, 2), (-2, -1), (0, 1)), \
+        None if A is None else np.moveaxis(A.reshape(*shape, 2, 2, 2, 2), (2, 3, 4, 5), (0, 1, 2, 3))
+
+
 def cook_membrane_fem(material, load, *, divisions, order=2, steps=8, tol=1e-10):
     """Cook's membrane in plane strain by scikit-fem's P``order`` triangles (Newton,
     the same `cnem.material.Hyperelastic` law at every quadrature point): the slow
     reference of the finite-strain C-NEM cases.
 
-    The tapered panel with corners (0, 0), (48, 44), (48, 60), (0, 44), clamped at
-    x = 0, a dead shear traction ``load / 16`` (total ``load``) in +y on x = 48; a
-    ``divisions x divisions`` grid of quadrilaterals, each cut in two triangles.
+    The tapered panel of `cook_mesh`, clamped at x = 0, a dead shear traction
+    ``load / 16`` (total ``load``) in +y on x = 48. Displacement-only: it locks as
+    the material becomes incompressible (use `cook_membrane_mixed` there).
 
     Returns
     -------
@@ -891,24 +927,17 @@ def cook_membrane_fem(material, load, *, divisions, order=2, steps=8, tol=1e-10)
         The vertical displacement of the corner (48, 60).
     """
     from skfem import (Basis, BilinearForm, ElementTriP2, ElementTriP3, ElementTriP4,
-                       ElementVector, FacetBasis, LinearForm, MeshTri, asm, condense, solve)
+                       ElementVector, FacetBasis, LinearForm, asm, condense, solve)
     from skfem.helpers import grad
 
-    unit = MeshTri.init_tensor(np.linspace(0, 1, divisions + 1), np.linspace(0, 1, divisions + 1))
-    xi, eta = unit.p
-    mesh = MeshTri(np.array([48 * xi, 44 * xi + eta * (44 + 16 * xi - 44 * xi)]), unit.t)
+    mesh = cook_mesh(divisions)
     element = ElementVector({2: ElementTriP2, 3: ElementTriP3, 4: ElementTriP4}[order]())
     basis = Basis(mesh, element, intorder=2 * order)
     right = FacetBasis(mesh, element, facets=mesh.facets_satisfying(lambda x: x[0] > 48 - 1e-9),
                        intorder=2 * order)
 
     def law(w, tangent):
-        F = grad(w["prev"]) + np.eye(2)[:, :, None, None]
-        shape = F.shape[2:]
-        _, P, A = material.evaluate(np.moveaxis(F, (0, 1), (-2, -1)).reshape(-1, 2, 2),
-                                    tangent=tangent)
-        return np.moveaxis(P.reshape(*shape, 2, 2), (-2, -1), (0, 1)), \
-            None if A is None else np.moveaxis(A.reshape(*shape, 2, 2, 2, 2), (2, 3, 4, 5), (0, 1, 2, 3))
+        return _skfem_law(material, grad(w["prev"]) + np.eye(2)[:, :, None, None], tangent)
 
     @LinearForm
     def internal(v, w):
@@ -922,7 +951,7 @@ def cook_membrane_fem(material, load, *, divisions, order=2, steps=8, tol=1e-10)
 
     @LinearForm
     def shear(v, w):
-        return load / 16.0 * v.value[1]
+        return load / 16.0 * v[1]
 
     fixed = basis.get_dofs(lambda x: x[0] < 1e-9).all()
     f_ext = asm(shear, right)
@@ -939,8 +968,128 @@ def cook_membrane_fem(material, load, *, divisions, order=2, steps=8, tol=1e-10)
             x += solve(*condense(K, -r, D=fixed))
         else:
             raise RuntimeError(f"cook_membrane_fem: step {step} did not converge")
-    corner = np.flatnonzero((np.abs(mesh.p[0] - 48) < 1e-9) & (np.abs(mesh.p[1] - 60) < 1e-9))[0]
-    return float(x[basis.nodal_dofs[1, corner]])
+    return _cook_corner_uy(mesh, basis, x)
+
+
+def cook_membrane_mixed(material, load, *, divisions, order=2, steps=10, graded=True,
+                        tol=1e-10):
+    """Cook's membrane (as `cook_membrane_fem`) by a mixed displacement-pressure form
+    that does not lock: Taylor-Hood triangles, continuous P``order`` displacements
+    and P``order - 1`` pressures (scikit-fem), Newton on both.
+
+    For ``NeoHookean(mu, lam)``, ``W = W_mu(F) + lam/2 (ln J)^2`` with ``W_mu`` the
+    law at ``lam = 0``; the pressure-like field ``p`` (= ``lam ln J`` at the
+    solution) enters the perturbed-Lagrangian energy
+
+        Pi(u, p) = int W_mu(F) + p ln J - p^2 / (2 lam) dA - f . u,
+
+    stationary in ``p`` where ``p = lam ln J``: the same energy as the compressible
+    law, with the volume constraint imposed only against the pressure space, so the
+    displacement does not lock as ``lam / mu -> infinity``. Residuals and tangent:
+
+        R_u = int (P_mu + p F^-T) : grad v,       R_p = int (ln J - p / lam) q,
+        K_uu = A_mu - p F^-1_Jk F^-1_Li,  K_up = F^-T : grad v q,  K_pp = -p q / lam.
+
+    Newton stops when ``|R_u| <= tol |f|`` and the last correction is below
+    ``tol`` of the displacement.
+
+    Parameters
+    ----------
+    material : cnem.material.NeoHookean
+    load : float
+        Total dead shear force on x = 48.
+    divisions : int
+        Grid of `cook_mesh`.
+    graded : bool
+        `cook_mesh`'s grading towards the clamp's singular corners (default).
+    order : int
+        Displacement order, 2 or 3 (pressure one lower).
+    steps : int
+        Equal load steps.
+
+    Returns
+    -------
+    float
+        The vertical displacement of the corner (48, 60).
+    """
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+    from skfem import (Basis, BilinearForm, ElementTriP1, ElementTriP2, ElementTriP3,
+                       ElementVector, FacetBasis, LinearForm, asm)
+    from skfem.helpers import grad
+
+    from cnem.material import NeoHookean
+
+    lam = material.lam
+    shear_law = NeoHookean(material.mu, 0.0)
+    mesh = cook_mesh(divisions, graded)
+    elements = {1: ElementTriP1, 2: ElementTriP2, 3: ElementTriP3}
+    ubasis = Basis(mesh, ElementVector(elements[order]()), intorder=2 * order)
+    pbasis = ubasis.with_element(elements[order - 1]())
+    nu = ubasis.N
+    right = FacetBasis(mesh, ubasis.elem, facets=mesh.facets_satisfying(lambda x: x[0] > 48 - 1e-9),
+                       intorder=2 * order)
+
+    def state(x):
+        """``P_mu + p F^-T`` (stress), ``A_mu - p F^-1_Jk F^-1_Li`` (tangent), ``F^-T``
+        and ``ln J - p / lam`` at the quadrature points, scikit-fem's layout."""
+        F = grad(ubasis.interpolate(x[:nu])) + np.eye(2)[:, :, None, None]
+        p = np.asarray(pbasis.interpolate(x[nu:]))
+        P, A = _skfem_law(shear_law, F, True)
+        inv_t = np.moveaxis(np.linalg.inv(np.moveaxis(F, (0, 1), (-2, -1))), (-2, -1), (1, 0))
+        log_j = np.log(F[0, 0] * F[1, 1] - F[0, 1] * F[1, 0])
+        return dict(stress=P + p * inv_t,
+                    tangent=A - p * np.einsum("iL...,kJ...->iJkL...", inv_t, inv_t),
+                    inv_t=inv_t, volume=log_j - p / lam)
+
+    @LinearForm
+    def residual_u(v, w):
+        return np.einsum("ij...,ij...->...", w["stress"], grad(v))
+
+    @LinearForm
+    def residual_p(q, w):
+        return w["volume"] * q
+
+    @BilinearForm
+    def tangent_uu(du, v, w):
+        return np.einsum("ijkl...,ij...,kl...->...", w["tangent"], grad(v), grad(du))
+
+    @BilinearForm
+    def tangent_up(dp, v, w):
+        return np.einsum("ij...,ij...->...", w["inv_t"], grad(v)) * dp
+
+    @BilinearForm
+    def tangent_pp(dp, q, w):
+        return -dp * q / lam
+
+    @LinearForm
+    def shear(v, w):
+        return load / 16.0 * v[1]
+
+    fixed = ubasis.get_dofs(lambda x: x[0] < 1e-9).all()
+    free = np.setdiff1d(np.arange(nu + pbasis.N), fixed)
+    f_ext = asm(shear, right)
+    x = np.zeros(nu + pbasis.N)
+    for step in range(1, steps + 1):
+        f = step / steps * f_ext
+        correction = np.inf
+        for _ in range(30):
+            fields = state(x)
+            r = np.concatenate([asm(residual_u, ubasis, stress=fields["stress"]) - f,
+                                asm(residual_p, pbasis, volume=fields["volume"])])
+            r[fixed] = 0.0
+            if (np.linalg.norm(r[:nu]) <= tol * np.linalg.norm(f)
+                    and correction <= tol * np.abs(x[:nu]).max()):
+                break
+            Kup = asm(tangent_up, pbasis, ubasis, inv_t=fields["inv_t"])
+            K = sp.bmat([[asm(tangent_uu, ubasis, tangent=fields["tangent"]), Kup],
+                         [Kup.T, asm(tangent_pp, pbasis)]]).tocsr()
+            dx = spla.spsolve(K[free][:, free].tocsc(), -r[free])
+            x[free] += dx
+            correction = np.abs(dx[:np.count_nonzero(free < nu)]).max()
+        else:
+            raise RuntimeError(f"cook_membrane_mixed: step {step} did not converge")
+    return _cook_corner_uy(mesh, ubasis, x)
 
 
 def cantilever_p2(length, width, material, load, cells_across):
