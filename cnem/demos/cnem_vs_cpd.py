@@ -69,7 +69,10 @@ import cnem
 from cnem.cli import demo_parser, positive_float, positive_int
 from cnem.errors import OptionError
 from cnem.demos.cpd.bond_law import BondContinuum
+from cnem.demos.cpd.lshape import lshape_runs
 from cnem.demos.cpd.pictures import compare_picture
+from cnem.demos.cpd.torsion import SAINT_VENANT_SQUARE, grip_loads, twist_cnem, twist_cpd
+from cnem.demos.cpd.torsion_picture import torsion_picture
 from cnem.demos.cpd.versus import run_cnem, run_cpd
 
 if TYPE_CHECKING:
@@ -195,7 +198,70 @@ def cantilever(h: float, factors: Sequence[float], steps: int, cloud: str,
                 xlabel="load $P$ ($\\mu H$)", ylabel="tip deflection ($H$)")
 
 
-EXAMPLES = {"tension": tension, "cantilever": cantilever}
+def lshape(h: float, factors: Sequence[float], steps: int, cloud: str) -> dict:
+    """Example 3 (2-D, spacing ``h / 2``; ``steps`` unused: one small step): the
+    displacement profiles along the row and the column through the re-entrant corner."""
+    res = lshape_runs(h / 2, factors, cloud)
+    pull, row, column = res["pull"], res["row"], res["column"]
+    path = np.concatenate([column[::-1], row[1:]])            # bottom -> corner -> left
+    s = np.concatenate([-res["distance"][1][::-1], res["distance"][0][1:]])
+    profile = {k: run.u[-1][path, 1] / pull for k, run in res["runs"].items()}
+    ref = res["runs"]["C-NEM"].u[-1]
+    lines = [f"L-shape (unit square less its top-right quarter), {len(res['model'].nodes)} nodes "
+             f"({cloud}, h = {h / 2:g}), BondContinuum n = 1, mu = 1, u_y = {pull:g} at the top "
+             f"of the left arm: u_y / pull along column (s < 0) and row (s > 0)",
+             f"{'s':>8}" + "".join(f"{k:>12}" for k in profile)]
+    for k in np.unique(np.linspace(0, len(s) - 1, 7).round().astype(int)):
+        lines.append(f"{s[k]:>8.3f}" + "".join(f"{p[k]:>12.4f}" for p in profile.values()))
+    for name, line in (("row", row), ("column", column)):
+        scale = np.linalg.norm(ref[line], axis=1).max()
+        lines.append(f"max |u_CPD - u_C-NEM| / max |u_C-NEM| on the {name}: " + ", ".join(
+            f"{k} {np.linalg.norm(r.u[-1][line] - ref[line], axis=1).max() / scale:.1%}"
+            for k, r in res["runs"].items() if k != "C-NEM"))
+    return dict(res, lines=lines, force=profile, x=s, closed=None, origin=None,
+                magnify=0.1 / pull, xlabel="$s$: column $x = 1/2$ ($s < 0$, from the "
+                "bottom), row $y = 1/2$ ($s > 0$, leftwards)", ylabel="$u_y$ / pull",
+                curve_title="L-shape: $u_y$ through the re-entrant corner ($s = 0$)")
+
+
+def torsion(h: float, factors: Sequence[float], steps: int, cloud: str) -> dict:
+    """Example 4 (3-D, spacing ``2 h``): torque and axial force of the square column
+    against the twist, to 90 degrees in ``max(2, steps // 2)`` increments after a small
+    first twist (the linear range)."""
+    length, spacing = 4.0, 2 * h
+    nodes = _cloud(cnem.geometry.box((0.0, 0.0, 0.0), (1.0, 1.0, length)), spacing, cloud)
+    model = cnem.discretize(nodes, progress=False)
+    increments = max(2, steps // 2)
+    degrees = np.concatenate([[0.5], 90.0 * np.arange(1, increments + 1) / increments])
+    angles = np.radians(degrees)
+    runs = {"C-NEM": twist_cnem(model, 1.0, length, angles)}
+    for m in factors:
+        runs[f"CPD {m:g}h"] = twist_cpd(nodes, m, 1.0, spacing, length, angles)
+    loads = {k: grip_loads(model.nodes, r) for k, r in runs.items()}
+    torque = {k: v[0] for k, v in loads.items()}
+    axial = {k: v[1] for k, v in loads.items()}
+    saint_venant = SAINT_VENANT_SQUARE / length                     # torque per radian
+    lines = [f"Torsion of a 1 x 1 x {length:g} column, {len(model.nodes)} nodes ({cloud}, "
+             f"h = {spacing:g}), SVK lambda = mu = 1 (CPD n = 2, C1 only), top turned by "
+             f"theta, u_z held: torque T and axial force N",
+             f"{'theta':>6}{'SV T':>9}" + "".join(f"{'T ' + k:>13}" for k in runs)
+             + "".join(f"{'N ' + k:>13}" for k in runs)]
+    for k in range(len(degrees)):
+        lines.append(f"{degrees[k]:>6.1f}{saint_venant * angles[k]:>9.5f}"
+                     + "".join(f"{t[k]:>13.6f}" for t in torque.values())
+                     + "".join(f"{n[k]:>13.3e}" for n in axial.values()))
+    lines.append("T / T_C-NEM at 90 deg: " + ", ".join(
+        f"{k} {t[-1] / torque['C-NEM'][-1]:.3f}" for k, t in torque.items() if k != "C-NEM")
+        + f"; C-NEM T at {degrees[0]:g} deg / Saint-Venant "
+        f"{torque['C-NEM'][0] / (saint_venant * angles[0]):.4f}")
+    lines.append("CPD C1 (lattice factor f; pairs, triplets that C2, C3 > 0 would add): "
+                 + ", ".join(f"{k} {r.C1:.4g} ({r.bulk:.3f}; {r.pairs:.3g}, {r.triplets:.3g})"
+                             for k, r in runs.items() if k != "C-NEM"))
+    return dict(model=model, points=model.nodes, runs=runs, degrees=degrees, torque=torque,
+                axial=axial, saint_venant=saint_venant, lines=lines)
+
+
+EXAMPLES = {"tension": tension, "cantilever": cantilever, "lshape": lshape, "torsion": torsion}
 
 
 def main(h: float = 0.1, factors: Sequence[float] = (2.0, 3.0, 4.0), *, steps: int = 8,
@@ -236,7 +302,9 @@ def main(h: float = 0.1, factors: Sequence[float] = (2.0, 3.0, 4.0), *, steps: i
             path = pathlib.Path(outdir) / f"{name}.png"
             path.parent.mkdir(parents=True, exist_ok=True)
             middle = [k for k in res["runs"] if k != "C-NEM"][len(factors) // 2]
-            files.append(compare_picture(str(path), res, middle, name))
+            draw = torsion_picture if name == "torsion" else \
+                lambda p, r, c: compare_picture(p, r, c, name)
+            files.append(draw(str(path), res, middle))
             print(f"wrote {files[-1]}")
         out[name] = res
     out["files"] = files
