@@ -20,8 +20,8 @@ def _columns(points, runs, cpd):
     top = max(np.linalg.norm(u_cnem, axis=1).max(), np.linalg.norm(u_cpd, axis=1).max())
     diff = np.linalg.norm(u_cpd - u_cnem, axis=1)
     views = (("C-NEM (|u|)", u_cnem, np.linalg.norm(u_cnem, axis=1), "|u|", "viridis", top),
-             (cpd.replace("h", " spacings") + " (|u|, same scale)", u_cpd, np.linalg.norm(u_cpd, axis=1), "|u| ",
-              "viridis", top),
+             (cpd.replace("h", " spacings") + " (|u|, same scale)", u_cpd,
+              np.linalg.norm(u_cpd, axis=1), "|u| ", "viridis", top),
              (f"|u_CPD - u_C-NEM| ({cpd.replace('h', ' sp.')}) on C-NEM", u_cnem, diff,
               "difference", "magma", diff.max()))
     pl = pv.Plotter(off_screen=True, shape=(1, 3), window_size=(1500, 640), border=False)
@@ -31,8 +31,8 @@ def _columns(points, runs, cpd):
         body = grid.copy()
         body.points = points + u
         body.point_data[name] = values
-        pl.add_mesh(body.extract_surface(algorithm="dataset_surface"), scalars=name, cmap=cmap, clim=(0.0, vmax),
-                    show_edges=True, edge_color="grey", line_width=0.3,
+        pl.add_mesh(body.extract_surface(algorithm="dataset_surface"), scalars=name,
+                    cmap=cmap, clim=(0.0, vmax), show_edges=True, edge_color="grey", line_width=0.3,
                     scalar_bar_args=dict(title=f"{name.strip()} (length unit)", color="black",
                                          vertical=False, position_x=0.15, width=0.7))
         pl.add_mesh(outline, color="grey", line_width=1.0, opacity=0.6)
