@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["compare_picture"]
+__all__ = ["compare_picture", "horizon_curves"]
 
 
 def _deformed(ax, tri, points, u, values, label, cmap, vmax):
@@ -90,21 +90,29 @@ def compare_picture(path: str, res: dict, cpd: str, name: str) -> str:
         fine, closed = res["closed"]
         ax.plot(fine, closed, color="k", lw=1.2,
                 label="closed form" if name == "tension" else "linear limit (C-NEM)")
-    origin = res.get("origin", 0.0 if name != "tension" else 1.0)
-    x = res["x"] if origin is None else np.concatenate([[origin], res["x"]])
-    for key, curve in res["force"].items():
+    horizon_curves(ax, res["x"], res["force"], res["xlabel"], res["ylabel"],
+                   res.get("origin", 0.0 if name != "tension" else 1.0))
+    ax.set_title(res.get("curve_title", f"{name}: C-NEM and CPD as the horizon shrinks"),
+                 fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+    return path
+
+
+def horizon_curves(ax, x: np.ndarray, curves: dict, xlabel: str, ylabel: str,
+                   origin: float | None = 0.0) -> None:
+    """Draw ``curves`` (run name -> values ``(s,)``: "C-NEM" and "CPD <m>h") against
+    ``x (s,)`` on the matplotlib axes ``ax``, each from ``(origin, 0)`` unless ``origin``
+    is None, C-NEM solid, CPD dashed."""
+    x = x if origin is None else np.concatenate([[origin], x])
+    for key, curve in curves.items():
         style = dict(marker="o", lw=1.8, color="tab:red") if key == "C-NEM" else \
             dict(marker="s", lw=1.0, ms=4, ls="--")
         ax.plot(x, curve if origin is None else np.concatenate([[0.0], curve]),
                 label=f"CPD, horizon {key[4:-1]} spacings" if key != "C-NEM" else "C-NEM",
                 **style)
-    ax.set_xlabel(res["xlabel"])
-    ax.set_ylabel(res["ylabel"])
-    ax.set_title(res.get("curve_title", f"{name}: C-NEM and CPD as the horizon shrinks"),
-                 fontsize=10)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-    return path

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .pictures import horizon_curves
+
 __all__ = ["torsion_picture"]
 
 
@@ -19,11 +21,12 @@ def _columns(points, runs, cpd):
     u_cnem, u_cpd = runs["C-NEM"].u[-1], runs[cpd].u[-1]
     top = max(np.linalg.norm(u_cnem, axis=1).max(), np.linalg.norm(u_cpd, axis=1).max())
     diff = np.linalg.norm(u_cpd - u_cnem, axis=1)
-    views = (("C-NEM (|u|)", u_cnem, np.linalg.norm(u_cnem, axis=1), "|u|", "viridis", top),
-             (cpd.replace("h", " spacings") + " (|u|, same scale)", u_cpd,
-              np.linalg.norm(u_cpd, axis=1), "|u| ", "viridis", top),
-             (f"|u_CPD - u_C-NEM| ({cpd.replace('h', ' sp.')}) on C-NEM", u_cnem, diff,
-              "difference", "magma", diff.max()))
+    size = "displacement magnitude"
+    views = (("C-NEM", u_cnem, np.linalg.norm(u_cnem, axis=1), size, "viridis", top),
+             (cpd.replace("h", " spacings") + " (same scale)", u_cpd,
+              np.linalg.norm(u_cpd, axis=1), size + " ", "viridis", top),
+             (f"difference, CPD {cpd[4:-1]} sp. - C-NEM", u_cnem, diff,
+              "difference magnitude", "magma", diff.max()))
     pl = pv.Plotter(off_screen=True, shape=(1, 3), window_size=(1500, 640), border=False)
     pl.set_background("white")
     for k, (title, u, values, name, cmap, vmax) in enumerate(views):
@@ -36,7 +39,7 @@ def _columns(points, runs, cpd):
                     scalar_bar_args=dict(title=f"{name.strip()} (length unit)", color="black",
                                          vertical=False, position_x=0.15, width=0.7))
         pl.add_mesh(outline, color="grey", line_width=1.0, opacity=0.6)
-        pl.add_text(title, font_size=9, color="black")
+        pl.add_text(title, font_size=11, color="black")
         pl.camera_position = "iso"
         pl.camera.zoom(1.1)
     image = pl.screenshot(return_img=True)
@@ -72,22 +75,14 @@ def torsion_picture(path: str, res: dict, cpd: str) -> str:
     ax.set_title(f"torsion of a 1 x 1 x 4 column at {res['degrees'][-1]:g} deg (grey: "
                  f"undeformed edges); left C-NEM, middle CPD, right their difference",
                  fontsize=10)
-    deg = np.concatenate([[0.0], res["degrees"]])
     for k, (key, label) in enumerate((("torque", "torque $T$ ($\\mu a^3$)"),
                                       ("axial", "axial force $N$ held by the grip ($\\mu a^2$)"))):
         ax = fig.add_subplot(grid[1, k])
         if key == "torque":
-            ax.plot(deg, res["saint_venant"] * np.radians(deg), color="k", lw=1.0,
+            ends = np.array([0.0, res["degrees"][-1]])
+            ax.plot(ends, res["saint_venant"] * np.radians(ends), color="k", lw=1.0,
                     label="Saint-Venant, linear")
-        for name, curve in res[key].items():
-            style = dict(marker="o", lw=1.8, color="tab:red") if name == "C-NEM" else \
-                dict(marker="s", lw=1.0, ms=4, ls="--")
-            ax.plot(deg, np.concatenate([[0.0], curve]), label=name if name == "C-NEM" else
-                    f"CPD, horizon {name[4:-1]} spacings", **style)
-        ax.set_xlabel("twist $\\theta$ (degrees)")
-        ax.set_ylabel(label)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        horizon_curves(ax, res["degrees"], res[key], "twist $\\theta$ (degrees)", label)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
