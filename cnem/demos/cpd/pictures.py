@@ -3,7 +3,12 @@ undeformed outline, their difference, and the curves of every run."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 __all__ = ["compare_picture", "horizon_curves"]
 
@@ -100,7 +105,7 @@ def compare_picture(path: str, res: dict, cpd: str, name: str) -> str:
     return path
 
 
-def horizon_curves(ax, x: np.ndarray, curves: dict, xlabel: str, ylabel: str,
+def horizon_curves(ax: Axes, x: np.ndarray, curves: dict, xlabel: str, ylabel: str,
                    origin: float | None = 0.0) -> None:
     """Draw ``curves`` (run name -> values ``(s,)``: "C-NEM" and "CPD <m>h") against
     ``x (s,)`` on the matplotlib axes ``ax``, each from ``(origin, 0)`` unless ``origin``
