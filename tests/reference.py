@@ -1177,3 +1177,33 @@ def beam_tip(length, width, material, force):
     inertia = width ** 4 / 12.0
     shear = E / (2.0 * (1.0 + nu)) * 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu) * width ** 2
     return force * length ** 3 / (3.0 * E * inertia) + force * length / shear
+
+
+def lshape_fem(points, pull, *, divisions=32):
+    """The unit L-shape of `cnem.demos.cpd.lshape` (the square less its top-right
+    quarter; bottom clamped, top of the left arm at ``u_x = 0``, ``u_y = pull``) in
+    linear plane strain with ``lambda = mu = 1``, by scikit-fem's P2 triangles on a
+    ``divisions x divisions`` grid (the quarter removed): the slow reference of the
+    small-pull C-NEM L-shape.
+
+    Returns
+    -------
+    (n, 2) ndarray
+        The displacement at ``points (n, 2)``.
+    """
+    from skfem import Basis, ElementTriP2, ElementVector, MeshTri, asm, condense, solve
+    from skfem.models.elasticity import linear_elasticity
+
+    g = np.linspace(0.0, 1.0, divisions + 1)
+    mesh = MeshTri.init_tensor(g, g)
+    centre = mesh.p[:, mesh.t].mean(axis=1)
+    mesh = mesh.remove_elements(np.flatnonzero((centre[0] > 0.5) & (centre[1] > 0.5)))
+    basis = Basis(mesh, ElementVector(ElementTriP2()))
+    K = asm(linear_elasticity(1.0, 1.0), basis)
+    top = basis.get_dofs(lambda x: x[1] > 1 - 1e-9)
+    fixed = np.concatenate([basis.get_dofs(lambda x: x[1] < 1e-9).all(), top.all("u^1"),
+                            top.all("u^2")])
+    x = np.zeros(basis.N)
+    x[top.all("u^2")] = pull
+    x = solve(*condense(K, np.zeros(basis.N), x=x, D=fixed))
+    return (basis.probes(np.asarray(points, float).T) @ x).reshape(2, -1).T

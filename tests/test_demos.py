@@ -185,6 +185,15 @@ def check_cnem_vs_cpd(demo, out, outdir):
     assert abs(beam["deflection"]["C-NEM"][0] / linear[0] - 1) < 0.03
     assert beam["deflection"]["C-NEM"][-1] < 0.95 * linear[-1]
     assert np.all(np.diff(beam["deflection"]["C-NEM"]) > 0)
+    torsion, lshape = out["torsion"], out["lshape"]
+    for k in cpd:                     # CPD's column is softer in torsion (surface effect)
+        assert (0 < torsion["torque"][k]).all()
+        assert (torsion["torque"][k] < torsion["torque"]["C-NEM"]).all()
+    assert (np.diff(torsion["torque"]["C-NEM"]) > 0).all()
+    assert (torsion["axial"]["C-NEM"][1:] > 0).all()      # the grip pulls, N ~ theta^2
+    corner = int(np.argmin(np.abs(lshape["x"])))
+    assert lshape["x"][corner] == 0.0 and np.allclose(lshape["force"]["C-NEM"][[0, -1]],
+                                                       [0.0, lshape["force"]["C-NEM"].max()])
     for path in out["files"]:
         assert pathlib.Path(path).stat().st_size > 10_000
 
@@ -433,7 +442,7 @@ CASES = [
          page="pd_vs_cnem_crack"),
     Case("pd-vs-cnem-3d", "pd_vs_cnem_3d", check_pd_vs_cnem_3d, args=((0.25, 0.125),)),
     Case("cnem-vs-cpd", "cnem_vs_cpd", check_cnem_vs_cpd, args=(0.25, (2.0, 3.0)),
-         sizes=dict(steps=4), plot=True),
+         sizes=lambda demo: dict(steps=4, examples=tuple(demo.EXAMPLES)), plot=True),
     Case("pd-crack-branching", "pd_crack_branching", check_pd_crack_branching,
          page="pd_crack_branching"),
     Case("kalthoff-winkler", "kalthoff_winkler", check_kalthoff_winkler, page="kalthoff_winkler"),

@@ -3,9 +3,14 @@ undeformed outline, their difference, and the curves of every run."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-__all__ = ["compare_picture"]
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+
+__all__ = ["compare_picture", "horizon_curves"]
 
 
 def _deformed(ax, tri, points, u, values, label, cmap, vmax):
@@ -49,7 +54,10 @@ def compare_picture(path: str, res: dict, cpd: str, name: str) -> str:
     path : str
     res : dict
         An example's result of `cnem.demos.cnem_vs_cpd` (``model``, ``runs``, ``force``,
-        ``x``, ``closed``, ``xlabel``, ``ylabel``).
+        ``x``, ``closed``, ``xlabel``, ``ylabel``; optional ``triangles`` of the nodes
+        for a non-convex body, ``origin``: the abscissa of the curves' zero point, None
+        for none, ``closed`` None for no reference curve, ``magnify`` the displacements
+        drawn).
     cpd : str
         The key of the CPD run drawn.
     name : str
@@ -64,37 +72,52 @@ def compare_picture(path: str, res: dict, cpd: str, name: str) -> str:
     from cnem.plot.charts import offscreen_pyplot
     plt = offscreen_pyplot()
     points = res["model"].nodes
-    tri = Triangulation(points[:, 0], points[:, 1])
+    tri = Triangulation(points[:, 0], points[:, 1], res.get("triangles"))
     u_cnem, u_cpd = res["runs"]["C-NEM"].u[-1], res["runs"][cpd].u[-1]
     size = [np.hypot(*u_cnem.T), np.hypot(*u_cpd.T)]
     top = max(s.max() for s in size)
+    magnify = res.get("magnify", 1.0)
+    shown = f" (x {magnify:g})" if magnify != 1.0 else ""
     wide = np.ptp(points[:, 0]) > 3 * np.ptp(points[:, 1])
     fig, axes = plt.subplots(2, 2, figsize=(13, 8.5 if wide else 9.5))
     for ax, u, s, label in ((axes[0, 0], u_cnem, size[0], "C-NEM (Hyperelasticity)"),
                             (axes[0, 1], u_cpd, size[1], f"{cpd.replace('h', ' h')}")):
-        shaded = _deformed(ax, tri, points, u, s, f"{name}: {label}, deformed", "viridis", top)
+        shaded = _deformed(ax, tri, points, magnify * u, s, f"{name}: {label}, deformed{shown}",
+                           "viridis", top)
         fig.colorbar(shaded, ax=ax, shrink=0.8, label="$|u|$ (length unit)")
     diff = np.hypot(*(u_cpd - u_cnem).T)
-    shaded = _deformed(axes[1, 0], tri, points, u_cnem, diff,
+    shaded = _deformed(axes[1, 0], tri, points, magnify * u_cnem, diff,
                        f"$|u_{{CPD}} - u_{{C-NEM}}|$ ({cpd}) on C-NEM's deformed body",
                        "magma", diff.max())
     fig.colorbar(shaded, ax=axes[1, 0], shrink=0.8, label="difference (length unit)")
     ax = axes[1, 1]
-    fine, closed = res["closed"]
-    ax.plot(fine, closed, color="k", lw=1.2,
-            label="closed form" if name == "tension" else "linear limit (C-NEM)")
-    x = np.concatenate([[0.0 if name != "tension" else 1.0], res["x"]])
-    for key, curve in res["force"].items():
-        style = dict(marker="o", lw=1.8, color="tab:red") if key == "C-NEM" else \
-            dict(marker="s", lw=1.0, ms=4, ls="--")
-        ax.plot(x, np.concatenate([[0.0], curve]), label=f"CPD, horizon {key[4:-1]} spacings"
-                if key != "C-NEM" else "C-NEM", **style)
-    ax.set_xlabel(res["xlabel"])
-    ax.set_ylabel(res["ylabel"])
-    ax.set_title(f"{name}: C-NEM and CPD as the horizon shrinks", fontsize=10)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    if res.get("closed") is not None:
+        fine, closed = res["closed"]
+        ax.plot(fine, closed, color="k", lw=1.2,
+                label="closed form" if name == "tension" else "linear limit (C-NEM)")
+    horizon_curves(ax, res["x"], res["force"], res["xlabel"], res["ylabel"],
+                   res.get("origin", 0.0 if name != "tension" else 1.0))
+    ax.set_title(res.get("curve_title", f"{name}: C-NEM and CPD as the horizon shrinks"),
+                 fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
     return path
+
+
+def horizon_curves(ax: Axes, x: np.ndarray, curves: dict, xlabel: str, ylabel: str,
+                   origin: float | None = 0.0) -> None:
+    """Draw ``curves`` (run name -> values ``(s,)``: "C-NEM" and "CPD <m>h") against
+    ``x (s,)`` on the matplotlib axes ``ax``, each from ``(origin, 0)`` unless ``origin``
+    is None, C-NEM solid, CPD dashed."""
+    x = x if origin is None else np.concatenate([[origin], x])
+    for key, curve in curves.items():
+        style = dict(marker="o", lw=1.8, color="tab:red") if key == "C-NEM" else \
+            dict(marker="s", lw=1.0, ms=4, ls="--")
+        ax.plot(x, curve if origin is None else np.concatenate([[0.0], curve]),
+                label=f"CPD, horizon {key[4:-1]} spacings" if key != "C-NEM" else "C-NEM",
+                **style)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
