@@ -23,6 +23,14 @@ What is compared (each against the case ``o = 0, s = 1``, mapped back by ``(x - 
 A case that raises prints the error's name instead of its numbers; ``inf``: a different
 number of nodes or cells (so nothing to compare entry by entry).
 
+3-D rows: Lamé's hollow sphere (radii ``0.5 s``, ``s`` about ``o``, E = 1, nu = 0.3, unit
+internal pressure, the exact displacement held on the outer surface; 3-D C-NEM) on one
+irregular cloud of spacing ``--h3`` (default 0.25) built at the origin and mapped, at the
+origin, shifted by 1e6 (1e6, -2e6, 5e5), scaled by 1e-3 and by 1e3: ``energy``  the
+energy-norm error over the exact energy norm; ``cavity``  the cavity's mean radial
+displacement over the exact one; ``du``  max displacement difference to the origin case /
+(s max |u_ref|).
+
 Run ``python benchmarks/invariance.py`` (``--quick`` for the CI smoke size).
 """
 
@@ -113,9 +121,57 @@ def _compare(got, ref, n):
     return out
 
 
+SPHERE_CASES = ((0.0, 1.0), (1e6, 1.0), (0.0, 1e-3), (0.0, 1e3))    # offset, scale
+SPHERE_SHIFT = np.array([1.0, -2.0, 0.5])
+
+
+def _sphere_run(points, s, o):
+    """The hollow sphere mapped by ``x -> s x + o SPHERE_SHIFT``: relative energy error,
+    cavity displacement over the exact one, displacements over ``s``."""
+    from cnem.exact import ThickSphere
+    centre = o * SPHERE_SHIFT
+    dom = cnem.geometry.hollow_sphere(0.5 * s, s, center=centre, subdivisions=2)
+    model = cnem.discretize(cnem.nodes.from_points(dom, points * s + centre), progress=False)
+    exact = ThickSphere(0.5 * s, s, 1.0, 0.3, pressure=1.0, center=centre)
+    u_inner = exact.radial_displacement(np.array([0.5 * s]))[0]
+    norm = np.sqrt(u_inner * 4 * np.pi * (0.5 * s) ** 2)
+    r = np.linalg.norm(model.nodes - centre, axis=1)
+    prob = cnem.Elasticity(model, (1.0, 0.3))
+    prob.add_dirichlet(model.boundary_nodes(lambda x: np.linalg.norm(x - centre, axis=1) > 0.75 * s),
+                       None, exact.displacement)
+    prob.add_traction(lambda x, n: np.linalg.norm(x - centre, axis=1) < 0.75 * s, lambda x, n: -n)
+    sol = prob.solve(progress=False)
+    cavity = r < 0.5 * s * (1 + 1e-9)
+    ur = np.einsum("ij,ij->i", sol.u[cavity], (model.nodes[cavity] - centre) / r[cavity, None])
+    return dict(energy=sol.energy_error(exact.stress) / norm, cavity=ur.mean() / u_inner,
+                u=sol.u / s)
+
+
+def sphere_rows(h):
+    """Print the 3-D rows (see the module's docstring)."""
+    dom = cnem.geometry.hollow_sphere(0.5, 1.0, subdivisions=2)
+    points = cnem.nodes.irregular(dom, h, seed=0).points
+    print(f"\n3-D hollow sphere: {len(points)} points, h = {h}")
+    print(f"{'offset':>8} {'scale':>8} {'energy':>12} {'cavity':>12} {'du':>9} {'time s':>8}")
+    ref = None
+    for o, s in SPHERE_CASES:
+        t0 = time.perf_counter()
+        try:
+            got = _sphere_run(points, s, o)
+        except cnem.CNEMError as exc:
+            print(f"{o:8.0e} {s:8.0e} {type(exc).__name__}: {str(exc)[:90]}")
+            continue
+        ref = got if ref is None else ref
+        du = (np.abs(got["u"] - ref["u"]).max() / np.abs(ref["u"]).max()
+              if got["u"].shape == ref["u"].shape else np.inf)
+        print(f"{o:8.0e} {s:8.0e} {got['energy']:12.10f} {got['cavity']:12.10f} {du:9.1e} "
+              f"{time.perf_counter() - t0:8.2f}")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--h", type=float, default=0.03, help="node spacing at scale 1")
+    parser.add_argument("--h3", type=float, default=0.25, help="3-D node spacing (sphere radius 1)")
     parser.add_argument("--quick", action="store_true", help="CI smoke size (h = 0.06)")
     args = parser.parse_args(argv)
     h = 0.06 if args.quick else args.h
@@ -139,6 +195,7 @@ def main(argv=None):
         except cnem.CNEMError as exc:
             row = f"{type(exc).__name__}: {str(exc)[:90]}"
         print(f"{o:8.0e} {s:8.0e} {row}")
+    sphere_rows(args.h3)
     print("\n" + machine.stop().report())
 
 

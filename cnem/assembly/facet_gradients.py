@@ -35,6 +35,7 @@ from typing import Any, Callable
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
+from .. import config
 from ..errors import GeometryError
 from .interface_facets import InterfacePieces, interface_pieces, on_triangles
 from .smoothed_gradient import SmoothedGradient
@@ -47,7 +48,9 @@ __all__ = ["facet_points", "facet_gradient", "boundary_points_3d", "pyramid_sub_
 PLANE_RESOLUTION = 2.0 ** 24
 
 #: Two facet points closer than this fraction of the model's size are one point (the
-#: two sides of a shared facet, computed from the same polygon).
+#: two sides of a shared facet, computed from the same polygon), or closer than
+#: ``config.ROUNDOFF_ULPS`` round-offs of the coordinates far from the origin
+#: (`_pair_tolerance`).
 PAIR_RTOL = 1e-10
 
 #: Shape functions at points: ``evaluate(points (q, 3)) -> csr (q, n)``.
@@ -418,21 +421,31 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
     """
     group, _, point, area_normal = _grouped_facet_points(cells.facet_triangles, cells.facet_cell,
                                                          cells.facet_normal)
-    size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
+    size, tol = _pair_tolerance(model)
     # shadow facets: unpaired, and on no boundary face
-    lone = np.flatnonzero(~_paired(point, area_normal, size))
+    lone = np.flatnonzero(~_paired(point, area_normal, tol))
     faces, normal = model.boundary_with_normals()
-    outer = _face_holding(point[lone], area_normal[lone], model.nodes[faces], normal, size) >= 0
+    outer = _face_holding(point[lone], area_normal[lone], model.nodes[faces], normal, tol) >= 0
     between = model.boundary_face_regions[:, 1] >= 0
     return interface_pieces(cells.facet_triangles, cells.facet_normal, group,
                             model.nodes[model.boundary_faces[between]], size,
                             also=np.isin(group, lone[~outer]))
 
 
-def _paired(point, area_normal, size):
-    """Whether each facet point ``(k, 3)`` has another at it (to ``PAIR_RTOL size``)
-    with an opposite area-normal: the two sides of one facet."""
-    pairs = cKDTree(point).query_pairs(PAIR_RTOL * size, output_type="ndarray")
+def _pair_tolerance(model):
+    """The model's size and the distance under which two facet points are one:
+    ``PAIR_RTOL`` of the size, or ``config.ROUNDOFF_ULPS`` round-offs of the largest
+    coordinate (a body far from the origin has its cells' vertices rounded to the
+    global coordinates' spacing)."""
+    size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
+    largest = float(np.abs(model.nodes).max())
+    return size, max(PAIR_RTOL * size, config.ROUNDOFF_ULPS * np.finfo(float).eps * largest)
+
+
+def _paired(point, area_normal, tol):
+    """Whether each facet point ``(k, 3)`` has another within ``tol`` with an opposite
+    area-normal: the two sides of one facet."""
+    pairs = cKDTree(point).query_pairs(tol, output_type="ndarray")
     opposite = np.einsum("ij,ij->i", area_normal[pairs[:, 0]], area_normal[pairs[:, 1]]) < 0
     shared = np.zeros(len(point), dtype=bool)
     shared[pairs[opposite].ravel()] = True
@@ -469,13 +482,13 @@ def boundary_points_3d(model: Any, interface: InterfacePieces | None = None
         interface = model_interface_pieces(model, cells)
     group, _, point, area_normal = _grouped_facet_points(cells.facet_triangles, cells.facet_cell,
                                                          cells.facet_normal, interface.on_interface)
-    size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
-    shared = _paired(point, area_normal, size)
+    _, tol = _pair_tolerance(model)
+    shared = _paired(point, area_normal, tol)
     shared[group[interface.on_interface]] = True
     outer = np.flatnonzero(~shared)
     faces, normal = model.boundary_with_normals()
     corners = model.nodes[faces]
-    face = _face_holding(point[outer], area_normal[outer], corners, normal, size)
+    face = _face_holding(point[outer], area_normal[outer], corners, normal, tol)
     keep = face >= 0
     if not keep.all():
         raise GeometryError(f"{int((~keep).sum())} cell facets on the boundary lie on no "
@@ -483,8 +496,9 @@ def boundary_points_3d(model: Any, interface: InterfacePieces | None = None
     return point[outer], area_normal[outer], face
 
 
-def _face_holding(points, area_normal, corners, normal, size):
-    """The boundary triangle (of the same outward normal) holding each point, -1 if none.
+def _face_holding(points, area_normal, corners, normal, tol):
+    """The boundary triangle (of the same outward normal) holding each point (within
+    ``tol`` of its plane), -1 if none.
 
     Candidates are the triangles whose bounding sphere about their centroid (the
     largest one's radius) reaches the point; each (point, candidate) pair is tested
@@ -500,7 +514,7 @@ def _face_holding(points, area_normal, corners, normal, size):
     unit = area_normal / np.linalg.norm(area_normal, axis=1)[:, None]
     facing = np.einsum("ij,ij->i", normal[face], unit[point]) > 1.0 - 1e-6
     face, point = face[facing], point[facing]
-    inside = on_triangles(points[point], corners[face], PAIR_RTOL * 1e3, PAIR_RTOL * size)
+    inside = on_triangles(points[point], corners[face], PAIR_RTOL * 1e3, tol)
     face, point = face[inside], point[inside]
     # the first hit of each point (pairs are in candidate order, grouped by point)
     first = np.flatnonzero(np.r_[True, point[1:] != point[:-1]]) if len(point) else point

@@ -4,7 +4,11 @@
 the nodes so that every boundary triangle of the cloud is a face
 (`conforming_tetrahedra`: boundary nodes are added where the input does not
 allow it, and are nodes like the others, ``node_of_point == -1``), then cuts the
-constrained Voronoi cells (`constrained_voronoi_cells`). `Model3D` answers the
+constrained Voronoi cells (`constrained_voronoi_cells`). Both run in the model's local frame (`frame`:
+the bounding box's corner rounded to a coarse origin, a power-of-two scale), so the
+same body moved a million units or in other units gives the same cells to round-off;
+the results are mapped back (the nodes are the cloud's points, bit for bit).
+`Model3D` answers the
 questions the problems ask of a model: shape functions (constrained Laplace or
 Sibson coordinates, `cnem.shape.natural3d`), its boundary with outward normals,
 its cells.
@@ -21,6 +25,8 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
+from .. import config
+from .._predicates import Frame, bounding_box, local_frame
 from ..shape.natural import ShapeGradients
 from ..shape.natural3d import TetMesh, shape_functions_3d, tet_mesh
 from .cells3d import Cells3D, constrained_voronoi_cells
@@ -62,6 +68,10 @@ class Model3D:
     cells : Cells3D
     timings : dict
         Seconds spent in each stage.
+    frame : cnem._predicates.Frame
+        The local frame the tetrahedra and cells were computed in (and the facet
+        geometry of the assembly is: its coordinates keep their digits far from the
+        origin).
     """
 
     cloud: NodeCloud
@@ -73,6 +83,7 @@ class Model3D:
     boundary_face_regions: np.ndarray
     cells: Cells3D
     timings: dict
+    frame: Frame
     #: what `tet_mesh` computed, kept
     _derived: dict = field(default_factory=dict, repr=False, compare=False)
 
@@ -175,22 +186,48 @@ def discretize_3d(cloud: NodeCloud) -> Model3D:
     """
     timings = {}
     t0 = time.perf_counter()
-    tets = conforming_tetrahedra(cloud.points, cloud.boundary_faces, cloud.boundary_face_regions)
+    frame = local_frame(np.stack(bounding_box(cloud.points)))
+    tets = conforming_tetrahedra(frame.to_local(cloud.points), cloud.boundary_faces,
+                                 cloud.boundary_face_regions)
     t1 = time.perf_counter()
     timings["tetrahedra"] = t1 - t0
     cells = constrained_voronoi_cells(tets.points, tets.tetrahedra, tets.tet_region,
                                       tets.boundary_faces, tets.boundary_face_regions)
-    cells = _without_flat_facets(cells, float(np.linalg.norm(np.ptp(tets.points, axis=0))))
+    cells = _without_flat_facets(cells, float(np.linalg.norm(np.ptp(tets.points, axis=0))),
+                                 config.ROUNDOFF_ULPS * frame.resolution)
     timings["cells"] = time.perf_counter() - t1
     node_of_point = np.full(len(tets.points), -1, dtype=np.int64)
     node_of_point[:tets.n_input] = np.arange(tets.n_input)
+    nodes = np.concatenate([np.asarray(cloud.points, dtype=np.float64),
+                            frame.to_global(tets.points[tets.n_input:])])
     log.info("discretize: %d nodes, %s", len(tets.points),
              ", ".join(f"{k} {v:.3f} s" for k, v in timings.items()))
-    return Model3D(cloud, tets.points, node_of_point, tets.tetrahedra, tets.tet_region,
-                   tets.boundary_faces, tets.boundary_face_regions, cells, timings)
+    return Model3D(cloud, nodes, node_of_point, tets.tetrahedra, tets.tet_region,
+                   tets.boundary_faces, tets.boundary_face_regions, _to_global(cells, frame),
+                   timings, frame)
 
 
-def _without_flat_facets(cells: Cells3D, size: float) -> Cells3D:
+def _to_global(cells: Cells3D, frame: Frame) -> Cells3D:
+    """Cells computed in ``frame`` back in global coordinates (the scale is a power of
+    two: volumes and normals come back exactly).
+
+    Parameters
+    ----------
+    cells : Cells3D
+        In the local frame.
+    frame : cnem._predicates.Frame
+
+    Returns
+    -------
+    Cells3D
+    """
+    apex = None if cells.apex is None else frame.to_global(cells.apex)
+    return Cells3D(cells.node, cells.region, cells.volume * frame.scale ** 3,
+                   frame.to_global(cells.facet_triangles), cells.facet_cell, cells.facet_normal,
+                   apex)
+
+
+def _without_flat_facets(cells: Cells3D, size: float, resolution: float) -> Cells3D:
     """The cells without their facet triangles of no area (on lattices, cospherical
     tetrahedra share a circumcentre and the dual polygons repeat vertices): they carry
     no flux, and their normals mean nothing.
@@ -200,6 +237,10 @@ def _without_flat_facets(cells: Cells3D, size: float) -> Cells3D:
     cells : Cells3D
     size : float
         The model's diameter; a triangle is flat below ``(FLAT_FACET_RTOL size)^2``.
+    resolution : float
+        The round-off of the global coordinates in the cells' units: a triangle thinner
+        than that (its height to its longest side) would be flat, or folded, once its
+        corners are mapped back far from the origin.
 
     Returns
     -------
@@ -207,7 +248,8 @@ def _without_flat_facets(cells: Cells3D, size: float) -> Cells3D:
     """
     tri = cells.facet_triangles
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    keep = area > (FLAT_FACET_RTOL * size) ** 2
+    longest = np.linalg.norm(tri - tri[:, [1, 2, 0]], axis=2).max(axis=1)
+    keep = (area > (FLAT_FACET_RTOL * size) ** 2) & (2.0 * area > resolution * longest)
     if keep.all():
         return cells
     return Cells3D(cells.node, cells.region, cells.volume, tri[keep], cells.facet_cell[keep],
