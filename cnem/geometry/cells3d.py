@@ -23,14 +23,18 @@ round-off.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
+from .._parallel import work_chunks
 from ..errors import GeometryError
+from ._cells3d_kernels import clear_of_faces
 from .cells3d_clip import GeneralCells
+from .cells3d_convex import convex_cells
 from .tetrahedra import signed_volumes, tet_neighbors
 
 __all__ = ["Cells3D", "constrained_voronoi_cells"]
@@ -158,24 +162,16 @@ def _fast_nodes(points, tets, centre, faces, boundary_node):
     normal = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
     cand = np.flatnonzero(~boundary_node & np.isfinite(far))
     hits = cKDTree(cen).query_ball_point(points[cand], far[cand] + rad.max())
-    count = np.array([len(h) for h in hits], dtype=np.int64)
-    node = np.repeat(cand, count)
-    face = np.concatenate([np.asarray(h, dtype=np.int64) for h in hits] + [node[:0]])
-    # one row per (node, face, tetrahedron at the node)
+    count = np.fromiter(map(len, hits), dtype=np.int64, count=len(cand))
+    hit_idx = np.fromiter(itertools.chain.from_iterable(hits), dtype=np.int64, count=count.sum())
     order = np.argsort(tets.ravel(), kind="stable")
     start = np.searchsorted(tets.ravel()[order], np.arange(n + 1))
-    deg = start[node + 1] - start[node]
-    pair = np.repeat(np.arange(len(node)), deg)
-    within = np.arange(deg.sum()) - np.repeat(np.cumsum(deg) - deg, deg)
-    tet = order[np.repeat(start[node], deg) + within] // 4
-    f = face[pair]
-    own = np.einsum("ij,ij->i", points[node] - x[face, 0], normal[face])
-    cc = np.einsum("ij,ij->i", centre[tet] - x[f, 0], normal[f])
-    same = (own[pair] * cc > 0) & (np.abs(cc) > 1e-9 * np.linalg.norm(normal[f], axis=1) * rad[f])
-    good = np.bincount(pair, weights=~same, minlength=len(node)) == 0
+    tol = 1e-9 * np.linalg.norm(normal, axis=1) * rad
+    clear = clear_of_faces(points, cand, np.concatenate([[0], np.cumsum(count)]), hit_idx, start,
+                           order // 4, centre, np.ascontiguousarray(x[:, 0]), normal, tol,
+                           work_chunks())
     fast = np.zeros(n, dtype=bool)
-    fast[cand] = True
-    fast[np.unique(node[~good])] = False
+    fast[cand[clear]] = True
     return fast
 
 
@@ -260,15 +256,21 @@ def constrained_voronoi_cells(points: ArrayLike, tetrahedra: ArrayLike, tet_regi
     tri, fcell, nrm = _fast_facets(points, tets, centre, fast, cell_of)
     general = GeneralCells(points, tets, tet_region, faces, face_regions)
     volume = np.zeros(len(cell_node))
-    parts_t, parts_c, parts_n = [tri], [fcell], [nrm]
-    for k in np.flatnonzero(~fast[cell_node]).tolist():
+    slow = np.flatnonzero(~fast[cell_node])
+    done, b_tri, b_cell, b_nrm, b_vol = convex_cells(general, cell_node[slow], cell_region[slow])
+    volume[slow[done]] = b_vol[done]
+    parts_t, parts_c, parts_n = [b_tri], [slow[b_cell]], [b_nrm]
+    for k in slow[~done].tolist():
         t, nr, vol = general.cell(int(cell_node[k]), int(cell_region[k]))
         parts_t.append(t)
         parts_c.append(np.full(len(t), k, dtype=np.int64))
         parts_n.append(nr)
         volume[k] = vol
-    tri, fcell, nrm = (np.concatenate(parts_t), np.concatenate(parts_c),
-                       np.concatenate(parts_n))
+    # the general cells in the order of the cells, after the fast ones
+    order = np.argsort(np.concatenate(parts_c), kind="stable")
+    tri = np.concatenate([tri, np.concatenate(parts_t)[order]])
+    fcell = np.concatenate([fcell, np.concatenate(parts_c)[order]])
+    nrm = np.concatenate([nrm, np.concatenate(parts_n)[order]])
     # the fast cells' volumes: pyramids from the node over each facet triangle
     rel = tri - points[cell_node[fcell]][:, None, :]
     pyramid = np.einsum("ij,ij->i", rel[:, 0], np.cross(rel[:, 1], rel[:, 2])) / 6.0
