@@ -32,15 +32,13 @@ from scipy.spatial import cKDTree
 
 from .._parallel import work_chunks
 from ..errors import GeometryError
-from ._cells3d_kernels import clear_of_faces
+from ._cells3d_kernels import clear_of_faces, dual_facets
 from .cells3d_clip import GeneralCells
 from .cells3d_convex import convex_cells
 from .tetrahedra import signed_volumes, tet_neighbors
 
 __all__ = ["Cells3D", "constrained_voronoi_cells"]
 
-#: The six edges of a tetrahedron.
-_EDGES = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])
 #: A tetrahedron is flat when ``|6 V| <= _FLAT * L^3`` (``L`` its longest edge).
 _FLAT = 1e-10
 
@@ -145,7 +143,7 @@ def _borrow_centres(centre, nb, bound):
     return centre
 
 
-def _fast_nodes(points, tets, centre, faces, boundary_node):
+def _fast_nodes(points, tets, centre, faces, boundary_node, star):
     """Nodes whose Voronoi cell (the hull of their circumcentres) meets no boundary face.
 
     Sufficient test: every face whose bounding sphere the ball to the farthest
@@ -164,56 +162,13 @@ def _fast_nodes(points, tets, centre, faces, boundary_node):
     hits = cKDTree(cen).query_ball_point(points[cand], far[cand] + rad.max())
     count = np.fromiter(map(len, hits), dtype=np.int64, count=len(cand))
     hit_idx = np.fromiter(itertools.chain.from_iterable(hits), dtype=np.int64, count=count.sum())
-    order = np.argsort(tets.ravel(), kind="stable")
-    start = np.searchsorted(tets.ravel()[order], np.arange(n + 1))
     tol = 1e-9 * np.linalg.norm(normal, axis=1) * rad
-    clear = clear_of_faces(points, cand, np.concatenate([[0], np.cumsum(count)]), hit_idx, start,
-                           order // 4, centre, np.ascontiguousarray(x[:, 0]), normal, tol,
+    clear = clear_of_faces(points, cand, np.concatenate([[0], np.cumsum(count)]), hit_idx, *star,
+                           centre, np.ascontiguousarray(x[:, 0]), normal, tol,
                            work_chunks())
     fast = np.zeros(n, dtype=bool)
     fast[cand[clear]] = True
     return fast
-
-
-def _fast_facets(points, tets, centre, fast, cell_of):
-    """Facet triangles of the fast cells: the Voronoi facets dual to their edges."""
-    n = len(points)
-    ends = tets[:, _EDGES]                              # (t, 6, 2)
-    lo, hi = ends.min(axis=2).ravel(), ends.max(axis=2).ravel()
-    c = np.repeat(centre, 6, axis=0)
-    want = fast[lo] | fast[hi]
-    lo, hi, c = lo[want], hi[want], c[want]
-    key = lo * n + hi
-    edge = np.unique(key)
-    edge_id = np.searchsorted(edge, key)
-    count = np.bincount(edge_id)
-    mean = np.stack([np.bincount(edge_id, weights=c[:, k]) for k in range(3)], axis=1)
-    mean = mean / count[:, None]                       # (float also when no edge is wanted)
-    a, b = points[edge // n], points[edge % n]
-    u = b - a
-    u /= np.linalg.norm(u, axis=1)[:, None]
-    helper = np.eye(3)[np.argmin(np.abs(u), axis=1)]
-    e1 = np.cross(u, helper)
-    e1 /= np.linalg.norm(e1, axis=1)[:, None]
-    e2 = np.cross(u, e1)
-    rel = c - mean[edge_id]
-    ang = np.arctan2(np.einsum("ij,ij->i", rel, e2[edge_id]), np.einsum("ij,ij->i", rel, e1[edge_id]))
-    order = np.lexsort((ang, edge_id))
-    edge_id, c = edge_id[order], c[order]
-    start = np.searchsorted(edge_id, np.arange(len(edge)))
-    rank = np.arange(len(edge_id)) - start[edge_id]
-    take = (rank >= 1) & (rank <= count[edge_id] - 2)
-    pos = np.flatnonzero(take)
-    e = edge_id[pos]
-    tri = np.stack([c[start[e]], c[pos], c[pos + 1]], axis=1)      # ccw about u
-    lo_n, hi_n = edge[e] // n, edge[e] % n
-    out_t, out_c, out_n = [], [], []
-    for node, sign, t in ((lo_n, 1.0, tri), (hi_n, -1.0, tri[:, [0, 2, 1]])):
-        keep = fast[node]
-        out_t.append(t[keep])
-        out_c.append(cell_of[node[keep]])
-        out_n.append(sign * u[e[keep]])
-    return np.concatenate(out_t), np.concatenate(out_c), np.concatenate(out_n)
 
 
 def constrained_voronoi_cells(points: ArrayLike, tetrahedra: ArrayLike, tet_region: ArrayLike,
@@ -252,8 +207,11 @@ def constrained_voronoi_cells(points: ArrayLike, tetrahedra: ArrayLike, tet_regi
     boundary_node = np.zeros(n, dtype=bool)
     boundary_node[faces.ravel()] = True
     centre = _borrow_centres(_circumcentres(points, tets), tet_neighbors(tets, n), 64)
-    fast = _fast_nodes(points, tets, centre, faces, boundary_node) & single
-    tri, fcell, nrm = _fast_facets(points, tets, centre, fast, cell_of)
+    order = np.argsort(tets.ravel(), kind="stable")         # the tetrahedra at each node
+    star = np.searchsorted(tets.ravel()[order], np.arange(n + 1)), order // 4
+    fast = _fast_nodes(points, tets, centre, faces, boundary_node, star) & single
+    # the fast cells' facets: the Voronoi facets dual to their edges
+    tri, fcell, nrm = dual_facets(points, tets, *star, centre, fast, cell_of)
     general = GeneralCells(points, tets, tet_region, faces, face_regions)
     volume = np.zeros(len(cell_node))
     slow = np.flatnonzero(~fast[cell_node])
