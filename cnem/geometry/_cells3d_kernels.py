@@ -47,10 +47,12 @@ def clear_of_faces(points, cand, hit_ptr, hit_idx, star_ptr, star_tet, centre, f
                 f = hit_idx[h]
                 nx, ny, nz = face_normal[f, 0], face_normal[f, 1], face_normal[f, 2]
                 ax, ay, az = face_x0[f, 0], face_x0[f, 1], face_x0[f, 2]
-                own = (points[i, 0] - ax) * nx + (points[i, 1] - ay) * ny + (points[i, 2] - az) * nz
+                own = ((points[i, 0] - ax) * nx + (points[i, 1] - ay) * ny
+                       + (points[i, 2] - az) * nz)
                 for s in range(star_ptr[i], star_ptr[i + 1]):
                     t = star_tet[s]
-                    cc = (centre[t, 0] - ax) * nx + (centre[t, 1] - ay) * ny + (centre[t, 2] - az) * nz
+                    cc = ((centre[t, 0] - ax) * nx + (centre[t, 1] - ay) * ny
+                          + (centre[t, 2] - az) * nz)
                     if not (own * cc > 0 and abs(cc) > face_tol[f]):
                         clear[k] = False
                         break

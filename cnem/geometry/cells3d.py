@@ -8,14 +8,16 @@ node on an interface owns one cell per region.
 
 Two paths compute the cells:
 
-* the *fast path* (vectorised numpy), for an interior node whose ball of radius
-  ``R`` (its farthest circumcentre) meets no boundary face: its cell is its Voronoi
-  cell, the polyhedron of the circumcentres of its tetrahedra. Each facet is the dual
-  of a Delaunay edge, the circumcentres of the tetrahedra around the edge ordered by
-  angle and fan-triangulated; the volume is ``sum(A d) / 6`` over the facets;
+* the *fast path* (numba kernels, `._cells3d_kernels`), for an interior node whose
+  ball of radius ``R`` (its farthest circumcentre) meets no boundary face: its cell
+  is its Voronoi cell, the polyhedron of the circumcentres of its tetrahedra. Each
+  facet is the dual of a Delaunay edge, the circumcentres of the tetrahedra around
+  the edge ordered by angle and fan-triangulated; the volume is ``sum(A d) / 6`` over the facets;
 * the *general path* (`.cells3d_clip`), for every other node: exact clipping of
   convex polytopes by bisectors, boundary planes or the region's tetrahedra, and
-  the shadows of the blocking faces (see there).
+  the shadows of the blocking faces (see there); its convex case (no face in reach
+  hides points or bends the region: a box's faces, edges and corners) for many
+  cells at once in numba (`.cells3d_convex`).
 
 The cells partition each region: their volumes sum to the region's volume to
 round-off.
