@@ -150,3 +150,36 @@ def test_invariance(shift, scale):
     tol = 1e-8 if shift else 1e-11
     np.testing.assert_allclose(moved.volume / scale ** 3, ref.volume, rtol=tol,
                                atol=tol * ref.volume.max())
+
+
+
+def _per_plane(tri, normal):
+    """Facet planes (rounded normals) of one cell, the area and centroid on each."""
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    keys, inverse = np.unique(np.round(normal * 1e6), axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    total = np.bincount(inverse, weights=area)
+    moment = np.column_stack([np.bincount(inverse, weights=area * tri[:, :, c].mean(axis=1))
+                              for c in range(3)])
+    return keys, total, moment / total[:, None]
+
+
+@pytest.mark.parametrize("name", ["box", "stacked"])
+def test_convex_cells_in_bulk_equal_the_general_path_cell_by_cell(name):
+    """The numba kernel's convex cells (`cells3d_convex`) are those of `GeneralCells.cell`:
+    same volume, and per facet plane the same area and centroid."""
+    from cnem.geometry.cells3d_clip import GeneralCells
+    from cnem.geometry.cells3d_convex import convex_cells
+    tet, cells = _cells(name, 0.3)
+    general = GeneralCells(tet.points, tet.tetrahedra, tet.tet_region, tet.boundary_faces,
+                           tet.boundary_face_regions)
+    done, tri, cell, normal, volume = convex_cells(general, cells.node, cells.region)
+    assert done.sum() >= len(done) // 2
+    for k in np.flatnonzero(done).tolist():
+        t, n, v = general.cell(int(cells.node[k]), int(cells.region[k]))
+        assert volume[k] == pytest.approx(v, rel=1e-12)
+        keys, area, centroid = _per_plane(tri[cell == k], normal[cell == k])
+        want_keys, want_area, want_centroid = _per_plane(t, n)
+        np.testing.assert_array_equal(keys, want_keys)
+        np.testing.assert_allclose(area, want_area, rtol=0, atol=1e-12 * want_area.max())
+        np.testing.assert_allclose(centroid, want_centroid, rtol=0, atol=1e-12)

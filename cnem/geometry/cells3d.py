@@ -8,14 +8,16 @@ node on an interface owns one cell per region.
 
 Two paths compute the cells:
 
-* the *fast path* (vectorised numpy), for an interior node whose ball of radius
-  ``R`` (its farthest circumcentre) meets no boundary face: its cell is its Voronoi
-  cell, the polyhedron of the circumcentres of its tetrahedra. Each facet is the dual
-  of a Delaunay edge, the circumcentres of the tetrahedra around the edge ordered by
-  angle and fan-triangulated; the volume is ``sum(A d) / 6`` over the facets;
+* the *fast path* (numba kernels, `._cells3d_kernels`), for an interior node whose
+  ball of radius ``R`` (its farthest circumcentre) meets no boundary face: its cell
+  is its Voronoi cell, the polyhedron of the circumcentres of its tetrahedra. Each
+  facet is the dual of a Delaunay edge, the circumcentres of the tetrahedra around
+  the edge ordered by angle and fan-triangulated; the volume is ``sum(A d) / 6`` over the facets;
 * the *general path* (`.cells3d_clip`), for every other node: exact clipping of
   convex polytopes by bisectors, boundary planes or the region's tetrahedra, and
-  the shadows of the blocking faces (see there).
+  the shadows of the blocking faces (see there); its convex case (no face in reach
+  hides points or bends the region: a box's faces, edges and corners) for many
+  cells at once in numba (`.cells3d_convex`).
 
 The cells partition each region: their volumes sum to the region's volume to
 round-off.
@@ -23,20 +25,22 @@ round-off.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
+from .._parallel import work_chunks
 from ..errors import GeometryError
+from ._cells3d_kernels import clear_of_faces, dual_facets
 from .cells3d_clip import GeneralCells
+from .cells3d_convex import convex_cells
 from .tetrahedra import signed_volumes, tet_neighbors
 
 __all__ = ["Cells3D", "constrained_voronoi_cells"]
 
-#: The six edges of a tetrahedron.
-_EDGES = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])
 #: A tetrahedron is flat when ``|6 V| <= _FLAT * L^3`` (``L`` its longest edge).
 _FLAT = 1e-10
 
@@ -141,7 +145,7 @@ def _borrow_centres(centre, nb, bound):
     return centre
 
 
-def _fast_nodes(points, tets, centre, faces, boundary_node):
+def _fast_nodes(points, tets, centre, faces, boundary_node, star):
     """Nodes whose Voronoi cell (the hull of their circumcentres) meets no boundary face.
 
     Sufficient test: every face whose bounding sphere the ball to the farthest
@@ -158,66 +162,15 @@ def _fast_nodes(points, tets, centre, faces, boundary_node):
     normal = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
     cand = np.flatnonzero(~boundary_node & np.isfinite(far))
     hits = cKDTree(cen).query_ball_point(points[cand], far[cand] + rad.max())
-    count = np.array([len(h) for h in hits], dtype=np.int64)
-    node = np.repeat(cand, count)
-    face = np.concatenate([np.asarray(h, dtype=np.int64) for h in hits] + [node[:0]])
-    # one row per (node, face, tetrahedron at the node)
-    order = np.argsort(tets.ravel(), kind="stable")
-    start = np.searchsorted(tets.ravel()[order], np.arange(n + 1))
-    deg = start[node + 1] - start[node]
-    pair = np.repeat(np.arange(len(node)), deg)
-    within = np.arange(deg.sum()) - np.repeat(np.cumsum(deg) - deg, deg)
-    tet = order[np.repeat(start[node], deg) + within] // 4
-    f = face[pair]
-    own = np.einsum("ij,ij->i", points[node] - x[face, 0], normal[face])
-    cc = np.einsum("ij,ij->i", centre[tet] - x[f, 0], normal[f])
-    same = (own[pair] * cc > 0) & (np.abs(cc) > 1e-9 * np.linalg.norm(normal[f], axis=1) * rad[f])
-    good = np.bincount(pair, weights=~same, minlength=len(node)) == 0
+    count = np.fromiter(map(len, hits), dtype=np.int64, count=len(cand))
+    hit_idx = np.fromiter(itertools.chain.from_iterable(hits), dtype=np.int64, count=count.sum())
+    tol = 1e-9 * np.linalg.norm(normal, axis=1) * rad
+    clear = clear_of_faces(points, cand, np.concatenate([[0], np.cumsum(count)]), hit_idx, *star,
+                           centre, np.ascontiguousarray(x[:, 0]), normal, tol,
+                           work_chunks())
     fast = np.zeros(n, dtype=bool)
-    fast[cand] = True
-    fast[np.unique(node[~good])] = False
+    fast[cand[clear]] = True
     return fast
-
-
-def _fast_facets(points, tets, centre, fast, cell_of):
-    """Facet triangles of the fast cells: the Voronoi facets dual to their edges."""
-    n = len(points)
-    ends = tets[:, _EDGES]                              # (t, 6, 2)
-    lo, hi = ends.min(axis=2).ravel(), ends.max(axis=2).ravel()
-    c = np.repeat(centre, 6, axis=0)
-    want = fast[lo] | fast[hi]
-    lo, hi, c = lo[want], hi[want], c[want]
-    key = lo * n + hi
-    edge = np.unique(key)
-    edge_id = np.searchsorted(edge, key)
-    count = np.bincount(edge_id)
-    mean = np.stack([np.bincount(edge_id, weights=c[:, k]) for k in range(3)], axis=1)
-    mean = mean / count[:, None]                       # (float also when no edge is wanted)
-    a, b = points[edge // n], points[edge % n]
-    u = b - a
-    u /= np.linalg.norm(u, axis=1)[:, None]
-    helper = np.eye(3)[np.argmin(np.abs(u), axis=1)]
-    e1 = np.cross(u, helper)
-    e1 /= np.linalg.norm(e1, axis=1)[:, None]
-    e2 = np.cross(u, e1)
-    rel = c - mean[edge_id]
-    ang = np.arctan2(np.einsum("ij,ij->i", rel, e2[edge_id]), np.einsum("ij,ij->i", rel, e1[edge_id]))
-    order = np.lexsort((ang, edge_id))
-    edge_id, c = edge_id[order], c[order]
-    start = np.searchsorted(edge_id, np.arange(len(edge)))
-    rank = np.arange(len(edge_id)) - start[edge_id]
-    take = (rank >= 1) & (rank <= count[edge_id] - 2)
-    pos = np.flatnonzero(take)
-    e = edge_id[pos]
-    tri = np.stack([c[start[e]], c[pos], c[pos + 1]], axis=1)      # ccw about u
-    lo_n, hi_n = edge[e] // n, edge[e] % n
-    out_t, out_c, out_n = [], [], []
-    for node, sign, t in ((lo_n, 1.0, tri), (hi_n, -1.0, tri[:, [0, 2, 1]])):
-        keep = fast[node]
-        out_t.append(t[keep])
-        out_c.append(cell_of[node[keep]])
-        out_n.append(sign * u[e[keep]])
-    return np.concatenate(out_t), np.concatenate(out_c), np.concatenate(out_n)
 
 
 def constrained_voronoi_cells(points: ArrayLike, tetrahedra: ArrayLike, tet_region: ArrayLike,
@@ -256,19 +209,28 @@ def constrained_voronoi_cells(points: ArrayLike, tetrahedra: ArrayLike, tet_regi
     boundary_node = np.zeros(n, dtype=bool)
     boundary_node[faces.ravel()] = True
     centre = _borrow_centres(_circumcentres(points, tets), tet_neighbors(tets, n), 64)
-    fast = _fast_nodes(points, tets, centre, faces, boundary_node) & single
-    tri, fcell, nrm = _fast_facets(points, tets, centre, fast, cell_of)
+    order = np.argsort(tets.ravel(), kind="stable")         # the tetrahedra at each node
+    star = np.searchsorted(tets.ravel()[order], np.arange(n + 1)), order // 4
+    fast = _fast_nodes(points, tets, centre, faces, boundary_node, star) & single
+    # the fast cells' facets: the Voronoi facets dual to their edges
+    tri, fcell, nrm = dual_facets(points, tets, *star, centre, fast, cell_of)
     general = GeneralCells(points, tets, tet_region, faces, face_regions)
     volume = np.zeros(len(cell_node))
-    parts_t, parts_c, parts_n = [tri], [fcell], [nrm]
-    for k in np.flatnonzero(~fast[cell_node]).tolist():
+    slow = np.flatnonzero(~fast[cell_node])
+    done, b_tri, b_cell, b_nrm, b_vol = convex_cells(general, cell_node[slow], cell_region[slow])
+    volume[slow[done]] = b_vol[done]
+    parts_t, parts_c, parts_n = [b_tri], [slow[b_cell]], [b_nrm]
+    for k in slow[~done].tolist():
         t, nr, vol = general.cell(int(cell_node[k]), int(cell_region[k]))
         parts_t.append(t)
         parts_c.append(np.full(len(t), k, dtype=np.int64))
         parts_n.append(nr)
         volume[k] = vol
-    tri, fcell, nrm = (np.concatenate(parts_t), np.concatenate(parts_c),
-                       np.concatenate(parts_n))
+    # the general cells in the order of the cells, after the fast ones
+    order = np.argsort(np.concatenate(parts_c), kind="stable")
+    tri = np.concatenate([tri, np.concatenate(parts_t)[order]])
+    fcell = np.concatenate([fcell, np.concatenate(parts_c)[order]])
+    nrm = np.concatenate([nrm, np.concatenate(parts_n)[order]])
     # the fast cells' volumes: pyramids from the node over each facet triangle
     rel = tri - points[cell_node[fcell]][:, None, :]
     pyramid = np.einsum("ij,ij->i", rel[:, 0], np.cross(rel[:, 1], rel[:, 2])) / 6.0
