@@ -34,6 +34,8 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
@@ -353,11 +355,17 @@ def _claim(pieces, nearer_i, origin_j, faces, who):
 
 def _boundary(pieces):
     """Triangles and outward normals of the union's boundary: faces shared by two pieces
-    (same plane, opposite sides) cancel where they overlap."""
+    (same plane, opposite sides) cancel where they overlap.
+
+    Faces are grouped by their geometric plane (`_plane_groups`), not by what made
+    them: a bisector, a shadow side and a boundary face's plane can coincide (the
+    shadow of a face seen from a node in its plane, beyond a re-entrant edge)."""
+    faces = [(p.vertices[idx], pl) for p in pieces for idx, pl in p.faces]
+    if not faces:
+        return np.zeros((0, 3, 3)), np.zeros((0, 3))
     groups: dict = {}
-    for p in pieces:
-        for idx, pl in p.faces:
-            groups.setdefault(pl.tag, []).append((p.vertices[idx], pl))
+    for (x, pl), g in zip(faces, _plane_groups([pl for _, pl in faces])):
+        groups.setdefault(g, []).append((x, pl))
     tris, normals = [], []
     for polys in groups.values():
         ref = polys[0][1].normal
@@ -378,9 +386,23 @@ def _boundary(pieces):
     return np.array(tris), np.array(normals)
 
 
+def _plane_groups(planes):
+    """A label ``(k,)`` per plane: planes equal up to orientation (normals and offsets to
+    ``_REFLEX``, local unit) share it, whatever their tags."""
+    normal = np.array([pl.normal for pl in planes])
+    offset = np.array([pl.offset for pl in planes])
+    same = np.abs(normal @ normal.T) >= 1.0 - _REFLEX
+    aligned = np.sign(normal @ normal.T)
+    same &= np.abs(offset[:, None] - aligned * offset[None, :]) <= _REFLEX
+    return connected_components(csr_matrix(same), directed=False)[1]
+
+
 def _difference(mine, other, normal, offset):
     """Triangles ``(3, 3)`` (counter-clockwise about ``normal``) of the union of the polygons
-    ``mine`` minus the union of ``other``, all lying in one plane."""
+    ``mine`` minus the union of ``other``, all lying in one plane.
+
+    A polygon of ``mine`` that overlaps none of ``other`` (they may touch) is kept as the
+    fan of its own vertices, bit for bit: its edges stay the twins of its neighbours'."""
     helper = np.eye(3)[np.argmin(np.abs(normal))]
     e1 = np.cross(normal, helper)
     e1 /= np.linalg.norm(e1)
@@ -391,10 +413,18 @@ def _difference(mine, other, normal, offset):
         return shapely.Polygon(np.column_stack([(x - base) @ e1, (x - base) @ e2]))
 
     grid = 1e-13
-    a = shapely.union_all([flat(x) for x in mine], grid_size=grid)
     b = shapely.union_all([flat(x) for x in other], grid_size=grid)
-    rest = shapely.difference(a, b, grid_size=grid)
-    out = []
+    out, cut = [], []
+    for x in mine:
+        if shapely.intersection(flat(x), b, grid_size=grid).area <= 1e-20:
+            for k in range(1, len(x) - 1):
+                t = np.array([x[0], x[k], x[k + 1]])
+                out.append(t if np.cross(t[1] - t[0], t[2] - t[0]) @ normal >= 0 else t[[0, 2, 1]])
+        else:
+            cut.append(flat(x))
+    if not cut:
+        return out
+    rest = shapely.difference(shapely.union_all(cut, grid_size=grid), b, grid_size=grid)
     if rest.is_empty or rest.area <= 1e-20:
         return out
     for tri in shapely.get_parts(shapely.constrained_delaunay_triangles(rest)):
