@@ -150,3 +150,18 @@ def test_invariance(shift, scale):
     tol = 1e-8 if shift else 1e-11
     np.testing.assert_allclose(moved.volume / scale ** 3, ref.volume, rtol=tol,
                                atol=tol * ref.volume.max())
+
+
+def test_cells_beside_a_re_entrant_edge_tile_the_boundary():
+    """An L-block at a coarse spacing: the cell of a node on the re-entrant edge wraps
+    round it (facets parallel to the boundary faces beyond it, shadows in a boundary
+    face's plane). Its facets must close, cancel inside the body, and those on the
+    boundary tile it: their areas sum to the L-block's surface, 5.5."""
+    import cnem
+    from cnem.assembly.facet_gradients import boundary_points_3d
+
+    p, f, _ = cases3d.l_block(2, jitter=0.0)
+    model = cnem.discretize(cnem.nodes.irregular(cnem.Domain3D((p, f)), 0.5, seed=1))
+    point, area_normal, _ = boundary_points_3d(model)
+    assert np.isclose(np.linalg.norm(area_normal, axis=1).sum(), 5.5, rtol=1e-12)
+    np.testing.assert_allclose(area_normal.sum(axis=0), 0.0, atol=1e-12)
