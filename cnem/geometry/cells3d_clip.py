@@ -391,9 +391,9 @@ def _plane_groups(planes):
     ``_REFLEX``, local unit) share it, whatever their tags."""
     normal = np.array([pl.normal for pl in planes])
     offset = np.array([pl.offset for pl in planes])
-    same = np.abs(normal @ normal.T) >= 1.0 - _REFLEX
-    aligned = np.sign(normal @ normal.T)
-    same &= np.abs(offset[:, None] - aligned * offset[None, :]) <= _REFLEX
+    aligned = np.where(normal @ normal.T < 0.0, -1.0, 1.0)
+    apart = np.linalg.norm(normal[:, None, :] - aligned[..., None] * normal[None, :, :], axis=2)
+    same = (apart <= _REFLEX) & (np.abs(offset[:, None] - aligned * offset[None, :]) <= _REFLEX)
     return connected_components(csr_matrix(same), directed=False)[1]
 
 
