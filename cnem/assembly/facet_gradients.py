@@ -486,7 +486,9 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
     """`interface_pieces` of a 3-D model's cells on its interface faces and on their
     shadow facets (in the plane of a boundary or interface face beyond its border,
     where the cells of the two sides cut the plane differently: their facet points
-    find no partner and lie on no boundary face).
+    find no partner and lie on no boundary face), and on the facets whose centroid
+    lies outside the body (non-convex facets round a re-entrant edge: one point per
+    overlap of the two sides' triangles).
 
     Parameters
     ----------
@@ -501,13 +503,22 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
                                                          cells.facet_normal)
     size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
     # shadow facets: unpaired, and on no boundary face
-    lone = np.flatnonzero(~_paired(point, area_normal, size))
+    paired = _paired(point, area_normal, size)
+    lone = np.flatnonzero(~paired)
     faces, normal = model.boundary_with_normals()
     outer = _face_holding(point[lone], area_normal[lone], model.nodes[faces], normal, size) >= 0
+    # a non-convex facet (wrapping a re-entrant edge) whose centroid lies outside the body:
+    # one point per piece of the two sides' triangles, each inside its triangles
+    astray = np.flatnonzero(~inside_tetrahedra(model.tet_mesh(), point))
+    if (~paired[astray]).any():
+        bad = point[astray[~paired[astray]]][:3]
+        raise GeometryError(f"expected the centroids of the cells' boundary facets to lie in "
+                            f"the body, received {bad.tolist()} outside; refine the cloud there")
+    split = np.isin(group, astray)
     between = model.boundary_face_regions[:, 1] >= 0
     return interface_pieces(cells.facet_triangles, cells.facet_normal, group,
                             model.nodes[model.boundary_faces[between]], size,
-                            also=np.isin(group, lone[~outer]))
+                            also=np.isin(group, lone[~outer]) | split, split=split)
 
 
 def _paired(point, area_normal, size):

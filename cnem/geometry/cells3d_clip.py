@@ -45,8 +45,11 @@ from .tet_pieces import RegionTets, connected, open_facets
 
 __all__ = ["GeneralCells"]
 
-#: Bound on the doublings of the cube around a cell.
-_GROW = 6
+#: The cube's first half-side (local unit): most cells lie within it, and the cost of a
+#: cell grows with the pieces and nodes the cube holds.
+_FIRST_HALF = 0.65
+#: Bound on the doublings of the cube around a cell (to ``_FIRST_HALF 2^(_GROW-1)``).
+_GROW = 8
 #: Vertices of a face beyond another face's plane by more than this (local unit) make
 #: the neighbourhood non-convex.
 _REFLEX = 1e-9
@@ -106,7 +109,7 @@ class GeneralCells:
         """Facet triangles ``(q, 3, 3)``, their outward normals ``(q, 3)`` and the volume of
         the cell of node ``i`` in region ``r``."""
         x0, s = self.points[i], self.scale[i]
-        half = 1.0
+        half = _FIRST_HALF
         for _ in range(_GROW):
             reach = np.sqrt(3.0) * half
             pieces, joins = self._pieces(i, r, x0, s, half, reach)
