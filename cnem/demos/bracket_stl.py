@@ -17,8 +17,8 @@ The same irregular cloud (`cnem.nodes.irregular`, spacing ``h``) is solved by
 * C-NEM + SCNI (`cnem.Elasticity` on `cnem.discretize`: constrained Voronoi cells,
   Laplace shape functions, the sub-cell stabilisation);
 * P1 tetrahedra on the model's own tetrahedrisation (`cnem.fem.P1Elasticity.from_model`);
-* a reference: scikit-fem P2 tetrahedra on that tetrahedrisation refined once (the
-  same faceted body, so the three differ by their discretisation only).
+* a reference: scikit-fem P2 tetrahedra on that tetrahedrisation (``--refine k``: refined
+  k times; the same faceted body, so the three differ by their discretisation only).
 
 Expected result
 ---------------
@@ -78,15 +78,15 @@ def _conditions(prob, size):
     prob.add_traction(lambda x, n: (x[:, 1] > 40.0 - 1e-9 * size) & (n[:, 1] > 0.5), TRACTION)
 
 
-def p2_reference(model) -> float:
-    """The tip x-displacement of scikit-fem P2 tetrahedra on the model's tetrahedra refined
-    once (the same faceted body)."""
+def p2_reference(model, refine: int = 0) -> float:
+    """The tip x-displacement of scikit-fem P2 tetrahedra on the model's tetrahedra
+    (refined ``refine`` times: the same faceted body)."""
     from skfem import Basis, ElementTetP2, ElementVector, FacetBasis, LinearForm, MeshTet, \
         asm, condense, solve
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
     size = float(np.linalg.norm(np.ptp(model.nodes, axis=0)))
-    mesh = MeshTet(model.nodes.T.copy(), model.tetrahedra.T.copy()).refined(1)
+    mesh = MeshTet(model.nodes.T.copy(), model.tetrahedra.T.copy()).refined(refine)
     element = ElementVector(ElementTetP2())
     basis = Basis(mesh, element)
     stiffness = asm(linear_elasticity(*lame_parameters(E, NU)), basis)
@@ -102,8 +102,8 @@ def p2_reference(model) -> float:
     return float((basis.probes(np.array(TIP)[:, None]) @ u)[0])
 
 
-def main(h: float = 4.0, *, reference: bool = True, outdir: str = "results/bracket_stl",
-         plot: bool = True) -> dict:
+def main(h: float = 4.0, *, reference: bool = True, refine: int = 0,
+         outdir: str = "results/bracket_stl", plot: bool = True) -> dict:
     """Write the STL, read it back, solve by C-NEM and by P1 on the same nodes (and P2
     on a refined mesh), print the numbers, write the VTU and the picture.
 
@@ -113,6 +113,9 @@ def main(h: float = 4.0, *, reference: bool = True, outdir: str = "results/brack
         Node spacing (mm).
     reference : bool
         Also solve the scikit-fem P2 reference.
+    refine : int
+        Refinements of the model's tetrahedra for the P2 reference (each one costs about
+        ten times more: 0 takes seconds, 1 minutes).
 
     Returns
     -------
@@ -146,7 +149,7 @@ def main(h: float = 4.0, *, reference: bool = True, outdir: str = "results/brack
            "p1": float(p1_sol.displacement(np.array([TIP]))[0, 0]), "p2": None}
     if reference:
         t0 = time.perf_counter()
-        tip["p2"] = p2_reference(model)
+        tip["p2"] = p2_reference(model, refine)
         times["P2 reference"] = time.perf_counter() - t0
     von_mises = {"cnem": float(sol.von_mises.max()), "p1": float(p1_sol.von_mises.max())}
     print(f"bracket from {stl.name}: {dom.volume:.6g} mm^3, h = {h:g} mm, {len(model.nodes)} "
@@ -181,8 +184,10 @@ def cli(argv: Sequence[str] | None = None, prog: str | None = None) -> None:
     parser.add_argument("--h", type=float, default=4.0, help="node spacing (mm)")
     parser.add_argument("--no-reference", action="store_true",
                         help="skip the scikit-fem P2 reference")
+    parser.add_argument("--refine", type=int, default=0,
+                        help="refinements of the tetrahedra for the P2 reference")
     args = parser.parse_args(argv)
-    return main(args.h, reference=not args.no_reference, outdir=args.out,
+    return main(args.h, reference=not args.no_reference, refine=args.refine, outdir=args.out,
                 plot=not args.no_plot)
 
 
