@@ -128,3 +128,7 @@ def test_patch_test_beside_a_faceted_hole():
     np.testing.assert_allclose(sol.u, model.nodes @ A.T + B, atol=1e-12)
     np.testing.assert_allclose(sol.stress, np.broadcast_to(_exact_stress(), sol.stress.shape),
                                atol=1e-10 * np.abs(_exact_stress()).max())
+    # the cells' vertices (VTU files, pictures) take the displacement inside the body
+    vertices, _ = cnem.io.cell_points(model)
+    nudge = cnem.config.VERTEX_NUDGE * np.abs(A).sum(axis=1).max() * 2.0     # diameter 2
+    np.testing.assert_allclose(sol.vertex_displacement(), vertices @ A.T + B, atol=nudge + 1e-12)
