@@ -161,7 +161,7 @@ def test_cells_beside_a_re_entrant_edge_tile_the_boundary():
     from cnem.assembly.facet_gradients import boundary_points_3d
 
     p, f, _ = cases3d.l_block(2, jitter=0.0)
-    model = cnem.discretize(cnem.nodes.irregular(cnem.Domain3D((p, f)), 0.5, seed=1))
+    model = cnem.discretize(cnem.nodes.irregular(cnem.Domain3D((p, f)), 0.45, seed=0))
     point, area_normal, _ = boundary_points_3d(model)
     assert np.isclose(np.linalg.norm(area_normal, axis=1).sum(), 5.5, rtol=1e-12)
     np.testing.assert_allclose(area_normal.sum(axis=0), 0.0, atol=1e-12)

@@ -112,8 +112,8 @@ def _facet_groups(facet_triangles, facet_cell, facet_normal, on_interface=None):
 
     Triangles of one cell and one normal lie in one facet when their planes' offsets,
     sorted, run without a gap above ``FACET_PLANE_RTOL`` times the triangles' extent
-    (the triangles of one polygon agree to round-off; parallel facets of a non-convex
-    cell are apart)."""
+    (plus the round-off of their coordinates: far from the origin) — the triangles of
+    one polygon agree to round-off; parallel facets of a non-convex cell are apart."""
     columns = [facet_cell, np.round(facet_normal * PLANE_RESOLUTION)]
     if on_interface is not None:
         columns.append(on_interface)
@@ -122,12 +122,16 @@ def _facet_groups(facet_triangles, facet_cell, facet_normal, on_interface=None):
     direction = direction.reshape(-1)
     if len(direction) == 0:
         return direction, direction
-    offset = np.einsum("ij,ij->i", facet_normal, facet_triangles.mean(axis=1))
-    extent = float(np.ptp(facet_triangles.reshape(-1, 3), axis=0).max())
+    corners = facet_triangles.reshape(-1, 3)
+    low = corners.min(axis=0)
+    offset = np.einsum("ij,ij->i", facet_normal, facet_triangles.mean(axis=1) - low)
+    # the planes' round-off: relative to the extent, and that of coordinates far from 0
+    tol = (FACET_PLANE_RTOL * float(np.ptp(corners, axis=0).max())
+           + 64.0 * np.finfo(float).eps * float(np.abs(corners).max()))
     order = np.lexsort((offset, direction))
     starts = np.ones(len(order), dtype=bool)
     starts[1:] = ((direction[order[1:]] != direction[order[:-1]])
-                  | (np.diff(offset[order]) > FACET_PLANE_RTOL * extent))
+                  | (np.diff(offset[order]) > tol))
     group = np.empty(len(order), dtype=np.int64)
     group[order] = np.cumsum(starts) - 1
     return group, order[starts]
