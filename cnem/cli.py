@@ -46,7 +46,7 @@ def _named(*modules: str) -> dict[str, str]:
 #: ``cnem demo <name>`` -> module of `cnem.demos`.
 DEMOS = _named("bimaterial_cylinder", "inclined_crack", "mode1_crack", "pd_vs_cnem_crack",
                "cracked_plate_geometry", "growth_sent", "growth_kink", "growth_two_holes",
-               "growth_pd_vs_cnem", "growth_dcb", "kalthoff_winkler")
+               "growth_pd_vs_cnem", "growth_dcb", "kalthoff_winkler", "bracket_stl")
 
 #: ``cnem pd <name>`` -> module of `cnem.demos` (add a PD demo here).
 PD_DEMOS = _named("pd_vs_cnem_crack", "pd_crack_branching", "pd_vs_cnem_3d", "cpd_examples",

@@ -152,7 +152,6 @@ def test_invariance(shift, scale):
                                atol=tol * ref.volume.max())
 
 
-
 def _per_plane(tri, normal):
     """Facet planes (rounded normals) of one cell, the area and centroid on each."""
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
@@ -183,3 +182,18 @@ def test_convex_cells_in_bulk_equal_the_general_path_cell_by_cell(name):
         np.testing.assert_array_equal(keys, want_keys)
         np.testing.assert_allclose(area, want_area, rtol=0, atol=1e-12 * want_area.max())
         np.testing.assert_allclose(centroid, want_centroid, rtol=0, atol=1e-12)
+
+
+def test_cells_beside_a_re_entrant_edge_tile_the_boundary():
+    """An L-block at a coarse spacing: the cell of a node on the re-entrant edge wraps
+    round it (facets parallel to the boundary faces beyond it, shadows in a boundary
+    face's plane). Its facets must close, cancel inside the body, and those on the
+    boundary tile it: their areas sum to the L-block's surface, 5.5."""
+    import cnem
+    from cnem.assembly.facet_gradients import boundary_points_3d
+
+    p, f, _ = cases3d.l_block(2, jitter=0.0)
+    model = cnem.discretize(cnem.nodes.irregular(cnem.Domain3D((p, f)), 0.45, seed=0))
+    point, area_normal, _ = boundary_points_3d(model)
+    assert np.isclose(np.linalg.norm(area_normal, axis=1).sum(), 5.5, rtol=1e-12)
+    np.testing.assert_allclose(area_normal.sum(axis=0), 0.0, atol=1e-12)

@@ -168,6 +168,23 @@ def check_pd_vs_cnem_3d(demo, out, outdir):
         assert row["pd_error"] > 10 * row["cnem_error"]
 
 
+def check_bracket_stl(demo, out, outdir):
+    """The bracket read back from its STL: C-NEM's tip displacement is nearer the P2
+    reference on the refined tetrahedra than P1's on the same nodes (P1 is too stiff in
+    bending), within 15 %; the stresses are finite and positive; the files are written."""
+    tip = out["tip"]
+    assert tip["p2"] > 0 and tip["cnem"] > 0 and tip["p1"] > 0
+    assert abs(tip["cnem"] / tip["p2"] - 1) < 0.15, tip
+    assert abs(tip["cnem"] - tip["p2"]) < abs(tip["p1"] - tip["p2"]), tip
+    assert tip["p1"] < tip["p2"]                         # P1 tetrahedra: too stiff
+    vm = out["max_von_mises"]
+    assert all(np.isfinite(v) and v > 0 for v in vm.values()), vm
+    for f in out["files"]:
+        assert pathlib.Path(f).stat().st_size > 0
+    dom = cnem.Domain3D.from_file(out["files"][0])      # the STL it wrote: the L minus the hole
+    assert dom.volume == pytest.approx((60 * 20 + 20 * 20 - np.pi * 36) * 10, rel=0.01)
+
+
 def check_cnem_vs_cpd(demo, out, outdir):
     """C-NEM on the strip is the homogeneous closed form at every stretch (the
     finite-strain patch test); CPD on the same nodes is softer in tension and in bending
@@ -441,6 +458,7 @@ CASES = [
     Case("pd-vs-cnem-crack", "pd_vs_cnem_crack", check_pd_vs_cnem_crack,
          page="pd_vs_cnem_crack"),
     Case("pd-vs-cnem-3d", "pd_vs_cnem_3d", check_pd_vs_cnem_3d, args=((0.25, 0.125),)),
+    Case("bracket-stl", "bracket_stl", check_bracket_stl, args=(6.0,)),
     Case("cnem-vs-cpd", "cnem_vs_cpd", check_cnem_vs_cpd, args=(0.25, (2.0, 3.0)),
          sizes=lambda demo: dict(steps=4, examples=tuple(demo.EXAMPLES)), plot=True),
     Case("pd-crack-branching", "pd_crack_branching", check_pd_crack_branching,

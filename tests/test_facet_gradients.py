@@ -16,7 +16,8 @@ import pytest
 import scipy.sparse as sp
 from scipy.spatial import Delaunay
 
-from cnem.assembly.facet_gradients import facet_gradient, facet_points, pyramid_sub_cells
+from cnem.assembly.facet_gradients import (facet_gradient, facet_points, merged_across_holes,
+                                           pyramid_sub_cells)
 from cnem.errors import GeometryError
 
 
@@ -151,3 +152,39 @@ def test_sub_cells_integrals_add_up_to_their_cells(node):
     subs = facet_gradient(tri, triangle_sub, nrm, vol, _smooth_functions, spokes=spokes)
     for w, s in zip(whole.components, subs.components):
         np.testing.assert_allclose(vol @ s.toarray(), w.toarray()[0], rtol=1e-13, atol=1e-14)
+
+
+def test_parallel_facets_of_one_cell_are_two_facets():
+    """A non-convex cell (at a re-entrant edge) can have two facets with the same outward
+    normal in different planes (a boundary face and a bisector beyond it): each keeps
+    its own point, in its own plane."""
+    square = np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 1.0, 1.0], [0.0, 0.0, 1.0]])
+    tri = np.concatenate([square[[[0, 1, 2], [0, 2, 3]]], square[[[0, 1, 2], [0, 2, 3]]]
+                          + [1.0, 2.0, 0.0]])
+    cell, point, area_normal = facet_points(tri, np.zeros(4, dtype=np.int64),
+                                            np.tile([1.0, 0.0, 0.0], (4, 1)))
+    assert cell.tolist() == [0, 0]
+    np.testing.assert_allclose(np.sort(point[:, 0]), [0.0, 1.0], atol=1e-15)
+    np.testing.assert_allclose(area_normal, [[1.0, 0.0, 0.0]] * 2, rtol=1e-15)
+
+
+def test_pyramids_merge_across_a_spoke_outside_the_body():
+    """A spoke whose point lies outside the body joins its two pyramids into one
+    sub-cell: the volumes add up, the spoke is gone, and the sub-cells' integrals
+    still add up to their cell's."""
+    tri, cell, nrm = _cube_cell()
+    whole = facet_gradient(tri, cell, nrm, np.array([1.0]), _smooth_functions)
+    parent, triangle_sub, vol, spokes = pyramid_sub_cells(np.array([[0.5, 0.5, 0.5]]), tri,
+                                                          cell, nrm)
+    outside = np.zeros(len(spokes[0]), dtype=bool)
+    outside[0] = True
+    a, b = spokes[2][0], spokes[3][0]
+    assert len(spokes[0]) == 12
+    parent, triangle_sub, merged, spokes = merged_across_holes(parent, triangle_sub, vol, spokes,
+                                                               ~outside)
+    assert len(merged) == 5
+    assert np.isclose(merged.max(), vol[a] + vol[b], rtol=1e-14)
+    assert len(spokes[0]) == 11 and np.all(spokes[2] != spokes[3])      # 12 cube edges
+    subs = facet_gradient(tri, triangle_sub, nrm, merged, _smooth_functions, spokes=spokes)
+    for w, s in zip(whole.components, subs.components):
+        np.testing.assert_allclose(merged @ s.toarray(), w.toarray()[0], rtol=1e-13, atol=1e-14)

@@ -147,3 +147,36 @@ def test_tractions_on_a_two_region_body(two_boxes, stabilization):
     sol = prob.solve(progress=False)
     exact = m.nodes @ A.T
     assert np.abs(sol.u - exact).max() <= 1e-12 * np.abs(exact).max()
+
+
+def test_a_split_facet_keeps_its_points_on_it():
+    """A thin L-shaped facet (a bisector wrapping a re-entrant edge) has its centroid off
+    itself, in the notch. Cut with ``split``, each piece of the two sides' (differently
+    triangulated) triangles keeps its own point, on the facet, and the pieces still
+    cover each side's area."""
+    from cnem.assembly.interface_facets import interface_pieces
+
+    outline = shapely.Polygon([(0, 0), (1, 0), (1, 0.2), (0.2, 0.2), (0.2, 1), (0, 1)])
+    sides = []
+    for sign, flip in ((1.0, False), (-1.0, True)):
+        rects = [shapely.box(0, 0, 1, 0.2), shapely.box(0, 0.2, 0.2, 1)] if not flip else \
+            [shapely.box(0, 0, 0.2, 1), shapely.box(0.2, 0, 1, 0.2)]
+        for rect in rects:
+            for tri in shapely.get_parts(shapely.delaunay_triangles(rect)):
+                xy = np.asarray(tri.exterior.coords)[:3]
+                xyz = np.column_stack([xy, np.zeros(3)])
+                if np.cross(xyz[1] - xyz[0], xyz[2] - xyz[0])[2] * sign < 0:
+                    xyz = xyz[::-1]
+                sides.append((xyz, sign, int(flip)))
+    tri = np.array([t for t, _, _ in sides])
+    normal = np.array([[0.0, 0.0, s] for _, s, _ in sides])
+    group = np.array([g for _, _, g in sides])
+    every = np.ones(len(tri), dtype=bool)
+    merged = interface_pieces(tri, normal, group, np.zeros((0, 3, 3)), 1.0, also=every)
+    assert not outline.buffer(1e-12).contains(shapely.points(merged.point[:, :2])).any()
+    pieces = interface_pieces(tri, normal, group, np.zeros((0, 3, 3)), 1.0, also=every,
+                              split=every)
+    assert len(pieces.point) > 2
+    assert outline.buffer(1e-12).contains(shapely.points(pieces.point[:, :2])).all()
+    np.testing.assert_allclose(pieces.area_normal_a.sum(axis=0), [0, 0, 0.36], atol=1e-14)
+    np.testing.assert_allclose(pieces.area_normal_b.sum(axis=0), [0, 0, -0.36], atol=1e-14)

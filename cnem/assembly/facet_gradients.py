@@ -34,18 +34,24 @@ from typing import Any, Callable
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 from .. import config
 from ..errors import GeometryError
+from ..shape.natural3d import inside_tetrahedra
 from .interface_facets import InterfacePieces, interface_pieces, on_triangles
 from .smoothed_gradient import SmoothedGradient
 
 __all__ = ["facet_points", "facet_gradient", "boundary_points_3d", "pyramid_sub_cells", "cell_gradient_3d",
-           "model_interface_pieces", "sub_cell_gradient_3d"]
+           "model_interface_pieces", "sub_cell_gradient_3d", "merged_across_holes"]
 
 #: Facet normals are told apart to ``1 / PLANE_RESOLUTION`` (unit normals of one
 #: cell's distinct Voronoi facets differ by far more).
 PLANE_RESOLUTION = 2.0 ** 24
+
+#: A cell's triangles of one outward normal whose planes are further apart than this
+#: fraction of the triangles' extent belong to different facets.
+FACET_PLANE_RTOL = 1e-9
 
 #: Two facet points closer than this fraction of the model's size are one point (the
 #: two sides of a shared facet, computed from the same polygon), or closer than
@@ -63,7 +69,9 @@ def facet_points(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_norm
     summed area times the facet's normal.
 
     A facet is the set of a cell's triangles of one outward normal (to
-    `PLANE_RESOLUTION`). Its centroid and area depend on the polygon only, not on
+    `PLANE_RESOLUTION`) in one plane (to `FACET_PLANE_RTOL`: a non-convex cell, at a
+    re-entrant edge, can have parallel facets with the same outward normal, a
+    boundary face and a bisector beyond it, which are two facets). Its centroid and area depend on the polygon only, not on
     how it was cut into triangles, so the two cells that share a facet evaluate
     the shape functions at the same point and their integrals cancel (the
     integration constraint), whichever triangles each was given.
@@ -88,7 +96,7 @@ def _grouped_facet_points(facet_triangles, facet_cell, facet_normal, on_interfac
     """`facet_points`, after the facet of every triangle (`_facet_groups`)."""
     tri = facet_triangles
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    group, first = _facet_groups(facet_cell, facet_normal, on_interface)
+    group, first = _facet_groups(tri, facet_cell, facet_normal, on_interface)
     total = np.bincount(group, weights=area, minlength=len(first))
     centre = tri.mean(axis=1)
     point = np.column_stack([np.bincount(group, weights=area * centre[:, i], minlength=len(first))
@@ -98,17 +106,37 @@ def _grouped_facet_points(facet_triangles, facet_cell, facet_normal, on_interfac
     return group, facet_cell[first], point, normal
 
 
-def _facet_groups(facet_cell, facet_normal, on_interface=None):
-    """The facet (cell, normal) of each triangle, numbered in the order of the cells,
-    and a triangle of each facet. With ``on_interface`` (f,) bool (the triangles cut
-    into interface pieces), a cell's triangles cut and not cut in one plane are two
-    facets."""
+def _facet_groups(facet_triangles, facet_cell, facet_normal, on_interface=None):
+    """The facet (cell, normal, plane) of each triangle, numbered in the order of the
+    cells, and a triangle of each facet. With ``on_interface`` (f,) bool (the triangles
+    cut into interface pieces), a cell's triangles cut and not cut in one plane are two
+    facets.
+
+    Triangles of one cell and one normal lie in one facet when their planes' offsets,
+    sorted, run without a gap above ``FACET_PLANE_RTOL`` times the triangles' extent
+    (plus the round-off of their coordinates: far from the origin) — the triangles of
+    one polygon agree to round-off; parallel facets of a non-convex cell are apart."""
     columns = [facet_cell, np.round(facet_normal * PLANE_RESOLUTION)]
     if on_interface is not None:
         columns.append(on_interface)
     key = np.column_stack(columns).astype(np.int64)
-    _, first, group = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    return group.reshape(-1), first
+    _, direction = np.unique(key, axis=0, return_inverse=True)
+    direction = direction.reshape(-1)
+    if len(direction) == 0:
+        return direction, direction
+    corners = facet_triangles.reshape(-1, 3)
+    low = corners.min(axis=0)
+    offset = np.einsum("ij,ij->i", facet_normal, facet_triangles.mean(axis=1) - low)
+    # the planes' round-off: relative to the extent, and that of coordinates far from 0
+    tol = (FACET_PLANE_RTOL * float(np.ptp(corners, axis=0).max())
+           + 64.0 * np.finfo(float).eps * float(np.abs(corners).max()))
+    order = np.lexsort((offset, direction))
+    starts = np.ones(len(order), dtype=bool)
+    starts[1:] = ((direction[order[1:]] != direction[order[:-1]])
+                  | (np.diff(offset[order]) > tol))
+    group = np.empty(len(order), dtype=np.int64)
+    group[order] = np.cumsum(starts) - 1
+    return group, order[starts]
 
 
 def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_normal: np.ndarray,
@@ -181,7 +209,7 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple]:
     """The pyramids from each cell's node to its facets, as sub-cells.
 
-    A facet is a group of triangles of one cell and one normal (`facet_points`).
+    A facet is a group of triangles of one cell, one normal and one plane (`facet_points`).
     Its pyramid's boundary is the facet itself and one spoke triangle (node, edge)
     per edge of its outline, shared with the pyramid of the neighbouring facet,
     where the two cancel. A facet through the node (a node on the cell's
@@ -221,7 +249,7 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     GeometryError
         A cell all of whose facets pass through its node (no volume).
     """
-    group, _ = _facet_groups(facet_cell, facet_normal)
+    group, _ = _facet_groups(facet_triangles, facet_cell, facet_normal)
     apex = node_xyz[facet_cell]
     a, b, c = (facet_triangles[:, i] - apex for i in range(3))
     six_v = np.einsum("ij,ij->i", a, np.cross(b, c))            # > 0: apex behind the facet
@@ -285,6 +313,59 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
     parent[triangle_sub] = facet_cell
     return parent, triangle_sub, sub_volume, (centroid[inner], area_normal[inner], sub_a[inner],
                                              sub_b[inner])
+
+
+def merged_across_holes(parent: np.ndarray, triangle_sub: np.ndarray, volume: np.ndarray,
+                        spokes: tuple, spoke_inside: np.ndarray) -> tuple:
+    """Pyramid sub-cells (`pyramid_sub_cells`) merged across the spokes whose point
+    lies outside the body.
+
+    Faces of a smooth curved hole or cavity do not cut visibility, so the cell of a
+    node near one need not be star-shaped from its node: a spoke (node, facet edge)
+    can cross the hole, and its one integration point fall where no shape function
+    is defined. The two pyramids on either side of such a spoke become one sub-cell
+    (the spoke, between two parts of one sub-cell, cancels and is dropped); the rule
+    stays exact for linear fields.
+
+    Parameters
+    ----------
+    parent : (s,) int64 ndarray
+    triangle_sub : (f,) int64 ndarray
+    volume : (s,) ndarray
+    spokes : (centroid (e, 3), area-normal (e, 3), sub_a (e,), sub_b (e,))
+        As `pyramid_sub_cells` returns them.
+    spoke_inside : (e,) bool ndarray
+        Whether each spoke's centroid lies in the body.
+
+    Returns
+    -------
+    parent, triangle_sub, volume, spokes
+        The same, for the merged sub-cells.
+
+    Raises
+    ------
+    GeometryError
+        A spoke outside the body with a sub-cell on one side only (a T-junction).
+    """
+    centroid, area_normal, sub_a, sub_b = spokes
+    out = ~spoke_inside
+    if not out.any():
+        return parent, triangle_sub, volume, spokes
+    if (sub_b[out] < 0).any():
+        bad = centroid[out & (sub_b < 0)][:3]
+        raise GeometryError(f"expected the spokes of the pyramid sub-cells that leave the body "
+                            f"to lie between two sub-cells, received one-sided spokes at "
+                            f"{bad.tolist()}; refine the cloud near them")
+    n = len(volume)
+    graph = sp.coo_matrix((np.ones(int(out.sum())), (sub_a[out], sub_b[out])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    merged_volume = np.bincount(label, weights=volume)
+    merged_parent = np.zeros(len(merged_volume), dtype=np.int64)
+    merged_parent[label] = parent
+    keep = label[sub_a] != np.where(sub_b >= 0, label[np.maximum(sub_b, 0)], -1)
+    b = np.where(sub_b >= 0, label[np.maximum(sub_b, 0)], -1)
+    return (merged_parent, label[triangle_sub], merged_volume,
+            (centroid[keep], area_normal[keep], label[sub_a[keep]], b[keep]))
 
 
 def _t_junction_pieces(p, q, cell, size):
@@ -377,7 +458,8 @@ def cell_gradient_3d(model: Any, cells: Any,
 def sub_cell_gradient_3d(model: Any, interface: InterfacePieces | None = None
                          ) -> tuple[Any, SmoothedGradient]:
     """The pyramid sub-cells of a 3-D model's cells and their ``B~``, from the cells'
-    facet points and one point on each spoke.
+    facet points and one point on each spoke (pyramids whose spoke's point lies
+    outside the body merged, `merged_across_holes`).
 
     Parameters
     ----------
@@ -394,6 +476,8 @@ def sub_cell_gradient_3d(model: Any, interface: InterfacePieces | None = None
     cells = model.cells
     parent, triangle_sub, volume, spokes = pyramid_sub_cells(
         model.nodes[cells.node], cells.facet_triangles, cells.facet_cell, cells.facet_normal)
+    parent, triangle_sub, volume, spokes = merged_across_holes(
+        parent, triangle_sub, volume, spokes, inside_tetrahedra(model.tet_mesh(), spokes[0]))
     sub = type(cells)(cells.node[parent], cells.region[parent], volume, cells.facet_triangles,
                       triangle_sub, cells.facet_normal, apex=model.nodes[cells.node[parent]])
     # the sub-cells' triangles are the cells': the interface pieces go to their sub-cells
@@ -408,7 +492,9 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
     """`interface_pieces` of a 3-D model's cells on its interface faces and on their
     shadow facets (in the plane of a boundary or interface face beyond its border,
     where the cells of the two sides cut the plane differently: their facet points
-    find no partner and lie on no boundary face).
+    find no partner and lie on no boundary face), and on the facets whose centroid
+    lies outside the body (non-convex facets round a re-entrant edge: one point per
+    overlap of the two sides' triangles).
 
     Parameters
     ----------
@@ -423,13 +509,22 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
                                                          cells.facet_normal)
     size, tol = _pair_tolerance(model)
     # shadow facets: unpaired, and on no boundary face
-    lone = np.flatnonzero(~_paired(point, area_normal, tol))
+    paired = _paired(point, area_normal, tol)
+    lone = np.flatnonzero(~paired)
     faces, normal = model.boundary_with_normals()
     outer = _face_holding(point[lone], area_normal[lone], model.nodes[faces], normal, tol) >= 0
+    # a non-convex facet (wrapping a re-entrant edge) whose centroid lies outside the body:
+    # one point per piece of the two sides' triangles, each inside its triangles
+    astray = np.flatnonzero(~inside_tetrahedra(model.tet_mesh(), point))
+    if (~paired[astray]).any():
+        bad = point[astray[~paired[astray]]][:3]
+        raise GeometryError(f"expected the centroids of the cells' boundary facets to lie in "
+                            f"the body, received {bad.tolist()} outside; refine the cloud there")
+    split = np.isin(group, astray)
     between = model.boundary_face_regions[:, 1] >= 0
     return interface_pieces(cells.facet_triangles, cells.facet_normal, group,
                             model.nodes[model.boundary_faces[between]], size,
-                            also=np.isin(group, lone[~outer]))
+                            also=np.isin(group, lone[~outer]) | split, split=split)
 
 
 def _pair_tolerance(model):

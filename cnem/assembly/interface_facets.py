@@ -61,7 +61,8 @@ class InterfacePieces(NamedTuple):
 
 def interface_pieces(facet_triangles: np.ndarray, facet_normal: np.ndarray,
                      facet_group: np.ndarray, face_corners: np.ndarray, size: float,
-                     also: np.ndarray | None = None) -> InterfacePieces:
+                     also: np.ndarray | None = None,
+                     split: np.ndarray | None = None) -> InterfacePieces:
     """The common refinement of the cells' facets on interface faces (and of ``also``).
 
     Parameters
@@ -79,6 +80,9 @@ def interface_pieces(facet_triangles: np.ndarray, facet_normal: np.ndarray,
     also : (f,) bool ndarray, optional
         Further triangles to cut into pieces with the other side's (facets that two
         cells cut differently off the interfaces: shadows of a face's plane).
+    split : (f,) bool ndarray, optional
+        Triangles (of ``also``) whose overlaps stay one piece each instead of one piece
+        per pair of facets (a non-convex facet, whose centroid may lie off it).
 
     Returns
     -------
@@ -114,6 +118,9 @@ def interface_pieces(facet_triangles: np.ndarray, facet_normal: np.ndarray,
     point = origin + centre[:, :1] * e1 + centre[:, 1:] * e2
     # one piece per pair of facets
     pair = np.column_stack([facet_group[ta], facet_group[tb]])
+    if split is not None:
+        alone = split[ta] | split[tb]
+        pair[alone] = np.column_stack([-1 - ta[alone], -1 - tb[alone]])
     _, first, which = np.unique(pair, axis=0, return_index=True, return_inverse=True)
     which = which.reshape(-1)
     total = np.bincount(which, weights=area)

@@ -34,7 +34,7 @@ for every entry of `cnem.cli.DEMOS` and `cnem.cli.PD_DEMOS`):
 """
 
 #: The demo modules (``cnem.demos.<name>``; `cnem.cli` gives them command-line names).
-MODULES = ("bimaterial_cylinder", "cnem_vs_cpd", "cpd_examples", "cracked_plate_geometry", "growth_dcb",
+MODULES = ("bimaterial_cylinder", "bracket_stl", "cnem_vs_cpd", "cpd_examples", "cracked_plate_geometry", "growth_dcb",
            "growth_kink", "growth_pd_vs_cnem", "growth_sent", "growth_two_holes", "inclined_crack",
            "kalthoff_winkler", "mode1_crack", "pd_crack_branching", "pd_vs_cnem_3d",
            "pd_vs_cnem_crack")

@@ -119,11 +119,18 @@ class CellSolution(Solution):
 
     def _inside_vertices(self) -> np.ndarray:
         """The cell vertices of `cnem.io.cell_points` moved `cnem.config.VERTEX_NUDGE`
-        of the way to their cell's node, ``(q, d)``."""
+        of the way to their cell's node, ``(q, d)``; in 3-D a vertex whose way to its
+        node leaves the body (a cell beside a faceted hole, not star-shaped from its
+        node) stays where it is."""
         from .. import io
         vertices, cell = io.cell_points(self.model)
         node = self.model.nodes[self.model.cells.node[cell]]
-        return vertices + config.VERTEX_NUDGE * (node - vertices)
+        nudged = vertices + config.VERTEX_NUDGE * (node - vertices)
+        if vertices.shape[1] == 3:
+            from ..shape.natural3d import inside_tetrahedra
+            astray = ~inside_tetrahedra(self.model.tet_mesh(), nudged)
+            nudged[astray] = vertices[astray]
+        return nudged
 
 
 @dataclass(eq=False, repr=False)

@@ -34,6 +34,8 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
@@ -43,8 +45,11 @@ from .tet_pieces import RegionTets, connected, open_facets
 
 __all__ = ["GeneralCells"]
 
-#: Bound on the doublings of the cube around a cell.
-_GROW = 6
+#: The cube's first half-side (local unit): most cells lie within it, and the cost of a
+#: cell grows with the pieces and nodes the cube holds.
+_FIRST_HALF = 0.65
+#: Bound on the doublings of the cube around a cell (to ``_FIRST_HALF 2^(_GROW-1)``).
+_GROW = 8
 #: Vertices of a face beyond another face's plane by more than this (local unit) make
 #: the neighbourhood non-convex.
 _REFLEX = 1e-9
@@ -104,7 +109,7 @@ class GeneralCells:
         """Facet triangles ``(q, 3, 3)``, their outward normals ``(q, 3)`` and the volume of
         the cell of node ``i`` in region ``r``."""
         x0, s = self.points[i], self.scale[i]
-        half = 1.0
+        half = _FIRST_HALF
         for _ in range(_GROW):
             reach = np.sqrt(3.0) * half
             pieces, joins = self._pieces(i, r, x0, s, half, reach)
@@ -353,11 +358,17 @@ def _claim(pieces, nearer_i, origin_j, faces, who):
 
 def _boundary(pieces):
     """Triangles and outward normals of the union's boundary: faces shared by two pieces
-    (same plane, opposite sides) cancel where they overlap."""
+    (same plane, opposite sides) cancel where they overlap.
+
+    Faces are grouped by their geometric plane (`_plane_groups`), not by what made
+    them: a bisector, a shadow side and a boundary face's plane can coincide (the
+    shadow of a face seen from a node in its plane, beyond a re-entrant edge)."""
+    faces = [(p.vertices[idx], pl) for p in pieces for idx, pl in p.faces]
+    if not faces:
+        return np.zeros((0, 3, 3)), np.zeros((0, 3))
     groups: dict = {}
-    for p in pieces:
-        for idx, pl in p.faces:
-            groups.setdefault(pl.tag, []).append((p.vertices[idx], pl))
+    for (x, pl), g in zip(faces, _plane_groups([pl for _, pl in faces])):
+        groups.setdefault(g, []).append((x, pl))
     tris, normals = [], []
     for polys in groups.values():
         ref = polys[0][1].normal
@@ -378,9 +389,23 @@ def _boundary(pieces):
     return np.array(tris), np.array(normals)
 
 
+def _plane_groups(planes):
+    """A label ``(k,)`` per plane: planes equal up to orientation (normals and offsets to
+    ``_REFLEX``, local unit) share it, whatever their tags."""
+    normal = np.array([pl.normal for pl in planes])
+    offset = np.array([pl.offset for pl in planes])
+    aligned = np.where(normal @ normal.T < 0.0, -1.0, 1.0)
+    apart = np.linalg.norm(normal[:, None, :] - aligned[..., None] * normal[None, :, :], axis=2)
+    same = (apart <= _REFLEX) & (np.abs(offset[:, None] - aligned * offset[None, :]) <= _REFLEX)
+    return connected_components(csr_matrix(same), directed=False)[1]
+
+
 def _difference(mine, other, normal, offset):
     """Triangles ``(3, 3)`` (counter-clockwise about ``normal``) of the union of the polygons
-    ``mine`` minus the union of ``other``, all lying in one plane."""
+    ``mine`` minus the union of ``other``, all lying in one plane.
+
+    A polygon of ``mine`` that overlaps none of ``other`` (they may touch) is kept as the
+    fan of its own vertices, bit for bit: its edges stay the twins of its neighbours'."""
     helper = np.eye(3)[np.argmin(np.abs(normal))]
     e1 = np.cross(normal, helper)
     e1 /= np.linalg.norm(e1)
@@ -391,10 +416,18 @@ def _difference(mine, other, normal, offset):
         return shapely.Polygon(np.column_stack([(x - base) @ e1, (x - base) @ e2]))
 
     grid = 1e-13
-    a = shapely.union_all([flat(x) for x in mine], grid_size=grid)
     b = shapely.union_all([flat(x) for x in other], grid_size=grid)
-    rest = shapely.difference(a, b, grid_size=grid)
-    out = []
+    out, cut = [], []
+    for x in mine:
+        if shapely.intersection(flat(x), b, grid_size=grid).area <= 1e-20:
+            for k in range(1, len(x) - 1):
+                t = np.array([x[0], x[k], x[k + 1]])
+                out.append(t if np.cross(t[1] - t[0], t[2] - t[0]) @ normal >= 0 else t[[0, 2, 1]])
+        else:
+            cut.append(flat(x))
+    if not cut:
+        return out
+    rest = shapely.difference(shapely.union_all(cut, grid_size=grid), b, grid_size=grid)
     if rest.is_empty or rest.area <= 1e-20:
         return out
     for tri in shapely.get_parts(shapely.constrained_delaunay_triangles(rest)):

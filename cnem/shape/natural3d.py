@@ -27,7 +27,7 @@ from . import _cavity3d as C
 from . import _kernels3d as K
 from .natural import KINDS, ShapeGradients
 
-__all__ = ["TetMesh", "tet_mesh", "shape_functions_3d"]
+__all__ = ["TetMesh", "tet_mesh", "shape_functions_3d", "inside_tetrahedra"]
 
 _log = logging.getLogger(__name__)
 
@@ -236,6 +236,30 @@ def _locate(mesh, spts):
         idx = np.concatenate([np.asarray(c, dtype=np.int64) for c in cands])
         tet_of[lost] = C.locate(nodes, tet, spts[lost], off, idx, mesh.tol)
     return tet_of
+
+
+def inside_tetrahedra(mesh: TetMesh, points: np.ndarray) -> np.ndarray:
+    """Whether each point lies in a tetrahedron of the mesh (on its faces included,
+    to the mesh's tolerance): where `shape_functions_3d` is defined.
+
+    Parameters
+    ----------
+    mesh : TetMesh
+    points : (p, 3) ndarray
+
+    Returns
+    -------
+    (p,) bool ndarray
+    """
+    pts = check_array("points", points, shape=(None, 3), error=GeometryError,
+                      fix="give the points as a (p, 3) array")
+    inside = np.zeros(len(pts), dtype=bool)
+    if len(pts) == 0:
+        return inside
+    local = mesh.frame.to_local(pts)
+    order = _path_order(local, local.min(axis=0), local.max(axis=0))
+    inside[order] = _locate(mesh, np.ascontiguousarray(local[order])) >= 0
+    return inside
 
 
 def shape_functions_3d(mesh: TetMesh, points: ArrayLike, *,
