@@ -16,7 +16,8 @@ from numpy.typing import ArrayLike
 from .errors import InputError, MaterialError, check_array, check_points
 from .material import effective_modulus, lame
 
-__all__ = ["LayeredCylinder", "ThickSphere", "CentralCrack", "rayleigh_speed"]
+__all__ = ["LayeredCylinder", "ThickSphere", "CentralCrack", "rayleigh_speed",
+           "inflated_sphere_pressure", "rivlin_torsion"]
 
 
 class LayeredCylinder:
@@ -272,3 +273,74 @@ class CentralCrack:
         """Normal stress ``(p,)`` on the crack line at distance ``r > 0`` ahead of a tip."""
         r = _distances("r", r)
         return self.normal * (self.a + r) / np.sqrt(r * (2 * self.a + r))
+
+
+def _positive_number(name: str, value: float) -> float:
+    """``value`` as a positive finite float, else an `InputError` naming ``name``."""
+    number = float(check_array(name, value, shape=(), fix=f"pass one positive number as {name}"))
+    if not number > 0.0:
+        raise InputError(f"{name}: expected a positive number, received {number!r}")
+    return number
+
+
+def inflated_sphere_pressure(inner_stretch: ArrayLike, inner: float, outer: float,
+                             mu: float) -> np.ndarray:
+    """Cavity pressure of a thick incompressible neo-Hookean sphere whose inner radius is
+    stretched to ``lambda_a inner`` (Green & Zerna; Ogden, *Non-linear elastic
+    deformations*, 1984, sec. 5.2.4), the outer surface free:
+
+    ``p = 2 mu [(1/lambda_b + 1/(4 lambda_b^4)) - (1/lambda_a + 1/(4 lambda_a^4))]``,
+    ``lambda_b^3 = 1 + (lambda_a^3 - 1) inner^3 / outer^3`` (volume conservation,
+    ``r^3 - R^3`` constant), from radial equilibrium
+    ``d sigma_rr / dr = 2 mu (lambda^2 - lambda^-4) / r`` with ``lambda = r / R``;
+    ``p > 0`` pushes the wall out. ``W = mu/2 (tr C - 3)``.
+
+    Parameters
+    ----------
+    inner_stretch : array_like, any shape
+        ``lambda_a = a / A > 0``.
+    inner, outer : float
+        Reference radii ``A < B``.
+    mu : float
+        Shear modulus.
+
+    Returns
+    -------
+    ndarray, the shape of ``inner_stretch``
+    """
+    la = check_array("inner_stretch", inner_stretch, fix="pass stretches a / A > 0")
+    if not (la > 0).all():
+        raise InputError(f"inner_stretch: expected stretches > 0, received minimum {la.min()!r}")
+    A, B, mu = (_positive_number(n, v) for n, v in (("inner", inner), ("outer", outer),
+                                                    ("mu", mu)))
+    if not A < B:
+        raise InputError(f"inner, outer: expected radii inner < outer, received {A!r}, {B!r}")
+    lb = np.cbrt(1.0 + (la ** 3 - 1.0) * (A / B) ** 3)
+    g = lambda s: 1.0 / s + 0.25 / s ** 4                         # noqa: E731
+    return 2.0 * mu * (g(lb) - g(la))
+
+
+def rivlin_torsion(twist: ArrayLike, radius: float, mu: float) -> tuple[np.ndarray, np.ndarray]:
+    """Torque and axial force on the ends of an incompressible neo-Hookean solid cylinder
+    twisted by ``tau`` per unit length at fixed length (Rivlin, Phil. Trans. A 242,
+    1949): ``M = pi/2 mu tau a^4``, ``N = -pi/4 mu tau^2 a^4`` (compressive: the
+    Poynting effect). From ``sigma = -p I + mu b``, ``b_zz = b_rr = 1``,
+    ``b_thetaz = tau r``, radial equilibrium ``d sigma_rr / dr = mu tau^2 r`` and
+    ``sigma_rr(a) = 0``, so ``sigma_zz = mu tau^2 (r^2 - a^2) / 2``.
+
+    Parameters
+    ----------
+    twist : array_like, any shape
+        ``tau``, the angle of twist per unit length (radians per length).
+    radius : float
+        ``a``.
+    mu : float
+        Shear modulus.
+
+    Returns
+    -------
+    torque, axial_force : ndarrays, the shape of ``twist``
+    """
+    tau = check_array("twist", twist, fix="pass twists per unit length")
+    a, mu = _positive_number("radius", radius), _positive_number("mu", mu)
+    return 0.5 * np.pi * mu * tau * a ** 4, -0.25 * np.pi * mu * tau ** 2 * a ** 4

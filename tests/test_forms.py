@@ -100,3 +100,36 @@ def test_groups_are_checked(model):
         form.assemble(basis, groups=np.zeros(m, dtype=int), k=np.ones((2, 2)))
     with pytest.raises(ValueError, match="groups: index 1 but the keywords hold 1 values"):
         form.assemble(basis, groups=np.arange(m) % 2, k=np.ones(1))
+
+
+def test_gradient_gram_of_3d_gradients_on_different_patterns():
+    """3-D smoothed gradients may drop an exact zero along one axis only, so the axes'
+    patterns differ: `gradient_gram` takes the node-block path on their union and
+    gives the product written out with scipy, leaving the basis's operators as they
+    were (unsorted node operators share their values with them)."""
+    from types import SimpleNamespace
+
+    from cnem.assembly.forms import gradient_gram
+    rng = np.random.default_rng(5)
+    m, n, d = 12, 9, 3
+    grads = [sp.random(m, n, density=0.4, format="csr", random_state=k) for k in range(d)]
+    for g in grads:                          # unsorted rows, as the 3-D gradients come
+        for i in range(m):
+            lo, hi = g.indptr[i], g.indptr[i + 1]
+            g.indices[lo:hi], g.data[lo:hi] = g.indices[lo:hi][::-1].copy(), g.data[lo:hi][::-1].copy()
+        g.has_sorted_indices = False
+    assert not all(np.array_equal(grads[0].indices, g.indices) for g in grads[1:])
+    basis = CellBasis.from_operators(SimpleNamespace(nodes=rng.uniform(size=(n, d))),
+                                     sp.identity(m, format="csr")[:, :n], grads,
+                                     rng.uniform(0.5, 2.0, m), rng.uniform(size=(m, d)),
+                                     vector=True)
+    before = [op.toarray() for op in basis.operators]
+    coeff = rng.uniform(-1, 1, (m, d * d, d * d))
+    ops = basis.operators[d:]
+    ref = sum((ops[b].T @ sp.diags(basis.dx * coeff[:, a, b]) @ ops[a]).toarray()
+              for a in range(d * d) for b in range(d * d))
+    assert basis.component_gradients() is not None
+    np.testing.assert_allclose(gradient_gram(basis, coeff).toarray(), ref,
+                               atol=1e-12 * abs(ref).max())
+    for op, old in zip(basis.operators, before):
+        np.testing.assert_array_equal(op.toarray(), old)

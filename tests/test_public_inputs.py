@@ -344,6 +344,12 @@ EXAMPLES = {
         lambda f: dict(inner=0.5, outer=1.0, E=1.0, nu=0.3, center=np.zeros(3))),
     "cnem.exact.CentralCrack": Example(lambda f: dict(half_length=1.0)),
     "cnem.exact.rayleigh_speed": Example(lambda f: dict(E=1.0, nu=0.3, density=1.0)),
+    "cnem.exact.inflated_sphere_pressure": Example(
+        lambda f: dict(inner_stretch=np.array([1.5, 2.0]), inner=1.0, outer=2.0, mu=1.0),
+        skip={"shape": _ELEMENTWISE, "scalar": _ELEMENTWISE}),
+    "cnem.exact.rivlin_torsion": Example(
+        lambda f: dict(twist=np.array([0.5, 1.0]), radius=1.0, mu=1.0),
+        skip={"shape": _ELEMENTWISE, "scalar": _ELEMENTWISE}),
     "cnem.fracture.sif": Example(lambda f: dict(sol=f.sol, tip=f.tip)),
     "cnem.fracture.Enrichment": Example(
         lambda f: dict(model=f.model, tips=f.tip[None, :], radius=0.3)),

@@ -166,17 +166,20 @@ class CellBasis:
 
     def component_gradients(self) -> tuple[sp.csr_matrix, ...] | None:
         """The scalar derivatives ``(m, nfun)`` CSR along each axis behind the
-        gradient operators of a vector basis, when all have one pattern (then forms
-        that see only gradients are assembled by ``dim x dim`` node blocks); None
-        for a scalar basis or operators set otherwise (`at_points`, assignment)."""
+        gradient operators of a vector basis, on one pattern (then forms that see
+        only gradients are assembled by ``dim x dim`` node blocks): where the axes'
+        patterns differ (3-D smoothed gradients with an exact zero along one axis),
+        on their union with explicit zeros. None for a scalar basis or operators set
+        otherwise (`at_points`, assignment)."""
         given = self.__dict__.get("operators", self._built)
         if not self.vector or given is not self._built:
             return None
-        first, *others = (g.tocsr() for g in self._node_ops[1:])
-        if not all(np.array_equal(first.indptr, g.indptr) and np.array_equal(first.indices, g.indices)
-                   for g in others):
-            return None
-        return (first, *others)
+        grads = [g.tocsr() for g in self._node_ops[1:]]
+        first = grads[0]
+        if all(np.array_equal(first.indptr, g.indptr) and np.array_equal(first.indices, g.indices)
+               for g in grads[1:]):
+            return tuple(grads)
+        return _on_union_pattern(grads)
 
     def at_points(self, operators: Sequence[sp.spmatrix], weights: np.ndarray,
                   points: np.ndarray) -> CellBasis:
@@ -262,3 +265,30 @@ class CellBasis:
             names = {2: "0, 1 or None (both)", 3: "0, 1, 2 or None (all)"}[d]
             raise ConditionError(f"component: expected {names}, received {component!r}")
         return d * nodes + component
+
+
+def _on_union_pattern(matrices: list[sp.csr_matrix]) -> tuple[sp.csr_matrix, ...]:
+    """The same-shape CSR ``matrices`` with one pattern, the union of theirs (entries
+    missing from a matrix stored as explicit zeros); sorted indices. The inputs are
+    not touched (scipy sorts operands in place, and a basis's operators share their
+    values with its node operators)."""
+    matrices = [a.copy() for a in matrices]
+    union = abs(matrices[0])
+    for a in matrices[1:]:
+        union = union + abs(a)
+    union = union.tocsr()
+    union.sort_indices()
+    ncol = union.shape[1]
+    rows = np.repeat(np.arange(union.shape[0], dtype=np.int64), np.diff(union.indptr))
+    keys = rows * ncol + union.indices
+    out = []
+    for a in matrices:
+        a = a.tocoo()
+        a.sum_duplicates()
+        a.eliminate_zeros()                 # every key left is in the union
+        data = np.zeros(union.nnz)
+        data[np.searchsorted(keys, a.row.astype(np.int64) * ncol + a.col)] = a.data
+        out.append(sp.csr_matrix((data, union.indices.copy(), union.indptr.copy()),
+                                 shape=union.shape))
+    return tuple(out)
+
