@@ -46,6 +46,7 @@ from numpy.typing import ArrayLike
 
 from .errors import FormatError, check_points
 from .geometry.model import Cells
+from ._sets import distinct
 
 if TYPE_CHECKING:
     from .geometry.model import Model
@@ -212,9 +213,9 @@ def _polyhedron_blocks(cells, triangles, shift):
     order = np.argsort(cells.facet_cell, kind="stable")
     starts = np.concatenate([[0], np.cumsum(np.bincount(cells.facet_cell, minlength=m))])
     faces = [triangles[order[starts[c]:starts[c + 1]]] + shift for c in range(m)]
-    sizes = np.array([len(np.unique(f)) for f in faces], dtype=np.int64)
+    sizes = np.array([len(distinct(f)) for f in faces], dtype=np.int64)
     blocks, ids = [], []
-    for size in np.unique(sizes):
+    for size in distinct(sizes):
         members = np.flatnonzero(sizes == size)
         blocks.append(meshio.CellBlock(f"polyhedron{size}", [list(faces[c]) for c in members]))
         ids.append(members)
@@ -226,7 +227,7 @@ def _blocks(offsets, connectivity, shift):
     sizes = np.diff(offsets)
     order = np.argsort(sizes, kind="stable")
     blocks, ids = [], []
-    for size in np.unique(sizes):
+    for size in distinct(sizes):
         members = order[sizes[order] == size]
         rows = offsets[members][:, None] + np.arange(size)
         blocks.append(meshio.CellBlock("polygon", connectivity[rows] + shift))
@@ -493,7 +494,7 @@ class CellMesh:
     def __repr__(self):
         extra = list(self.point_data) + list(self.cell_data)
         return (f"<CellMesh {len(self.nodes)} nodes, {len(self.node)} cells, "
-                f"{len(np.unique(self.region))} regions"
+                f"{len(distinct(self.region))} regions"
                 + (f", data: {', '.join(extra)}" if extra else "") + ">")
 
 

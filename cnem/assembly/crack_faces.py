@@ -11,6 +11,7 @@ import shapely
 from ..geometry.pslg import CRACK
 from ..geometry.topology import constraint_edges
 from ..spatial.rtree import RTree
+from .._sets import isin
 
 if TYPE_CHECKING:
     from ..geometry.model import Cells, Model
@@ -31,7 +32,7 @@ def crack_faces(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     crack = model.segments[model.segment_kind == CRACK]
     n = len(model.nodes)
     edges, owner = constraint_edges(model.triangles, model.neighbors())
-    is_face = np.isin(np.sort(edges, axis=1) @ [n, 1], np.sort(crack, axis=1) @ [n, 1])
+    is_face = isin(np.sort(edges, axis=1) @ [n, 1], np.sort(crack, axis=1) @ [n, 1])
     edges, owner = edges[is_face], owner[is_face]
     return model.nodes[edges[:, 0]], model.nodes[edges[:, 1]], owner
 

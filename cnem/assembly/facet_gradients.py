@@ -41,6 +41,7 @@ from ..errors import GeometryError
 from ..shape.natural3d import inside_tetrahedra
 from .interface_facets import InterfacePieces, interface_pieces, on_triangles
 from .smoothed_gradient import SmoothedGradient
+from .._sets import distinct, isin
 
 __all__ = ["facet_points", "facet_gradient", "boundary_points_3d", "pyramid_sub_cells", "cell_gradient_3d",
            "model_interface_pieces", "sub_cell_gradient_3d", "merged_across_holes"]
@@ -280,7 +281,7 @@ def pyramid_sub_cells(node_xyz: np.ndarray, facet_triangles: np.ndarray, facet_c
         across = np.where(paired, owner[edge_group[np.maximum(twin, 0)]], -1)
         give = todo & (across >= 0)
         if not give.any():
-            bad = np.unique(edge_cell[todo])[:5]
+            bad = distinct(edge_cell[todo])[:5]
             raise GeometryError(f"cells {bad.tolist()}: every facet passes through the cell's "
                                 "node; expected cells of positive volume")
         largest = np.full(n_groups, -np.inf)
@@ -389,7 +390,7 @@ def _t_junction_pieces(p, q, cell, size):
         Each piece along ``a``'s direction.
     """
     order = np.argsort(cell, kind="stable")
-    bounds = np.searchsorted(cell[order], np.unique(cell), side="left")
+    bounds = np.searchsorted(cell[order], distinct(cell), side="left")
     count = np.diff(np.append(bounds, len(order)))
     # all pairs of edges within a cell
     first = np.repeat(bounds, count * count)
@@ -520,11 +521,11 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
         bad = point[astray[~paired[astray]]][:3]
         raise GeometryError(f"expected the centroids of the cells' boundary facets to lie in "
                             f"the body, received {bad.tolist()} outside; refine the cloud there")
-    split = np.isin(group, astray)
+    split = isin(group, astray)
     between = model.boundary_face_regions[:, 1] >= 0
     return interface_pieces(cells.facet_triangles, cells.facet_normal, group,
                             model.nodes[model.boundary_faces[between]], size,
-                            also=np.isin(group, lone[~outer]) | split, split=split)
+                            also=isin(group, lone[~outer]) | split, split=split)
 
 
 def _pair_tolerance(model):

@@ -19,6 +19,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
+from .._sets import distinct
 
 __all__ = ["InterfacePieces", "interface_pieces", "on_triangles"]
 
@@ -131,7 +132,7 @@ def interface_pieces(facet_triangles: np.ndarray, facet_normal: np.ndarray,
     ga, gb = facet_group[ta], facet_group[tb]
     covered = np.bincount(np.concatenate([ga, gb]), weights=np.concatenate([total, total]),
                           minlength=len(area_normal))
-    facets = np.unique(facet_group[on])
+    facets = distinct(facet_group[on])
     _check_cover(np.linalg.norm(area_normal[facets], axis=1), covered[facets])
     flux_a, flux_b = (area_normal[g] * (total / covered[g])[:, None] for g in (ga, gb))
     return InterfacePieces(moment / total[:, None], flux_a, flux_b, ta, tb, on)

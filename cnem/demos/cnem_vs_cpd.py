@@ -99,6 +99,7 @@ from cnem.demos.cpd.pictures import compare_picture
 from cnem.demos.cpd.torsion import SAINT_VENANT_SQUARE, grip_loads, twist_cnem, twist_cpd
 from cnem.demos.cpd.torsion_picture import torsion_picture
 from cnem.demos.cpd.versus import run_cnem, run_cpd
+from .._sets import distinct
 
 if TYPE_CHECKING:
     from typing import Sequence
@@ -236,7 +237,7 @@ def lshape(h: float, factors: Sequence[float], steps: int, cloud: str) -> dict:
              f"({cloud}, h = {h / 2:g}), BondContinuum n = 1, mu = 1, u_y = {pull:g} at the top "
              f"of the left arm: u_y / pull along column (s < 0) and row (s > 0)",
              f"{'s':>8}" + "".join(f"{k:>12}" for k in profile)]
-    for k in np.unique(np.linspace(0, len(s) - 1, 7).round().astype(int)):
+    for k in distinct(np.linspace(0, len(s) - 1, 7).round().astype(int)):
         lines.append(f"{s[k]:>8.3f}" + "".join(f"{p[k]:>12.4f}" for p in profile.values()))
     for name, line in (("row", row), ("column", column)):
         scale = np.linalg.norm(ref[line], axis=1).max()

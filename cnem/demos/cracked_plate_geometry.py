@@ -42,6 +42,7 @@ import cnem.io
 import cnem.plot
 from cnem.cli import demo_parser, positive_float, positive_int
 from cnem.geometry import SegmentKind, rectangle
+from .._sets import distinct
 
 if TYPE_CHECKING:
     from typing import Sequence
@@ -113,7 +114,7 @@ def main(h: float = 0.1, h_min: float = 0.01, gamma_deg: float = 30.0, growth: f
     model = cnem.discretize(cloud, progress=False)
     seconds = time.perf_counter() - t0
 
-    crack_points = np.unique(cloud.segments[cloud.segment_kind == SegmentKind.CRACK])
+    crack_points = distinct(cloud.segments[cloud.segment_kind == SegmentKind.CRACK])
     exact_area = (2 * HALF_WIDTH) ** 2
     cell_area = float(model.cells.area.sum())
     files = {"vtu": cnem.io.write(model, out / "cracked_plate.vtu")}

@@ -83,6 +83,7 @@ from cnem.errors import InputError
 from cnem.exact import rayleigh_speed
 from cnem.pd import cracks
 from cnem.pd.guards import checked_schedule
+from .._sets import distinct
 
 if TYPE_CHECKING:
     from typing import Literal, Sequence
@@ -259,7 +260,7 @@ def _plots(problem, shape, run, res, h, out, montage=6):
     from cnem.plot.charts import offscreen_pyplot
     plt = offscreen_pyplot()
     times = res["times"]
-    picks = np.unique(np.linspace(0, len(times) - 1, montage).round().astype(int))
+    picks = distinct(np.linspace(0, len(times) - 1, montage).round().astype(int))
     rows = (len(picks) + 1) // 2
     fig, axes = plt.subplots(rows, 2, figsize=(9.6, 1.9 * rows + 0.7), sharex=True, sharey=True,
                              layout="constrained")

@@ -26,6 +26,7 @@ from ..errors import GeometryError
 from ..geometry.model import check_model
 from ..solvers.conditions import Conditions, traction_at
 from ..solvers.facet_loads import facet_loads
+from .._sets import isin
 
 if TYPE_CHECKING:
     from ..geometry.domain import Domain
@@ -133,7 +134,7 @@ class ModelProblem(Conditions):
         if self._boundary_points is None:
             self._boundary_points = boundary_points_3d(self.model, self.gradients.interface())
         points, area_normal, face = self._boundary_points
-        take = np.isin(face, faces)
+        take = isin(face, faces)
         area = np.linalg.norm(area_normal[take], axis=1)
         tr = traction_at(t, points[take], area_normal[take] / area[:, None])
         return np.asarray(self.model.shape_functions(points[take]).T @ (area[:, None] * tr))

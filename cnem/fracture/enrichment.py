@@ -28,6 +28,7 @@ from ..assembly.edge_quadrature import boundary_quadrature
 from ..errors import FractureError, InputError, check_choice, check_real
 from ..geometry.topology import circumcenters
 from .williams import sided_polar
+from .._sets import isin
 
 if TYPE_CHECKING:
     from typing import Callable
@@ -196,12 +197,12 @@ class Enrichment:
         """Per tip, a radius about it holding the supports of its enriched functions
         (the circumcircles of the triangles at the enriched nodes)."""
         tri = self.model.triangles
-        at = np.isin(tri, self.nodes).any(axis=1)
+        at = isin(tri, self.nodes).any(axis=1)
         centre = circumcenters(self.model.nodes, tri[at])
         reach = np.hypot(*(self.model.nodes[tri[at, 0]] - centre).T)
         out = np.zeros(len(self.tips))
         for t in range(len(self.tips)):
-            mine = np.isin(tri[at], self.nodes[self.tip_of == t]).any(axis=1)
+            mine = isin(tri[at], self.nodes[self.tip_of == t]).any(axis=1)
             if mine.any():
                 out[t] = (np.hypot(*(centre[mine] - self.tips[t]).T) + reach[mine]).max()
         return out

@@ -31,6 +31,7 @@ from ..errors import FractureError, SIFWarning, check_array, check_real
 from ..material import effective_modulus
 from .discs import clearance, default_radii, local_spacing
 from .williams import williams
+from .._sets import distinct
 
 if TYPE_CHECKING:
     from typing import Any
@@ -97,7 +98,7 @@ def _disc_integrals(sol, at, d, radii, order):
         raise FractureError(f"radius {np.min(radii):g} holds no integration point about the tip "
                             f"{at.tolist()}; expected at least one: choose a larger radius")
     cell, local, r, w = near[cell[inside]], local[inside], r[inside], weights[inside]
-    regions = np.unique(sol.cells.region[cell])
+    regions = distinct(sol.cells.region[cell])
     if len(regions) > 1:
         raise FractureError(f"the disc of radius {big:g} about the tip {at.tolist()} reaches "
                             f"into regions {regions.tolist()}; the interaction integral needs one "

@@ -46,6 +46,7 @@ from ._kernels import FAST, fan_regions, fast_cells, place_rows
 from ._mesh_kernels import close_neighbours
 from .halfplane import HalfPlaneCells
 from .topology import circumcenters, constraint_edges, triangle_neighbors, vertex_triangles
+from .._sets import distinct, isin
 
 __all__ = ["voronoi_cells"]
 
@@ -248,7 +249,7 @@ class _ExactCells:
             inside = dist <= radius * (1.0 - _BAND)
             far = dist[inside & (dist > tiny)]
             if not (~inside & (dist <= radius * (1.0 + _BAND))).any() and \
-                    len(np.unique(far)) == len(far):
+                    len(distinct(far)) == len(far):
                 return near[inside], dist[inside]
         if self.node_tree is None:
             self.node_tree = cKDTree(self.nodes)
@@ -290,7 +291,7 @@ class _ExactCells:
         w /= np.linalg.norm(w, axis=1)[:, None]
         angle = np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], (u * v).sum(axis=1))
         after = {int(a): t for t, a in enumerate(first)}
-        starts = np.flatnonzero(~np.isin(first, last))
+        starts = np.flatnonzero(~isin(first, last))
         sectors = []
         for t in starts:
             chain = [int(t)]
@@ -465,7 +466,7 @@ def voronoi_cells(nodes: np.ndarray, triangles: np.ndarray, region: np.ndarray, 
     cc = circumcenters(nodes, triangles)
     resolution = 0.0 if frame is None else frame.resolution
     max_deg = int(np.diff(offsets).max())
-    which = np.arange(n, dtype=np.int64) if only is None else np.unique(np.asarray(only, dtype=np.int64))
+    which = np.arange(n, dtype=np.int64) if only is None else distinct(np.asarray(only, dtype=np.int64))
     extent = bounding_box(nodes)
     # a cell has at most one vertex per triangle of its node plus three: each node
     # writes into its own room of one array (placed by `_in_place_of_slow`)

@@ -38,6 +38,7 @@ from ._cells3d_kernels import clear_of_faces, dual_facets
 from .cells3d_clip import GeneralCells
 from .cells3d_convex import convex_cells
 from .tetrahedra import signed_volumes, tet_neighbors
+from .._sets import distinct
 
 __all__ = ["Cells3D", "constrained_voronoi_cells"]
 
@@ -201,7 +202,7 @@ def constrained_voronoi_cells(points: ArrayLike, tetrahedra: ArrayLike, tet_regi
     face_regions = np.ascontiguousarray(boundary_face_regions, dtype=np.int64)
     n = len(points)
     n_reg = int(tet_region.max()) + 1
-    pair = np.unique(np.repeat(tet_region, 4) + n_reg * tets.ravel())
+    pair = distinct(np.repeat(tet_region, 4) + n_reg * tets.ravel())
     cell_node, cell_region = pair // n_reg, pair % n_reg
     single = np.bincount(cell_node, minlength=n) == 1
     cell_of = np.full(n, -1, dtype=np.int64)

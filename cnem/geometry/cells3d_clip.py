@@ -42,6 +42,7 @@ from ..errors import GeometryError
 from .polytope import _ON, Plane, Polytope, cut, subtract
 from .smooth_patches import blocking_sides
 from .tet_pieces import RegionTets, connected, open_facets
+from .._sets import distinct
 
 __all__ = ["GeneralCells"]
 
@@ -92,7 +93,7 @@ class GeneralCells:
             mine = np.where(inner[idx], 0, 1)
             self.region_faces.append((idx, sign[:, None] * normal[idx], cKDTree(centroid[idx]),
                                       blocking[idx, mine], reentrant[idx, mine]))
-            nodes = np.unique(tets[tet_region == r])
+            nodes = distinct(tets[tet_region == r])
             self.region_nodes.append((nodes, cKDTree(points[nodes])))
         self.region_tets = RegionTets(points, tets, tet_region, faces)
         edge_len = np.zeros(len(points))

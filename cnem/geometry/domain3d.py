@@ -24,6 +24,7 @@ from .surface_checks import (check_closed, check_faces, check_self_intersections
                              face_components)
 from .surface_queries import (face_tree, faces_within, region_weights, region_winding,
                               solid_angle_winding)
+from .._sets import distinct
 
 __all__ = ["Domain3D"]
 
@@ -192,7 +193,7 @@ class Domain3D:
             faces = self._orient(local, faces, role, r)
             region_faces.append(faces)
             region_names.append(names)
-        used = np.unique(np.concatenate(region_faces))
+        used = distinct(np.concatenate(region_faces))
         renumber = np.full(len(local), -1)
         renumber[used] = np.arange(len(used))
         self._local = np.ascontiguousarray(local[used])
@@ -222,7 +223,7 @@ class Domain3D:
                     depth[c] += w > 0.5
         cavity = depth % 2 == 1
         for c in range(count):
-            roles = np.unique(role[comp == c])
+            roles = distinct(role[comp == c])
             if (roles >= 0).any() and not cavity[c]:
                 raise GeometryError(
                     f"region {r} cavity {roles.max()} is not inside the region's shell; give "

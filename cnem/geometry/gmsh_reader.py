@@ -20,6 +20,7 @@ import numpy as np
 
 from ..errors import FormatError, GeometryError
 from .outlines import chain_pieces, drop_straight_vertices, outline_tolerance, polygons_from_rings
+from .._sets import distinct, isin
 
 __all__ = ["read_gmsh"]
 
@@ -83,7 +84,7 @@ def _outlines(edges, points, named_vertices, tol, path):
     rings = []
     for ring in chain_pieces(edges, path, points):
         ids = np.array([edges[p, 0] if forward else edges[p, 1] for p, forward in ring])
-        rings.append(drop_straight_vertices(points[ids], np.isin(ids, named_vertices), tol))
+        rings.append(drop_straight_vertices(points[ids], isin(ids, named_vertices), tol))
     return polygons_from_rings(rings, path)
 
 
@@ -124,7 +125,7 @@ def read_gmsh(path: str | os.PathLike) -> dict:
                           "mesh (in gmsh: Mesh > 2D, then save)")
     tol = outline_tolerance(points)
     boundaries, named_vertices = {}, [np.empty(0, dtype=np.int64)]
-    for tag in np.unique(line_tag[line_tag > 0]):
+    for tag in distinct(line_tag[line_tag > 0]):
         segs = lines[line_tag == tag]
         boundaries[names.get((1, int(tag)), str(tag))] = points[segs]
         # where a group ends (one of its segments there) the outline keeps a corner
@@ -133,7 +134,7 @@ def read_gmsh(path: str | os.PathLike) -> dict:
     named_vertices = np.concatenate(named_vertices)
     regions, region_names = [], []
     if len(surface):
-        for tag in np.unique(surface_tag):
+        for tag in distinct(surface_tag):
             polygons = _outlines(_once(surface[surface_tag == tag]), points, named_vertices,
                                  tol, path)
             regions += polygons

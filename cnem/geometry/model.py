@@ -25,6 +25,7 @@ from .topology import (circumcenters, constraint_edges, cut_between_regions,
                        triangle_neighbors, vertex_triangles)
 
 from .triangulation import constrained_delaunay
+from .._sets import distinct
 
 if TYPE_CHECKING:
     from .domain import Domain
@@ -245,7 +246,7 @@ class Model:
         """
         if isinstance(name_or_predicate, str):
             return np.flatnonzero(self.domain.on_boundary(self.nodes, name_or_predicate))
-        on = np.unique(self.segments[self.segment_kind == SegmentKind.BOUNDARY])
+        on = distinct(self.segments[self.segment_kind == SegmentKind.BOUNDARY])
         return boundary_subset(self.nodes, on, name_or_predicate)
 
     def node_sides(self) -> np.ndarray:

@@ -35,6 +35,7 @@ from .cloud import NodeCloud
 from .domain3d import Domain3D
 from .selection import boundary_subset
 from .tetrahedra import conforming_tetrahedra
+from .._sets import distinct
 
 __all__ = ["Model3D", "discretize_3d"]
 
@@ -163,7 +164,7 @@ class Model3D:
             raise ConditionError(f"{name_or_predicate!r}: a 3-D body has no named boundaries "
                                  "yet; select the nodes with a predicate (p, 3) -> (p,) bool")
         faces, _ = self.boundary_with_normals()
-        return boundary_subset(self.nodes, np.unique(faces), name_or_predicate)
+        return boundary_subset(self.nodes, distinct(faces), name_or_predicate)
 
     def __repr__(self):
         added = int(np.count_nonzero(self.node_of_point < 0))

@@ -35,6 +35,7 @@ from .spacing import count_along as _count_along
 from .spacing import check_seed as _check_seed
 from .spacing import check_spacing as _check_spacing
 from .spacing import point_spacing as _point_spacing
+from .._sets import isin
 
 if TYPE_CHECKING:
     from .domain import Domain
@@ -393,7 +394,7 @@ def from_points(domain: Domain, points: ArrayLike, *, fill: bool = True) -> Node
     seg_of = np.concatenate([seg_of, filled_edge])
     pts = np.concatenate([pts, filled])
     # a crack edge between two tips with no point on it gets its midpoint
-    lonely = np.flatnonzero(_tip_to_tip(domain) & ~np.isin(np.arange(len(edges)), seg_of))
+    lonely = np.flatnonzero(_tip_to_tip(domain) & ~isin(np.arange(len(edges)), seg_of))
     mids = 0.5 * (v[edges[lonely, 0]] + v[edges[lonely, 1]])
     seg_of = np.concatenate([seg_of, lonely])
     pts = np.concatenate([pts, mids])

@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from .._sets import distinct
 
 __all__ = ["Polytope", "Plane", "cut", "subtract"]
 
@@ -120,7 +121,7 @@ class Polytope:
             faces.append((np.array(cap)[np.argsort(ang)], plane))
         if len(faces) < 4:
             return None
-        used = np.unique(np.concatenate([f for f, _ in faces]))
+        used = distinct(np.concatenate([f for f, _ in faces]))
         renum = np.full(len(verts), -1)
         renum[used] = np.arange(len(used))
         return Polytope(verts[used], [(renum[f], pl) for f, pl in faces])

@@ -30,6 +30,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from .. import config
+from .._sets import isin
 
 __all__ = ["blocking_sides"]
 
@@ -97,7 +98,7 @@ def blocking_sides(points: ArrayLike, faces: ArrayLike,
     sharp = np.zeros(len(face), dtype=bool)
     sharp[ea[reentrant & ~smooth]] = True
     sharp[eb[reentrant & ~smooth]] = True
-    sharp[entry[np.isin(edge, np.flatnonzero(uses != 2))]] = True   # non-manifold edges
+    sharp[entry[isin(edge, np.flatnonzero(uses != 2))]] = True   # non-manifold edges
     blocking = np.zeros(patch.max(initial=-1) + 1, dtype=bool)
     blocking[patch[sharp]] = True
     bent = np.zeros(len(face), dtype=bool)

@@ -30,6 +30,7 @@ from .pslg import SegmentKind
 from .face_batch import fill_faces
 from .spacing import SpacingLaw, count_along
 from .surface_checks import edge_table
+from .._sets import distinct, isin
 
 if TYPE_CHECKING:
     from .domain3d import Domain3D
@@ -181,7 +182,7 @@ def _triangulate_patch(points, first_new, normal, patch_faces, segs, inner, law,
     origin, u, v = _patch_frame(points, normal, segs)
     # the patch's own vertices off its border (a fan's centre) are nodes inside it too
     inner = np.setdiff1d(np.concatenate([inner, patch_faces.ravel()]), segs.ravel())
-    ids = np.unique(np.concatenate([segs.ravel(), inner]))
+    ids = distinct(np.concatenate([segs.ravel(), inner]))
     xy = np.column_stack([(points[ids] - origin) @ u, (points[ids] - origin) @ v])
     tri2d = np.stack([np.column_stack([(points[f] - origin) @ u, (points[f] - origin) @ v])
                       for f in patch_faces.T], axis=1)
@@ -300,7 +301,7 @@ def sample_surface(dom: Domain3D, law: SpacingLaw, rng: np.random.Generator | No
                          vertices, law if fill else None)
     faces_out.append(dom.faces[plain])
     regions_out.append(dom.face_regions[plain])
-    todo = np.unique(patch[~plain])
+    todo = distinct(patch[~plain])
     members = np.argsort(patch, kind="stable")
     member_start = np.searchsorted(patch[members], np.arange(patch.max() + 2))
     # single faces (curved surfaces) at a uniform spacing, with no user's point inside: at once
@@ -347,7 +348,7 @@ def _plain_faces(faces, patch, face_edge, border, seg_start, ppatch, area, edges
     alone = size[patch] == 1
     pieces = seg_start[1:] - seg_start[:-1]
     split = (pieces[face_edge] > 1).any(axis=1)
-    pinned = np.isin(patch, ppatch[ppatch >= 0])
+    pinned = isin(patch, ppatch[ppatch >= 0])
     length = np.linalg.norm(vertices[edges[face_edge, 1]] - vertices[edges[face_edge, 0]],
                             axis=2).sum(axis=1)
     inradius = 2 * area / length

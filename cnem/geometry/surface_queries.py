@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..spatial import RTree
+from .._sets import distinct
 
 __all__ = ["triangle_distance", "faces_within", "face_tree", "solid_angle_winding",
            "region_winding", "region_weights"]
@@ -233,7 +234,7 @@ def region_winding(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray,
     out = np.zeros((len(points), weights.shape[1]))
     hit = np.flatnonzero(covered)[above]
     np.add.at(out, point[hit], sigma[above][:, None] * weights[cand[hit]])
-    redo = np.unique(point[unsure])
+    redo = distinct(point[unsure])
     if len(redo):
         out[redo] = np.rint(solid_angle_winding(points[redo], vertices, faces, weights))
     return out

@@ -33,7 +33,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import Delaunay
 
-from .._sets import isin
+from .._sets import distinct, isin
 from ..errors import GeometryError
 from .face_refinement import refine_faces
 
@@ -298,7 +298,7 @@ class _TieRecovery:
         hull = [sorted(f) for f, m in count.items() if m == 1]
         v_old = np.abs(signed_volumes(p, old)).sum()
         fits = []
-        for apex in np.unique(old).tolist():
+        for apex in distinct(old).tolist():
             new = np.array([[apex, *f] for f in hull if apex not in f], dtype=np.int64)
             flat = ~_solid(p, new) if len(new) else np.zeros(0, dtype=bool)
             if len(new) == 0 or (flat.any() and not push) or \
@@ -361,7 +361,7 @@ class _TieRecovery:
         if ends and ends != {frozenset((a, c, b)), frozenset((a, c, d))}:
             return False                       # an open ring must end at the tied pair
         v_old = np.abs(signed_volumes(p, old)).sum()
-        verts = np.unique(old)
+        verts = distinct(old)
         for apex in (b, d):                        # a cone from either end of the diagonal
             caps = [f for f, m in count.items() if m == 1 and not {a, c} <= f and apex not in f]
             new = np.array([[apex, *sorted(f)] for f in caps], dtype=np.int64).reshape(-1, 4)
@@ -432,7 +432,7 @@ def _remove_flats(points, tets, faces, scale):
     flat = np.flatnonzero(~_solid(points, tets))
     if len(flat) == 0:
         return tets
-    fixer = _TieRecovery(points, tets, np.unique(tets[flat]), scale)
+    fixer = _TieRecovery(points, tets, distinct(tets[flat]), scale)
     keep = {frozenset(f) for f in faces.tolist()}
     todo = flat.tolist()
     for _ in range(16):
@@ -590,7 +590,7 @@ def conforming_tetrahedra(points: ArrayLike, boundary_faces: ArrayLike,
         missing = _missing_faces(points, tets, faces)
         for _ in range(3):            # each pass may leave a face held by a sliver only
             if len(missing):
-                fixer = _TieRecovery(points, tets, np.unique(faces[missing]), scale)
+                fixer = _TieRecovery(points, tets, distinct(faces[missing]), scale)
                 for f in missing.tolist():
                     fixer.recover(faces[f])
                 tets = fixer.result()

@@ -10,6 +10,7 @@ from .. import config
 from ..errors import InputError, check_array, check_points
 from ..spatial import family_search, remove_crossing
 from ._kernels import bond_geometry, image_factors
+from .._sets import distinct
 
 if TYPE_CHECKING:
     from ..geometry.cloud import NodeCloud
@@ -189,7 +190,7 @@ class Body:
         if cloud.dim == 3:
             return cls._from_model_3d(model, horizon_factor, thickness)
         area = np.bincount(model.cells.node, weights=model.cells.area, minlength=len(model.nodes))
-        h = np.sqrt(model.domain.area / len(np.unique(model.node_of_point)))
+        h = np.sqrt(model.domain.area / len(distinct(model.node_of_point)))
         copies = np.bincount(model.node_of_point)[model.node_of_point] > 1
         # a crack-face copy is nudged towards its own face for the crossing test only,
         # in the model's local frame (at 1e8 a nudge of 1e-6 h would round away)

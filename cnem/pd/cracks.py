@@ -27,6 +27,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..errors import GeometryError, check_array
+from .._sets import distinct, isin
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -94,7 +95,7 @@ def crack_region(image: np.ndarray, origin: np.ndarray, spacing: float, start: n
     r = int(np.ceil(_length("reach", reach, "distance (typically the horizon)") / h))
     col, row = _index_at(start[0], x0, h), _index_at(start[1], y0, h)
     near = labels[max(col - r, 0):col + r, max(row - r, 0):row + r]
-    return np.isin(labels, np.unique(near[near > 0]))
+    return isin(labels, distinct(near[near > 0]))
 
 
 def crack_tip(mask: np.ndarray, origin: ArrayLike, spacing: float, start_x: float) -> float:

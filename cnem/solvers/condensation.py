@@ -30,6 +30,7 @@ from .._aliases import renamed_attributes
 from ..errors import InputError
 from . import _condense_kernels as kernels
 from .multigrid import parallel_operator
+from .._sets import distinct
 
 __all__ = ["free_dofs", "principal_submatrix", "FreeBlock", "free_system", "condensed_system"]
 
@@ -198,7 +199,7 @@ def free_system(K: sp.spmatrix, f: np.ndarray, *, x: np.ndarray, D: np.ndarray
                              f"{vector.shape}; pass one value per dof")
     I = free_dofs(n, D)
     if K.format == "csc":                      # the fixed columns, a few (once each)
-        D = np.unique(np.asarray(D, dtype=np.int64))
+        D = distinct(np.asarray(D, dtype=np.int64))
         lifted = K[:, D] @ x[D]
     else:
         xd = x.astype(float)

@@ -28,6 +28,7 @@ import numpy as np
 
 from .. import config
 from ..errors import ConditionError, UnsupportedError, check_array, check_points, check_real
+from .._sets import distinct
 
 
 if TYPE_CHECKING:
@@ -79,7 +80,7 @@ def select_nodes(nodes: np.ndarray, where: str | Callable[..., np.ndarray] | Arr
         if named is None:
             raise ConditionError(f"where={where!r}: boundary names need a problem on a domain; "
                                  "select the nodes with a predicate, a mask or indices")
-        return np.unique(np.asarray(named(where), dtype=np.int64))
+        return distinct(np.asarray(named(where), dtype=np.int64))
     if callable(where):
         mask = np.asarray(_call_where(where, nodes))
         if mask.shape != (n,) or mask.dtype != bool:
@@ -99,7 +100,7 @@ def select_nodes(nodes: np.ndarray, where: str | Callable[..., np.ndarray] | Arr
     if arr.ndim > 1:
         raise ConditionError(f"where: expected a flat array of node indices, received shape "
                              f"{arr.shape}; pass e.g. np.array([0, 4, 7])")
-    idx = np.unique(arr.astype(np.int64).reshape(-1))
+    idx = distinct(arr.astype(np.int64).reshape(-1))
     if idx.size and (idx[0] < 0 or idx[-1] >= n):
         raise ConditionError(f"where: node indices must lie in [0, {n}), received "
                              f"[{idx[0]}, {idx[-1]}]; index the model's nodes")

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 import cnem.pd as pd
+from ..._sets import distinct
 
 if TYPE_CHECKING:
     from typing import Sequence
@@ -51,7 +52,7 @@ def convergence_table(title: str, history: Sequence[float], labels: Sequence[str
                       columns: int = 5) -> str:
     """The residual norms per Newton iteration (rows) of up to ``columns`` load steps
     (evenly chosen, always the last), like the paper's Tables 4-8."""
-    pick = np.unique(np.linspace(0, len(history) - 1, min(columns, len(history))).round()
+    pick = distinct(np.linspace(0, len(history) - 1, min(columns, len(history))).round()
                      .astype(int))
     rows = max(len(history[k]) for k in pick)
     lines = [title, "iteration" + "".join(f"{labels[k]:>14}" for k in pick)]

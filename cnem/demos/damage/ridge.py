@@ -18,6 +18,7 @@ from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
 from cnem.errors import GeometryError
+from ..._sets import distinct, isin
 
 __all__ = ["ridge_path", "ridge_bands"]
 
@@ -158,8 +159,8 @@ def ridge_path(points: ArrayLike, field: ArrayLike, start: ArrayLike, *, thresho
     pieces = sparse.csr_matrix((np.ones(same.sum()), (links.row[same], links.col[same])),
                                shape=links.shape)
     _, piece = csgraph.connected_components(pieces, directed=False)
-    on_spine = np.unique(piece[spine])
-    keep = np.isin(piece, on_spine) & (bins >= 0)
+    on_spine = distinct(piece[spine])
+    keep = isin(piece, on_spine) & (bins >= 0)
     vertices = []
     for b in range(bins[far] + 1):
         sel = keep & (bins == b)

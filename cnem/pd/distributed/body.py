@@ -12,6 +12,7 @@ from ..body import bond_reach, checked_input, crack_segments
 from . import _kernels as K
 from .comm import Halo, collectively, same_on_every_rank, world
 from .partition import bisect, ghost_candidates
+from ..._sets import distinct
 
 if TYPE_CHECKING:
     from typing import Any
@@ -89,7 +90,7 @@ class Body:
         self.part = bisect(pts, weights, size)
         owned = np.flatnonzero(self.part == rank)
         offsets, members = self._owned_rows(self.part, rank)
-        ghosts = np.setdiff1d(np.unique(members), owned)
+        ghosts = np.setdiff1d(distinct(members), owned)
         self.owned, self.ghosts = owned, ghosts
         local = np.concatenate([owned, ghosts])
         index = np.int32 if len(local) < 2 ** 31 - 1 else np.int64

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...spatial import RTree
+from ..._sets import distinct
 
 __all__ = ["bisect", "ghost_candidates"]
 
@@ -77,5 +78,5 @@ def ghost_candidates(points: np.ndarray, part: np.ndarray, rank: int, reach: flo
     lo, hi = own.min(axis=0) - reach, own.max(axis=0) + reach
     tree = RTree.from_points(points, period=period)
     _, hits = tree.query(lo[None, :], hi[None, :])
-    hits = np.unique(hits)
+    hits = distinct(hits)
     return hits[~mine[hits]]
