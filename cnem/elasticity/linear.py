@@ -241,8 +241,8 @@ class Elasticity(ModelProblem):
         constant ``C`` per cell (a linear law); a state-dependent tangent needs the
         difference form.
         """
+        coarse = self.basis.grad                 # first: it keeps the fan's for below
         sub, grad = self.gradients.fan(release=True)
-        coarse = self.basis.grad
         stacked = [sp.vstack([a, b], format="csr") for a, b in zip(coarse, grad)]
         del grad
         node = np.concatenate([self.cells.node, sub.node])
