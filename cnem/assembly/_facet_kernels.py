@@ -8,11 +8,7 @@ import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from .._parallel import parallel_kernel
-
-
-@numba.njit(cache=True, inline="always")
-def _chunk(ch, nch, n):
-    return ch * n // nch, (ch + 1) * n // nch
+from . import _sparse_kernels as SK
 
 
 @parallel_kernel("ptr")
@@ -39,42 +35,15 @@ def weighted_rows(ptr, item, weight, v_ptr, v_idx, v_val, ncol, nch):
     data : (d, nnz) float64
     """
     m, d = len(ptr) - 1, weight.shape[1]
-    counts = np.zeros(m, dtype=np.int64)
-    for ch in numba.prange(nch):
-        mark = np.full(ncol, -1, dtype=np.int64)
-        lo, hi = _chunk(ch, nch, m)
-        for i in range(lo, hi):
-            count = 0
-            for p in range(ptr[i], ptr[i + 1]):
-                r = item[p]
-                for k in range(v_ptr[r], v_ptr[r + 1]):
-                    if mark[v_idx[k]] != i:
-                        mark[v_idx[k]] = i
-                        count += 1
-            counts[i] = count
-    indptr = np.zeros(m + 1, dtype=np.int64)
-    for i in range(m):
-        indptr[i + 1] = indptr[i] + counts[i]
+    indptr = SK._offsets(SK._block_counts(ptr, item, v_ptr, v_idx, ncol, nch))
     indices = np.empty(indptr[m], dtype=np.int32)
     data = np.zeros((d, indptr[m]))
     for ch in numba.prange(nch):
         slot = np.full(ncol, -1, dtype=np.int64)
-        lo, hi = _chunk(ch, nch, m)
-        for i in range(lo, hi):
-            start = indptr[i]
-            end = start
-            for p in range(ptr[i], ptr[i + 1]):             # the row's columns ...
-                r = item[p]
-                for k in range(v_ptr[r], v_ptr[r + 1]):
-                    j = v_idx[k]
-                    if slot[j] < start:
-                        slot[j] = start
-                        indices[end] = j
-                        end += 1
-            indices[start:end].sort()                       # ... in order
-            for e in range(start, end):
-                slot[indices[e]] = e
-            for p in range(ptr[i], ptr[i + 1]):             # then their values
+        lo, hi = SK._chunk(ch, nch, m)
+        for i in range(lo, hi):                             # the row's columns, sorted ...
+            SK._block_row_columns(i, ptr, item, v_ptr, v_idx, indptr[i], slot, indices)
+            for p in range(ptr[i], ptr[i + 1]):             # ... then their values
                 r = item[p]
                 for k in range(v_ptr[r], v_ptr[r + 1]):
                     at = slot[v_idx[k]]
