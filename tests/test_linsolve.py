@@ -78,6 +78,27 @@ def test_amg_solution_is_the_direct_one(name, enrich, weight, caplog):
     np.testing.assert_allclose(amg.u, direct.u, atol=1e-9 * scale)
 
 
+def test_amg_solution_is_the_direct_one_in_3d(caplog):
+    """In 3-D the stabilised K is smoothed with itself on the finest level of the P1
+    hierarchy (the P1 hierarchy alone needs five times the CG iterations), and pyamg + CG
+    gives the direct solution."""
+    box = cnem.geometry.box((0.0, 0.0, 0.0), (2.0, 1.0, 1.0))
+    model = cnem.discretize(cnem.nodes.irregular(box, 0.25, seed=2))
+
+    def solve(method):
+        prob = cnem.Elasticity(model, (E, NU))
+        prob.add_dirichlet(lambda p: p[:, 0] < 1e-9, None)
+        prob.add_traction(lambda x, nrm: nrm[:, 0] > 0.5, [1.0, -2.0, 3.0])
+        return prob.solve(method=method, tol=1e-12, progress=False)
+
+    direct = solve("direct")
+    with caplog.at_level("INFO", logger="cnem.solvers.linsolve"):
+        amg = solve("amg")
+    assert "pyamg (hierarchy on the preconditioner matrix, smoothing with the matrix) + CG" \
+        in caplog.text
+    np.testing.assert_allclose(amg.u, direct.u, atol=1e-9 * np.abs(direct.u).max())
+
+
 def _laplacian(n):
     """A 1-D Dirichlet Laplacian ``(n, n)`` (SPD)."""
     return sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1], format="csr")

@@ -287,11 +287,13 @@ def _transpose_pattern(ptr, idx, ncol):
 def _block_counts(t_ptr, t_row, ptr, idx, ncol, nch):
     """Number of node columns in every block row of ``G^T G`` (``G`` the CSR pattern
     ``ptr, idx``, its columns ``t_ptr, t_row``), ``(ncol,)`` (inlined: its loop over
-    chunks runs in parallel in the parallel copy of the caller)."""
-    counts = np.zeros(ncol, dtype=np.int64)
+    chunks runs in parallel in the parallel copy of the caller); for any ``t_ptr, t_row``
+    (rows of ``G`` summed per output row), the columns of each of its rows."""
+    rows = t_ptr.shape[0] - 1
+    counts = np.zeros(rows, dtype=np.int64)
     for ch in numba.prange(nch):
         mark = np.full(ncol, -1, dtype=np.int64)
-        lo, hi = _chunk(ch, nch, ncol)
+        lo, hi = _chunk(ch, nch, rows)
         for i in range(lo, hi):
             count = 0
             for t in range(t_ptr[i], t_ptr[i + 1]):

@@ -37,8 +37,10 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 from .. import config
+from .._parallel import work_chunks
 from ..errors import GeometryError
 from ..shape.natural3d import inside_tetrahedra
+from . import _facet_kernels as FK
 from .interface_facets import InterfacePieces, interface_pieces, on_triangles
 from .smoothed_gradient import SmoothedGradient
 from .._sets import distinct, isin
@@ -196,12 +198,19 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
         column = np.concatenate([column, at, at[other]])
         cell = np.concatenate([cell, a, b[other]])
         flux = np.concatenate([flux, flux_a, flux_b[other]])
-    phi = evaluate(points)
+    phi = evaluate(points).tocsr()
     q = len(points)
-    parts = []
-    for i in range(3):
-        to_cell = sp.csr_matrix((flux[:, i] / volume[cell], (cell, column)), shape=(m, q))
-        parts.append((to_cell @ phi).tocsr())
+    # each cell's points in the order of their columns, the three directions on one
+    # pattern (what `cnem.assembly.forms` assembles by node blocks)
+    order = np.lexsort((column, cell))
+    ptr = np.zeros(m + 1, dtype=np.int64)
+    np.cumsum(np.bincount(cell, minlength=m), out=ptr[1:])
+    weight = np.ascontiguousarray((flux / volume[cell][:, None])[order])
+    indptr, indices, data = FK.weighted_rows(ptr, column[order], weight,
+                                             phi.indptr.astype(np.int64), phi.indices,
+                                             phi.data, phi.shape[1], work_chunks())
+    parts = [sp.csr_matrix((data[i], indices, indptr), shape=(m, phi.shape[1]))
+             for i in range(3)]
     return SmoothedGradient(*parts, points=q)
 
 
@@ -419,18 +428,8 @@ def _has_reverse(owner, p, q):
 
 def _reverse_in(owner, p, q):
     """The index of the edge ``q -> p`` of the same owner for each edge ``p -> q``, -1 if none."""
-    key_pq = _edge_keys(owner, p, q)
-    key_qp = _edge_keys(owner, q, p)
-    order = np.argsort(key_pq, kind="stable")
-    pos = np.minimum(np.searchsorted(key_pq[order], key_qp), max(len(order) - 1, 0))
-    twin = order[pos] if len(order) else np.zeros(0, dtype=np.int64)
-    return np.where(key_pq[twin] == key_qp, twin, -1)
-
-
-def _edge_keys(cell, p, q):
-    """One hashable key per (cell, directed edge) from exact coordinates (rows of bytes)."""
-    rows = np.column_stack([cell.astype(np.float64), p, q])
-    return np.ascontiguousarray(rows).view(np.dtype((np.void, rows.dtype.itemsize * 7))).ravel()
+    bits = [np.ascontiguousarray(x, dtype=np.float64).view(np.uint64) for x in (p, q)]
+    return FK.reverse_edges(np.asarray(owner, dtype=np.int64), *bits)
 
 
 def cell_gradient_3d(model: Any, cells: Any,

@@ -209,7 +209,8 @@ def solve_spd(A: sp.spmatrix | FreeBlock, b: np.ndarray, *, modes: np.ndarray | 
         With a preconditioner matrix: smooth the finest level with ``A`` itself
         (its coarse levels stay the preconditioner's), for matrices whose
         low-energy oscillating modes the preconditioner matrix lacks (plain SCNI
-        against P1: 35 CG iterations instead of 246 at 100k nodes).
+        against P1: 35 CG iterations instead of 246 at 100k nodes; stabilised 3-D
+        SCNI: 59 instead of 291 at 10k nodes).
     nodal : (N,) bool array_like, optional
         The dofs of the nodal shape functions; the others are enrichment dofs.
         With enrichment dofs, CG is preconditioned by the sum of smoothed aggregation

@@ -92,7 +92,8 @@ class VCycle(spla.LinearOperator):
     top : sparse (N, N), optional
         The finest level's matrix for the sweeps and the residual (default: the
         hierarchy's own). It is swept as one block (plain, sequential Gauss-Seidel): the
-        oscillating low-energy modes of plain SCNI's K, for which it is given, are
+        oscillating low-energy modes of plain SCNI's K (and of 3-D SCNI's), for which it
+        is given, are
         what the smoothing there must remove, and the Jacobi coupling across blocks
         leaves them (50 CG iterations instead of 41 at 100k nodes with 16 blocks).
 
