@@ -44,17 +44,22 @@ def test_small_twist_torque_is_saint_venants_and_the_axial_force_second_order():
     +1-2 % at L = 4 a; five spacings across the section; the demo's stabilised C-NEM
     gives 1.27, 1.01 and 1.08 at 4, 5 and 8 spacings across), linear in the twist, and
     the axial force is second order (the Poynting effect): 4 times larger at twice the
-    twist."""
+    twist. The lattice's Delaunay ties are broken one way, so the discrete column is not
+    quite symmetric and N has a small part odd in the twist (3 % of it at 0.5 degree):
+    the even part, from twisting both ways, is the second-order one."""
     length = 4.0
     model = cnem.discretize(cnem.nodes.regular(
         cnem.geometry.box((0.0, 0.0, 0.0), (1.0, 1.0, length)), 0.2), progress=False)
     angles = np.radians([0.5, 1.0])
-    run = twist_cnem(model, 1.0, length, angles)
-    torque, axial = grip_loads(model.nodes, run)
+    torque, axial = grip_loads(model.nodes, twist_cnem(model, 1.0, length, angles))
+    back_torque, back_axial = grip_loads(model.nodes, twist_cnem(model, 1.0, length, -angles))
     saint_venant = SAINT_VENANT_SQUARE * angles / length
     assert np.all(np.abs(torque / saint_venant - 1.0) < 0.10), torque / saint_venant
     assert abs(torque[1] / torque[0] - 2.0) < 2e-3
-    assert abs(axial[1] / axial[0] - 4.0) < 0.02
+    np.testing.assert_allclose(back_torque, -torque, rtol=1e-3)
+    even, odd = (axial + back_axial) / 2, (axial - back_axial) / 2
+    assert abs(even[1] / even[0] - 4.0) < 4e-3
+    assert np.all(np.abs(odd) < 0.05 * np.abs(even))
     assert abs(axial[1]) < 0.05 * abs(torque[1])
 
 
