@@ -131,7 +131,8 @@ def region_surfaces(points, faces, face_regions):
     """
     out = []
     for r in range(int(face_regions.max()) + 1):
-        own = np.concatenate([faces[face_regions[:, 0] == r], faces[face_regions[:, 1] == r, ::-1]])
+        own = np.concatenate([faces[face_regions[:, 0] == r],
+                              faces[face_regions[:, 1] == r, ::-1]])
         used, local = np.unique(own, return_inverse=True)
         out.append((points[used], local.reshape(own.shape)))
     return out

@@ -26,7 +26,8 @@ from test_interface_facets import (A, LOWER, UPPER, Z_INTERFACE, _bimaterial_fie
 
 #: Each region's exact volume: the L-block's two halves, the cavity box's.
 CAVITY_HALF = 0.5 - (1.0 / 3.0) ** 2 / 6.0
-BODIES = {"two_material_l_block": (0.375, 0.375), "two_material_cavity": (CAVITY_HALF, CAVITY_HALF)}
+BODIES = {"two_material_l_block": (0.375, 0.375),
+          "two_material_cavity": (CAVITY_HALF, CAVITY_HALF)}
 
 
 def _voigt(s):
@@ -120,7 +121,8 @@ def test_a_right_triangle_splits_on_its_hypotenuse(seed):
     ring = np.array([[-1.0, 0.0], [np.cos(angle[1]), np.sin(angle[1])], [1.0, 0.0],
                      [np.cos(angle[0]), np.sin(angle[0])]])    # counter-clockwise
     edge = np.roll(ring, -1, axis=0) - ring
-    apex = 0.5 * (ring + np.roll(ring, -1, axis=0)) + 0.8 * np.column_stack([edge[:, 1], -edge[:, 0]])
+    outward = np.column_stack([edge[:, 1], -edge[:, 0]])
+    apex = 0.5 * (ring + np.roll(ring, -1, axis=0)) + 0.8 * outward
     flat = np.concatenate([ring, apex])
     frame = np.linalg.qr(rng.normal(size=(3, 3)))[0]
     points = np.column_stack([flat, np.zeros(len(flat))]) @ frame.T * 0.37 + rng.normal(size=3)

@@ -4,10 +4,10 @@ A boundary face is a face of the Delaunay tetrahedrisation when some sphere thro
 three nodes holds no other node. `refine_faces` splits the faces that are missing
 (Ruppert's rule: at the circumcentre, or at the midpoint of an edge when the
 circumcentre falls outside the face or on its border, or encroaches an edge that cannot
-flip), then restores the Delaunay property of every planar patch by edge flips (Lawson). Without
-the flips a node inserted at one face's circumcentre falls inside its neighbours'
-circumcircles: they go missing in turn, and the splitting runs along the surface
-without end.
+flip), then restores the Delaunay property of every planar patch by edge flips
+(Lawson). Without the flips a node inserted at one face's circumcentre falls inside its
+neighbours' circumcircles: they go missing in turn, and the splitting runs along the
+surface without end.
 
 Edges shared by exactly two coplanar faces with the same regions flip; feature edges,
 region borders and interface borders (three or more faces) never do. The refined faces
