@@ -113,6 +113,53 @@ def slotted(n=6, *, gap=0.02, jitter=0.3, seed=4):
     return voxel_body(*axes, labels, jitter=jitter, seed=seed)
 
 
+def region_surfaces(points, faces, face_regions):
+    """The closed surface of every region of a voxel body, as `cnem.Domain3D` takes them.
+
+    Parameters
+    ----------
+    points : (n, 3) ndarray
+    faces : (b, 3) int64 ndarray
+    face_regions : (b, 2) int64 ndarray
+        As `voxel_body` returns them (normals out of ``face_regions[:, 0]``).
+
+    Returns
+    -------
+    list of ((k, 3) ndarray, (f, 3) int64 ndarray)
+        Region ``r``'s vertices and its faces oriented outwards (an interface face is in
+        both regions' surfaces, once each way round).
+    """
+    out = []
+    for r in range(int(face_regions.max()) + 1):
+        own = np.concatenate([faces[face_regions[:, 0] == r],
+                              faces[face_regions[:, 1] == r, ::-1]])
+        used, local = np.unique(own, return_inverse=True)
+        out.append((points[used], local.reshape(own.shape)))
+    return out
+
+
+def two_material_l_block():
+    """The L-block of `l_block` (two voxels a side), region 0 below z = 0.5 and region 1
+    above: the interface meets the re-entrant edge."""
+    labels = np.zeros((2, 2, 2), dtype=int)
+    labels[:, :, 1] = 1
+    labels[1, 1, :] = -1
+    axes = [np.linspace(0.0, 1.0, 3)] * 3
+    return region_surfaces(*voxel_body(*axes, labels))
+
+
+def two_material_cavity():
+    """The unit cube with the cubic cavity of `box_with_cavity` (a third of its side at
+    its centre), region 0 below z = 0.5 and region 1 above: the interface cuts the
+    cavity in half."""
+    third = np.linspace(0.0, 1.0, 4)
+    zs = np.array([0.0, 1.0 / 3.0, 0.5, 2.0 / 3.0, 1.0])
+    labels = np.zeros((3, 3, 4), dtype=int)
+    labels[:, :, 2:] = 1
+    labels[1, 1, 1:3] = -1
+    return region_surfaces(*voxel_body(third, third, zs, labels))
+
+
 def segments_blocked(a, b, tri):
     """Whether each segment ``a[k] -> b[k]`` crosses the interior of a triangle of ``tri``.
 

@@ -492,7 +492,9 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
     """`interface_pieces` of a 3-D model's cells on its interface faces and on their
     shadow facets (in the plane of a boundary or interface face beyond its border,
     where the cells of the two sides cut the plane differently: their facet points
-    find no partner and lie on no boundary face), and on the facets whose centroid
+    find no partner, and the triangles lie on no boundary face; a cell's facet in a
+    face's plane can be partly on the face and partly beyond it, and only the part
+    beyond is cut into pieces), and on the facets whose centroid
     lies outside the body (non-convex facets round a re-entrant edge: one point per
     overlap of the two sides' triangles).
 
@@ -505,14 +507,20 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
     -------
     InterfacePieces
     """
-    group, _, point, area_normal = _grouped_facet_points(cells.facet_triangles, cells.facet_cell,
+    tri = cells.facet_triangles
+    group, _, point, area_normal = _grouped_facet_points(tri, cells.facet_cell,
                                                          cells.facet_normal)
     size, tol = _pair_tolerance(model)
-    # shadow facets: unpaired, and on no boundary face
+    # shadow triangles: of an unpaired facet, and on no boundary face (one facet in a
+    # face's plane can be partly on the face and partly its shadow beyond the face's
+    # border, which the cells on the other side cut differently)
     paired = _paired(point, area_normal, tol)
-    lone = np.flatnonzero(~paired)
+    lone = np.flatnonzero(~paired[group])
     faces, normal = model.boundary_with_normals()
-    outer = _face_holding(point[lone], area_normal[lone], model.nodes[faces], normal, tol) >= 0
+    outer = _face_holding(tri[lone].mean(axis=1), cells.facet_normal[lone], model.nodes[faces],
+                          normal, tol) >= 0
+    shadow = np.zeros(len(tri), dtype=bool)
+    shadow[lone[~outer]] = True
     # a non-convex facet (wrapping a re-entrant edge) whose centroid lies outside the body:
     # one point per piece of the two sides' triangles, each inside its triangles
     astray = np.flatnonzero(~inside_tetrahedra(model.tet_mesh(), point))
@@ -522,9 +530,9 @@ def model_interface_pieces(model: Any, cells: Any) -> InterfacePieces:
                             f"the body, received {bad.tolist()} outside; refine the cloud there")
     split = isin(group, astray)
     between = model.boundary_face_regions[:, 1] >= 0
-    return interface_pieces(cells.facet_triangles, cells.facet_normal, group,
+    return interface_pieces(tri, cells.facet_normal, group,
                             model.nodes[model.boundary_faces[between]], size,
-                            also=isin(group, lone[~outer]) | split, split=split)
+                            also=shadow | split, split=split)
 
 
 def _pair_tolerance(model):

@@ -3,11 +3,11 @@
 A boundary face is a face of the Delaunay tetrahedrisation when some sphere through its
 three nodes holds no other node. `refine_faces` splits the faces that are missing
 (Ruppert's rule: at the circumcentre, or at the midpoint of an edge when the
-circumcentre falls outside the face or encroaches an edge that cannot flip), then
-restores the Delaunay property of every planar patch by edge flips (Lawson). Without
-the flips a node inserted at one face's circumcentre falls inside its neighbours'
-circumcircles: they go missing in turn, and the splitting runs along the surface
-without end.
+circumcentre falls outside the face or on its border, or encroaches an edge that cannot
+flip), then restores the Delaunay property of every planar patch by edge flips
+(Lawson). Without the flips a node inserted at one face's circumcentre falls inside its
+neighbours' circumcircles: they go missing in turn, and the splitting runs along the
+surface without end.
 
 Edges shared by exactly two coplanar faces with the same regions flip; feature edges,
 region borders and interface borders (three or more faces) never do. The refined faces
@@ -25,6 +25,10 @@ _COPLANAR = 1e-10
 #: An edge flips when the far node lies inside the circumcircle by more than this
 #: fraction of its squared radius (cocircular ties do not flip back and forth).
 _IN_CIRCLE = 1e-9
+#: A face splits at its circumcentre only when the centre's barycentric coordinates
+#: exceed this: a centre on an edge (a right triangle's, on its hypotenuse) would make a
+#: face of no area there, so the edge splits at its midpoint instead (the same point).
+_INSIDE = 1e-9
 
 
 def _circle(x):
@@ -96,7 +100,7 @@ class _Surface:
             if np.sum((centre - mid) ** 2) < 0.25 * lengths[i] and \
                     self._flippable(frozenset((u, v))) is None:
                 return self.split_edge(u, v)
-        if bary.min() > 0 and bary.sum() < 1:
+        if bary.min() > _INSIDE and bary.sum() < 1 - _INSIDE:
             c = len(self.points)
             self.points.append(centre)
             self._remove(k)
