@@ -37,6 +37,7 @@ from ..errors import GeometryError
 from ._cells3d_kernels import clear_of_faces, dual_facets
 from .cells3d_clip import GeneralCells
 from .cells3d_convex import convex_cells
+from .cells3d_curved import curved_cells
 from .tetrahedra import signed_volumes, tet_neighbors
 from .._sets import distinct
 
@@ -221,7 +222,13 @@ def constrained_voronoi_cells(points: ArrayLike, tetrahedra: ArrayLike, tet_regi
     done, b_tri, b_cell, b_nrm, b_vol = convex_cells(general, cell_node[slow], cell_region[slow])
     volume[slow[done]] = b_vol[done]
     parts_t, parts_c, parts_n = [b_tri], [slow[b_cell]], [b_nrm]
-    for k in slow[~done].tolist():
+    rest = slow[~done]
+    done, c_tri, c_cell, c_nrm, c_vol = curved_cells(general, cell_node[rest], cell_region[rest])
+    volume[rest[done]] = c_vol[done]
+    parts_t.append(c_tri)
+    parts_c.append(rest[c_cell])
+    parts_n.append(c_nrm)
+    for k in rest[~done].tolist():
         t, nr, vol = general.cell(int(cell_node[k]), int(cell_region[k]))
         parts_t.append(t)
         parts_c.append(np.full(len(t), k, dtype=np.int64))
