@@ -143,7 +143,6 @@ def test_curved_cells_in_bulk_equal_the_general_path_cell_by_cell(name):
     """The numba kernels' cells (`cells3d_curved`: Voronoi polytopes cut by the region's
     tetrahedra, or one polytope where the faces in reach are convex) are those of
     `GeneralCells.cell`: same volume, and per facet plane the same area and centroid."""
-    from test_cells3d import _per_plane
     from cnem.geometry.cells3d_clip import GeneralCells
     from cnem.geometry.cells3d_curved import curved_cells
     _, tet, cells = _cells(name)
@@ -154,13 +153,8 @@ def test_curved_cells_in_bulk_equal_the_general_path_cell_by_cell(name):
     done, tri, cell, normal, volume = curved_cells(general, node, region)
     assert done.all()                   # nothing blocks: every boundary cell is the kernels'
     for k in range(len(node)):
-        t, n, v = general.cell(int(node[k]), int(region[k]))
-        assert volume[k] == pytest.approx(v, rel=1e-12)
-        keys, area, centroid = _per_plane(tri[cell == k], normal[cell == k])
-        want_keys, want_area, want_centroid = _per_plane(t, n)
-        np.testing.assert_array_equal(keys, want_keys)
-        np.testing.assert_allclose(area, want_area, rtol=0, atol=1e-12 * want_area.max())
-        np.testing.assert_allclose(centroid, want_centroid, rtol=0, atol=1e-12)
+        cases3d.assert_same_cell((tri[cell == k], normal[cell == k], volume[k]),
+                                 general.cell(int(node[k]), int(region[k])))
 
 
 def test_a_cell_split_by_the_region_is_refused(monkeypatch):

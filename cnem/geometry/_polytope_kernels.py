@@ -336,6 +336,40 @@ def _radius(nv, vx):
     return np.sqrt(top)
 
 
+@numba.njit(cache=True)
+def scratch(fcap):
+    """A polytope's arrays ``(vx, start, idx, normal, offset, kind, ident)`` and `clip`'s
+    work arrays, for polytopes of at most ``fcap`` faces."""
+    vcap = 6 * fcap
+    poly = (np.empty((vcap, 3)), np.empty(fcap + 1, dtype=np.int64),
+            np.empty(12 * fcap, dtype=np.int64), np.empty((fcap, 3)), np.empty(fcap),
+            np.empty(fcap, dtype=np.int64), np.empty(fcap, dtype=np.int64))
+    work = (np.empty(vcap), np.empty((vcap, 3)), np.empty((3 * fcap, 3), dtype=np.int64),
+            np.empty(vcap, dtype=np.int64), np.empty(vcap), np.empty(vcap, dtype=np.int64),
+            np.empty(fcap + 1, dtype=np.int64), np.empty(12 * fcap, dtype=np.int64))
+    return poly, work
+
+
+@numba.njit(cache=True)
+def outputs(w, out_ptr):
+    """A cell kernel's outputs for ``w`` cells (see `convex_cells`): whether it writes
+    (``out_ptr`` not empty), ``status`` (all `REFUSED`), ``ntri``, ``vol``, ``tri``,
+    ``normal``."""
+    write = out_ptr.shape[0] > 0
+    q = out_ptr[w] if write else 0
+    return (write, np.full(w, REFUSED, dtype=np.int8), np.zeros(w, dtype=np.int64),
+            np.zeros(w), np.empty((q, 3, 3)), np.empty((q, 3)))
+
+
+@numba.njit(cache=True)
+def widest(ptr, first, last):
+    """The longest of the rows ``first .. last - 1`` of the CSR ``ptr`` (at least 1)."""
+    most = 1
+    for s in range(first, last):
+        most = max(most, ptr[s + 1] - ptr[s])
+    return most
+
+
 @parallel_kernel("cell_node")
 def convex_cells(points, faces, cell_node, half, scale, face_ptr, face_rows, table_face,
                  table_normal, near, near_far, out_ptr, chunks):
@@ -381,32 +415,17 @@ def convex_cells(points, faces, cell_node, half, scale, face_ptr, face_rows, tab
         Their outward unit normals.
     """
     w, k_near = cell_node.shape[0], near.shape[1]
-    write = out_ptr.shape[0] > 0
-    q = out_ptr[w] if write else 0
-    status = np.full(w, REFUSED, dtype=np.int8)
-    ntri = np.zeros(w, dtype=np.int64)
-    vol = np.zeros(w)
-    tri = np.empty((q, 3, 3))
-    normal_out = np.empty((q, 3))
+    write, status, ntri, vol, tri, normal_out = outputs(w, out_ptr)
     nch = max(1, min(chunks, w))
     for ch in numba.prange(nch):
         first, last = ch * w // nch, (ch + 1) * w // nch
-        most = 1
-        for s in range(first, last):
-            most = max(most, face_ptr[s + 1] - face_ptr[s])
-        fcap = 6 + most + k_near
-        vcap = 6 * fcap
+        most = widest(face_ptr, first, last)
         fx, fn, fo = np.empty((most, 3, 3)), np.empty((most, 3)), np.empty(most)
         key, fid = np.empty((most, 4)), np.empty(most, dtype=np.int64)
         order = np.empty(most, dtype=np.int64)
         y, dist = np.empty((k_near, 3)), np.empty(k_near)
         yid, rank = np.empty(k_near, dtype=np.int64), np.empty(k_near, dtype=np.int64)
-        poly = (np.empty((vcap, 3)), np.empty(fcap + 1, dtype=np.int64),
-                np.empty(12 * fcap, dtype=np.int64), np.empty((fcap, 3)), np.empty(fcap),
-                np.empty(fcap, dtype=np.int64), np.empty(fcap, dtype=np.int64))
-        work = (np.empty(vcap), np.empty((vcap, 3)), np.empty((3 * fcap, 3), dtype=np.int64),
-                np.empty(vcap, dtype=np.int64), np.empty(vcap), np.empty(vcap, dtype=np.int64),
-                np.empty(fcap + 1, dtype=np.int64), np.empty(12 * fcap, dtype=np.int64))
+        poly, work = scratch(6 + most + k_near)
         vx, start, idx, normal = poly[0], poly[1], poly[2], poly[3]
         for s in range(first, last):
             i = cell_node[s]

@@ -17,8 +17,8 @@ import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from .._parallel import parallel_kernel
-from ._polytope_kernels import (BISECTOR, BOX, DONE, GROW, ON, REFLEX, REFUSED, _box,
-                                _face_planes, clip, volume)
+from ._polytope_kernels import (BISECTOR, BOX, DONE, GROW, ON, REFLEX, _box, _face_planes,
+                                clip, outputs, scratch, volume, widest)
 from .tetrahedra import _FACES
 
 #: Tag of a face between two tetrahedra of the region (its ident: the face's key).
@@ -30,21 +30,6 @@ FLAT = 1e-10
 #: Face vertex indices counter-clockwise from outside, for each orientation of a tetrahedron.
 _TURNED = (np.ascontiguousarray(_FACES.astype(np.int64)),
            np.ascontiguousarray(_FACES[:, ::-1].astype(np.int64)))
-
-
-@numba.njit(cache=True)
-def _scratch(n_near, n_faces):
-    """A polytope's arrays ``(vx, start, idx, normal, offset, kind, ident)`` and `clip`'s
-    work arrays, for polytopes of at most ``6 + n_near + n_faces`` faces."""
-    fcap = 6 + n_faces + n_near
-    vcap = 6 * fcap
-    poly = (np.empty((vcap, 3)), np.empty(fcap + 1, dtype=np.int64),
-            np.empty(12 * fcap, dtype=np.int64), np.empty((fcap, 3)), np.empty(fcap),
-            np.empty(fcap, dtype=np.int64), np.empty(fcap, dtype=np.int64))
-    work = (np.empty(vcap), np.empty((vcap, 3)), np.empty((3 * fcap, 3), dtype=np.int64),
-            np.empty(vcap, dtype=np.int64), np.empty(vcap), np.empty(vcap, dtype=np.int64),
-            np.empty(fcap + 1, dtype=np.int64), np.empty(12 * fcap, dtype=np.int64))
-    return poly, work
 
 
 @numba.njit(cache=True)
@@ -144,16 +129,13 @@ def voronoi_balls(points, faces, cell_node, half, scale, face_ptr, face_rows, ta
     nch = max(1, min(chunks, w))
     for ch in numba.prange(nch):
         first, last = ch * w // nch, (ch + 1) * w // nch
-        most_f, most_n = 1, 1
-        for t in range(first, last):
-            most_f = max(most_f, face_ptr[t + 1] - face_ptr[t])
-            most_n = max(most_n, near_ptr[t + 1] - near_ptr[t])
+        most_f, most_n = widest(face_ptr, first, last), widest(near_ptr, first, last)
         fx, fn, fo = np.empty((most_f, 3, 3)), np.empty((most_f, 3)), np.empty(most_f)
         key, fid = np.empty((most_f, 4)), np.empty(most_f, dtype=np.int64)
         order = np.empty(most_f, dtype=np.int64)
         y, dist = np.empty((most_n, 3)), np.empty(most_n)
         yid = np.empty(most_n, dtype=np.int64)
-        poly, work = _scratch(most_n, 0)
+        poly, work = scratch(6 + most_n)
         vx = poly[0]
         for t in range(first, last):
             i = cell_node[t]
@@ -308,24 +290,15 @@ def tet_cut_cells(points, tets, tet_kind, tet_ident, face_key, cell_node, half, 
         Their outward unit normals.
     """
     w = cell_node.shape[0]
-    write = out_ptr.shape[0] > 0
-    q = out_ptr[w] if write else 0
-    status = np.full(w, REFUSED, dtype=np.int8)
-    ntri = np.zeros(w, dtype=np.int64)
-    vol = np.zeros(w)
-    tri = np.empty((q, 3, 3))
-    normal_out = np.empty((q, 3))
+    write, status, ntri, vol, tri, normal_out = outputs(w, out_ptr)
     nch = max(1, min(chunks, w))
     for ch in numba.prange(nch):
         first, last = ch * w // nch, (ch + 1) * w // nch
-        most_n, most_t = 1, 1
-        for t in range(first, last):
-            most_n = max(most_n, near_ptr[t + 1] - near_ptr[t])
-            most_t = max(most_t, tet_ptr[t + 1] - tet_ptr[t])
+        most_n, most_t = widest(near_ptr, first, last), widest(tet_ptr, first, last)
         y, dist = np.empty((most_n, 3)), np.empty(most_n)
         yid = np.empty(most_n, dtype=np.int64)
-        poly, work = _scratch(most_n, 4)
-        piece, _ = _scratch(most_n, 4)
+        poly, work = scratch(10 + most_n)           # the cube's faces, a tetrahedron's
+        piece, _ = scratch(10 + most_n)
         vx, start, idx, normal, offset, kind, ident = poly
         pvx, pstart, pidx, pnormal, poffset, pkind, pident = piece
         side, tv, made, cap, ang, used, tstart, tidx = work

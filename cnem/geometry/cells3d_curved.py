@@ -45,17 +45,11 @@ def curved_cells(general: GeneralCells, node: np.ndarray,
 
     Returns
     -------
-    done : (w,) bool ndarray
-        The cells computed here (the others: `GeneralCells.cell`).
-    triangles : (q, 3, 3) float64 ndarray
-        Their facet triangles, counter-clockwise from outside, cell by cell in the
-        order of ``node``.
-    cell : (q,) int64 ndarray
-        The position in ``node`` of each triangle's cell.
-    normal : (q, 3) float64 ndarray
-        Outward unit normals.
-    volume : (w,) float64 ndarray
-        The cells' volumes (0 where not ``done``).
+    done, triangles, cell, normal, volume
+        As `.cells3d_convex.convex_cells`: the cells computed here (the others:
+        `GeneralCells.cell`), their facet triangles ``(q, 3, 3)`` cell by cell in the
+        order of ``node``, the position in ``node`` of each triangle's cell ``(q,)``,
+        the outward unit normals ``(q, 3)`` and the volumes ``(w,)`` (0 where not done).
     """
     w = len(node)
     done = np.zeros(w, dtype=bool)
@@ -68,7 +62,7 @@ def curved_cells(general: GeneralCells, node: np.ndarray,
                 volume)
     table_face, table_normal, first_row = _face_table(general)
     table_bent = np.concatenate([f[4] for f in general.region_faces])
-    tags = _tet_tags(general)
+    tags = None                                 # the tetrahedra's tags, when a cell needs them
     for _ in range(_GROW):                      # each round doubles the cubes of some cells
         if len(todo) == 0:
             break
@@ -80,25 +74,16 @@ def curved_cells(general: GeneralCells, node: np.ndarray,
                                               table_normal, table_bent, near_ptr, near_ids,
                                               work_chunks())
         status = np.full(len(todo), REFUSED, dtype=np.int8)
-        # the faces in reach are in convex position: one polytope
         one = np.flatnonzero(route == CONVEX)
-        rows_csr, near_csr = _subset(rows_ptr, rows, one), _subset(near_ptr, near_ids, one)
-        padded = _padded(*near_csr)
-        status[one] = _counted_then_written(
-            lambda sub, out: _convex_kernel(
-                general.points, general.faces, n[one][sub], hf[one][sub], general.scale,
-                *_subset(*rows_csr, sub), table_face, table_normal, padded[sub],
-                np.full(len(sub), np.inf), out, work_chunks()),
-            todo[one], done, volume, parts)
-        # else the polytope cut by the tetrahedra near it
+        status[one] = _one_polytope(general, todo[one], n[one], hf[one],
+                                    _subset(rows_ptr, rows, one), table_face, table_normal,
+                                    _subset(near_ptr, near_ids, one), done, volume, parts)
         cut = np.flatnonzero(route == CUT)
-        near_csr = _subset(near_ptr, near_ids, cut)
-        tet_csr = _near_tets(general, r[cut], centre[cut], radius[cut])
-        status[cut] = _counted_then_written(
-            lambda sub, out: tet_cut_cells(
-                general.points, general.tets, *tags, n[cut][sub], hf[cut][sub], general.scale,
-                *_subset(*near_csr, sub), *_subset(*tet_csr, sub), out, work_chunks()),
-            todo[cut], done, volume, parts)
+        if len(cut) and tags is None:
+            tags = _tet_tags(general)
+        status[cut] = _cut_by_tets(general, todo[cut], n[cut], r[cut], hf[cut], tags,
+                                   _subset(near_ptr, near_ids, cut), centre[cut], radius[cut],
+                                   done, volume, parts)
         grow = todo[status == GROW]
         half[grow] *= 2.0
         grow = grow[half[grow] <= _FIRST_HALF * 2.0 ** (_GROW - 1)]
@@ -106,11 +91,40 @@ def curved_cells(general: GeneralCells, node: np.ndarray,
     return (done,) + _gathered(parts, volume)
 
 
+def _one_polytope(general, cells, node, half, rows_csr, table_face, table_normal, near_csr,
+                  done, volume, parts):
+    """The cells whose faces in reach are in convex position: one polytope each, the cube
+    clipped by the faces' planes and the bisectors (`._polytope_kernels.convex_cells`,
+    given every candidate node). Their statuses; `_counted_then_written` for the rest."""
+    near = _padded(*near_csr)
+    far = np.full(len(cells), np.inf)             # every node that may cut is in ``near``
+    return _counted_then_written(
+        lambda sub, out: _convex_kernel(general.points, general.faces, node[sub], half[sub],
+                                        general.scale, *_subset(*rows_csr, sub), table_face,
+                                        table_normal, near[sub], far[sub], out, work_chunks()),
+        cells, done, volume, parts)
+
+
+def _cut_by_tets(general, cells, node, region, half, tags, near_csr, centre, radius, done,
+                 volume, parts):
+    """The cells whose Voronoi polytopes (balls ``centre``, ``radius``) are cut by the
+    region's tetrahedra near them (`._tet_cut_kernels.tet_cut_cells`). Their statuses;
+    `_counted_then_written` for the rest."""
+    tet_csr = _near_tets(general, region, centre, radius)
+    return _counted_then_written(
+        lambda sub, out: tet_cut_cells(general.points, general.tets, *tags, node[sub],
+                                       half[sub], general.scale, *_subset(*near_csr, sub),
+                                       *_subset(*tet_csr, sub), out, work_chunks()),
+        cells, done, volume, parts)
+
+
 def _counted_then_written(run, cells, done, volume, parts):
     """Run a cell kernel twice: ``run(sub, out_ptr)`` on the rows ``sub`` of ``cells``
     counting (``out_ptr`` empty), then writing the `DONE` ones; their triangles and
     normals appended to ``parts``, ``done`` and ``volume`` set. The statuses ``(w,)``."""
     every = np.arange(len(cells))
+    if len(every) == 0:
+        return np.zeros(0, dtype=np.int8)
     status, ntri, vol, _, _ = run(every, np.zeros(0, dtype=np.int64))
     sub = np.flatnonzero(status == DONE)
     if len(sub):
