@@ -248,7 +248,7 @@ def _face_planes(points, faces, x0, s, reach, rows, table_face, table_normal, fx
 
 @numba.njit(cache=True)
 def convex_cell(points, faces, i, x0, s, half, rows, table_face, table_normal, near, near_far,
-                fx, fn, fo, key, fid, order, y, dist, yid, rank, poly, work):
+                fx, fn, fo, key, fid, order, y, dist, yid, poly, work):
     """The cell of node ``i`` at ``x0`` (local unit ``s``) in its cube of half-side
     ``half``, when the faces in reach are in convex position: the cube clipped by their
     planes and by the bisectors of the candidate nodes ``near`` (nearest first, -1 past
@@ -284,6 +284,32 @@ def convex_cell(points, faces, i, x0, s, half, rows, table_face, table_normal, n
                       fid[q], side, tv, made, cap, ang, used, tstart, tidx)
         if nv <= 0:
             return REFUSED, 0, 0
+    nv, nf, radius = bisectors(points, i, x0, s, near, y, dist, yid, nv, nf, poly, work)
+    if nv <= 0:
+        return REFUSED, 0, 0
+    if near[-1] >= 0 and 0.5 * near_far / s * (1.0 - 1e-9) < radius:
+        return MORE, nv, nf
+    for f in range(nf):
+        if kind[f] == BOX:
+            return GROW, nv, nf
+    return DONE, nv, nf
+
+
+@numba.njit(cache=True)
+def bisectors(points, i, x0, s, near, y, dist, yid, nv, nf, poly, work):
+    """Clip the polytope ``(nv, nf)`` in ``poly`` by the bisectors of the nodes ``near``
+    that cut it (``i`` skipped, -1 past the last), nearest first; ``y``, ``dist``,
+    ``yid`` are scratch (as long as ``near``).
+
+    Returns
+    -------
+    nv, nf : int
+        The clipped polytope's counts (`clip`'s: ``nv <= 0`` when it failed).
+    radius : float
+        Its largest distance of a vertex from the origin.
+    """
+    vx, start, idx, normal, offset, kind, ident = poly
+    side, tv, made, cap, ang, used, tstart, tidx = work
     m = 0
     for j in near:
         if j < 0:
@@ -294,12 +320,8 @@ def convex_cell(points, faces, i, x0, s, half, rows, table_face, table_normal, n
             y[m, c] = (points[j, c] - x0[c]) / s
         dist[m] = np.sqrt(y[m, 0] * y[m, 0] + y[m, 1] * y[m, 1] + y[m, 2] * y[m, 2])
         yid[m] = j
-        t = m
-        while t > 0 and dist[rank[t - 1]] > dist[m]:      # stable: nearest first
-            rank[t] = rank[t - 1]
-            t -= 1
-        rank[t] = m
         m += 1
+    rank = np.argsort(dist[:m], kind="mergesort")          # stable: nearest first
     radius = _radius(nv, vx)
     u = np.empty(3)
     for k in range(m):
@@ -317,14 +339,9 @@ def convex_cell(points, faces, i, x0, s, half, rows, table_face, table_normal, n
         nv, nf = clip(nv, nf, vx, start, idx, normal, offset, kind, ident, u, hd, BISECTOR,
                       yid[q], side, tv, made, cap, ang, used, tstart, tidx)
         if nv <= 0:
-            return REFUSED, 0, 0
+            return nv, nf, 0.0
         radius = _radius(nv, vx)
-    if near[-1] >= 0 and 0.5 * near_far / s * (1.0 - 1e-9) < radius:
-        return MORE, nv, nf
-    for f in range(nf):
-        if kind[f] == BOX:
-            return GROW, nv, nf
-    return DONE, nv, nf
+    return nv, nf, radius
 
 
 @numba.njit(cache=True)
@@ -424,7 +441,7 @@ def convex_cells(points, faces, cell_node, half, scale, face_ptr, face_rows, tab
         key, fid = np.empty((most, 4)), np.empty(most, dtype=np.int64)
         order = np.empty(most, dtype=np.int64)
         y, dist = np.empty((k_near, 3)), np.empty(k_near)
-        yid, rank = np.empty(k_near, dtype=np.int64), np.empty(k_near, dtype=np.int64)
+        yid = np.empty(k_near, dtype=np.int64)
         poly, work = scratch(6 + most + k_near)
         vx, start, idx, normal = poly[0], poly[1], poly[2], poly[3]
         for s in range(first, last):
@@ -433,7 +450,7 @@ def convex_cells(points, faces, cell_node, half, scale, face_ptr, face_rows, tab
             st, nv, nf = convex_cell(points, faces, i, x0, sc, half[s],
                                      face_rows[face_ptr[s]:face_ptr[s + 1]], table_face,
                                      table_normal, near[s], near_far[s], fx, fn, fo, key, fid,
-                                     order, y, dist, yid, rank, poly, work)
+                                     order, y, dist, yid, poly, work)
             status[s] = st
             if st != DONE:
                 continue

@@ -17,7 +17,7 @@ import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from .._parallel import parallel_kernel
-from ._polytope_kernels import (BISECTOR, BOX, DONE, GROW, ON, REFLEX, _box, _face_planes,
+from ._polytope_kernels import (BOX, DONE, GROW, ON, REFLEX, _box, _face_planes, bisectors,
                                 clip, outputs, scratch, volume, widest)
 from .tetrahedra import _FACES
 
@@ -36,30 +36,9 @@ _TURNED = (np.ascontiguousarray(_FACES.astype(np.int64)),
 def _voronoi(points, i, x0, s, half, near, y, dist, yid, poly, work):
     """The cube of half-side ``half`` clipped by the bisectors of the nodes ``near`` (those
     that cut it, nearest first, ``i`` skipped) into ``poly``; its counts ``(nv, nf)``
-    (`._polytope_kernels.clip`'s, ``nv <= 0`` when it failed)."""
-    vx, start, idx, normal, offset, kind, ident = poly
-    side, tv, made, cap, ang, used, tstart, tidx = work
-    m = 0
-    for j in near:
-        if j == i:
-            continue
-        for c in range(3):
-            y[m, c] = (points[j, c] - x0[c]) / s
-        dist[m] = np.sqrt(y[m, 0] * y[m, 0] + y[m, 1] * y[m, 1] + y[m, 2] * y[m, 2])
-        yid[m] = j
-        m += 1
-    rank = np.argsort(dist[:m], kind="mergesort")
-    nv, nf = _box(half, vx, start, idx, normal, offset, kind, ident)
-    u = np.empty(3)
-    for k in range(m):
-        q = rank[k]
-        hd = 0.5 * dist[q]
-        for c in range(3):
-            u[c] = y[q, c] / dist[q]
-        nv, nf = clip(nv, nf, vx, start, idx, normal, offset, kind, ident, u, hd, BISECTOR,
-                      yid[q], side, tv, made, cap, ang, used, tstart, tidx)
-        if nv <= 0:
-            return nv, nf
+    (``nv <= 0`` when `._polytope_kernels.clip` failed)."""
+    nv, nf = _box(half, *poly)
+    nv, nf, _ = bisectors(points, i, x0, s, near, y, dist, yid, nv, nf, poly, work)
     return nv, nf
 
 

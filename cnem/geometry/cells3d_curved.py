@@ -39,14 +39,12 @@ def curved_cells(general: GeneralCells, node: np.ndarray,
     Parameters
     ----------
     general : GeneralCells
-        The general path's tables of the model.
     node, region : (w,) int64 ndarray
-        The cells to try.
 
     Returns
     -------
     done, triangles, cell, normal, volume
-        As `.cells3d_convex.convex_cells`: the cells computed here (the others:
+        As `.cells3d_convex.convex_cells`: the cells computed here ``(w,)`` (the others:
         `GeneralCells.cell`), their facet triangles ``(q, 3, 3)`` cell by cell in the
         order of ``node``, the position in ``node`` of each triangle's cell ``(q,)``,
         the outward unit normals ``(q, 3)`` and the volumes ``(w,)`` (0 where not done).
