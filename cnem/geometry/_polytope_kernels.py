@@ -247,6 +247,20 @@ def _face_planes(points, faces, x0, s, reach, rows, table_face, table_normal, fx
 
 
 @numba.njit(cache=True)
+def in_convex_position(w, p, fx, fn, fo, order):
+    """Whether no corner of the faces ``fx[:w]`` lies beyond (by more than `REFLEX`) the
+    plane ``fn[q] . x <= fo[q]`` of a face ``q`` in ``order[:p]`` (`_face_planes`)."""
+    for a in range(w):
+        for v in range(3):
+            for k in range(p):
+                q = order[k]
+                if (fx[a, v, 0] * fn[q, 0] + fx[a, v, 1] * fn[q, 1] + fx[a, v, 2] * fn[q, 2]
+                        - fo[q] > REFLEX):
+                    return False
+    return True
+
+
+@numba.njit(cache=True)
 def convex_cell(points, faces, i, x0, s, half, rows, table_face, table_normal, near, near_far,
                 fx, fn, fo, key, fid, order, y, dist, yid, poly, work):
     """The cell of node ``i`` at ``x0`` (local unit ``s``) in its cube of half-side
@@ -270,13 +284,8 @@ def convex_cell(points, faces, i, x0, s, half, rows, table_face, table_normal, n
     reach = np.sqrt(3.0) * half
     w, p = _face_planes(points, faces, x0, s, reach, rows, table_face, table_normal, fx, fn,
                         fo, key, fid, order)
-    for a in range(w):
-        for v in range(3):
-            for k in range(p):
-                q = order[k]
-                if (fx[a, v, 0] * fn[q, 0] + fx[a, v, 1] * fn[q, 1] + fx[a, v, 2] * fn[q, 2]
-                        - fo[q] > REFLEX):
-                    return REFUSED, 0, 0
+    if not in_convex_position(w, p, fx, fn, fo, order):
+        return REFUSED, 0, 0
     nv, nf = _box(half, vx, start, idx, normal, offset, kind, ident)
     for k in range(p):
         q = order[k]
@@ -387,6 +396,22 @@ def widest(ptr, first, last):
     return most
 
 
+@numba.njit(cache=True)
+def write_fan(f, vx, start, idx, normal, s, x0, tri, normal_out, t):
+    """Face ``f`` of a polytope (local frame, unit ``s``, origin ``x0``) as the fan of its
+    vertices into ``tri[t:]`` (global coordinates) and its normal into ``normal_out[t:]``;
+    the next free row."""
+    a = idx[start[f]]
+    for k in range(start[f] + 1, start[f + 1] - 1):
+        for c in range(3):
+            tri[t, 0, c] = vx[a, c] * s + x0[c]
+            tri[t, 1, c] = vx[idx[k], c] * s + x0[c]
+            tri[t, 2, c] = vx[idx[k + 1], c] * s + x0[c]
+            normal_out[t, c] = normal[f, c]
+        t += 1
+    return t
+
+
 @parallel_kernel("cell_node")
 def convex_cells(points, faces, cell_node, half, scale, face_ptr, face_rows, table_face,
                  table_normal, near, near_far, out_ptr, chunks):
@@ -460,12 +485,5 @@ def convex_cells(points, faces, cell_node, half, scale, face_ptr, face_rows, tab
                 continue
             t = out_ptr[s]
             for f in range(nf):
-                a = idx[start[f]]
-                for k in range(start[f] + 1, start[f + 1] - 1):
-                    for c in range(3):
-                        tri[t, 0, c] = vx[a, c] * sc + x0[c]
-                        tri[t, 1, c] = vx[idx[k], c] * sc + x0[c]
-                        tri[t, 2, c] = vx[idx[k + 1], c] * sc + x0[c]
-                        normal_out[t, c] = normal[f, c]
-                    t += 1
+                t = write_fan(f, vx, start, idx, normal, sc, x0, tri, normal_out, t)
     return status, ntri, vol, tri, normal_out

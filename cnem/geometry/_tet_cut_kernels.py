@@ -17,8 +17,9 @@ import numpy as np
 
 from .. import _compile  # noqa: F401  (says once when the kernels compile)
 from .._parallel import parallel_kernel
-from ._polytope_kernels import (BOX, DONE, GROW, ON, REFLEX, _box, _face_planes, bisectors,
-                                clip, outputs, scratch, volume, widest)
+from ._polytope_kernels import (BOX, DONE, GROW, ON, _box, _face_planes, bisectors, clip,
+                                in_convex_position, outputs, scratch, volume, widest,
+                                write_fan)
 from .tetrahedra import _FACES
 
 #: Tag of a face between two tetrahedra of the region (its ident: the face's key).
@@ -55,14 +56,7 @@ def _convex_faces(points, faces, x0, s, reach, rows, table_face, table_normal, t
             if table_bent[row]:
                 return False
             a += 1
-    for b in range(w):
-        for v in range(3):
-            for k in range(p):
-                q = order[k]
-                if (fx[b, v, 0] * fn[q, 0] + fx[b, v, 1] * fn[q, 1] + fx[b, v, 2] * fn[q, 2]
-                        - fo[q] > REFLEX):
-                    return False
-    return True
+    return in_convex_position(w, p, fx, fn, fo, order)
 
 
 @parallel_kernel("cell_node")
@@ -340,16 +334,9 @@ def tet_cut_cells(points, tets, tet_kind, tet_ident, face_key, cell_node, half, 
                         piece_of[n_links], piece_key[n_links] = n_pieces, pident[f]
                         n_links += 1
                         continue
-                    a = pidx[pstart[f]]
-                    for k in range(pstart[f] + 1, pstart[f + 1] - 1):
-                        if write:
-                            for d in range(3):
-                                tri[at, 0, d] = pvx[a, d] * s + x0[d]
-                                tri[at, 1, d] = pvx[pidx[k], d] * s + x0[d]
-                                tri[at, 2, d] = pvx[pidx[k + 1], d] * s + x0[d]
-                                normal_out[at, d] = pnormal[f, d]
-                            at += 1
-                        n_tri += 1
+                    n_tri += pstart[f + 1] - pstart[f] - 2
+                    if write:
+                        at = write_fan(f, pvx, pstart, pidx, pnormal, s, x0, tri, normal_out, at)
                 n_pieces += 1
             if failed or n_pieces == 0:
                 continue
