@@ -157,6 +157,24 @@ def test_curved_cells_in_bulk_equal_the_general_path_cell_by_cell(name):
                                  general.cell(int(node[k]), int(region[k])))
 
 
+@pytest.mark.slow
+def test_curved_cells_in_parallel_equal_the_serial_ones():
+    """The kernels' parallel copies (`cnem._parallel.always_parallel`) give the cells of
+    the serial ones, bit for bit: each cell's work is its own."""
+    from cnem._parallel import always_parallel
+    from cnem.geometry.cells3d_clip import GeneralCells
+    from cnem.geometry.cells3d_curved import curved_cells
+    _, tet, cells = _cells("tube")
+    general = GeneralCells(tet.points, tet.tetrahedra, tet.tet_region, tet.boundary_faces,
+                           tet.boundary_face_regions)
+    serial = curved_cells(general, cells.node, cells.region)
+    with always_parallel():
+        parallel = curved_cells(general, cells.node, cells.region)
+    assert serial[0].sum() > 0
+    for a, b in zip(serial, parallel):
+        np.testing.assert_array_equal(a, b)
+
+
 def test_a_cell_split_by_the_region_is_refused(monkeypatch):
     """Were the pieces of a cell not to meet inside the region, the error names the node
     and asks for a finer cloud."""
