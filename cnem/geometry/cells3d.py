@@ -17,7 +17,9 @@ Two paths compute the cells:
   convex polytopes by bisectors, boundary planes or the region's tetrahedra, and
   the shadows of the blocking faces (see there); its convex case (no face in reach
   hides points or bends the region: a box's faces, edges and corners) for many
-  cells at once in numba (`.cells3d_convex`).
+  cells at once in numba (`.cells3d_convex`), and so its unblocked case near a curved
+  cavity or hole (the Voronoi polytope cut by the region's tetrahedra,
+  `.cells3d_curved`).
 
 The cells partition each region: their volumes sum to the region's volume to
 round-off.
