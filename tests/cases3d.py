@@ -244,3 +244,28 @@ def facet_flux(cells):
     flux = np.stack([np.bincount(cells.facet_cell, weights=cells.facet_normal[:, k] * area,
                                  minlength=m) for k in range(3)], axis=1)
     return flux, np.bincount(cells.facet_cell, weights=area, minlength=m)
+
+
+def assert_same_cell(got, want):
+    """Two computations ``(triangles (q, 3, 3), normals (q, 3), volume)`` of one cell agree:
+    the volume to 1e-12 relative (as ``pytest.approx(rel=1e-12)``), and per facet plane
+    the area and the centroid."""
+    (tri, normal, volume), (want_tri, want_normal, want_volume) = got, want
+    assert abs(volume - want_volume) <= max(1e-12 * abs(want_volume), 1e-12), (volume,
+                                                                                 want_volume)
+    keys, area, centroid = _per_plane(tri, normal)
+    want_keys, want_area, want_centroid = _per_plane(want_tri, want_normal)
+    np.testing.assert_array_equal(keys, want_keys)
+    np.testing.assert_allclose(area, want_area, rtol=0, atol=1e-12 * want_area.max())
+    np.testing.assert_allclose(centroid, want_centroid, rtol=0, atol=1e-12)
+
+
+def _per_plane(tri, normal):
+    """Facet planes (rounded normals) of one cell, the area and centroid on each."""
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    keys, inverse = np.unique(np.round(normal * 1e6), axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    total = np.bincount(inverse, weights=area)
+    moment = np.column_stack([np.bincount(inverse, weights=area * tri[:, :, c].mean(axis=1))
+                              for c in range(3)])
+    return keys, total, moment / total[:, None]

@@ -152,17 +152,6 @@ def test_invariance(shift, scale):
                                atol=tol * ref.volume.max())
 
 
-def _per_plane(tri, normal):
-    """Facet planes (rounded normals) of one cell, the area and centroid on each."""
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    keys, inverse = np.unique(np.round(normal * 1e6), axis=0, return_inverse=True)
-    inverse = inverse.ravel()
-    total = np.bincount(inverse, weights=area)
-    moment = np.column_stack([np.bincount(inverse, weights=area * tri[:, :, c].mean(axis=1))
-                              for c in range(3)])
-    return keys, total, moment / total[:, None]
-
-
 @pytest.mark.parametrize("name", ["box", "stacked"])
 def test_convex_cells_in_bulk_equal_the_general_path_cell_by_cell(name):
     """The numba kernel's convex cells (`cells3d_convex`) are those of `GeneralCells.cell`:
@@ -175,13 +164,8 @@ def test_convex_cells_in_bulk_equal_the_general_path_cell_by_cell(name):
     done, tri, cell, normal, volume = convex_cells(general, cells.node, cells.region)
     assert done.sum() >= len(done) // 2
     for k in np.flatnonzero(done).tolist():
-        t, n, v = general.cell(int(cells.node[k]), int(cells.region[k]))
-        assert volume[k] == pytest.approx(v, rel=1e-12)
-        keys, area, centroid = _per_plane(tri[cell == k], normal[cell == k])
-        want_keys, want_area, want_centroid = _per_plane(t, n)
-        np.testing.assert_array_equal(keys, want_keys)
-        np.testing.assert_allclose(area, want_area, rtol=0, atol=1e-12 * want_area.max())
-        np.testing.assert_allclose(centroid, want_centroid, rtol=0, atol=1e-12)
+        cases3d.assert_same_cell((tri[cell == k], normal[cell == k], volume[k]),
+                                 general.cell(int(cells.node[k]), int(cells.region[k])))
 
 
 def test_cells_beside_a_re_entrant_edge_tile_the_boundary():

@@ -126,10 +126,67 @@ def test_pieces_join_only_through_shared_internal_faces():
     assert connected([up, apart], np.array([[7, 8, 9, 10]]))
 
 
+def test_the_kernel_joins_pieces_only_through_shared_internal_faces():
+    """`_tet_cut_kernels._connected` as `tet_pieces.connected` above: two pieces sharing
+    the internal face 7 are one cell; sharing nothing, two; joined by a flat
+    tetrahedron's faces (7, 8, 9, 10), one again."""
+    from cnem.geometry._tet_cut_kernels import _connected
+    piece_of, none = np.array([0, 1]), np.zeros((0, 4), dtype=np.int64)
+    assert _connected(2, piece_of, np.array([7, 7]), 2, none, 0)
+    assert not _connected(2, piece_of, np.array([7, 8]), 2, none, 0)
+    assert _connected(2, piece_of, np.array([7, 8]), 2, np.array([[7, 8, 9, 10]]), 1)
+    assert _connected(1, piece_of[:1], np.array([7]), 1, none, 0)
+
+
+@pytest.mark.parametrize("name", ["hollow_sphere", "tube"])
+def test_curved_cells_in_bulk_equal_the_general_path_cell_by_cell(name):
+    """The numba kernels' cells (`cells3d_curved`: Voronoi polytopes cut by the region's
+    tetrahedra, or one polytope where the faces in reach are convex) are those of
+    `GeneralCells.cell`: same volume, and per facet plane the same area and centroid."""
+    from cnem.geometry.cells3d_clip import GeneralCells
+    from cnem.geometry.cells3d_curved import curved_cells
+    _, tet, cells = _cells(name)
+    general = GeneralCells(tet.points, tet.tetrahedra, tet.tet_region, tet.boundary_faces,
+                           tet.boundary_face_regions)
+    on_boundary = np.isin(cells.node, tet.boundary_faces)
+    node, region = cells.node[on_boundary], cells.region[on_boundary]
+    done, tri, cell, normal, volume = curved_cells(general, node, region)
+    assert done.all()                   # nothing blocks: every boundary cell is the kernels'
+    for k in range(len(node)):
+        cases3d.assert_same_cell((tri[cell == k], normal[cell == k], volume[k]),
+                                 general.cell(int(node[k]), int(region[k])))
+
+
+@pytest.mark.slow
+def test_curved_cells_in_parallel_equal_the_serial_ones():
+    """The kernels' parallel copies (`cnem._parallel.always_parallel`) give the cells of
+    the serial ones, bit for bit: each cell's work is its own."""
+    from cnem._parallel import always_parallel
+    from cnem.geometry.cells3d_clip import GeneralCells
+    from cnem.geometry.cells3d_curved import curved_cells
+    _, tet, cells = _cells("tube")
+    general = GeneralCells(tet.points, tet.tetrahedra, tet.tet_region, tet.boundary_faces,
+                           tet.boundary_face_regions)
+    serial = curved_cells(general, cells.node, cells.region)
+    with always_parallel():
+        parallel = curved_cells(general, cells.node, cells.region)
+    assert serial[0].sum() > 0
+    for a, b in zip(serial, parallel):
+        np.testing.assert_array_equal(a, b)
+
+
 def test_a_cell_split_by_the_region_is_refused(monkeypatch):
     """Were the pieces of a cell not to meet inside the region, the error names the node
     and asks for a finer cloud."""
+    import cnem.geometry.cells3d as cells3d
     import cnem.geometry.cells3d_clip as clip
+    from cnem.geometry.cells3d_curved import curved_cells
+
+    def declined(general, node, region):            # the kernel's cells: by GeneralCells.cell
+        done, *rest = curved_cells(general, node[:0], region[:0])
+        return (np.zeros(len(node), dtype=bool), *rest[:3], np.zeros(len(node)))
+
+    monkeypatch.setattr(cells3d, "curved_cells", declined)
     monkeypatch.setattr(clip, "connected", lambda pieces, joins: False)
     dom, h = _domain("tube")
     cloud = cnem.nodes.irregular(dom, h, seed=1)

@@ -247,8 +247,22 @@ def _face_planes(points, faces, x0, s, reach, rows, table_face, table_normal, fx
 
 
 @numba.njit(cache=True)
+def in_convex_position(w, p, fx, fn, fo, order):
+    """Whether no corner of the faces ``fx[:w]`` lies beyond (by more than `REFLEX`) the
+    plane ``fn[q] . x <= fo[q]`` of a face ``q`` in ``order[:p]`` (`_face_planes`)."""
+    for a in range(w):
+        for v in range(3):
+            for k in range(p):
+                q = order[k]
+                if (fx[a, v, 0] * fn[q, 0] + fx[a, v, 1] * fn[q, 1] + fx[a, v, 2] * fn[q, 2]
+                        - fo[q] > REFLEX):
+                    return False
+    return True
+
+
+@numba.njit(cache=True)
 def convex_cell(points, faces, i, x0, s, half, rows, table_face, table_normal, near, near_far,
-                fx, fn, fo, key, fid, order, y, dist, yid, rank, poly, work):
+                fx, fn, fo, key, fid, order, y, dist, yid, poly, work):
     """The cell of node ``i`` at ``x0`` (local unit ``s``) in its cube of half-side
     ``half``, when the faces in reach are in convex position: the cube clipped by their
     planes and by the bisectors of the candidate nodes ``near`` (nearest first, -1 past
@@ -270,13 +284,8 @@ def convex_cell(points, faces, i, x0, s, half, rows, table_face, table_normal, n
     reach = np.sqrt(3.0) * half
     w, p = _face_planes(points, faces, x0, s, reach, rows, table_face, table_normal, fx, fn,
                         fo, key, fid, order)
-    for a in range(w):
-        for v in range(3):
-            for k in range(p):
-                q = order[k]
-                if (fx[a, v, 0] * fn[q, 0] + fx[a, v, 1] * fn[q, 1] + fx[a, v, 2] * fn[q, 2]
-                        - fo[q] > REFLEX):
-                    return REFUSED, 0, 0
+    if not in_convex_position(w, p, fx, fn, fo, order):
+        return REFUSED, 0, 0
     nv, nf = _box(half, vx, start, idx, normal, offset, kind, ident)
     for k in range(p):
         q = order[k]
@@ -284,6 +293,32 @@ def convex_cell(points, faces, i, x0, s, half, rows, table_face, table_normal, n
                       fid[q], side, tv, made, cap, ang, used, tstart, tidx)
         if nv <= 0:
             return REFUSED, 0, 0
+    nv, nf, radius = bisectors(points, i, x0, s, near, y, dist, yid, nv, nf, poly, work)
+    if nv <= 0:
+        return REFUSED, 0, 0
+    if near[-1] >= 0 and 0.5 * near_far / s * (1.0 - 1e-9) < radius:
+        return MORE, nv, nf
+    for f in range(nf):
+        if kind[f] == BOX:
+            return GROW, nv, nf
+    return DONE, nv, nf
+
+
+@numba.njit(cache=True)
+def bisectors(points, i, x0, s, near, y, dist, yid, nv, nf, poly, work):
+    """Clip the polytope ``(nv, nf)`` in ``poly`` by the bisectors of the nodes ``near``
+    that cut it (``i`` skipped, -1 past the last), nearest first; ``y``, ``dist``,
+    ``yid`` are scratch (as long as ``near``).
+
+    Returns
+    -------
+    nv, nf : int
+        The clipped polytope's counts (`clip`'s: ``nv <= 0`` when it failed).
+    radius : float
+        Its largest distance of a vertex from the origin.
+    """
+    vx, start, idx, normal, offset, kind, ident = poly
+    side, tv, made, cap, ang, used, tstart, tidx = work
     m = 0
     for j in near:
         if j < 0:
@@ -294,12 +329,8 @@ def convex_cell(points, faces, i, x0, s, half, rows, table_face, table_normal, n
             y[m, c] = (points[j, c] - x0[c]) / s
         dist[m] = np.sqrt(y[m, 0] * y[m, 0] + y[m, 1] * y[m, 1] + y[m, 2] * y[m, 2])
         yid[m] = j
-        t = m
-        while t > 0 and dist[rank[t - 1]] > dist[m]:      # stable: nearest first
-            rank[t] = rank[t - 1]
-            t -= 1
-        rank[t] = m
         m += 1
+    rank = np.argsort(dist[:m], kind="mergesort")          # stable: nearest first
     radius = _radius(nv, vx)
     u = np.empty(3)
     for k in range(m):
@@ -317,14 +348,9 @@ def convex_cell(points, faces, i, x0, s, half, rows, table_face, table_normal, n
         nv, nf = clip(nv, nf, vx, start, idx, normal, offset, kind, ident, u, hd, BISECTOR,
                       yid[q], side, tv, made, cap, ang, used, tstart, tidx)
         if nv <= 0:
-            return REFUSED, 0, 0
+            return nv, nf, 0.0
         radius = _radius(nv, vx)
-    if near[-1] >= 0 and 0.5 * near_far / s * (1.0 - 1e-9) < radius:
-        return MORE, nv, nf
-    for f in range(nf):
-        if kind[f] == BOX:
-            return GROW, nv, nf
-    return DONE, nv, nf
+    return nv, nf, radius
 
 
 @numba.njit(cache=True)
@@ -334,6 +360,56 @@ def _radius(nv, vx):
     for v in range(nv):
         top = max(top, vx[v, 0] * vx[v, 0] + vx[v, 1] * vx[v, 1] + vx[v, 2] * vx[v, 2])
     return np.sqrt(top)
+
+
+@numba.njit(cache=True)
+def scratch(fcap):
+    """A polytope's arrays ``(vx, start, idx, normal, offset, kind, ident)`` and `clip`'s
+    work arrays, for polytopes of at most ``fcap`` faces."""
+    vcap = 6 * fcap
+    poly = (np.empty((vcap, 3)), np.empty(fcap + 1, dtype=np.int64),
+            np.empty(12 * fcap, dtype=np.int64), np.empty((fcap, 3)), np.empty(fcap),
+            np.empty(fcap, dtype=np.int64), np.empty(fcap, dtype=np.int64))
+    work = (np.empty(vcap), np.empty((vcap, 3)), np.empty((3 * fcap, 3), dtype=np.int64),
+            np.empty(vcap, dtype=np.int64), np.empty(vcap), np.empty(vcap, dtype=np.int64),
+            np.empty(fcap + 1, dtype=np.int64), np.empty(12 * fcap, dtype=np.int64))
+    return poly, work
+
+
+@numba.njit(cache=True)
+def outputs(w, out_ptr):
+    """A cell kernel's outputs for ``w`` cells (see `convex_cells`): whether it writes
+    (``out_ptr`` not empty), ``status`` (all `REFUSED`), ``ntri``, ``vol``, ``tri``,
+    ``normal``."""
+    write = out_ptr.shape[0] > 0
+    q = out_ptr[w] if write else 0
+    return (write, np.full(w, REFUSED, dtype=np.int8), np.zeros(w, dtype=np.int64),
+            np.zeros(w), np.empty((q, 3, 3)), np.empty((q, 3)))
+
+
+@numba.njit(cache=True)
+def widest(ptr, first, last):
+    """The longest of the rows ``first .. last - 1`` of the CSR ``ptr`` (at least 1)."""
+    most = 1
+    for s in range(first, last):
+        most = max(most, ptr[s + 1] - ptr[s])
+    return most
+
+
+@numba.njit(cache=True)
+def write_fan(f, vx, start, idx, normal, s, x0, tri, normal_out, t):
+    """Face ``f`` of a polytope (local frame, unit ``s``, origin ``x0``) as the fan of its
+    vertices into ``tri[t:]`` (global coordinates) and its normal into ``normal_out[t:]``;
+    the next free row."""
+    a = idx[start[f]]
+    for k in range(start[f] + 1, start[f + 1] - 1):
+        for c in range(3):
+            tri[t, 0, c] = vx[a, c] * s + x0[c]
+            tri[t, 1, c] = vx[idx[k], c] * s + x0[c]
+            tri[t, 2, c] = vx[idx[k + 1], c] * s + x0[c]
+            normal_out[t, c] = normal[f, c]
+        t += 1
+    return t
 
 
 @parallel_kernel("cell_node")
@@ -381,32 +457,17 @@ def convex_cells(points, faces, cell_node, half, scale, face_ptr, face_rows, tab
         Their outward unit normals.
     """
     w, k_near = cell_node.shape[0], near.shape[1]
-    write = out_ptr.shape[0] > 0
-    q = out_ptr[w] if write else 0
-    status = np.full(w, REFUSED, dtype=np.int8)
-    ntri = np.zeros(w, dtype=np.int64)
-    vol = np.zeros(w)
-    tri = np.empty((q, 3, 3))
-    normal_out = np.empty((q, 3))
+    write, status, ntri, vol, tri, normal_out = outputs(w, out_ptr)
     nch = max(1, min(chunks, w))
     for ch in numba.prange(nch):
         first, last = ch * w // nch, (ch + 1) * w // nch
-        most = 1
-        for s in range(first, last):
-            most = max(most, face_ptr[s + 1] - face_ptr[s])
-        fcap = 6 + most + k_near
-        vcap = 6 * fcap
+        most = widest(face_ptr, first, last)
         fx, fn, fo = np.empty((most, 3, 3)), np.empty((most, 3)), np.empty(most)
         key, fid = np.empty((most, 4)), np.empty(most, dtype=np.int64)
         order = np.empty(most, dtype=np.int64)
         y, dist = np.empty((k_near, 3)), np.empty(k_near)
-        yid, rank = np.empty(k_near, dtype=np.int64), np.empty(k_near, dtype=np.int64)
-        poly = (np.empty((vcap, 3)), np.empty(fcap + 1, dtype=np.int64),
-                np.empty(12 * fcap, dtype=np.int64), np.empty((fcap, 3)), np.empty(fcap),
-                np.empty(fcap, dtype=np.int64), np.empty(fcap, dtype=np.int64))
-        work = (np.empty(vcap), np.empty((vcap, 3)), np.empty((3 * fcap, 3), dtype=np.int64),
-                np.empty(vcap, dtype=np.int64), np.empty(vcap), np.empty(vcap, dtype=np.int64),
-                np.empty(fcap + 1, dtype=np.int64), np.empty(12 * fcap, dtype=np.int64))
+        yid = np.empty(k_near, dtype=np.int64)
+        poly, work = scratch(6 + most + k_near)
         vx, start, idx, normal = poly[0], poly[1], poly[2], poly[3]
         for s in range(first, last):
             i = cell_node[s]
@@ -414,7 +475,7 @@ def convex_cells(points, faces, cell_node, half, scale, face_ptr, face_rows, tab
             st, nv, nf = convex_cell(points, faces, i, x0, sc, half[s],
                                      face_rows[face_ptr[s]:face_ptr[s + 1]], table_face,
                                      table_normal, near[s], near_far[s], fx, fn, fo, key, fid,
-                                     order, y, dist, yid, rank, poly, work)
+                                     order, y, dist, yid, poly, work)
             status[s] = st
             if st != DONE:
                 continue
@@ -424,12 +485,5 @@ def convex_cells(points, faces, cell_node, half, scale, face_ptr, face_rows, tab
                 continue
             t = out_ptr[s]
             for f in range(nf):
-                a = idx[start[f]]
-                for k in range(start[f] + 1, start[f + 1] - 1):
-                    for c in range(3):
-                        tri[t, 0, c] = vx[a, c] * sc + x0[c]
-                        tri[t, 1, c] = vx[idx[k], c] * sc + x0[c]
-                        tri[t, 2, c] = vx[idx[k + 1], c] * sc + x0[c]
-                        normal_out[t, c] = normal[f, c]
-                    t += 1
+                t = write_fan(f, vx, start, idx, normal, sc, x0, tri, normal_out, t)
     return status, ntri, vol, tri, normal_out

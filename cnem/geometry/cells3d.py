@@ -17,7 +17,9 @@ Two paths compute the cells:
   convex polytopes by bisectors, boundary planes or the region's tetrahedra, and
   the shadows of the blocking faces (see there); its convex case (no face in reach
   hides points or bends the region: a box's faces, edges and corners) for many
-  cells at once in numba (`.cells3d_convex`).
+  cells at once in numba (`.cells3d_convex`), and so its unblocked case near a curved
+  cavity or hole (the Voronoi polytope cut by the region's tetrahedra,
+  `.cells3d_curved`).
 
 The cells partition each region: their volumes sum to the region's volume to
 round-off.
@@ -37,6 +39,7 @@ from ..errors import GeometryError
 from ._cells3d_kernels import clear_of_faces, dual_facets
 from .cells3d_clip import GeneralCells
 from .cells3d_convex import convex_cells
+from .cells3d_curved import curved_cells
 from .tetrahedra import signed_volumes, tet_neighbors
 from .._sets import distinct
 
@@ -221,7 +224,13 @@ def constrained_voronoi_cells(points: ArrayLike, tetrahedra: ArrayLike, tet_regi
     done, b_tri, b_cell, b_nrm, b_vol = convex_cells(general, cell_node[slow], cell_region[slow])
     volume[slow[done]] = b_vol[done]
     parts_t, parts_c, parts_n = [b_tri], [slow[b_cell]], [b_nrm]
-    for k in slow[~done].tolist():
+    rest = slow[~done]
+    done, c_tri, c_cell, c_nrm, c_vol = curved_cells(general, cell_node[rest], cell_region[rest])
+    volume[rest[done]] = c_vol[done]
+    parts_t.append(c_tri)
+    parts_c.append(rest[c_cell])
+    parts_n.append(c_nrm)
+    for k in rest[~done].tolist():
         t, nr, vol = general.cell(int(cell_node[k]), int(cell_region[k]))
         parts_t.append(t)
         parts_c.append(np.full(len(t), k, dtype=np.int64))

@@ -32,6 +32,8 @@ re-entrant edge) hide points; the faceted facets of a curved cavity or hole do n
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import shapely
 from scipy.sparse import csr_matrix
@@ -95,7 +97,6 @@ class GeneralCells:
                                       blocking[idx, mine], reentrant[idx, mine]))
             nodes = distinct(tets[tet_region == r])
             self.region_nodes.append((nodes, cKDTree(points[nodes])))
-        self.region_tets = RegionTets(points, tets, tet_region, faces)
         edge_len = np.zeros(len(points))
         for a, b in ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)):
             d = np.linalg.norm(tet_x[:, a] - tet_x[:, b], axis=1)
@@ -105,6 +106,12 @@ class GeneralCells:
         order = np.argsort(tets.ravel(), kind="stable")
         self.star_tets = order // 4
         self.star_offsets = np.searchsorted(tets.ravel()[order], np.arange(len(points) + 1))
+
+    @functools.cached_property
+    def region_tets(self) -> RegionTets:
+        """The region's tetrahedra with their faces' tags, built when a cell first needs
+        them (only cells near a curved re-entrant surface do)."""
+        return RegionTets(self.points, self.tets, self.tet_region, self.faces)
 
     def cell(self, i: int, r: int) -> tuple[np.ndarray, np.ndarray, float]:
         """Facet triangles ``(q, 3, 3)``, their outward normals ``(q, 3)`` and the volume of

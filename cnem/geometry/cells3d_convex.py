@@ -124,15 +124,16 @@ def _face_table(general):
             np.ascontiguousarray(np.concatenate([f[1] for f in general.region_faces])), first)
 
 
-def _unblocked(general, node, region, half):
+def _unblocked(general, node, region, half, bent=True):
     """Positions of the cells with no blocking face within the general path's face search
-    (``3 reach``) and no face with a re-entrant edge within ``reach`` (bounding spheres):
-    those may hide points or bend the region, and go to `GeneralCells.cell`."""
+    (``3 reach``) and (with ``bent``) no face with a re-entrant edge within ``reach``
+    (bounding spheres): those may hide points or bend the region, and go to
+    `GeneralCells.cell`."""
     keep = np.ones(len(node), dtype=bool)
     reach = np.sqrt(3.0) * half * general.scale[node]
-    for r, (idx, _, _, block, bent) in enumerate(general.region_faces):
+    for r, (idx, _, _, block, bends) in enumerate(general.region_faces):
         mine = np.flatnonzero(region == r)
-        for flag, radius in ((block, 3.0 * reach), (bent, reach)):
+        for flag, radius in ((block, 3.0 * reach), (bends, reach))[:2 if bent else 1]:
             if not flag.any() or len(mine) == 0:
                 continue
             centre = general.points[general.faces[idx[flag]]].mean(axis=1)
