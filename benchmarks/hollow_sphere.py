@@ -30,7 +30,7 @@ How to run
 ----------
 ::
 
-    python benchmarks/hollow_sphere.py                      # h = 0.25 0.2 0.15 0.1
+    python benchmarks/hollow_sphere.py                      # h = 0.27 0.135 0.0675 (~2 min)
     python benchmarks/hollow_sphere.py --h 0.3 0.2 --subdivisions 3
 """
 import argparse
@@ -119,7 +119,7 @@ def table(rows):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--h", type=float, nargs="+", default=[0.25, 0.2, 0.15, 0.1],
+    parser.add_argument("--h", type=float, nargs="+", default=[0.27, 0.135, 0.0675],
                         help="node spacings (default: %(default)s)")
     parser.add_argument("--subdivisions", type=int, default=None,
                         help="icosphere levels of the two surfaces (default: per h, the fewest "
