@@ -201,7 +201,9 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
     parts = []
     for i in range(3):
         to_cell = sp.csr_matrix((flux[:, i] / volume[cell], (cell, column)), shape=(m, q))
-        parts.append((to_cell @ phi).tocsr())
+        part = (to_cell @ phi).tocsr()
+        part.sum_duplicates()           # canonical: sorted indices (`CellBasis` shares them)
+        parts.append(part)
     return SmoothedGradient(*parts, points=q)
 
 
