@@ -102,18 +102,12 @@ def test_groups_are_checked(model):
         form.assemble(basis, groups=np.arange(m) % 2, k=np.ones(1))
 
 
-def test_gradient_gram_of_3d_gradients_on_different_patterns():
-    """3-D smoothed gradients may drop an exact zero along one axis only, so the axes'
-    patterns differ: `gradient_gram` takes the node-block path on their union and
-    gives the product written out with scipy, leaving the basis's operators as they
-    were (unsorted node operators share their values with them)."""
+def _basis_on_unsorted_gradients(rng, m=12, n=9, d=3):
+    """A vector `CellBasis` on random gradient operators with reversed (unsorted) rows
+    on different patterns, as 3-D smoothed gradients may come; and those operators."""
     from types import SimpleNamespace
-
-    from cnem.assembly.forms import gradient_gram
-    rng = np.random.default_rng(5)
-    m, n, d = 12, 9, 3
     grads = [sp.random(m, n, density=0.4, format="csr", random_state=k) for k in range(d)]
-    for g in grads:                          # unsorted rows, as the 3-D gradients come
+    for g in grads:
         for i in range(m):
             lo, hi = g.indptr[i], g.indptr[i + 1]
             g.indices[lo:hi], g.data[lo:hi] = g.indices[lo:hi][::-1].copy(), g.data[lo:hi][::-1].copy()
@@ -123,6 +117,38 @@ def test_gradient_gram_of_3d_gradients_on_different_patterns():
                                      sp.identity(m, format="csr")[:, :n], grads,
                                      rng.uniform(0.5, 2.0, m), rng.uniform(size=(m, d)),
                                      vector=True)
+    return basis, grads
+
+
+def test_vector_operators_survive_scipy_sorting_one_of_them():
+    """The components of a vector basis share their node operator's values: scipy's
+    ``abs`` and ``+`` sort a non-canonical operand in place, which once reordered the
+    values under the other components' unsorted indices (3-D F-bar's patches took
+    ``abs`` of the u_0 gradients and corrupted u_1's and u_2's: an indefinite tangent).
+    The basis spreads canonical copies; its inputs stay as they were."""
+    rng = np.random.default_rng(3)
+    basis, grads = _basis_on_unsorted_gradients(rng)
+    inputs = [(g.indices.copy(), g.data.copy()) for g in grads]
+    ops = basis.operators
+    before = [op.toarray() for op in ops]
+    for op in ops:
+        abs(op) + op
+    for op, old in zip(basis.operators, before):
+        np.testing.assert_array_equal(op.toarray(), old)
+    for g, (indices, data) in zip(grads, inputs):
+        np.testing.assert_array_equal(g.indices, indices)
+        np.testing.assert_array_equal(g.data, data)
+
+
+def test_gradient_gram_of_3d_gradients_on_different_patterns():
+    """3-D smoothed gradients may drop an exact zero along one axis only, so the axes'
+    patterns differ: `gradient_gram` takes the node-block path on their union and
+    gives the product written out with scipy, leaving the basis's operators as they
+    were (unsorted node operators share their values with them)."""
+    from cnem.assembly.forms import gradient_gram
+    rng = np.random.default_rng(5)
+    basis, _ = _basis_on_unsorted_gradients(rng)
+    m, d = len(basis.dx), basis.dim
     before = [op.toarray() for op in basis.operators]
     coeff = rng.uniform(-1, 1, (m, d * d, d * d))
     ops = basis.operators[d:]

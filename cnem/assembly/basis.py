@@ -26,10 +26,34 @@ __all__ = ["CellBasis", "spread_component"]
 
 def spread_component(op: sp.csr_matrix, component: int, ncomp: int) -> sp.csr_matrix:
     """Move the columns of a node operator ``(m, n)`` to the dofs of one
-    component of an interleaved vector field ``(m, ncomp * n)``."""
+    component of an interleaved vector field ``(m, ncomp * n)``.
+
+    The result shares ``op``'s values and row pointers (the components of a vector
+    basis share one copy), so ``op`` must be in canonical format (`_canonical`): scipy
+    sorts a non-canonical operand's indices in place (``abs``, ``+``, ...), which
+    would reorder the values under the other components' unsorted indices."""
     op = op.tocsr()
     return sp.csr_matrix((op.data, op.indices * ncomp + component, op.indptr),
                          shape=(op.shape[0], op.shape[1] * ncomp))
+
+
+def _canonical(op: sp.spmatrix) -> sp.csr_matrix:
+    """``op`` as CSR in canonical format (sorted indices, no duplicates): itself when
+    it already is, else a canonical copy (the input is left untouched).
+
+    Parameters
+    ----------
+    op : scipy.sparse matrix, shape (m, n)
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (m, n)
+    """
+    op = op.tocsr()
+    if not op.has_canonical_format:
+        op = op.copy()
+        op.sum_duplicates()
+    return op
 
 
 class CellBasis:
@@ -155,9 +179,9 @@ class CellBasis:
             du_1/dy]`` in 2-D, ``[u_0, u_1, u_2, du_0/dx, du_0/dy, du_0/dz, du_1/dx,
             ...]`` in 3-D (row-major ``grad[i, j] = du_i/dx_j``).
         """
-        value, *grads = self._node_ops
+        value, *grads = (_canonical(op) for op in self._node_ops)
         if not self.vector:
-            self._built = [op.tocsr() for op in self._node_ops]
+            self._built = [value, *grads]
         else:
             d = self.ncomp
             values = [spread_component(value, c, d) for c in range(d)]

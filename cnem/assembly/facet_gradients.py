@@ -209,8 +209,12 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
     indptr, indices, data = FK.weighted_rows(ptr, column[order], weight,
                                              phi.indptr.astype(np.int64), phi.indices,
                                              phi.data, phi.shape[1], work_chunks())
+    # canonical (the kernel sorts every row): the three share ``indices``, so nothing may
+    # sort one of them in place (`CellBasis` spreads them as they are)
     parts = [sp.csr_matrix((data[i], indices, indptr), shape=(m, phi.shape[1]))
              for i in range(3)]
+    for part in parts:
+        part.has_canonical_format = True
     return SmoothedGradient(*parts, points=q)
 
 
