@@ -88,13 +88,14 @@ def test_thick_sphere_inflation_coarse_against_the_closed_form():
 
 
 @pytest.mark.slow
-def test_thick_sphere_inflation_to_twice_the_radius_with_fbar():
+def test_thick_sphere_inflation_with_fbar():
     """The same sphere with ``volumetric="fbar"`` (and the default stabilisation), to
-    ``lambda_a = 2`` in 20 load steps with a line search (10 stall in the second).
-    Measured: -2.2 % at 1.1,
-    crossing zero near 1.7, +2.2 % at 2.0 (docs/finite_strain.md; the default ends
+    ``lambda_a = 1.5`` in 10 load steps with a line search (the increments of the 20
+    steps to 2 of docs/finite_strain.md, where 10 steps to 2 stall in the second; the
+    whole curve to 2 takes two minutes, too long for the suite). Measured: -2.2 % at
+    1.1, -0.9 % at 1.5; to 2: crossing zero near 1.7, +2.2 % at 2.0 (the default ends
     +9 % high at 1.6 and does not converge past 1.65); bound 3 % at every step."""
-    la_end, steps = 2.0, 20
+    la_end, steps = 1.5, 10
     model, inner, pressure, exact = _thick_sphere()
     prob = cnem.Hyperelasticity(model, cnem.material.NeoHookean(1.0, 2000.0),
                                 volumetric="fbar")
