@@ -58,6 +58,9 @@ _GROW = 8
 _REFLEX = 1e-9
 #: A tetrahedron whose edges from the node (local unit) span less than this is flat.
 _FLAT = 1e-10
+#: A piece whose thickness (``2 V / A``, local unit) is below this is flat: its faces lie
+#: in one plane group (`_plane_groups`), where they would cancel its neighbours' faces.
+_THIN = 16 * _REFLEX
 
 
 class GeneralCells:
@@ -133,7 +136,9 @@ class GeneralCells:
             raise GeometryError(f"node {i} at {x0.tolist()} has an empty cell in region {r}; "
                                 f"it is not visible from any point of its region")
         if joins is None:
-            tri, normal = _boundary(pieces)
+            # slivers a round-off thick (from near-tied nodes mapped far from the origin)
+            # carry no facet: their volume stays in the cell's
+            tri, normal = _boundary([p for p in pieces if not _is_flat(p)])
         elif connected(pieces, joins):
             tri, normal = open_facets(pieces)
         else:
@@ -395,6 +400,13 @@ def _boundary(pieces):
     if not tris:
         return np.zeros((0, 3, 3)), np.zeros((0, 3))
     return np.array(tris), np.array(normals)
+
+
+def _is_flat(piece):
+    """Whether a convex piece is thinner than ``_THIN`` (``2 V / A``: a slab's thickness)."""
+    tri, _ = piece.triangles()
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
+    return 2.0 * piece.volume() <= _THIN * area
 
 
 def _plane_groups(planes):
