@@ -189,27 +189,31 @@ def test_bad_options_are_named(holed):
 # -- cases against references ------------------------------------------------------------
 def test_thick_cylinder_inflation_against_the_incompressible_closed_form():
     """A quarter of a plane-strain tube (A = 1, B = 2), nearly incompressible neo-Hookean
-    (lam / mu = 2000), inner radius stretched to lambda_a = 1.5 (imposed displacement):
-    the pressure from the inner nodes' reaction, ``sum f . e_r / (lambda_a A pi / 2)``,
-    against ``mu [ln(la / lb) + 1 / (2 lb^2) - 1 / (2 la^2)]``,
+    (lam / mu = 2000), inner radius stretched to lambda_a = 2 in 20 steps (imposed
+    displacement): at every step the pressure from the inner nodes' reaction,
+    ``sum f . e_r / (lambda_a A pi / 2)``, against
+    ``mu [ln(la / lb) + 1 / (2 lb^2) - 1 / (2 la^2)]``,
     ``lb^2 = 1 + (la^2 - 1) A^2 / B^2`` (volume conservation), within 1 %."""
-    mu, A, B, la = 1.0, 1.0, 2.0, 1.5
-    lb = np.sqrt(1 + (la ** 2 - 1) * A ** 2 / B ** 2)
-    exact = mu * (np.log(la / lb) + 1 / (2 * lb ** 2) - 1 / (2 * la ** 2))
+    mu, A, B = 1.0, 1.0, 2.0
     dom = cnem.geometry.annulus([A, B], angles=[0, np.pi / 2], spacing=0.1)
     model = cnem.discretize(cnem.nodes.irregular(dom, 0.1, seed=1))
     inner = np.flatnonzero(np.abs(np.linalg.norm(model.nodes, axis=1) - A) < 1e-9)
+    X = model.nodes[inner]
     for volumetric in (None, "fbar"):
         prob = cnem.Hyperelasticity(model, NeoHookean(mu, 2000.0), volumetric=volumetric,
                                     stabilization=1.0)
         prob.add_dirichlet("start", 1)
         prob.add_dirichlet("stop", 0)
-        prob.add_dirichlet(inner, None, lambda p: (la - 1) * p)
-        sol = prob.solve(steps=10, tol=1e-8, max_iterations=30)
-        f = prob.system.evaluate(sol.dofs, False)[0].reshape(-1, 2)
-        X = model.nodes[inner]
-        radial = (f[inner] * X / np.linalg.norm(X, axis=1)[:, None]).sum()
-        assert abs(radial / (la * A * np.pi / 2) / exact - 1) < 0.01
+        prob.add_dirichlet(inner, None, lambda p: p)            # lambda_a = 2 at the end
+        sol = prob.solve(steps=20, tol=1e-8, max_iterations=30, line_search=True)
+        assert len(sol.steps) == 20
+        for factor, dofs in sol.steps:
+            la = 1.0 + factor
+            lb = np.sqrt(1 + (la ** 2 - 1) * A ** 2 / B ** 2)
+            exact = mu * (np.log(la / lb) + 1 / (2 * lb ** 2) - 1 / (2 * la ** 2))
+            f = prob.system.evaluate(dofs, False)[0].reshape(-1, 2)
+            radial = (f[inner] * X / np.linalg.norm(X, axis=1)[:, None]).sum()
+            assert abs(radial / (la * A * np.pi / 2) / exact - 1) < 0.01, (volumetric, la)
 
 
 def test_cooks_membrane_coarse_against_p2_triangles():
