@@ -13,12 +13,13 @@ from tqdm.auto import tqdm
 
 from ..assembly import CellBasis
 from ..errors import InputError, MaterialError, OptionError
-from ..material import Hyperelastic, NeoHookean, check_plane, parse_materials
+from ..material import Hyperelastic, check_plane, parse_materials
 from ..solvers.newton import newton
 from .fbar import FbarOperator, patch_average
 from .finite_strain import EnergySum, FiniteStrainOperator
 from .hyperelastic_solution import HyperelasticSolution
 from .model_problem import ModelProblem
+from .stabilization import IsochoricNeoHookean
 
 if TYPE_CHECKING:
     from typing import Literal, Sequence
@@ -58,15 +59,16 @@ class Hyperelasticity(ModelProblem):
         `cnem.Elasticity`; 0 is plain SCNI, whose Newton iterations may invert cells or
         end on an indefinite tangent: Cook's membrane, `docs/finite_strain.md`). The
         energy becomes
-        ``sum_k V_k W(F~_k) + a [sum_s V_s W_mu(F~_s) - sum_k V_k W_mu(F~_k)]`` over
-        the fan sub-cells ``s`` of the cells ``k``, ``W_mu`` the neo-Hookean law of the
-        region's shear modulus alone (``lam = 0``). The sub-cells' gradients average
-        to their cell's, so the term vanishes for homogeneous deformations (the patch
-        test holds) and, near the reference state (where ``W_mu`` is convex, by
-        Jensen's inequality), is positive for the oscillating modes one gradient
-        per cell does not see; with ``mu`` alone it does not lock
-        as the material becomes incompressible. At small strain it is the
-        stabilisation of `cnem.Elasticity` with the same weight.
+        ``sum_k V_k W(F~_k) + a [sum_s V_s W_dev(F~_s) - sum_k V_k W_dev(F~_k)]`` over
+        the fan sub-cells ``s`` of the cells ``k``, ``W_dev`` the isochoric neo-Hookean
+        law ``mu/2 (J^(-2/3) tr C - 3)`` of the region's shear modulus
+        (`cnem.elasticity.stabilization.IsochoricNeoHookean`). The sub-cells' gradients
+        average to their cell's, so the term vanishes for homogeneous deformations (the
+        patch test holds) and, near the reference state, is positive for the
+        oscillating modes one gradient per cell does not see; it has no bulk stiffness,
+        so it neither locks nor stiffens the volume change as the material becomes
+        incompressible. At small strain it is the deviatoric stabilisation of
+        `cnem.Elasticity` with the same weight.
     gradients : GradientCache, optional
         The model's smoothed gradients at ``gauss``, shared with other problems
         on the model (an `Elasticity` on the same model, say).
@@ -161,7 +163,7 @@ class Hyperelasticity(ModelProblem):
             else:
                 sub, grad = self.gradients.fan(release=True)     # B~ of the cells with it
                 fine = CellBasis(self.model, vector=True, cells=sub, gradient=grad)
-                shear = [NeoHookean(m.lame(self.dim, self.plane)[1], 0.0)
+                shear = [IsochoricNeoHookean(m.lame(self.dim, self.plane)[1])
                          for m in self.region_materials]
                 cells = self.operator
                 self._system = EnergySum([
