@@ -13,7 +13,7 @@ from tqdm.auto import tqdm
 
 from ..assembly import CellBasis
 from ..errors import InputError, MaterialError, OptionError
-from ..material import Hyperelastic, check_plane, parse_materials
+from ..material import Hyperelastic, NeoHookean, check_plane, parse_materials
 from ..solvers.newton import newton
 from .fbar import FbarOperator, patch_average
 from .finite_strain import EnergySum, FiniteStrainOperator
@@ -68,7 +68,9 @@ class Hyperelasticity(ModelProblem):
         oscillating modes one gradient per cell does not see; it has no bulk stiffness,
         so it neither locks nor stiffens the volume change as the material becomes
         incompressible. At small strain it is the deviatoric stabilisation of
-        `cnem.Elasticity` with the same weight.
+        `cnem.Elasticity` with the same weight. With ``volumetric="fbar"`` ``W_dev`` is
+        instead the neo-Hookean law of ``lam = 0`` (``mu/2 (tr C - 3) - mu ln J``),
+        whose volumetric part holds each cell's own volume change, which F-bar frees.
     gradients : GradientCache, optional
         The model's smoothed gradients at ``gauss``, shared with other problems
         on the model (an `Elasticity` on the same model, say).
@@ -163,13 +165,21 @@ class Hyperelasticity(ModelProblem):
             else:
                 sub, grad = self.gradients.fan(release=True)     # B~ of the cells with it
                 fine = CellBasis(self.model, vector=True, cells=sub, gradient=grad)
-                shear = [IsochoricNeoHookean(m.lame(self.dim, self.plane)[1])
+                shear = [self._stabilization_law(m.lame(self.dim, self.plane)[1])
                          for m in self.region_materials]
                 cells = self.operator
                 self._system = EnergySum([
                     (1.0, cells), (a, FiniteStrainOperator(fine, shear, sub.region)),
                     (-a, FiniteStrainOperator(cells.basis, shear, self.cells.region))])
         return self._system
+
+    def _stabilization_law(self, mu):
+        """The sub-cell stabilisation's energy of shear modulus ``mu``: deviatoric
+        (`IsochoricNeoHookean`), or with F-bar the neo-Hookean law of ``lam = 0``, whose
+        volumetric part holds the cells' own volume changes that the patches free (with
+        the deviatoric law the F-bar patch test of `tests/test_fbar.py` inverts cells
+        in Newton's first iterates at two load steps)."""
+        return NeoHookean(mu, 0.0) if self.volumetric == "fbar" else IsochoricNeoHookean(mu)
 
     def load(self) -> np.ndarray:
         """The whole dead load (tractions and body forces), ``(dim n,)``."""

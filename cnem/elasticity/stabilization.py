@@ -34,7 +34,7 @@ import numpy as np
 
 from .. import hyperdual as hd
 from ..errors import MaterialError
-from ..material import Hyperelastic, _deformation_gradients, check_plane
+from ..material import Hyperelastic, LinearElastic, _deformation_gradients, check_plane
 
 if TYPE_CHECKING:
     from typing import Literal
@@ -109,7 +109,7 @@ class IsochoricNeoHookean(Hyperelastic):
         check_plane(dim, "strain" if dim == 2 and plane is None else plane)
         return -2.0 * self.mu / 3.0, self.mu
 
-    def linearized(self):
+    def linearized(self) -> LinearElastic:
         """Refused: the law has no bulk stiffness, hence no ``(E, nu)``."""
         raise MaterialError("IsochoricNeoHookean: a deviatoric energy has no Young's modulus "
                             "and Poisson ratio (zero bulk modulus); use its tangent() instead")
