@@ -2,8 +2,9 @@
 law is ``2 mu dev(e3) : dev(e3)`` of the body's 3-D strain in every idealisation; the
 stabilised free stiffness has exactly the rigid motions as its nullspace on irregular
 2-D and 3-D clouds, also as ``nu -> 1/2`` (the deviator alone leaves no spurious
-zero-energy mode); the isochoric neo-Hookean energy's stress and tangent are its
-hyper-dual derivatives, it ignores volume changes and linearises to the deviatoric law;
+zero-energy mode); the isochoric neo-Hookean energy ignores volume changes and
+linearises to the deviatoric law (its stress and tangent against hyper-dual derivatives
+and its plane strain: `tests/test_materials_hyper.py`);
 the finite-strain tangent at rest is the linear stabilised stiffness in 3-D."""
 
 from __future__ import annotations
@@ -14,7 +15,6 @@ import pytest
 import cases
 import cases3d
 import cnem
-from cnem import hyperdual as hd
 from cnem.elasticity.stabilization import IsochoricNeoHookean, deviatoric_lame
 from cnem.material import SaintVenantKirchhoff
 
@@ -90,35 +90,6 @@ def _gradients(d, q=12, spread=0.3):
     F = np.eye(d) + spread * RNG.normal(size=(q, d, d))
     F[np.linalg.det(F) < 0, 0] *= -1.0
     return F
-
-
-@pytest.mark.parametrize("d", [2, 3])
-def test_isochoric_stress_and_tangent_are_the_energy_derivatives(d):
-    law = IsochoricNeoHookean(1.3)
-    F = _gradients(d)
-    W, P, A = law.evaluate(F)
-    q = len(F)
-    value, grad, hess = hd.derivatives(lambda y: law.energy(y.reshape(y.shape[:-1] + (d, d))),
-                                       F.reshape(q, -1))
-    np.testing.assert_allclose(W, value, rtol=1e-13, atol=1e-13)
-    np.testing.assert_allclose(P.reshape(q, -1), grad, rtol=1e-12, atol=1e-12)
-    np.testing.assert_allclose(A.reshape(q, d * d, d * d), hess, rtol=1e-11,
-                               atol=1e-11 * np.abs(hess).max())
-    np.testing.assert_allclose(A, np.transpose(A, (0, 3, 4, 1, 2)), atol=1e-12 * np.abs(A).max())
-    W2, P2, none = law.evaluate(F, tangent=False)
-    assert none is None and np.array_equal(W2, W) and np.array_equal(P2, P)
-
-
-def test_isochoric_plane_strain_is_the_3d_law_with_f33_one():
-    law = IsochoricNeoHookean(0.8)
-    F2 = _gradients(2)
-    F3 = np.zeros((len(F2), 3, 3))
-    F3[:, :2, :2], F3[:, 2, 2] = F2, 1.0
-    W2, P2, A2 = law.evaluate(F2)
-    W3, P3, A3 = law.evaluate(F3)
-    np.testing.assert_allclose(W2, W3, rtol=1e-13, atol=1e-14)
-    np.testing.assert_allclose(P2, P3[:, :2, :2], rtol=1e-13, atol=1e-13)
-    np.testing.assert_allclose(A2, A3[:, :2, :2, :2, :2], rtol=1e-13, atol=1e-13)
 
 
 def test_isochoric_energy_ignores_volume_and_linearises_to_the_deviatoric_law():
