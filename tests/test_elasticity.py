@@ -72,13 +72,15 @@ def test_stiffness_is_spd_up_to_rigid_motions(name):
 @pytest.mark.parametrize("name", ["lshape_irregular", "kinked_crack_irregular",
                                   "three_rectangles_irregular"])
 def test_stabilised_stiffness_is_the_difference_form(name, weight):
-    """K = sum_k A_k B~_k^T C B~_k + a sum_s A_s (B~_s - B~_k)^T C_mu (B~_s - B~_k),
+    """K = sum_k A_k B~_k^T C B~_k + a sum_s A_s (B~_s - B~_k)^T C_dev (B~_s - B~_k),
     built here term by term from the fan sub-cells (slow reference); the sub-cells'
     spokes integrated whole or cut, their integrals cancel between neighbours. The
-    stabilisation's C_mu has the shear modulus alone (lam = 0: no locking)."""
+    stabilisation's C_dev is the deviatoric law of the shear modulus alone
+    (`deviatoric_lame`: no locking, no volumetric stiffening)."""
     import scipy.sparse as sp
     from cnem.assembly.subdivision import subdivide, tip_cells
     from cnem.elasticity.linear import elasticity_form, lame
+    from cnem.elasticity.stabilization import deviatoric_lame
     _, _, model = cases.model(name)
     nreg = len(model.domain.regions)
     mats = [(E * (1 + r), NU - 0.1 * r) for r in range(nreg)]
@@ -94,7 +96,8 @@ def test_stabilised_stiffness_is_the_difference_form(name, weight):
                            shape=(len(parent), len(prob.cells.area)))
     fine.operators = [f - to_sub @ c for f, c in zip(fine.operators, coarse.operators)]
     _, mu = lame(*prob.materials[sub.region].T, "stress")
-    reference += weight * elasticity_form.assemble(fine, lam=0.0 * mu, mu=mu).toarray()
+    lam_s = deviatoric_lame(mu, prob.materials[sub.region, 1], "stress")
+    reference += weight * elasticity_form.assemble(fine, lam=lam_s, mu=mu).toarray()
     np.testing.assert_allclose(K, reference, atol=1e-11 * np.abs(reference).max())
 
 
@@ -235,6 +238,7 @@ def test_block_assembly_equals_the_general_one(name, monkeypatch):
     """Forms that see only gradients of a vector field are assembled by 2 x 2 node
     blocks; the result is the general descriptor-by-descriptor assembly's."""
     from cnem.elasticity.linear import elasticity_form, lame
+    from cnem.elasticity.stabilization import deviatoric_lame
     _, _, model = cases.model(name)
     nreg = len(model.domain.regions)
     prob = cnem.Elasticity(model, [(E * (1 + r), NU - 0.1 * r) for r in range(nreg)])

@@ -19,6 +19,7 @@ from .fbar import FbarOperator, patch_average
 from .finite_strain import EnergySum, FiniteStrainOperator
 from .hyperelastic_solution import HyperelasticSolution
 from .model_problem import ModelProblem
+from .stabilization import IsochoricNeoHookean
 
 if TYPE_CHECKING:
     from typing import Literal, Sequence
@@ -58,15 +59,18 @@ class Hyperelasticity(ModelProblem):
         `cnem.Elasticity`; 0 is plain SCNI, whose Newton iterations may invert cells or
         end on an indefinite tangent: Cook's membrane, `docs/finite_strain.md`). The
         energy becomes
-        ``sum_k V_k W(F~_k) + a [sum_s V_s W_mu(F~_s) - sum_k V_k W_mu(F~_k)]`` over
-        the fan sub-cells ``s`` of the cells ``k``, ``W_mu`` the neo-Hookean law of the
-        region's shear modulus alone (``lam = 0``). The sub-cells' gradients average
-        to their cell's, so the term vanishes for homogeneous deformations (the patch
-        test holds) and, near the reference state (where ``W_mu`` is convex, by
-        Jensen's inequality), is positive for the oscillating modes one gradient
-        per cell does not see; with ``mu`` alone it does not lock
-        as the material becomes incompressible. At small strain it is the
-        stabilisation of `cnem.Elasticity` with the same weight.
+        ``sum_k V_k W(F~_k) + a [sum_s V_s W_dev(F~_s) - sum_k V_k W_dev(F~_k)]`` over
+        the fan sub-cells ``s`` of the cells ``k``, ``W_dev`` the isochoric neo-Hookean
+        law ``mu/2 (J^(-2/3) tr C - 3)`` of the region's shear modulus
+        (`cnem.elasticity.stabilization.IsochoricNeoHookean`). The sub-cells' gradients
+        average to their cell's, so the term vanishes for homogeneous deformations (the
+        patch test holds) and, near the reference state, is positive for the
+        oscillating modes one gradient per cell does not see; it has no bulk stiffness,
+        so it neither locks nor stiffens the volume change as the material becomes
+        incompressible. At small strain it is the deviatoric stabilisation of
+        `cnem.Elasticity` with the same weight. With ``volumetric="fbar"`` ``W_dev`` is
+        instead the neo-Hookean law of ``lam = 0`` (``mu/2 (tr C - 3) - mu ln J``),
+        whose volumetric part holds each cell's own volume change, which F-bar frees.
     gradients : GradientCache, optional
         The model's smoothed gradients at ``gauss``, shared with other problems
         on the model (an `Elasticity` on the same model, say).
@@ -161,13 +165,21 @@ class Hyperelasticity(ModelProblem):
             else:
                 sub, grad = self.gradients.fan(release=True)     # B~ of the cells with it
                 fine = CellBasis(self.model, vector=True, cells=sub, gradient=grad)
-                shear = [NeoHookean(m.lame(self.dim, self.plane)[1], 0.0)
+                shear = [self._stabilization_law(m.lame(self.dim, self.plane)[1])
                          for m in self.region_materials]
                 cells = self.operator
                 self._system = EnergySum([
                     (1.0, cells), (a, FiniteStrainOperator(fine, shear, sub.region)),
                     (-a, FiniteStrainOperator(cells.basis, shear, self.cells.region))])
         return self._system
+
+    def _stabilization_law(self, mu):
+        """The sub-cell stabilisation's energy of shear modulus ``mu``: deviatoric
+        (`IsochoricNeoHookean`), or with F-bar the neo-Hookean law of ``lam = 0``, whose
+        volumetric part holds the cells' own volume changes that the patches free (with
+        the deviatoric law the F-bar patch test of `tests/test_fbar.py` inverts cells
+        in Newton's first iterates at two load steps)."""
+        return NeoHookean(mu, 0.0) if self.volumetric == "fbar" else IsochoricNeoHookean(mu)
 
     def load(self) -> np.ndarray:
         """The whole dead load (tractions and body forces), ``(dim n,)``."""

@@ -25,6 +25,7 @@ from ..errors import InputError
 from ..material import check_plane, check_stiffness, lame, moduli, parse_materials, stiffness_matrix
 from .model_problem import ModelProblem
 from .solution import ElasticSolution
+from .stabilization import deviatoric_lame
 
 if TYPE_CHECKING:
     from typing import Literal, Sequence
@@ -63,14 +64,16 @@ class Elasticity(ModelProblem):
         per function and enriched node, after the nodal ones. The integration
         cells are then split into fan sub-cells (`cnem.assembly.subdivide`).
     stabilization : float
-        Weight ``a`` of the sub-cell stabilisation of SCNI (Puso et al. 2008):
-        ``K += a sum_s A_s (B~_s - B~_k)^T C_mu (B~_s - B~_k)`` over the fan
-        sub-cells ``s`` of every cell ``k``, ``C_mu`` the elasticity of the shear
-        modulus alone (``lam = 0``), so that it does not lock as ``nu -> 1/2``. It
-        vanishes for linear fields (the patch test still holds) and stiffens the
-        low-energy oscillating modes that plain SCNI (``a = 0``, the paper's
-        method) leaves almost free, which otherwise show as node-to-node
-        oscillations along free crack faces.
+        Weight ``a`` of the sub-cell stabilisation of SCNI (after Puso et al. 2008):
+        ``K += a sum_s A_s (B~_s - B~_k)^T C_dev (B~_s - B~_k)`` over the fan
+        sub-cells ``s`` of every cell ``k``, ``C_dev`` the deviatoric elasticity of the
+        shear modulus alone, ``2 mu dev(e) : dev(e)`` of the 3-D strain
+        (`cnem.elasticity.stabilization`), so that it neither locks nor stiffens the
+        volume change as ``nu -> 1/2``. It vanishes for linear fields (the patch test
+        still holds) and stiffens the low-energy oscillating modes that plain SCNI
+        (``a = 0``, the paper's method) leaves almost free, which otherwise show as
+        node-to-node oscillations along free crack faces. ``a = 1`` gives each sub-cell's
+        strain deviation the shear energy of the material.
     gradients : GradientCache, optional
         The model's smoothed gradients at ``gauss``, to share with other
         problems on the model (what it has computed is not computed again); by
@@ -173,10 +176,10 @@ class Elasticity(ModelProblem):
         """Global stiffness ``K`` (eq. 33), ``(dim n, dim n)`` CSR.
 
         With stabilisation ``a`` it is ``K_cells + a S``, where ``S`` penalises the
-        difference between each sub-cell's smoothed strain and its cell's with the
-        shear modulus alone, ``2 mu (e_s - e_k) : (e_s - e_k)``: bounded as
-        ``nu -> 1/2``, so that it never locks, while it still controls every strain
-        component of the modes one smoothed strain per cell does not see.
+        deviator of the difference between each sub-cell's smoothed strain and its
+        cell's with the shear modulus alone, ``2 mu dev(e_s - e_k) : dev(e_s - e_k)``:
+        independent of ``lam``, so that it never locks, and free of volume change, so
+        that it does not stiffen nearly incompressible bodies.
         """
         if self._K is None:
             (lam, mu), stabilization = self.stiffness_moduli()
@@ -199,10 +202,12 @@ class Elasticity(ModelProblem):
         """Lamé parameters per region of the cells' term of `stiffness` and of its
         stabilisation term (None without stabilisation).
 
-        The sub-cell stabilisation of weight ``a`` takes the shear modulus alone
-        (``lam = 0``, ``a mu``): with sub-cells, whose strains average to their cell's,
-        ``K_cells(lam, mu) + a sum_s A_s (B~_s - B~_k)^T C_mu (B~_s - B~_k)`` is
-        ``K_cells(lam, (1 - a) mu) + a sum_s K_s(0, mu)`` (`_sub_cell_stiffness`). The
+        The sub-cell stabilisation of weight ``a`` is deviatoric: ``a mu`` and ``a lam_s``
+        with ``lam_s`` of `cnem.elasticity.stabilization.deviatoric_lame` (``-2 mu / 3``
+        in 3-D and plane strain). With sub-cells, whose strains average to their cell's,
+        ``K_cells(lam, mu) + a sum_s A_s (B~_s - B~_k)^T C_dev (B~_s - B~_k)`` is
+        ``K_cells(lam - a lam_s, (1 - a) mu) + a sum_s K_s(lam_s, mu)``
+        (`_cell_and_sub_cell_stiffness`). The
         pointwise term of enriched problems (`_pointwise_stabilization_stiffness`)
         keeps the full law ``a lam, a mu``.
 
@@ -219,7 +224,8 @@ class Elasticity(ModelProblem):
             # with enrichment the pointwise term completes the smoothed stiffness towards
             # the Galerkin one on the few cells near the tips: it keeps the full law
             return (lam, mu), (a * lam, a * mu)
-        return (lam, (1.0 - a) * mu), (np.zeros_like(mu), a * mu)
+        lam_s = a * deviatoric_lame(mu, self.materials[:, 1], self.plane)
+        return (lam - lam_s, (1.0 - a) * mu), (lam_s, a * mu)
 
     def _sub_cells(self):
         """Whether the stabilisation uses the fan sub-cells of the model's cells
