@@ -227,7 +227,8 @@ class GradientGram:
     >>> basis = CellBasis(model, vector=True)
     >>> gram = GradientGram([basis, basis])
     >>> coeff = np.tile(np.eye(4), (2 * len(basis.dx), 1, 1))
-    >>> bool(abs(gram.matrix(coeff) - 2 * gradient_gram(basis, coeff[:len(basis.dx)])).max() < 1e-12)
+    >>> twice = 2 * gradient_gram(basis, coeff[:len(basis.dx)])
+    >>> bool(abs(gram.matrix(coeff) - twice).max() < 1e-12)
     True
     """
 

@@ -146,12 +146,8 @@ class FiniteStrainOperator:
 
     def local_evaluate(self, u: np.ndarray, tangent: bool = True
                        ) -> tuple[np.ndarray, np.ndarray | None, sp.spmatrix | None]:
-        """`evaluate` with the tangent left in parts: ``K = gram.matrix(coeff) + extra``.
-
-        Parameters
-        ----------
-        u : (N,) ndarray
-        tangent : bool
+        """`evaluate` (the same ``u (N,)`` and ``tangent``) with the tangent left in
+        parts: ``K = gram.matrix(coeff) + extra``.
 
         Returns
         -------
