@@ -481,28 +481,11 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
 
 
 def gradient_block_gram_nd(ptr, idx, grads, coeff, group, weight, ncol, nch):
-    """`gradient_block_gram` in any dimension: ``K`` by ``d x d`` node blocks.
-
-    Parameters
-    ----------
-    ptr, idx : CSR pattern (m, ncol)
-    grads : (d, nnz) float64
-        Values of the derivatives along each axis (one pattern).
-    coeff : (G, d d, d d) float64
-        ``coeff[g, a, b]`` for trial descriptor ``a = d c + e`` (component ``c``,
-        direction ``e``) and test descriptor ``b``, in the cells of group ``g``.
-    group : (m,) int64
-    weight : (m,) float64
-    ncol, nch : int
-
-    Returns
-    -------
-    indptr : (d ncol + 1,) int64
-    indices : (nnz,) int32
-    data : (nnz,) float64
-        ``K`` in CSR over the interleaved dofs, ``(d ncol, d ncol)``; in 2-D the
-        same numbers as `gradient_block_gram`.
-    """
+    """`gradient_block_gram` in any dimension: ``K`` by ``d x d`` node blocks
+    (`gradient_block_pattern`, then `gradient_block_values_nd`), from ``grads (d, nnz)``,
+    the derivatives along each axis on the one pattern, and ``coeff (G, d d, d d)``
+    (trial descriptor ``a = d c + e``: component ``c``, direction ``e``); the other
+    arguments and the result as there, over ``d ncol`` dofs (in 2-D the same numbers)."""
     out_ptr, out_idx, *pattern = gradient_block_pattern(ptr, idx, grads.shape[0], ncol, nch)
     t_ptr, t_row, t_pos = pattern[2:]
     data = gradient_block_values_nd(ptr, idx, grads, coeff, group, weight, t_ptr, t_row,
