@@ -15,6 +15,7 @@ from skfem.helpers import dot, grad, sym_grad, ddot
 
 import cases
 from cnem.assembly import BilinearForm, CellBasis
+from cnem.errors import FormError
 
 
 def _reference(basis, pairs):
@@ -159,3 +160,28 @@ def test_gradient_gram_of_3d_gradients_on_different_patterns():
                                atol=1e-12 * abs(ref).max())
     for op, old in zip(basis.operators, before):
         np.testing.assert_array_equal(op.toarray(), old)
+
+
+@pytest.mark.parametrize("by_blocks", [True, False])
+def test_gradient_gram_over_two_bases_in_one_pass(model, by_blocks):
+    """`GradientGram` over the cells of two bases (node blocks on one kept pattern, or by
+    descriptors for operators set otherwise) equals the two products written out with
+    scipy and added, for two sets of coefficients on the same pattern."""
+    from cnem.assembly.forms import GradientGram
+    basis = CellBasis(model, vector=True)
+    m, d = len(basis.dx), basis.dim
+    other = basis.at_points(basis.operators, 0.5 * basis.dx, basis.x.T)   # no node blocks
+    second = CellBasis(model, vector=True) if by_blocks else other
+    bases = [basis if by_blocks else other, second]
+    gram = GradientGram(bases)
+    rng = np.random.default_rng(3)
+    for _ in range(2):
+        coeff = rng.uniform(-1, 1, (2 * m, d * d, d * d))
+        ref = sum((b.operators[d + j].T @ sp.diags(b.dx * c[:, i, j])
+                   @ b.operators[d + i]).toarray()
+                  for b, c in zip(bases, (coeff[:m], coeff[m:]))
+                  for i in range(d * d) for j in range(d * d))
+        np.testing.assert_allclose(gram.matrix(coeff).toarray(), ref,
+                                   atol=1e-12 * abs(ref).max())
+    with pytest.raises(FormError, match="expected coefficients of shape"):
+        gram.matrix(coeff[:m])

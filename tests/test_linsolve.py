@@ -172,3 +172,18 @@ def test_triangle_basis_rejects_degenerate_triangles():
                            triangles=np.array([[0, 1, 3], [0, 1, 2]]))
     with pytest.raises(ValueError, match="1 of 2 triangles are degenerate or clockwise"):
         triangle_basis(flat)
+
+
+def test_a_built_hierarchy_is_used_as_the_preconditioner():
+    """`solve_spd` with a `VCycle` (a hierarchy kept by the caller) solves like with the
+    matrix it was built on, and does not call it as a matrix factory."""
+    import scipy.sparse.linalg as spla
+    from test_multigrid import p1_elasticity
+    from cnem.solvers.multigrid import hierarchy
+    A, b, modes = p1_elasticity(30)
+    P = (A + sp.diags(0.1 * A.diagonal())).tocsr()
+    exact = spla.spsolve(A.tocsc(), b)
+    for smooth in (False, True):
+        x = linsolve.solve_spd(A, b, modes=modes, tol=1e-10, method="amg",
+                               preconditioner=hierarchy(P, modes), smooth_with_matrix=smooth)
+        np.testing.assert_allclose(x, exact, rtol=0, atol=1e-8 * np.abs(exact).max())

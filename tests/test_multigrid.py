@@ -160,3 +160,17 @@ def test_top_of_another_shape_is_refused(system):
     A, _, modes = system
     with pytest.raises(InputError, match="top: expected shape"):
         hierarchy(A, modes, top=sp.eye(A.shape[0] + 2, format="csr"))
+
+
+def test_smoothing_with_another_top_equals_building_with_it(system):
+    """`VCycle.smoothing_with` gives the cycle `hierarchy(..., top=)` builds, and leaves
+    the original cycle as it was."""
+    A, b, modes = system
+    P = (A + sp.diags(0.1 * A.diagonal())).tocsr()           # a preconditioner matrix
+    plain = hierarchy(P, modes)
+    before = plain.matvec(b)
+    np.testing.assert_array_equal(plain.smoothing_with(A).matvec(b),
+                                  hierarchy(P, modes, top=A).matvec(b))
+    np.testing.assert_array_equal(plain.matvec(b), before)
+    with pytest.raises(InputError, match="top: expected shape"):
+        plain.smoothing_with(sp.eye(A.shape[0] + 2, format="csr"))

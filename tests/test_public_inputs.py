@@ -75,7 +75,8 @@ NOT_ENTRY_POINTS = {
     # methods that are plumbing: the library calls them with arrays it built and checked
     **{name: "plumbing: called by the library with the arrays it built" for name in (
         "cnem.Elasticity.body_forces_at", "cnem.Elasticity.preconditioner_matrix",
-        "cnem.Elasticity.solver_options", "cnem.ElasticSolution.from_dofs",
+        "cnem.Elasticity.solver_options", "cnem.Hyperelasticity.solver_options",
+        "cnem.ElasticSolution.from_dofs",
         "cnem.ElasticSolution.write_fields", "cnem.elasticity.HyperelasticSolution.from_dofs",
         "cnem.fem.P1Solution.from_dofs",
         "cnem.fem.P1Solution.write_fields", "cnem.pd.StaticSolution.write_fields",

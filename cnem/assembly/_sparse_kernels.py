@@ -320,8 +320,134 @@ def _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices):
 
 
 @parallel_kernel("ncol")
+def gradient_block_pattern(ptr, idx, d, ncol, nch):
+    """The pattern of `gradient_block_gram` (``d x d`` node blocks of ``G^T G``, ``G`` the
+    CSR pattern ``ptr, idx``, ``(m, ncol)``), computed once for any number of value
+    passes (`gradient_block_values`, `gradient_block_values_nd`).
+
+    Parameters
+    ----------
+    ptr, idx : CSR pattern (m, ncol)
+    d : int
+        Components per node.
+    ncol, nch : int
+
+    Returns
+    -------
+    out_ptr : (d ncol + 1,) int64
+    out_idx : (nnz,) int32
+        ``K``'s CSR pattern over the interleaved dofs, ``(d ncol, d ncol)``, sorted.
+    indptr : (ncol + 1,) int64
+    indices : (nnz / d^2,) int32
+        The node blocks' CSR pattern, ``(ncol, ncol)``, sorted.
+    t_ptr, t_row, t_pos : int64 arrays
+        ``G``'s columns: the rows holding column ``j`` and the positions of those entries.
+    """
+    t_ptr, t_row, t_pos = _transpose_pattern(ptr, idx, ncol)
+    counts = _block_counts(t_ptr, t_row, ptr, idx, ncol, nch)
+    indptr = _offsets(counts)                   # of the node blocks
+    out_ptr = np.empty(d * ncol + 1, dtype=np.int64)     # of the dofs: d rows per node
+    out_ptr[0] = 0
+    for i in range(ncol):
+        for r in range(d):
+            out_ptr[d * i + r + 1] = d * d * indptr[i] + (r + 1) * d * counts[i]
+    indices = np.empty(indptr[ncol], dtype=np.int32)
+    out_idx = np.empty(d * d * indptr[ncol], dtype=np.int32)
+    for ch in numba.prange(nch):
+        slot = np.full(ncol, -1, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            start = indptr[i]
+            end = _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices)
+            for r in range(d):
+                row = out_ptr[d * i + r] - d * start        # block q -> row + d q
+                for q in range(start, end):
+                    for c in range(d):
+                        out_idx[row + d * q + c] = d * indices[q] + c
+    return out_ptr, out_idx, indptr, indices, t_ptr, t_row, t_pos
+
+
+@numba.njit(cache=True, inline="always")
+def _point_slots(indptr, indices, i, slot):
+    """Point ``slot`` at the positions of block row ``i``'s node columns."""
+    for q in range(indptr[i], indptr[i + 1]):
+        slot[indices[q]] = q
+
+
+@parallel_kernel("ncol")
+def gradient_block_values(ptr, idx, gx, gy, coeff, group, weight, t_ptr, t_row, t_pos,
+                          indptr, indices, out_ptr, ncol, nch):
+    """The values of `gradient_block_gram` on its pattern (`gradient_block_pattern`,
+    ``d = 2``): ``(nnz,)`` float64, in the order of ``out_idx``."""
+    data = np.zeros(out_ptr[2 * ncol])
+    for ch in numba.prange(nch):
+        slot = np.full(ncol, -1, dtype=np.int64)
+        v = np.empty((2, 4))
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            _point_slots(indptr, indices, i, slot)
+            start = indptr[i]
+            row0 = out_ptr[2 * i] - 2 * start               # block q -> row0 + 2 q
+            row1 = out_ptr[2 * i + 1] - 2 * start
+            for t in range(t_ptr[i], t_ptr[i + 1]):
+                k = t_row[t]
+                gi0, gi1 = weight[k] * gx[t_pos[t]], weight[k] * gy[t_pos[t]]
+                c = group[k]
+                for r in range(2):                          # test component r
+                    for a in range(4):
+                        v[r, a] = gi0 * coeff[c, a, 2 * r] + gi1 * coeff[c, a, 2 * r + 1]
+                for p in range(ptr[k], ptr[k + 1]):
+                    gj0, gj1 = gx[p], gy[p]
+                    q = 2 * slot[idx[p]]
+                    data[row0 + q] += v[0, 0] * gj0 + v[0, 1] * gj1
+                    data[row0 + q + 1] += v[0, 2] * gj0 + v[0, 3] * gj1
+                    data[row1 + q] += v[1, 0] * gj0 + v[1, 1] * gj1
+                    data[row1 + q + 1] += v[1, 2] * gj0 + v[1, 3] * gj1
+    return data
+
+
+@parallel_kernel("ncol")
+def gradient_block_values_nd(ptr, idx, grads, coeff, group, weight, t_ptr, t_row, t_pos,
+                             indptr, indices, out_ptr, ncol, nch):
+    """The values of `gradient_block_gram_nd` on its pattern (`gradient_block_pattern`):
+    ``(nnz,)`` float64, in the order of ``out_idx``."""
+    d = grads.shape[0]
+    data = np.zeros(out_ptr[d * ncol])
+    for ch in numba.prange(nch):
+        slot = np.full(ncol, -1, dtype=np.int64)
+        v = np.empty((d, d * d))
+        gi = np.empty(d)
+        row = np.empty(d, dtype=np.int64)
+        lo, hi = _chunk(ch, nch, ncol)
+        for i in range(lo, hi):
+            _point_slots(indptr, indices, i, slot)
+            for r in range(d):
+                row[r] = out_ptr[d * i + r] - d * indptr[i]     # block q -> row[r] + d q
+            for t in range(t_ptr[i], t_ptr[i + 1]):
+                k = t_row[t]
+                c = group[k]
+                for e in range(d):
+                    gi[e] = weight[k] * grads[e, t_pos[t]]
+                for r in range(d):                          # test component r
+                    for a in range(d * d):
+                        total = 0.0
+                        for e in range(d):
+                            total += gi[e] * coeff[c, a, d * r + e]
+                        v[r, a] = total
+                for p in range(ptr[k], ptr[k + 1]):
+                    q = d * slot[idx[p]]
+                    for r in range(d):
+                        for s in range(d):                  # trial component s
+                            total = 0.0
+                            for e in range(d):
+                                total += v[r, d * s + e] * grads[e, p]
+                            data[row[r] + q + s] += total
+    return data
+
+
 def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
-    """``K`` of a vector form that sees only gradients, by 2 x 2 node blocks.
+    """``K`` of a vector form that sees only gradients, by 2 x 2 node blocks
+    (`gradient_block_pattern`, then `gradient_block_values`).
 
     The gradients of the two components are the scalar operators ``gx``,
     ``gy`` (one CSR pattern ``ptr, idx``, ``(m, ncol)``) on interleaved dofs.
@@ -347,116 +473,23 @@ def gradient_block_gram(ptr, idx, gx, gy, coeff, group, weight, ncol, nch):
     data : (nnz,) float64
         ``K`` in CSR over the interleaved dofs, ``(2 ncol, 2 ncol)``.
     """
-    t_ptr, t_row, t_pos = _transpose_pattern(ptr, idx, ncol)
-    counts = _block_counts(t_ptr, t_row, ptr, idx, ncol, nch)
-    indptr = _offsets(counts)                   # of the node blocks
-    out_ptr = np.empty(2 * ncol + 1, dtype=np.int64)     # of the dofs: two rows per node
-    out_ptr[0] = 0
-    for i in range(ncol):
-        out_ptr[2 * i + 1] = 4 * indptr[i] + 2 * counts[i]
-        out_ptr[2 * i + 2] = 4 * indptr[i + 1]
-    indices = np.empty(indptr[ncol], dtype=np.int32)
-    out_idx = np.empty(4 * indptr[ncol], dtype=np.int32)
-    data = np.zeros(4 * indptr[ncol])
-    for ch in numba.prange(nch):
-        slot = np.full(ncol, -1, dtype=np.int64)
-        v = np.empty((2, 4))
-        lo, hi = _chunk(ch, nch, ncol)
-        for i in range(lo, hi):
-            start = indptr[i]
-            end = _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices)
-            row0 = out_ptr[2 * i] - 2 * start               # block q -> row0 + 2 q
-            row1 = out_ptr[2 * i + 1] - 2 * start
-            for q in range(start, end):
-                for c in range(2):
-                    out_idx[row0 + 2 * q + c] = 2 * indices[q] + c
-                    out_idx[row1 + 2 * q + c] = 2 * indices[q] + c
-            for t in range(t_ptr[i], t_ptr[i + 1]):         # then their values
-                k = t_row[t]
-                gi0, gi1 = weight[k] * gx[t_pos[t]], weight[k] * gy[t_pos[t]]
-                c = group[k]
-                for r in range(2):                          # test component r
-                    for a in range(4):
-                        v[r, a] = gi0 * coeff[c, a, 2 * r] + gi1 * coeff[c, a, 2 * r + 1]
-                for p in range(ptr[k], ptr[k + 1]):
-                    gj0, gj1 = gx[p], gy[p]
-                    q = 2 * slot[idx[p]]
-                    data[row0 + q] += v[0, 0] * gj0 + v[0, 1] * gj1
-                    data[row0 + q + 1] += v[0, 2] * gj0 + v[0, 3] * gj1
-                    data[row1 + q] += v[1, 0] * gj0 + v[1, 1] * gj1
-                    data[row1 + q + 1] += v[1, 2] * gj0 + v[1, 3] * gj1
+    out_ptr, out_idx, *pattern = gradient_block_pattern(ptr, idx, 2, ncol, nch)
+    t_ptr, t_row, t_pos = pattern[2:]
+    data = gradient_block_values(ptr, idx, gx, gy, coeff, group, weight, t_ptr, t_row, t_pos,
+                                 pattern[0], pattern[1], out_ptr, ncol, nch)
     return out_ptr, out_idx, data
 
 
-@parallel_kernel("ncol")
 def gradient_block_gram_nd(ptr, idx, grads, coeff, group, weight, ncol, nch):
-    """`gradient_block_gram` in any dimension: ``K`` by ``d x d`` node blocks.
-
-    Parameters
-    ----------
-    ptr, idx : CSR pattern (m, ncol)
-    grads : (d, nnz) float64
-        Values of the derivatives along each axis (one pattern).
-    coeff : (G, d d, d d) float64
-        ``coeff[g, a, b]`` for trial descriptor ``a = d c + e`` (component ``c``,
-        direction ``e``) and test descriptor ``b``, in the cells of group ``g``.
-    group : (m,) int64
-    weight : (m,) float64
-    ncol, nch : int
-
-    Returns
-    -------
-    indptr : (d ncol + 1,) int64
-    indices : (nnz,) int32
-    data : (nnz,) float64
-        ``K`` in CSR over the interleaved dofs, ``(d ncol, d ncol)``; in 2-D the
-        same numbers as `gradient_block_gram`.
-    """
-    d = grads.shape[0]
-    t_ptr, t_row, t_pos = _transpose_pattern(ptr, idx, ncol)
-    counts = _block_counts(t_ptr, t_row, ptr, idx, ncol, nch)
-    indptr = _offsets(counts)                   # of the node blocks
-    out_ptr = np.empty(d * ncol + 1, dtype=np.int64)     # of the dofs: d rows per node
-    out_ptr[0] = 0
-    for i in range(ncol):
-        for r in range(d):
-            out_ptr[d * i + r + 1] = d * d * indptr[i] + (r + 1) * d * counts[i]
-    indices = np.empty(indptr[ncol], dtype=np.int32)
-    out_idx = np.empty(d * d * indptr[ncol], dtype=np.int32)
-    data = np.zeros(d * d * indptr[ncol])
-    for ch in numba.prange(nch):
-        slot = np.full(ncol, -1, dtype=np.int64)
-        v = np.empty((d, d * d))
-        gi = np.empty(d)
-        row = np.empty(d, dtype=np.int64)
-        lo, hi = _chunk(ch, nch, ncol)
-        for i in range(lo, hi):
-            start = indptr[i]
-            end = _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices)
-            for r in range(d):
-                row[r] = out_ptr[d * i + r] - d * start     # block q -> row[r] + d q
-                for q in range(start, end):
-                    for c in range(d):
-                        out_idx[row[r] + d * q + c] = d * indices[q] + c
-            for t in range(t_ptr[i], t_ptr[i + 1]):         # then their values
-                k = t_row[t]
-                c = group[k]
-                for e in range(d):
-                    gi[e] = weight[k] * grads[e, t_pos[t]]
-                for r in range(d):                          # test component r
-                    for a in range(d * d):
-                        total = 0.0
-                        for e in range(d):
-                            total += gi[e] * coeff[c, a, d * r + e]
-                        v[r, a] = total
-                for p in range(ptr[k], ptr[k + 1]):
-                    q = d * slot[idx[p]]
-                    for r in range(d):
-                        for s in range(d):                  # trial component s
-                            total = 0.0
-                            for e in range(d):
-                                total += v[r, d * s + e] * grads[e, p]
-                            data[row[r] + q + s] += total
+    """`gradient_block_gram` in any dimension: ``K`` by ``d x d`` node blocks
+    (`gradient_block_pattern`, then `gradient_block_values_nd`), from ``grads (d, nnz)``,
+    the derivatives along each axis on the one pattern, and ``coeff (G, d d, d d)``
+    (trial descriptor ``a = d c + e``: component ``c``, direction ``e``); the other
+    arguments and the result as there, over ``d ncol`` dofs (in 2-D the same numbers)."""
+    out_ptr, out_idx, *pattern = gradient_block_pattern(ptr, idx, grads.shape[0], ncol, nch)
+    t_ptr, t_row, t_pos = pattern[2:]
+    data = gradient_block_values_nd(ptr, idx, grads, coeff, group, weight, t_ptr, t_row,
+                                    t_pos, pattern[0], pattern[1], out_ptr, ncol, nch)
     return out_ptr, out_idx, data
 
 

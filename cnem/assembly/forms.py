@@ -24,10 +24,11 @@ from ..errors import FormError
 from . import _sparse_kernels as SK
 
 if TYPE_CHECKING:
-    from typing import Any
+    from typing import Any, Sequence
     from .basis import CellBasis
 
-__all__ = ["BilinearForm", "LinearForm", "Functional", "asm", "gradient_gram"]
+__all__ = ["BilinearForm", "LinearForm", "Functional", "asm", "gradient_gram",
+           "GradientGram"]
 
 
 def _extras(basis, kwargs):
@@ -162,9 +163,8 @@ class BilinearForm(_Form):
                 other[a, b] = basis.dx * value[group]
         if not active:
             return sp.csr_matrix((basis.N, basis.N))
-        grads = basis.component_gradients() if basis.vector and not other else None
-        if grads is not None:          # dim x dim node blocks from the scalar gradients
-            return _gradient_blocks(grads, grad_coeff, group, basis.dx, basis.N)
+        if basis.vector and not other and basis.component_gradients() is not None:
+            return GradientGram([basis]).matrix(grad_coeff, group)    # dim x dim node blocks
         ops = basis.operators
         used = sorted({a for a, _ in active} | {b for _, b in active})
         weights = np.zeros((m, len(used), len(used)))
@@ -191,7 +191,8 @@ def _weighted_gram(ops, weights, N):
 def gradient_gram(basis: CellBasis, coeff: np.ndarray) -> sp.csr_matrix:
     """``sum_k dx_k G_k^T coeff_k G_k`` for a vector basis, ``G_k`` the ``d^2`` gradient
     descriptors at cell ``k`` (``du_i/dx_j`` at ``d i + j``): the matrix of a form
-    whose coefficients differ from cell to cell (a tangent of finite strain, say).
+    whose coefficients differ from cell to cell (a tangent of finite strain, say;
+    `GradientGram` keeps its pattern for repeated calls).
 
     Parameters
     ----------
@@ -204,33 +205,81 @@ def gradient_gram(basis: CellBasis, coeff: np.ndarray) -> sp.csr_matrix:
     -------
     scipy.sparse.csr_matrix, shape (N, N)
     """
-    m, d = len(basis.dx), basis.ncomp
-    coeff = np.ascontiguousarray(coeff, dtype=float)
-    if not basis.vector or coeff.shape != (m, d * d, d * d):
-        raise FormError(f"gradient_gram: expected a vector basis and coefficients of shape "
-                        f"({m}, {d * d}, {d * d}), received a {'vector' if basis.vector else 'scalar'} "
-                        f"basis and shape {coeff.shape}")
-    grads = basis.component_gradients()
-    if grads is not None:              # d x d node blocks from the scalar gradients
-        return _gradient_blocks(grads, coeff, np.arange(m), basis.dx, basis.N)
-    return _weighted_gram(basis.operators[d:], basis.dx[:, None, None] * coeff, basis.N)
+    return GradientGram([basis]).matrix(coeff)
 
 
-def _gradient_blocks(grads, coeff, group, weight, N):
-    """``K`` ``(N, N)`` CSR of a vector form that sees only gradients, by node blocks
-    (`cnem.assembly._sparse_kernels.gradient_block_gram`, its 2-D specialisation, or
-    `gradient_block_gram_nd`) from the scalar derivatives ``grads`` (one pattern)."""
-    first, d = grads[0], len(grads)
-    if d == 2:
-        indptr, indices, data = SK.gradient_block_gram(first.indptr, first.indices, first.data,
-                                                       grads[1].data, coeff, group, weight,
-                                                       N // 2, work_chunks())
-    else:
-        stacked = np.stack([g.data for g in grads])
-        indptr, indices, data = SK.gradient_block_gram_nd(first.indptr, first.indices, stacked,
-                                                          coeff, group, weight, N // d,
-                                                          work_chunks())
-    return sp.csr_matrix((data, indices, indptr), shape=(N, N))
+class GradientGram:
+    """``sum_k dx_k G_k^T coeff_k G_k`` over the cells of one or more vector bases on the
+    same dofs (cells and their sub-cells, say), in one pass on one pattern that is
+    computed once: between calls only the coefficients change (Newton's tangents).
+
+    Parameters
+    ----------
+    bases : sequence of CellBasis
+        Vector bases of the same dimension and dofs, ``m_1, m_2, ...`` cells; their
+        cells are taken in this order (``m = m_1 + m_2 + ...``).
+
+    Examples
+    --------
+    >>> import numpy as np, cnem
+    >>> from cnem.assembly import CellBasis
+    >>> model = cnem.discretize(cnem.nodes.regular(cnem.geometry.rectangle(), 0.25))
+    >>> basis = CellBasis(model, vector=True)
+    >>> gram = GradientGram([basis, basis])
+    >>> coeff = np.tile(np.eye(4), (2 * len(basis.dx), 1, 1))
+    >>> twice = 2 * gradient_gram(basis, coeff[:len(basis.dx)])
+    >>> bool(abs(gram.matrix(coeff) - twice).max() < 1e-12)
+    True
+    """
+
+    def __init__(self, bases: Sequence[CellBasis]):
+        bases = tuple(bases)
+        shapes = {(b.vector, b.ncomp, b.N) for b in bases}
+        if not bases or len(shapes) != 1 or not bases[0].vector:
+            raise FormError(f"GradientGram: expected vector bases of one dimension on the same "
+                            f"dofs, received (vector, components, dofs) {sorted(shapes)}")
+        self.d, self.N = bases[0].ncomp, bases[0].N
+        self.size = sum(len(b.dx) for b in bases)
+        self.weight = np.concatenate([b.dx for b in bases])
+        grads = [b.component_gradients() for b in bases]
+        if any(g is None for g in grads):          # no node blocks: by descriptors
+            self._pattern = None
+            self._ops = [sp.vstack(ops, format="csr") for ops in
+                         zip(*(b.operators[self.d:] for b in bases))]
+            return
+        # each basis's axes share one pattern, and so do the stacked axes
+        stacked = [sp.vstack(axis, format="csr") for axis in zip(*grads)]
+        self._ptr, self._idx = stacked[0].indptr, stacked[0].indices
+        self._values = np.stack([g.data for g in stacked])
+        self._pattern = SK.gradient_block_pattern(self._ptr, self._idx, self.d, self.N // self.d,
+                                                  work_chunks())
+
+    def __repr__(self):
+        return f"<GradientGram {self.d}-D, {self.size} cells, {self.N} dofs>"
+
+    def matrix(self, coeff: np.ndarray, group: np.ndarray | None = None) -> sp.csr_matrix:
+        """The matrix of the coefficients ``coeff`` (``coeff[k, a, b]``: trial descriptor
+        ``a``, test descriptor ``b``), per cell ``(m, d d, d d)`` or, with ``group``
+        ``(m,)`` int, per group ``(G, d d, d d)`` (cell ``k`` takes
+        ``coeff[group[k]]``); ``(N, N)`` CSR."""
+        d, m = self.d, self.size
+        coeff = np.ascontiguousarray(coeff, dtype=float)
+        group = np.arange(m) if group is None else np.asarray(group, dtype=np.int64)
+        if coeff.ndim != 3 or coeff.shape[1:] != (d * d, d * d) or group.shape != (m,) or \
+                (m and (group.min() < 0 or group.max() >= len(coeff))):
+            raise FormError(f"gradient_gram: expected coefficients of shape ({m}, {d * d}, "
+                            f"{d * d}) (or one per group with a ({m},) group index), received "
+                            f"shape {coeff.shape} with group shape {group.shape}")
+        if self._pattern is None:
+            return _weighted_gram(self._ops, self.weight[:, None, None] * coeff[group], self.N)
+        out_ptr, out_idx, indptr, indices, t_ptr, t_row, t_pos = self._pattern
+        args = (coeff, group, self.weight, t_ptr, t_row, t_pos, indptr, indices, out_ptr,
+                self.N // d, work_chunks())
+        if d == 2:
+            data = SK.gradient_block_values(self._ptr, self._idx, *self._values, *args)
+        else:
+            data = SK.gradient_block_values_nd(self._ptr, self._idx, self._values, *args)
+        return sp.csr_matrix((data, out_idx, out_ptr), shape=(self.N, self.N))
 
 
 class LinearForm(_Form):

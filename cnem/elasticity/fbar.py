@@ -46,7 +46,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly.forms import gradient_gram
 from ..errors import InputError
 from .finite_strain import FiniteStrainOperator
 
@@ -168,10 +167,11 @@ class FbarOperator(FiniteStrainOperator):
         x = per_cell.reshape(-1, d * d)
         return sum(op.T @ x[:, a] for a, op in enumerate(self._gradient_ops))
 
-    def evaluate(self, u: np.ndarray, tangent: bool = True
-                 ) -> tuple[np.ndarray, sp.csr_matrix | None]:
-        """Internal forces ``(N,)`` and (with ``tangent``) their symmetric derivative
-        ``(N, N)`` CSR: the ``evaluate`` of `cnem.solvers.newton.newton`."""
+    def local_evaluate(self, u: np.ndarray, tangent: bool = True
+                       ) -> tuple[np.ndarray, np.ndarray | None, sp.spmatrix | None]:
+        """Internal forces ``(N,)`` and (with ``tangent``) their symmetric derivative in
+        parts (`FiniteStrainOperator.local_evaluate`): the cells' coefficients at fixed
+        patch volumes, and the coupling through the patch volumes ``(N, N)``."""
         d, V = self.dim, self.basis.dx
         F, J, J_bar, s = self._kinematics(u)
         Fb = s[:, None, None] * F
@@ -184,7 +184,7 @@ class FbarOperator(FiniteStrainOperator):
         force = (V * s)[:, None, None] * P + ((y * J - V * q / d))[:, None, None] * T
         f = self._to_dofs(force)
         if not tangent:
-            return f, None
+            return f, None, None
         R = P + np.einsum("kiJlL,klL->kiJ", A, Fb)
         RF = np.einsum("kij,kij->k", R, Fb)
         outer = np.einsum("kij,klm->kijlm", T, T)                 # T_iJ T_kL
@@ -195,7 +195,6 @@ class FbarOperator(FiniteStrainOperator):
             + (V * RF / d ** 2 + y * J)[:, None, None, None, None] * outer \
             + (V * q / d - y * J)[:, None, None, None, None] * cross
         local = np.swapaxes(D.reshape(-1, d * d, d * d), 1, 2) / np.where(V > 0, V, 1.0)[:, None, None]
-        K = gradient_gram(self.basis, local)
         mixed = (V / (d * J_bar))[:, None, None] * (s[:, None, None] * R
                                                    - (RF / d)[:, None, None] * T)
         curvature = V / (d * J_bar ** 2) * (RF / d - q)
@@ -203,5 +202,4 @@ class FbarOperator(FiniteStrainOperator):
         Lb = self._to_dofs((mixed,))
         M = self.average
         coupling = Lb @ M @ Lc.T
-        K = K + coupling + coupling.T + Lc @ (M.T @ sp.diags(curvature) @ M) @ Lc.T
-        return f, K.tocsr()
+        return f, local, coupling + coupling.T + Lc @ (M.T @ sp.diags(curvature) @ M) @ Lc.T

@@ -26,11 +26,12 @@ True
 
 from __future__ import annotations
 
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..assembly.forms import gradient_gram
+from ..assembly.forms import GradientGram
 from ..errors import InputError, MaterialError
 from ..material import Hyperelastic
 
@@ -115,6 +116,12 @@ class FiniteStrainOperator:
         W, _, _ = self.laws(self.deformation_gradient(u), tangent=False)
         return float(self.basis.dx @ W)
 
+    @cached_property
+    def gram(self) -> GradientGram:
+        """The tangent's assembly on the basis's cells, its pattern kept
+        (`cnem.assembly.forms.GradientGram`)."""
+        return GradientGram([self.basis])
+
     def evaluate(self, u: np.ndarray, tangent: bool = True
                  ) -> tuple[np.ndarray, sp.csr_matrix | None]:
         """Internal forces and (with ``tangent``) their derivative: the ``evaluate`` of
@@ -131,6 +138,27 @@ class FiniteStrainOperator:
         K : scipy.sparse.csr_matrix (N, N), or None
             Symmetric.
         """
+        f, coeff, extra = self.local_evaluate(u, tangent)
+        if not tangent:
+            return f, None
+        K = self.gram.matrix(coeff)
+        return f, K if extra is None else (K + extra).tocsr()
+
+    def local_evaluate(self, u: np.ndarray, tangent: bool = True
+                       ) -> tuple[np.ndarray, np.ndarray | None, sp.spmatrix | None]:
+        """`evaluate` (the same ``u (N,)`` and ``tangent``) with the tangent left in
+        parts: ``K = gram.matrix(coeff) + extra``.
+
+        Returns
+        -------
+        f_int : (N,) ndarray
+        coeff : (m, d d, d d) ndarray, or None
+            Per cell, ``coeff[k, a, b]`` for trial descriptor ``a`` and test ``b``
+            (`cnem.assembly.forms.GradientGram`); None without ``tangent``.
+        extra : scipy.sparse matrix (N, N), or None
+            What the tangent holds besides (None here; the patch coupling of
+            `cnem.elasticity.fbar.FbarOperator`).
+        """
         d = self.dim
         _, P, A = self.laws(self.deformation_gradient(u), tangent=tangent)
         weighted = self.basis.dx[:, None] * P.reshape(-1, d * d)
@@ -138,10 +166,9 @@ class FiniteStrainOperator:
         for a, op in enumerate(self._gradient_ops):
             f += op.T @ weighted[:, a]
         if not tangent:
-            return f, None
+            return f, None, None
         # the kernel's coeff[k, a, b] has trial descriptor a and test b: A's transpose
-        coeff = np.swapaxes(A.reshape(-1, d * d, d * d), 1, 2)
-        return f, gradient_gram(self.basis, coeff)
+        return f, np.swapaxes(A.reshape(-1, d * d, d * d), 1, 2), None
 
 
 class EnergySum:
@@ -161,6 +188,12 @@ class EnergySum:
         if len(sizes) != 1:
             raise InputError(f"EnergySum: expected operators on the same dofs, received "
                              f"{sorted(sizes)} dofs")
+        self._bases, self._basis_of_term = [], []       # distinct bases, by identity
+        for _, op in self.terms:
+            known = [b for b, basis in enumerate(self._bases) if basis is op.basis]
+            if not known:
+                self._bases.append(op.basis)
+            self._basis_of_term.append(known[0] if known else len(self._bases) - 1)
 
     def __repr__(self):
         return f"<EnergySum of {len(self.terms)} terms>"
@@ -169,13 +202,26 @@ class EnergySum:
         """``sum_t w_t Pi_t(u)``."""
         return sum(w * op.energy(u) for w, op in self.terms)
 
+    @cached_property
+    def gram(self) -> GradientGram:
+        """The summed tangent's assembly over the cells of the terms' distinct bases,
+        in one pass on one pattern (`cnem.assembly.forms.GradientGram`)."""
+        return GradientGram(self._bases)
+
     def evaluate(self, u: np.ndarray, tangent: bool = True
                  ) -> tuple[np.ndarray, sp.csr_matrix | None]:
-        """Summed internal forces ``(N,)`` and tangent (see `FiniteStrainOperator.evaluate`)."""
-        f, K = 0.0, None
-        for w, op in self.terms:
-            f_t, K_t = op.evaluate(u, tangent)
+        """Summed internal forces ``(N,)`` and tangent (see `FiniteStrainOperator.evaluate`):
+        the terms' coefficients are summed per basis (the cells' law and the cells'
+        stabilisation on one basis) and assembled in one pass."""
+        f, coeff, extras = 0.0, [None] * len(self._bases), []
+        for (w, op), b in zip(self.terms, self._basis_of_term):
+            f_t, c_t, extra = op.local_evaluate(u, tangent)
             f = f + w * f_t
             if tangent:
-                K = w * K_t if K is None else K + w * K_t
-        return f, K
+                coeff[b] = w * c_t if coeff[b] is None else coeff[b] + w * c_t
+                if extra is not None:
+                    extras.append(w * extra)
+        if not tangent:
+            return f, None
+        K = self.gram.matrix(np.concatenate(coeff))
+        return f, sum(extras, K).tocsr() if extras else K

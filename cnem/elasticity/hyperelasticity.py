@@ -14,10 +14,13 @@ from tqdm.auto import tqdm
 from ..assembly import CellBasis
 from ..errors import InputError, MaterialError, OptionError
 from ..material import Hyperelastic, NeoHookean, check_plane, parse_materials
+from ..solvers.linsolve import rigid_modes
+from ..solvers.multigrid import hierarchy
 from ..solvers.newton import newton
 from .fbar import FbarOperator, patch_average
 from .finite_strain import EnergySum, FiniteStrainOperator
 from .hyperelastic_solution import HyperelasticSolution
+from .linear import Elasticity
 from .model_problem import ModelProblem
 from .stabilization import IsochoricNeoHookean
 
@@ -129,6 +132,7 @@ class Hyperelasticity(ModelProblem):
         self.volumetric = volumetric
         self._operator = None
         self._system = None
+        self._preconditioner = None          # (dofs, VCycle) of `solver_options`
 
     def __repr__(self):
         idealisation = f"plane {self.plane}" if self.plane else "3-D"
@@ -180,6 +184,38 @@ class Hyperelasticity(ModelProblem):
         the deviatoric law the F-bar patch test of `tests/test_fbar.py` inverts cells
         in Newton's first iterates at two load steps)."""
         return NeoHookean(mu, 0.0) if self.volumetric == "fbar" else IsochoricNeoHookean(mu)
+
+    def solver_options(self, dofs: np.ndarray) -> dict:
+        """The keywords of `cnem.solvers.linsolve.solve_spd` for Newton's corrections on
+        ``dofs`` (the free ones): those of the linear `cnem.Elasticity` of the laws
+        linearised at ``F = I`` (`cnem.Elasticity.solver_options`: smoothed aggregation
+        on the P1 stiffness of the nodes), with the hierarchy built once, when the first
+        correction takes the iterative path, and kept for every later correction on
+        the same dofs. The P1 matrix does not change with the tangent, so the
+        hierarchy stays as good as it was (in 3-D and for plain SCNI its finest level
+        is smoothed with each correction's tangent itself).
+
+        Returns
+        -------
+        dict
+        """
+        dofs = np.asarray(dofs)
+        linear = Elasticity(self.model, [m.linearized() for m in self.region_materials],
+                            plane=self.plane, gauss=self.gauss,
+                            stabilization=self.stabilization, gradients=self.gradients)
+        options = linear.solver_options(dofs)
+        matrix = options.pop("preconditioner")
+
+        def preconditioner():
+            kept = self._preconditioner
+            if kept is None or not np.array_equal(kept[0], dofs):
+                P = matrix()
+                kept = (dofs, None if P is None else
+                        hierarchy(P, rigid_modes(np.asarray(self.model.nodes))[dofs]))
+                self._preconditioner = kept
+            return kept[1]
+
+        return dict(options, preconditioner=preconditioner)
 
     def load(self) -> np.ndarray:
         """The whole dead load (tractions and body forces), ``(dim n,)``."""
@@ -235,7 +271,8 @@ class Hyperelasticity(ModelProblem):
         try:
             u, history = newton(system.evaluate, self.load(), D, values, points=self.model.nodes,
                                 tol=tol, steps=steps, max_iterations=max_iterations,
-                                line_search=line_search, on_step=on_step)
+                                line_search=line_search, on_step=on_step,
+                                options=self.solver_options)
         finally:
             bar.close()
         t2 = time.perf_counter()

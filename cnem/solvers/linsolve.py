@@ -21,7 +21,7 @@ import scipy.sparse.linalg as spla
 from .. import config
 from ..errors import InputError, SolveError, check_choice
 from .condensation import FreeBlock
-from .multigrid import hierarchy
+from .multigrid import VCycle, hierarchy
 
 if TYPE_CHECKING:
     from typing import Callable, Literal
@@ -199,12 +199,15 @@ def solve_spd(A: sp.spmatrix | FreeBlock, b: np.ndarray, *, modes: np.ndarray | 
         Relative residual for the iterative solver.
     method : {"auto", "direct", "amg"}
         ``"auto"``: direct up to `cnem.config.DIRECT_NNZ` non-zeros, pyamg + CG above.
-    preconditioner : sparse (N, N) or callable returning one, optional
+    preconditioner : sparse (N, N), VCycle, or callable returning one, optional
         A sparser SPD matrix spectrally close to ``A`` (the P1 stiffness of the
         same nodes, `cnem.assembly.triangles`): the smoothed-aggregation
-        hierarchy is built on it and preconditions CG on ``A``. Should CG not
-        reach ``tol`` so, the hierarchy is built on ``A`` itself. A callable is
-        called only when the iterative path is taken.
+        hierarchy is built on it and preconditions CG on ``A``; or such a hierarchy
+        already built (`cnem.solvers.multigrid.hierarchy` of that matrix and
+        ``modes``), kept by a caller that solves several systems close to one
+        another (Newton's corrections). Should CG not reach ``tol`` so, the
+        hierarchy is built on ``A`` itself. A callable is called only when the
+        iterative path is taken.
     smooth_with_matrix : bool
         With a preconditioner matrix: smooth the finest level with ``A`` itself
         (its coarse levels stay the preconditioner's), for matrices whose
@@ -245,7 +248,7 @@ def solve_spd(A: sp.spmatrix | FreeBlock, b: np.ndarray, *, modes: np.ndarray | 
             return x
         return _fall_back(A, b, rel, its, tol, "smoothed aggregation on the nodal block + LU "
                           "of the enriched block")
-    if callable(preconditioner):
+    if callable(preconditioner) and not isinstance(preconditioner, VCycle):
         preconditioner = preconditioner()
     if preconditioner is not None:
         if preconditioner.shape != A.shape:
@@ -340,8 +343,9 @@ def _cg(A, b, M, tol, label):
 
 
 def _amg_cg(A, b, P, modes, tol, smooth_with_A=False):
-    """CG on ``A x = b`` preconditioned by a smoothed-aggregation V-cycle built on ``P``
-    (its finest level smoothed with ``A`` if ``smooth_with_A``), `cnem.solvers.multigrid`.
+    """CG on ``A x = b`` preconditioned by a smoothed-aggregation V-cycle built on ``P``,
+    or by ``P`` itself if it is one (its finest level smoothed with ``A`` if
+    ``smooth_with_A``), `cnem.solvers.multigrid`.
 
     Returns
     -------
@@ -352,8 +356,11 @@ def _amg_cg(A, b, P, modes, tol, smooth_with_A=False):
         Iterations.
     """
     same = P is A
-    cycle = hierarchy(A.matrix() if same else P, modes,
-                      top=A.matrix() if smooth_with_A and not same else None)
+    if isinstance(P, VCycle):
+        cycle = P.smoothing_with(A.matrix()) if smooth_with_A else P
+    else:
+        cycle = hierarchy(A.matrix() if same else P, modes,
+                          top=A.matrix() if smooth_with_A and not same else None)
     label = "hierarchy on " + ("the matrix" if same else "the preconditioner matrix" +
                                (", smoothing with the matrix" if smooth_with_A else ""))
     return _cg(A, b, cycle, tol, label)

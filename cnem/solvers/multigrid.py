@@ -21,6 +21,7 @@ True
 
 from __future__ import annotations
 
+import copy
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -115,16 +116,25 @@ class VCycle(spla.LinearOperator):
         self._coarse_A, self._coarse = levels[-1].A, ml.coarse_solver
         self._starts, self._diagonal = [], []
         for level, A in enumerate(self._A):
-            n = A.shape[0]
-            exact = level == 0 and top is not None
-            blocks = 1 if exact else max(1, min(MAX_BLOCKS, n // BLOCK_ROWS))
-            starts = np.arange(blocks + 1, dtype=np.int64) * n // blocks
-            diagonal = np.empty(n)
-            kernels.l1_diagonal(A.indptr, A.indices, A.data, starts, diagonal)
+            starts, diagonal = _sweep_blocks(A, level == 0 and top is not None)
             self._starts.append(starts)
             self._diagonal.append(diagonal)
         self.levels = len(levels)
         super().__init__(dtype=float, shape=levels[0].A.shape)
+
+    def smoothing_with(self, top: sp.spmatrix) -> VCycle:
+        """The same hierarchy with its finest level smoothed with ``top`` ``(N, N)``
+        instead (see ``top`` above): its coarse levels are shared, not copied."""
+        if top.shape != self.shape:
+            raise InputError(f"top: expected shape {self.shape} like the hierarchy's finest "
+                             f"level, received {top.shape}; pass the system's matrix")
+        out = copy.copy(self)
+        if self._A:
+            out._A, out._starts, out._diagonal = list(self._A), list(self._starts), \
+                list(self._diagonal)
+            out._A[0] = _csr(top)
+            out._starts[0], out._diagonal[0] = _sweep_blocks(out._A[0], True)
+        return out
 
     def _matvec(self, b):
         return self._cycle(0, np.ascontiguousarray(b, dtype=float).reshape(-1))
@@ -154,6 +164,17 @@ class VCycle(spla.LinearOperator):
         for backward in (False, True):
             np.copyto(before, x)
             kernels.sweep(A.indptr, A.indices, A.data, diagonal, starts, b, x, before, backward)
+
+def _sweep_blocks(A, exact):
+    """The blocks of rows a level's sweeps cut ``A`` (`Rows`) into (one if ``exact``),
+    ``starts``, and the l1 diagonal the sweeps divide by."""
+    n = A.shape[0]
+    blocks = 1 if exact else max(1, min(MAX_BLOCKS, n // BLOCK_ROWS))
+    starts = np.arange(blocks + 1, dtype=np.int64) * n // blocks
+    diagonal = np.empty(n)
+    kernels.l1_diagonal(A.indptr, A.indices, A.data, starts, diagonal)
+    return starts, diagonal
+
 
 def parallel_operator(A: sp.spmatrix) -> spla.LinearOperator:
     """``A`` as a `scipy.sparse.linalg.LinearOperator` whose product runs in parallel

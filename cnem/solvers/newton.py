@@ -43,7 +43,8 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
            initial: ArrayLike | None = None, tol: float = 1e-10, steps: int = 1,
            max_iterations: int = 20, line_search: bool = False, linear: bool = False,
            halvings: int = LINE_SEARCH_HALVINGS,
-           on_step: Callable[[int, np.ndarray], None] | None = None
+           on_step: Callable[[int, np.ndarray], None] | None = None,
+           options: Callable[[np.ndarray], dict] | None = None
            ) -> tuple[np.ndarray, list[list[float]]]:
     """Newton-Raphson with the exact tangent, Dirichlet values and loads ramped in
     ``steps`` equal increments.
@@ -91,6 +92,9 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
         Most halvings of the line search.
     on_step : callable ``(step, u (N,)) -> None``, optional
         Called after each converged load step ``1..steps`` with a copy of ``u``.
+    options : callable, optional
+        ``options(free) -> dict``: the linear solver's keywords for the corrections
+        (a preconditioner, ...), as in `cnem.solvers.constrained.solve_constrained`.
 
     Returns
     -------
@@ -128,7 +132,7 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
     def correction(rhs, rtol):
         """``K_ff x_f = rhs_f`` with ``x`` zero at the prescribed dofs, ``(N,)``."""
         return solve_constrained(Kt, rhs, fixed, np.zeros(len(fixed)), points=points,
-                                 tol=rtol, check=False)
+                                 tol=rtol, options=options, check=False)
 
     history = []
     for step in range(1, steps + 1):
