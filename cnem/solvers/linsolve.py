@@ -353,7 +353,7 @@ def _amg_cg(A, b, P, modes, tol, smooth_with_A=False):
     """
     same = P is A
     cycle = hierarchy(A.matrix() if same else P, modes,
-                      top=A.matrix() if smooth_with_A and not same else None)
+                      top=A.upper() if smooth_with_A and not same else None)
     label = "hierarchy on " + ("the matrix" if same else "the preconditioner matrix" +
                                (", smoothing with the matrix" if smooth_with_A else ""))
     return _cg(A, b, cycle, tol, label)

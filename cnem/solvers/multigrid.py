@@ -29,6 +29,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import InputError
 from . import _multigrid_kernels as kernels
+from .symmetric import UpperTriangle
 
 if TYPE_CHECKING:
     import pyamg
@@ -58,7 +59,7 @@ class Rows(NamedTuple):
 
 
 def hierarchy(matrix: sp.spmatrix, modes: np.ndarray | None = None,
-              top: sp.spmatrix | None = None) -> VCycle:
+              top: sp.spmatrix | UpperTriangle | None = None) -> VCycle:
     """Smoothed aggregation on ``matrix`` (pyamg), as a `VCycle`.
 
     Parameters
@@ -67,7 +68,7 @@ def hierarchy(matrix: sp.spmatrix, modes: np.ndarray | None = None,
         Symmetric positive definite; the hierarchy is built on it.
     modes : (N, k) ndarray, optional
         Near-null space (rigid motions); pyamg's constant vector if None.
-    top : sparse (N, N), optional
+    top : sparse (N, N) or UpperTriangle, optional
         Smooth the finest level with this matrix instead (the system's own matrix
         when ``matrix`` only approximates it).
 
@@ -89,9 +90,11 @@ class VCycle(spla.LinearOperator):
     ml : pyamg.MultilevelSolver
         Its level matrices, prolongations and restrictions are copied to CSR (the
         solver may then be dropped); its coarse solver solves the last level.
-    top : sparse (N, N), optional
+    top : sparse (N, N) or UpperTriangle, optional
         The finest level's matrix for the sweeps and the residual (default: the
-        hierarchy's own). It is swept as one block (plain, sequential Gauss-Seidel): the
+        hierarchy's own), held as an `UpperTriangle` (half the bytes and half the data
+        read per sweep; a sparse matrix is converted). It is swept as one block
+        (plain, sequential Gauss-Seidel: `UpperTriangle.sweep`): the
         oscillating low-energy modes of plain SCNI's K (and of 3-D SCNI's), for which it
         is given, are
         what the smoothing there must remove, and the Jacobi coupling across blocks
@@ -102,22 +105,29 @@ class VCycle(spla.LinearOperator):
     levels : int
     """
 
-    def __init__(self, ml: pyamg.MultilevelSolver, top: sp.spmatrix | None = None) -> None:
+    def __init__(self, ml: pyamg.MultilevelSolver,
+                 top: sp.spmatrix | UpperTriangle | None = None) -> None:
         levels = ml.levels
         if top is not None and top.shape != levels[0].A.shape:
             raise InputError(f"top: expected shape {levels[0].A.shape} like the hierarchy's "
                              f"finest level, received {top.shape}; pass the system's matrix")
         self._A = [_csr(lv.A) for lv in levels[:-1]]
+        self._top = None
         if top is not None and self._A:
-            self._A[0] = _csr(top)
+            self._top = top if isinstance(top, UpperTriangle) else UpperTriangle.from_matrix(top)
+            self._A = self._A[1:]
+            self._A.insert(0, None)             # level 0 is self._top
         self._P = [_csr(lv.P) for lv in levels[:-1]]
         self._R = [_csr(lv.R) for lv in levels[:-1]]
         self._coarse_A, self._coarse = levels[-1].A, ml.coarse_solver
         self._starts, self._diagonal = [], []
-        for level, A in enumerate(self._A):
+        for A in self._A:
+            if A is None:                       # the top: swept by its own kernel
+                self._starts.append(None)
+                self._diagonal.append(None)
+                continue
             n = A.shape[0]
-            exact = level == 0 and top is not None
-            blocks = 1 if exact else max(1, min(MAX_BLOCKS, n // BLOCK_ROWS))
+            blocks = max(1, min(MAX_BLOCKS, n // BLOCK_ROWS))
             starts = np.arange(blocks + 1, dtype=np.int64) * n // blocks
             diagonal = np.empty(n)
             kernels.l1_diagonal(A.indptr, A.indices, A.data, starts, diagonal)
@@ -139,8 +149,11 @@ class VCycle(spla.LinearOperator):
         A, P, R = self._A[level], self._P[level], self._R[level]
         x, before = np.zeros_like(b), np.empty_like(b)
         self._smooth(level, b, x, before)
-        r = np.empty_like(b)
-        kernels.residual(A.indptr, A.indices, A.data, x, b, r)
+        if A is None:
+            r = b - self._top @ x
+        else:
+            r = np.empty_like(b)
+            kernels.residual(A.indptr, A.indices, A.data, x, b, r)
         coarse_b = np.empty(R.shape[0])
         kernels.multiply(R.indptr, R.indices, R.data, r, coarse_b, False)
         kernels.multiply(P.indptr, P.indices, P.data, self._cycle(level + 1, coarse_b), x, True)
@@ -151,6 +164,9 @@ class VCycle(spla.LinearOperator):
         """A forward then a backward sweep on ``x`` (a symmetric smoother: the same one
         before and after the coarse correction makes the cycle symmetric)."""
         A, starts, diagonal = self._A[level], self._starts[level], self._diagonal[level]
+        if A is None:
+            self._top.sweep(b, x)
+            return
         for backward in (False, True):
             np.copyto(before, x)
             kernels.sweep(A.indptr, A.indices, A.data, diagonal, starts, b, x, before, backward)
