@@ -64,8 +64,10 @@ def test_sweep_is_forward_then_backward_gauss_seidel(n, seed):
     b, x = rng.standard_normal(n), rng.standard_normal(n)
     expected = gauss_seidel(A, b, gauss_seidel(A, b, x, range(n)), range(n - 1, -1, -1))
     U = UpperTriangle.from_matrix(A)
-    U.sweep(b, x)
+    residual = U.sweep(b, x)
     np.testing.assert_allclose(x, expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())
+    np.testing.assert_allclose(residual, b - A @ x, rtol=0,
+                               atol=1e-12 * (np.abs(b).max() + np.abs(A @ x).max()))
 
 
 def test_sweeps_converge_to_the_solution():

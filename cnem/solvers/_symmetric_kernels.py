@@ -56,8 +56,9 @@ def multiply(indptr, indices, data, x, out, partial):
 
 
 @numba.njit(cache=True)
-def symmetric_sweep(indptr, indices, data, b, x, lower):
-    """A forward then a backward Gauss-Seidel sweep on ``A x = b``, in place on ``x``.
+def symmetric_sweep(indptr, indices, data, b, x, lower, residual):
+    """A forward then a backward Gauss-Seidel sweep on ``A x = b``, in place on ``x``,
+    and the residual ``b - A x`` after it.
 
     Parameters
     ----------
@@ -68,6 +69,11 @@ def symmetric_sweep(indptr, indices, data, b, x, lower):
         The iterate, updated.
     lower : (n,) ndarray
         Work space (overwritten): ``sum_{j < i} a_ij x_j`` of the new values.
+    residual : (n,) ndarray
+        Filled with ``b - A x`` of the final ``x``: row ``i`` of the backward sweep
+        leaves a zero residual but for the changes of the ``x_j`` left of it, which it
+        then makes, ``sum_{j < i} a_ij (x_j^forward - x_j^final)``, scattered from the
+        rows as they change (no further pass over the matrix).
     """
     n = x.shape[0]
     lower[:] = 0.0
@@ -80,9 +86,14 @@ def symmetric_sweep(indptr, indices, data, b, x, lower):
         x[i] = xi
         for p in range(first + 1, end):
             lower[indices[p]] += data[p] * xi
+    residual[:] = 0.0
     for i in range(n - 1, -1, -1):          # backward: new values right, forward's left
         first, end = indptr[i], indptr[i + 1]
         s = b[i] - lower[i]
         for p in range(first + 1, end):
             s -= data[p] * x[indices[p]]
-        x[i] = s / data[first]
+        xi = s / data[first]
+        change = x[i] - xi
+        x[i] = xi
+        for p in range(first + 1, end):
+            residual[indices[p]] += data[p] * change

@@ -148,10 +148,10 @@ class VCycle(spla.LinearOperator):
             return np.asarray(self._coarse(self._coarse_A, b), dtype=float).reshape(-1)
         A, P, R = self._A[level], self._P[level], self._R[level]
         x, before = np.zeros_like(b), np.empty_like(b)
-        self._smooth(level, b, x, before)
-        if A is None:
-            r = b - self._top @ x
+        if A is None:                           # the top's sweep gives the residual
+            r = self._top.sweep(b, x)
         else:
+            self._smooth(level, b, x, before)
             r = np.empty_like(b)
             kernels.residual(A.indptr, A.indices, A.data, x, b, r)
         coarse_b = np.empty(R.shape[0])

@@ -90,11 +90,19 @@ class UpperTriangle(spla.LinearOperator):
     def _rmatvec(self, x):                  # symmetric
         return self._matvec(x)
 
-    def sweep(self, b: np.ndarray, x: np.ndarray) -> None:
+    def sweep(self, b: np.ndarray, x: np.ndarray) -> np.ndarray:
         """A symmetric Gauss-Seidel sweep on ``A x = b`` (forward, then backward), in
-        place on ``x``; ``b``, ``x`` ``(n,)`` float64, contiguous."""
+        place on ``x``; ``b``, ``x`` ``(n,)`` float64, contiguous.
+
+        Returns
+        -------
+        (n,) ndarray
+            The residual ``b - A x`` after the sweep (made by the sweep itself).
+        """
+        residual = np.empty(self.shape[0])
         kernels.symmetric_sweep(self.indptr, self.indices, self.data, b, x,
-                                np.empty(self.shape[0]))
+                                np.empty(self.shape[0]), residual)
+        return residual
 
     def tocsr(self) -> sp.csr_matrix:
         """The whole matrix, CSR ``(n, n)`` (for a direct solve or a check)."""
