@@ -206,8 +206,9 @@ def solve_spd(A: sp.spmatrix | FreeBlock, b: np.ndarray, *, modes: np.ndarray | 
         reach ``tol`` so, the hierarchy is built on ``A`` itself. A callable is
         called only when the iterative path is taken.
     smooth_with_matrix : bool
-        With a preconditioner matrix: smooth the finest level with ``A`` itself
-        (its coarse levels stay the preconditioner's), for matrices whose
+        With a preconditioner matrix: smooth the finest level with ``A`` itself,
+        held once as its upper triangle (`FreeBlock.upper`), on which CG's products
+        then run too (its coarse levels stay the preconditioner's), for matrices whose
         low-energy oscillating modes the preconditioner matrix lacks (plain SCNI
         against P1: 35 CG iterations instead of 246 at 100k nodes; stabilised 3-D
         SCNI: 59 instead of 291 at 10k nodes).
