@@ -70,6 +70,19 @@ def test_sweep_is_forward_then_backward_gauss_seidel(n, seed):
                                atol=1e-12 * (np.abs(b).max() + np.abs(A @ x).max()))
 
 
+def test_sweep_from_zero_and_without_residual_is_the_same_sweep():
+    A = random_symmetric(300, 11)
+    b = np.random.default_rng(11).standard_normal(300)
+    U = UpperTriangle.from_matrix(A)
+    x, y = np.zeros(300), np.zeros(300)
+    residual = U.sweep(b, x)
+    np.testing.assert_array_equal(U.sweep(b, y, from_zero=True), residual)
+    np.testing.assert_array_equal(y, x)
+    assert U.sweep(b, x, residual=False) is None
+    U.sweep(b, y)
+    np.testing.assert_array_equal(x, y)
+
+
 def test_sweeps_converge_to_the_solution():
     A = random_symmetric(300, 8)
     b = np.random.default_rng(8).standard_normal(300)

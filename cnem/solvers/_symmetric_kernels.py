@@ -56,7 +56,7 @@ def multiply(indptr, indices, data, x, out, partial):
 
 
 @numba.njit(cache=True)
-def symmetric_sweep(indptr, indices, data, b, x, lower, residual):
+def symmetric_sweep(indptr, indices, data, b, x, lower, residual, from_zero):
     """A forward then a backward Gauss-Seidel sweep on ``A x = b``, in place on ``x``,
     and the residual ``b - A x`` after it.
 
@@ -69,23 +69,27 @@ def symmetric_sweep(indptr, indices, data, b, x, lower, residual):
         The iterate, updated.
     lower : (n,) ndarray
         Work space (overwritten): ``sum_{j < i} a_ij x_j`` of the new values.
-    residual : (n,) ndarray
-        Filled with ``b - A x`` of the final ``x``: row ``i`` of the backward sweep
+    residual : (n,) or (0,) ndarray
+        Unless empty, filled with ``b - A x`` of the final ``x``: row ``i`` of the backward sweep
         leaves a zero residual but for the changes of the ``x_j`` left of it, which it
         then makes, ``sum_{j < i} a_ij (x_j^forward - x_j^final)``, scattered from the
         rows as they change (no further pass over the matrix).
+    from_zero : bool
+        ``x`` is zero on entry: the forward sweep reads nothing right of the diagonal.
     """
     n = x.shape[0]
     lower[:] = 0.0
     for i in range(n):                      # forward: new values left, old right
         first, end = indptr[i], indptr[i + 1]
         s = b[i] - lower[i]
-        for p in range(first + 1, end):
-            s -= data[p] * x[indices[p]]
+        if not from_zero:
+            for p in range(first + 1, end):
+                s -= data[p] * x[indices[p]]
         xi = s / data[first]
         x[i] = xi
         for p in range(first + 1, end):
             lower[indices[p]] += data[p] * xi
+    track = residual.shape[0] == n
     residual[:] = 0.0
     for i in range(n - 1, -1, -1):          # backward: new values right, forward's left
         first, end = indptr[i], indptr[i + 1]
@@ -95,5 +99,6 @@ def symmetric_sweep(indptr, indices, data, b, x, lower, residual):
         xi = s / data[first]
         change = x[i] - xi
         x[i] = xi
-        for p in range(first + 1, end):
-            residual[indices[p]] += data[p] * change
+        if track:
+            for p in range(first + 1, end):
+                residual[indices[p]] += data[p] * change

@@ -149,7 +149,7 @@ class VCycle(spla.LinearOperator):
         A, P, R = self._A[level], self._P[level], self._R[level]
         x, before = np.zeros_like(b), np.empty_like(b)
         if A is None:                           # the top's sweep gives the residual
-            r = self._top.sweep(b, x)
+            r = self._top.sweep(b, x, from_zero=True)
         else:
             self._smooth(level, b, x, before)
             r = np.empty_like(b)
@@ -165,7 +165,7 @@ class VCycle(spla.LinearOperator):
         before and after the coarse correction makes the cycle symmetric)."""
         A, starts, diagonal = self._A[level], self._starts[level], self._diagonal[level]
         if A is None:
-            self._top.sweep(b, x)
+            self._top.sweep(b, x, residual=False)
             return
         for backward in (False, True):
             np.copyto(before, x)

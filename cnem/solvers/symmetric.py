@@ -90,19 +90,29 @@ class UpperTriangle(spla.LinearOperator):
     def _rmatvec(self, x):                  # symmetric
         return self._matvec(x)
 
-    def sweep(self, b: np.ndarray, x: np.ndarray) -> np.ndarray:
+    def sweep(self, b: np.ndarray, x: np.ndarray, *, from_zero: bool = False,
+              residual: bool = True) -> np.ndarray | None:
         """A symmetric Gauss-Seidel sweep on ``A x = b`` (forward, then backward), in
-        place on ``x``; ``b``, ``x`` ``(n,)`` float64, contiguous.
+        place on ``x``.
+
+        Parameters
+        ----------
+        b, x : (n,) float64 ndarray, contiguous
+        from_zero : bool
+            ``x`` is zero on entry (a quarter of the sweep's work saved).
+        residual : bool
+            Return the residual after the sweep (made by the sweep itself; without it,
+            another quarter saved).
 
         Returns
         -------
-        (n,) ndarray
-            The residual ``b - A x`` after the sweep (made by the sweep itself).
+        (n,) ndarray or None
+            ``b - A x`` after the sweep, if ``residual``.
         """
-        residual = np.empty(self.shape[0])
+        out = np.empty(self.shape[0] if residual else 0)
         kernels.symmetric_sweep(self.indptr, self.indices, self.data, b, x,
-                                np.empty(self.shape[0]), residual)
-        return residual
+                                np.empty(self.shape[0]), out, from_zero)
+        return out if residual else None
 
     def tocsr(self) -> sp.csr_matrix:
         """The whole matrix, CSR ``(n, n)`` (for a direct solve or a check)."""
