@@ -115,8 +115,7 @@ class VCycle(spla.LinearOperator):
         self._top = None
         if top is not None and self._A:
             self._top = top if isinstance(top, UpperTriangle) else UpperTriangle.from_matrix(top)
-            self._A = self._A[1:]
-            self._A.insert(0, None)             # level 0 is self._top
+            self._A[0] = None                   # level 0 is self._top
         self._P = [_csr(lv.P) for lv in levels[:-1]]
         self._R = [_csr(lv.R) for lv in levels[:-1]]
         self._coarse_A, self._coarse = levels[-1].A, ml.coarse_solver
