@@ -9,8 +9,9 @@ from .._parallel import parallel_kernel
 
 
 @parallel_kernel("rows")
-def kept_counts(indptr, indices, rows, new_index, counts):
-    """``counts[r]``: the entries of row ``rows[r]`` whose column is kept.
+def kept_counts(indptr, indices, rows, new_index, counts, upper):
+    """``counts[r]``: the entries of row ``rows[r]`` whose column is kept (and, with
+    ``upper``, whose new number is at least ``r``: the upper triangle).
 
     Parameters
     ----------
@@ -21,17 +22,19 @@ def kept_counts(indptr, indices, rows, new_index, counts):
         The new number of every kept column, -1 for the others.
     counts : (k,) int64 ndarray
         Filled.
+    upper : bool
     """
     for r in numba.prange(rows.shape[0]):
+        lowest = r if upper else 0
         count = 0
         for p in range(indptr[rows[r]], indptr[rows[r] + 1]):
-            if new_index[indices[p]] >= 0:
+            if new_index[indices[p]] >= lowest:
                 count += 1
         counts[r] = count
 
 
 @parallel_kernel("rows")
-def fill_kept(indptr, indices, data, rows, new_index, out_ptr, out_indices, out_data):
+def fill_kept(indptr, indices, data, rows, new_index, out_ptr, out_indices, out_data, upper):
     """Copy the kept entries of the kept rows, columns renumbered by ``new_index`` (in
     the order of the input: sorted input rows give sorted output rows).
 
@@ -43,12 +46,15 @@ def fill_kept(indptr, indices, data, rows, new_index, out_ptr, out_indices, out_
         Offsets from `kept_counts`'s counts.
     out_indices, out_data : (out_ptr[k],) ndarray
         Filled.
+    upper : bool
+        The upper triangle only (as in `kept_counts`).
     """
     for r in numba.prange(rows.shape[0]):
+        lowest = r if upper else 0
         at = out_ptr[r]
         for p in range(indptr[rows[r]], indptr[rows[r] + 1]):
             j = new_index[indices[p]]
-            if j >= 0:
+            if j >= lowest:
                 out_indices[at] = j
                 out_data[at] = data[p]
                 at += 1

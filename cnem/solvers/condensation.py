@@ -30,6 +30,7 @@ from .._aliases import renamed_attributes
 from ..errors import InputError
 from . import _condense_kernels as kernels
 from .multigrid import parallel_operator
+from .symmetric import UpperTriangle
 from .._sets import distinct
 
 __all__ = ["free_dofs", "principal_submatrix", "FreeBlock", "free_system", "condensed_system"]
@@ -85,7 +86,17 @@ def principal_submatrix(A: sp.spmatrix, keep: np.ndarray) -> sp.spmatrix:
     A = _compressed(A)
     rows = _kept(keep, A.shape[0])
     k = len(rows)
-    counts, new_index = _kept_counts(A, rows)
+    out = type(A)(_kept_arrays(A, rows, upper=False), shape=(k, k))
+    out.has_canonical_format = True          # kept columns of canonical rows, in order
+    return out
+
+
+def _kept_arrays(A, rows, upper):
+    """``(data, indices, indptr)`` of the principal submatrix of ``A`` (compressed,
+    canonical) on ``rows`` (strictly increasing), its upper triangle only if ``upper``;
+    int32 indices when they fit."""
+    k = len(rows)
+    counts, new_index = _kept_counts(A, rows, upper)
     total = int(counts.sum())
     index = np.int32 if max(total, k) <= _INT32_MAX else np.int64
     out_ptr = np.zeros(k + 1, dtype=index)
@@ -93,10 +104,8 @@ def principal_submatrix(A: sp.spmatrix, keep: np.ndarray) -> sp.spmatrix:
     out_indices = np.empty(total, dtype=index)
     out_data = np.empty(total, dtype=A.data.dtype)
     kernels.fill_kept(A.indptr, A.indices, A.data, rows, new_index.astype(index, copy=False),
-                      out_ptr, out_indices, out_data)
-    out = type(A)((out_data, out_indices, out_ptr), shape=(k, k))
-    out.has_canonical_format = True          # kept columns of canonical rows, in order
-    return out
+                      out_ptr, out_indices, out_data, upper)
+    return out_data, out_indices, out_ptr
 
 
 class FreeBlock(spla.LinearOperator):
@@ -124,6 +133,7 @@ class FreeBlock(spla.LinearOperator):
         self._all = len(self.free) == n
         self._product = parallel_operator(self._K.T if self._K.format == "csc" else self._K)
         self._matrix = None
+        self._upper = None
         self._nnz = None
         super().__init__(dtype=float, shape=(len(self.free), len(self.free)))
 
@@ -142,6 +152,14 @@ class FreeBlock(spla.LinearOperator):
             self._matrix = self._K if self._all else principal_submatrix(self._K, self.free)
         return self._matrix
 
+    def upper(self) -> UpperTriangle:
+        """The submatrix's upper triangle (half its bytes), formed at the first call and
+        kept; the block's products then run on it (reading half the data of ``K``'s)."""
+        if self._upper is None:
+            data, indices, indptr = _kept_arrays(self._K, self.free, upper=True)
+            self._upper = UpperTriangle(indptr, indices, data)
+        return self._upper
+
     def submatrix(self, keep: np.ndarray) -> sp.spmatrix:
         """The principal submatrix of this block on ``keep`` (its own numbering), taken
         from ``K`` directly.
@@ -158,6 +176,8 @@ class FreeBlock(spla.LinearOperator):
 
     def _matvec(self, x):
         x = np.asarray(x, dtype=float).reshape(-1)
+        if self._upper is not None:
+            return self._upper @ x
         if self._all:
             return self._product @ x
         whole = np.zeros(self._K.shape[0])
@@ -234,15 +254,15 @@ def condensed_system(K: sp.spmatrix, f: np.ndarray, *, x: np.ndarray, D: np.ndar
     return principal_submatrix(K, I), b, x, I
 
 
-def _kept_counts(A, rows):
+def _kept_counts(A, rows, upper=False):
     """The kept entries of each kept row of a principal submatrix of ``A`` (compressed,
-    canonical) on ``rows``: ``counts (k,)`` int64 and ``new_index (n,)``, the new number of
-    every kept dof, -1 for the others."""
+    canonical) on ``rows`` (its upper triangle if ``upper``): ``counts (k,)`` int64 and
+    ``new_index (n,)``, the new number of every kept dof, -1 for the others."""
     n = A.shape[0]
     counts = np.empty(len(rows), dtype=np.int64)
     new_index = np.full(n, -1, dtype=np.int32 if n <= _INT32_MAX else np.int64)
     new_index[rows] = np.arange(len(rows))
-    kernels.kept_counts(A.indptr, A.indices, rows, new_index, counts)
+    kernels.kept_counts(A.indptr, A.indices, rows, new_index, counts, upper)
     return counts, new_index
 
 

@@ -30,6 +30,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import InputError
 from . import _multigrid_kernels as kernels
+from .symmetric import UpperTriangle
 
 if TYPE_CHECKING:
     import pyamg
@@ -59,7 +60,7 @@ class Rows(NamedTuple):
 
 
 def hierarchy(matrix: sp.spmatrix, modes: np.ndarray | None = None,
-              top: sp.spmatrix | None = None) -> VCycle:
+              top: sp.spmatrix | UpperTriangle | None = None) -> VCycle:
     """Smoothed aggregation on ``matrix`` (pyamg), as a `VCycle`.
 
     Parameters
@@ -68,7 +69,7 @@ def hierarchy(matrix: sp.spmatrix, modes: np.ndarray | None = None,
         Symmetric positive definite; the hierarchy is built on it.
     modes : (N, k) ndarray, optional
         Near-null space (rigid motions); pyamg's constant vector if None.
-    top : sparse (N, N), optional
+    top : sparse (N, N) or UpperTriangle, optional
         Smooth the finest level with this matrix instead (the system's own matrix
         when ``matrix`` only approximates it).
 
@@ -90,9 +91,11 @@ class VCycle(spla.LinearOperator):
     ml : pyamg.MultilevelSolver
         Its level matrices, prolongations and restrictions are copied to CSR (the
         solver may then be dropped); its coarse solver solves the last level.
-    top : sparse (N, N), optional
+    top : sparse (N, N) or UpperTriangle, optional
         The finest level's matrix for the sweeps and the residual (default: the
-        hierarchy's own). It is swept as one block (plain, sequential Gauss-Seidel): the
+        hierarchy's own), held as an `UpperTriangle` (half the bytes and half the data
+        read per sweep; a sparse matrix is converted). It is swept as one block
+        (plain, sequential Gauss-Seidel: `UpperTriangle.sweep`): the
         oscillating low-energy modes of plain SCNI's K (and of 3-D SCNI's), for which it
         is given, are
         what the smoothing there must remove, and the Jacobi coupling across blocks
@@ -103,26 +106,30 @@ class VCycle(spla.LinearOperator):
     levels : int
     """
 
-    def __init__(self, ml: pyamg.MultilevelSolver, top: sp.spmatrix | None = None) -> None:
+    def __init__(self, ml: pyamg.MultilevelSolver,
+                 top: sp.spmatrix | UpperTriangle | None = None) -> None:
         levels = ml.levels
         if top is not None and top.shape != levels[0].A.shape:
             raise InputError(f"top: expected shape {levels[0].A.shape} like the hierarchy's "
                              f"finest level, received {top.shape}; pass the system's matrix")
         self._A = [_csr(lv.A) for lv in levels[:-1]]
+        self._top = None
         if top is not None and self._A:
-            self._A[0] = _csr(top)
+            self._top = top if isinstance(top, UpperTriangle) else UpperTriangle.from_matrix(top)
+            self._A[0] = None                   # level 0 is self._top
         self._P = [_csr(lv.P) for lv in levels[:-1]]
         self._R = [_csr(lv.R) for lv in levels[:-1]]
         self._coarse_A, self._coarse = levels[-1].A, ml.coarse_solver
         self._starts, self._diagonal = [], []
-        for level, A in enumerate(self._A):
-            starts, diagonal = _sweep_blocks(A, level == 0 and top is not None)
+        for A in self._A:
+            # the top (None) is swept by its own kernel
+            starts, diagonal = (None, None) if A is None else _sweep_blocks(A)
             self._starts.append(starts)
             self._diagonal.append(diagonal)
         self.levels = len(levels)
         super().__init__(dtype=float, shape=levels[0].A.shape)
 
-    def smoothing_with(self, top: sp.spmatrix) -> VCycle:
+    def smoothing_with(self, top: sp.spmatrix | UpperTriangle) -> VCycle:
         """The same hierarchy with its finest level smoothed with ``top`` ``(N, N)``
         instead (see ``top`` above): its coarse levels are shared, not copied."""
         if top.shape != self.shape:
@@ -132,8 +139,8 @@ class VCycle(spla.LinearOperator):
         if self._A:
             out._A, out._starts, out._diagonal = list(self._A), list(self._starts), \
                 list(self._diagonal)
-            out._A[0] = _csr(top)
-            out._starts[0], out._diagonal[0] = _sweep_blocks(out._A[0], True)
+            out._A[0], out._starts[0], out._diagonal[0] = None, None, None
+            out._top = top if isinstance(top, UpperTriangle) else UpperTriangle.from_matrix(top)
         return out
 
     def _matvec(self, b):
@@ -148,9 +155,12 @@ class VCycle(spla.LinearOperator):
             return np.asarray(self._coarse(self._coarse_A, b), dtype=float).reshape(-1)
         A, P, R = self._A[level], self._P[level], self._R[level]
         x, before = np.zeros_like(b), np.empty_like(b)
-        self._smooth(level, b, x, before)
-        r = np.empty_like(b)
-        kernels.residual(A.indptr, A.indices, A.data, x, b, r)
+        if A is None:                           # the top's sweep gives the residual
+            r = self._top.sweep(b, x, from_zero=True)
+        else:
+            self._smooth(level, b, x, before)
+            r = np.empty_like(b)
+            kernels.residual(A.indptr, A.indices, A.data, x, b, r)
         coarse_b = np.empty(R.shape[0])
         kernels.multiply(R.indptr, R.indices, R.data, r, coarse_b, False)
         kernels.multiply(P.indptr, P.indices, P.data, self._cycle(level + 1, coarse_b), x, True)
@@ -161,15 +171,18 @@ class VCycle(spla.LinearOperator):
         """A forward then a backward sweep on ``x`` (a symmetric smoother: the same one
         before and after the coarse correction makes the cycle symmetric)."""
         A, starts, diagonal = self._A[level], self._starts[level], self._diagonal[level]
+        if A is None:
+            self._top.sweep(b, x, residual=False)
+            return
         for backward in (False, True):
             np.copyto(before, x)
             kernels.sweep(A.indptr, A.indices, A.data, diagonal, starts, b, x, before, backward)
 
-def _sweep_blocks(A, exact):
-    """The blocks of rows a level's sweeps cut ``A`` (`Rows`) into (one if ``exact``),
-    ``starts``, and the l1 diagonal the sweeps divide by."""
+def _sweep_blocks(A):
+    """The blocks of rows a level's sweeps cut ``A`` (`Rows`) into, ``starts``, and the
+    l1 diagonal the sweeps divide by."""
     n = A.shape[0]
-    blocks = 1 if exact else max(1, min(MAX_BLOCKS, n // BLOCK_ROWS))
+    blocks = max(1, min(MAX_BLOCKS, n // BLOCK_ROWS))
     starts = np.arange(blocks + 1, dtype=np.int64) * n // blocks
     diagonal = np.empty(n)
     kernels.l1_diagonal(A.indptr, A.indices, A.data, starts, diagonal)
