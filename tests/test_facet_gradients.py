@@ -1,4 +1,5 @@
-"""3-D smoothed gradients from facet quadratures (`cnem.assembly.facet_gradients`).
+"""3-D smoothed gradients from facet quadratures (`cnem.assembly.facet_gradients`) and
+the pyramid sub-cells (`cnem.assembly.pyramid_cells`).
 
 On synthetic cells — the Delaunay tetrahedra of a jittered cube lattice — with the
 P1 interpolant as the shape functions, the smoothed gradient of every cell must be
@@ -16,8 +17,8 @@ import pytest
 import scipy.sparse as sp
 from scipy.spatial import Delaunay
 
-from cnem.assembly.facet_gradients import (facet_gradient, facet_points, merged_across_holes,
-                                           pyramid_sub_cells)
+from cnem.assembly.facet_gradients import facet_gradient, facet_points
+from cnem.assembly.pyramid_cells import merged_across_holes, pyramid_sub_cells
 from cnem.errors import GeometryError
 
 

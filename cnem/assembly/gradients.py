@@ -11,7 +11,8 @@ import numpy as np
 from .._aliases import renamed_attributes
 from ..errors import GeometryError
 from .edge_quadrature import boundary_quadratures, check_gauss
-from .facet_gradients import cell_gradient_3d, model_interface_pieces, sub_cell_gradient_3d
+from .facet_gradients import cell_gradient_3d, model_interface_pieces
+from .pyramid_cells import sub_cell_gradient_3d
 from .fan_quadrature import fan_quadratures
 from .passes import cell_runs, gradients_in_passes
 from .smoothed_gradient import SmoothedGradient
