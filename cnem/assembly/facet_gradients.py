@@ -26,7 +26,7 @@ interfaces too.
 from __future__ import annotations
 
 from itertools import chain
-from typing import Any, Callable
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
@@ -118,19 +118,21 @@ def _facet_groups(facet_triangles, facet_cell, facet_normal, on_interface=None):
     if on_interface is not None:
         columns.append(on_interface)
     key = np.column_stack(columns).astype(np.int64)
-    _, direction = np.unique(key, axis=0, return_inverse=True)
-    direction = direction.reshape(-1)
-    if len(direction) == 0:
-        return direction, direction
+    if len(key) == 0:
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty
     corners = facet_triangles.reshape(-1, 3)
     low = corners.min(axis=0)
     offset = np.einsum("ij,ij->i", facet_normal, facet_triangles.mean(axis=1) - low)
     # the planes' round-off: relative to the extent, and that of coordinates far from 0
     tol = (FACET_PLANE_RTOL * float(np.ptp(corners, axis=0).max())
            + 64.0 * np.finfo(float).eps * float(np.abs(corners).max()))
-    order = np.lexsort((offset, direction))
+    # by key (cell, normal[, cut]), then by offset (a lexsort: sorting the rows as
+    # records is several times slower)
+    order = np.lexsort((offset, *key.T[::-1]))
+    ranked = key[order]
     starts = np.ones(len(order), dtype=bool)
-    starts[1:] = ((direction[order[1:]] != direction[order[:-1]])
+    starts[1:] = ((ranked[1:] != ranked[:-1]).any(axis=1)
                   | (np.diff(offset[order]) > tol))
     group = np.empty(len(order), dtype=np.int64)
     group[order] = np.cumsum(starts) - 1
@@ -169,8 +171,50 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
     -------
     SmoothedGradient
         ``x, y, z`` sparse ``(m, n)``.
+
+    Raises
+    ------
+    GeometryError
+        A cell of volume not positive.
     """
-    m = len(volume)
+    rule = facet_rule(facet_triangles, facet_cell, facet_normal, volume, spokes=spokes,
+                      interface=interface)
+    return gradients_of_rules([rule], evaluate)[0]
+
+
+class FacetRule(NamedTuple):
+    """The boundary quadrature of ``m`` cells: each cell's points and their weights.
+
+    Attributes
+    ----------
+    points : (q, 3) ndarray
+        The quadrature points (a point on a face between two cells is one row, used by both).
+    point : (e,) int64 ndarray
+        The row of ``points`` of every (cell, point) entry.
+    cell : (e,) int64 ndarray
+    flux : (e, 3) ndarray
+        Area-normal out of ``cell``.
+    volume : (m,) ndarray
+    """
+
+    points: np.ndarray
+    point: np.ndarray
+    cell: np.ndarray
+    flux: np.ndarray
+    volume: np.ndarray
+
+
+def facet_rule(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_normal: np.ndarray,
+               volume: np.ndarray, *,
+               spokes: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None,
+               interface: InterfacePieces | None = None) -> FacetRule:
+    """The quadrature `facet_gradient` integrates with (same parameters), before the
+    shape functions are evaluated.
+
+    Returns
+    -------
+    FacetRule
+    """
     if np.any(~(volume > 0)):
         bad = np.flatnonzero(~(volume > 0))[:5]
         raise GeometryError(f"expected cells of positive volume, received volumes "
@@ -193,24 +237,62 @@ def facet_gradient(facet_triangles: np.ndarray, facet_cell: np.ndarray, facet_no
         column = np.concatenate([column, at, at[other]])
         cell = np.concatenate([cell, a, b[other]])
         flux = np.concatenate([flux, flux_a, flux_b[other]])
-    phi = evaluate(points).tocsr()
-    q = len(points)
-    # each cell's points in the order of their columns, the three directions on one
-    # pattern (what `cnem.assembly.forms` assembles by node blocks)
-    order = np.lexsort((column, cell))
-    ptr = np.zeros(m + 1, dtype=np.int64)
-    np.cumsum(np.bincount(cell, minlength=m), out=ptr[1:])
-    weight = np.ascontiguousarray((flux / volume[cell][:, None])[order])
-    indptr, indices, data = FK.weighted_rows(ptr, column[order], weight,
-                                             phi.indptr.astype(np.int64), phi.indices,
-                                             phi.data, phi.shape[1], work_chunks())
-    # canonical (the kernel sorts every row): the three share ``indices``, so nothing may
-    # sort one of them in place (`CellBasis` spreads them as they are)
-    parts = [sp.csr_matrix((data[i], indices, indptr), shape=(m, phi.shape[1]))
-             for i in range(3)]
-    for part in parts:
-        part.has_canonical_format = True
-    return SmoothedGradient(*parts, points=q)
+    return FacetRule(points, column, cell, flux, volume)
+
+
+def gradients_of_rules(rules: list[FacetRule], evaluate: Evaluate) -> list[SmoothedGradient]:
+    """``B~`` of each rule's cells, the shape functions evaluated once at each distinct
+    point of all the rules (the cells and their sub-cells share their facet points,
+    and the two cells on either side of a facet often compute the same point).
+
+    Parameters
+    ----------
+    rules : list of FacetRule
+    evaluate : callable ``(q, 3) -> csr (q, n)``
+
+    Returns
+    -------
+    list of SmoothedGradient
+        One per rule, equal to evaluating each rule's points on their own.
+    """
+    every = np.concatenate([rule.points for rule in rules])
+    first, label = _distinct_points(every)
+    phi = evaluate(every[first]).tocsr()
+    v_ptr = phi.indptr.astype(np.int64)
+    out, base = [], 0
+    for rule in rules:
+        m = len(rule.volume)
+        # each cell's points in the order of their rows, the three directions on one
+        # pattern (what `cnem.assembly.forms` assembles by node blocks)
+        order = np.lexsort((rule.point, rule.cell))
+        ptr = np.zeros(m + 1, dtype=np.int64)
+        np.cumsum(np.bincount(rule.cell, minlength=m), out=ptr[1:])
+        weight = np.ascontiguousarray((rule.flux / rule.volume[rule.cell][:, None])[order])
+        item = np.ascontiguousarray(label[base + rule.point[order]])
+        indptr, indices, data = FK.weighted_rows(ptr, item, weight, v_ptr, phi.indices,
+                                                 phi.data, phi.shape[1], work_chunks())
+        # canonical (the kernel sorts every row): the three share ``indices``, so nothing
+        # may sort one of them in place (`CellBasis` spreads them as they are)
+        parts = [sp.csr_matrix((data[i], indices, indptr), shape=(m, phi.shape[1]))
+                 for i in range(3)]
+        for part in parts:
+            part.has_canonical_format = True
+        out.append(SmoothedGradient(*parts, points=len(rule.points)))
+        base += len(rule.points)
+    return out
+
+
+def _distinct_points(points):
+    """The distinct rows of ``points (q, 3)``, bit for bit: a row of each ``(d,)`` and the
+    distinct row of every point ``(q,)``, in ``0..d-1``."""
+    bits = np.ascontiguousarray(points, dtype=np.float64).view(np.uint64)
+    order = np.lexsort(bits.T[::-1])
+    ranked = bits[order]
+    new = np.ones(len(order), dtype=bool)
+    new[1:] = (ranked[1:] != ranked[:-1]).any(axis=1)
+    label = np.empty(len(order), dtype=np.int64)
+    label[order] = np.cumsum(new) - 1
+    return order[new], label
 
 
 def cell_gradient_3d(model: Any, cells: Any,

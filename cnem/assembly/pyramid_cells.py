@@ -20,7 +20,8 @@ from scipy.sparse.csgraph import connected_components
 from ..errors import GeometryError
 from ..shape.natural3d import inside_tetrahedra
 from . import _facet_kernels as FK
-from .facet_gradients import _facet_groups, facet_gradient, model_interface_pieces
+from .facet_gradients import (_facet_groups, facet_rule, gradients_of_rules,
+                              model_interface_pieces)
 from .interface_facets import InterfacePieces
 from .smoothed_gradient import SmoothedGradient
 from .._sets import distinct
@@ -244,23 +245,31 @@ def _reverse_in(owner, p, q):
     bits = [np.ascontiguousarray(x, dtype=np.float64).view(np.uint64) for x in (p, q)]
     return FK.reverse_edges(np.asarray(owner, dtype=np.int64), *bits)
 
-def sub_cell_gradient_3d(model: Any, interface: InterfacePieces | None = None
-                         ) -> tuple[Any, SmoothedGradient]:
+
+def sub_cell_gradient_3d(model: Any, interface: InterfacePieces | None = None, *,
+                         with_cells: bool = False
+                         ) -> tuple[Any, SmoothedGradient, SmoothedGradient | None]:
     """The pyramid sub-cells of a 3-D model's cells and their ``B~``, from the cells'
     facet points and one point on each spoke (pyramids whose spoke's point lies
-    outside the body merged, `merged_across_holes`).
+    outside the body merged, `merged_across_holes`); with ``with_cells`` also ``B~``
+    of the cells, from the same shape-function values (their facet points are the
+    sub-cells').
 
     Parameters
     ----------
     model : Model3D
     interface : InterfacePieces, optional
         `model_interface_pieces` of ``model.cells``, when already known.
+    with_cells : bool
+        Also ``B~`` of ``model.cells`` (`cell_gradient_3d`).
 
     Returns
     -------
     sub : Cells3D
         One cell per kept pyramid, with its parent's node and region.
     grad : SmoothedGradient
+    cells_grad : SmoothedGradient or None
+        ``B~`` of the cells, None unless ``with_cells``.
     """
     cells = model.cells
     parent, triangle_sub, volume, spokes = pyramid_sub_cells(
@@ -272,6 +281,10 @@ def sub_cell_gradient_3d(model: Any, interface: InterfacePieces | None = None
     # the sub-cells' triangles are the cells': the interface pieces go to their sub-cells
     if interface is None:
         interface = model_interface_pieces(model, cells)
-    grad = facet_gradient(sub.facet_triangles, sub.facet_cell, sub.facet_normal, volume,
-                          model.shape_functions, spokes=spokes, interface=interface)
-    return sub, grad
+    rules = [facet_rule(sub.facet_triangles, sub.facet_cell, sub.facet_normal, volume,
+                        spokes=spokes, interface=interface)]
+    if with_cells:
+        rules.append(facet_rule(cells.facet_triangles, cells.facet_cell, cells.facet_normal,
+                                cells.volume, interface=interface))
+    grads = gradients_of_rules(rules, model.shape_functions)
+    return sub, grads[0], (grads[1] if with_cells else None)
