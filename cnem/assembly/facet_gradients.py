@@ -283,16 +283,20 @@ def gradients_of_rules(rules: list[FacetRule], evaluate: Evaluate) -> list[Smoot
 
 
 def _distinct_points(points):
-    """The distinct rows of ``points (q, 3)``, bit for bit: a row of each ``(d,)`` and the
-    distinct row of every point ``(q,)``, in ``0..d-1``."""
+    """The distinct rows of ``points (q, 3)``, bit for bit: the first row of each ``(d,)``,
+    increasing, and the distinct row of every point ``(q,)``, in ``0..d-1`` (numbered in
+    the order of their first rows: a cell's points stay near each other)."""
     bits = np.ascontiguousarray(points, dtype=np.float64).view(np.uint64)
-    order = np.lexsort(bits.T[::-1])
+    order = np.lexsort(bits.T[::-1])                # stable: a group's first row leads it
     ranked = bits[order]
     new = np.ones(len(order), dtype=bool)
     new[1:] = (ranked[1:] != ranked[:-1]).any(axis=1)
+    first = order[new]
+    number = np.empty(len(first), dtype=np.int64)
+    number[np.argsort(first)] = np.arange(len(first))
     label = np.empty(len(order), dtype=np.int64)
-    label[order] = np.cumsum(new) - 1
-    return order[new], label
+    label[order] = number[np.cumsum(new) - 1]
+    return np.sort(first), label
 
 
 def cell_gradient_3d(model: Any, cells: Any,
