@@ -40,8 +40,8 @@ from .interface_facets import InterfacePieces, interface_pieces, on_triangles
 from .smoothed_gradient import SmoothedGradient
 from .._sets import isin
 
-__all__ = ["facet_points", "facet_gradient", "boundary_points_3d", "cell_gradient_3d",
-           "model_interface_pieces"]
+__all__ = ["facet_points", "facet_gradient", "FacetRule", "facet_rule", "gradients_of_rules",
+           "boundary_points_3d", "cell_gradient_3d", "model_interface_pieces"]
 
 #: Facet normals are told apart to ``1 / PLANE_RESOLUTION`` (unit normals of one
 #: cell's distinct Voronoi facets differ by far more).
