@@ -1,4 +1,5 @@
-"""3-D smoothed gradients from facet quadratures (`cnem.assembly.facet_gradients`).
+"""3-D smoothed gradients from facet quadratures (`cnem.assembly.facet_gradients`) and
+the pyramid sub-cells (`cnem.assembly.pyramid_cells`).
 
 On synthetic cells — the Delaunay tetrahedra of a jittered cube lattice — with the
 P1 interpolant as the shape functions, the smoothed gradient of every cell must be
@@ -16,8 +17,9 @@ import pytest
 import scipy.sparse as sp
 from scipy.spatial import Delaunay
 
-from cnem.assembly.facet_gradients import (facet_gradient, facet_points, merged_across_holes,
-                                           pyramid_sub_cells)
+from cnem.assembly.facet_gradients import (facet_gradient, facet_points, facet_rule,
+                                           gradients_of_rules)
+from cnem.assembly.pyramid_cells import merged_across_holes, pyramid_sub_cells
 from cnem.errors import GeometryError
 
 
@@ -99,6 +101,37 @@ def test_sub_cell_gradients_are_the_p1_gradients_and_fill_the_cell(apex):
         expected = np.zeros_like(dense)
         np.put_along_axis(expected, tets[parent], exact[:, :, i], axis=1)
         np.testing.assert_allclose(dense, expected, atol=1e-10)
+
+
+def test_rules_evaluated_together_equal_each_alone_and_evaluate_each_point_once():
+    nodes, dt, tets = _lattice(k=3)
+    tets, tri, cell, nrm, vol = _facets(nodes, tets)
+    parent, triangle_sub, sub_vol, spokes = pyramid_sub_cells(nodes[tets].mean(axis=1), tri,
+                                                              cell, nrm)
+    evaluated = []
+
+    def one_by_one(points):
+        """The P1 values point by point (`find_simplex` starts where the last point's
+        walk ended: a point on a face would take either tetrahedron)."""
+        return sp.vstack([_p1(nodes, dt)(x[None]) for x in points], format="csr")
+
+    def recorded(points):
+        evaluated.append(np.array(points))
+        return one_by_one(points)
+
+    rules = [facet_rule(tri, triangle_sub, nrm, sub_vol, spokes=spokes),
+             facet_rule(tri, cell, nrm, vol)]
+    together = gradients_of_rules(rules, recorded)
+    (points,) = evaluated                                   # one call
+    assert len(np.unique(points, axis=0)) == len(points)    # no point twice
+    # the sub-cells' facet points are the cells': fewer points than the two rules hold
+    assert len(points) <= sum(len(rule.points) for rule in rules) - len(rules[1].points)
+    alone = [facet_gradient(tri, triangle_sub, nrm, sub_vol, one_by_one, spokes=spokes),
+             facet_gradient(tri, cell, nrm, vol, one_by_one)]
+    for got, want in zip(together, alone):
+        for a, b in zip(got.components, want.components):
+            assert np.array_equal(a.indptr, b.indptr) and np.array_equal(a.indices, b.indices)
+            np.testing.assert_array_equal(a.data, b.data)
 
 
 def test_cells_without_volume_are_refused():

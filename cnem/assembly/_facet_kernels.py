@@ -1,6 +1,6 @@
-"""Numba kernels of the 3-D smoothed gradients (`cnem.assembly.facet_gradients`): the
-cells' boundary integrals as ``d`` matrices on one pattern, and the twin of every
-directed facet edge by a hash table on exact coordinates.
+"""Numba kernels of the 3-D smoothed gradients (`cnem.assembly.facet_gradients`,
+`cnem.assembly.pyramid_cells`): the cells' boundary integrals as ``d`` matrices on one
+pattern, and the twin of every directed facet edge by a hash table on exact coordinates.
 """
 
 import numba

@@ -11,7 +11,8 @@ import numpy as np
 from .._aliases import renamed_attributes
 from ..errors import GeometryError
 from .edge_quadrature import boundary_quadratures, check_gauss
-from .facet_gradients import cell_gradient_3d, model_interface_pieces, sub_cell_gradient_3d
+from .facet_gradients import cell_gradient_3d, model_interface_pieces
+from .pyramid_cells import sub_cell_gradient_3d
 from .fan_quadrature import fan_quadratures
 from .passes import cell_runs, gradients_in_passes
 from .smoothed_gradient import SmoothedGradient
@@ -89,8 +90,8 @@ def _fan_gradients(model, gauss, with_cells, interface=None):
     if model.nodes.shape[1] == 3:
         if interface is None:
             interface = model_interface_pieces(model, model.cells)
-        sub, grad = sub_cell_gradient_3d(model, interface)
-        return (cell_gradient_3d(model, model.cells, interface) if with_cells else None), sub, grad
+        sub, grad, of_cells = sub_cell_gradient_3d(model, interface, with_cells=with_cells)
+        return of_cells, sub, grad
     cells = model.cells
     sub, parent = subdivide(cells, model.nodes, node_apex=tip_cells(model), mark_spokes=True)
     runs = cell_runs(model, cells)

@@ -68,7 +68,7 @@ class Cells3D:
         Outward unit normal of each triangle.
     apex : (m, 3) float64 ndarray or None
         A point each cell is star-shaped from, whose cones over the facets make the
-        cell (sub-cells: the pyramids of `cnem.assembly.facet_gradients`, whose
+        cell (sub-cells: the pyramids of `cnem.assembly.pyramid_cells`, whose
         spokes are not among the facets); None for closed cells.
     """
 
