@@ -215,7 +215,8 @@ def _to_global(cells: Cells3D, frame: Frame) -> Cells3D:
     Parameters
     ----------
     cells : Cells3D
-        In the local frame.
+        In the local frame; its facet triangles are mapped in place (do not use it
+        after).
     frame : cnem._predicates.Frame
 
     Returns
@@ -223,9 +224,11 @@ def _to_global(cells: Cells3D, frame: Frame) -> Cells3D:
     Cells3D
     """
     apex = None if cells.apex is None else frame.to_global(cells.apex)
+    # in place: the local cells are not used after, and their triangles are the largest
+    # array of the model (a second copy would be a GB at 300k nodes)
     return Cells3D(cells.node, cells.region, cells.volume * frame.scale ** 3,
-                   frame.to_global(cells.facet_triangles), cells.facet_cell, cells.facet_normal,
-                   apex)
+                   frame.to_global(cells.facet_triangles, out=cells.facet_triangles),
+                   cells.facet_cell, cells.facet_normal, apex)
 
 
 def _without_flat_facets(cells: Cells3D, size: float, resolution: float) -> Cells3D:
@@ -248,8 +251,12 @@ def _without_flat_facets(cells: Cells3D, size: float, resolution: float) -> Cell
     Cells3D
     """
     tri = cells.facet_triangles
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    longest = np.linalg.norm(tri - tri[:, [1, 2, 0]], axis=2).max(axis=1)
+    # (f, 3) temporaries only: the triangles are the model's largest array
+    u, v = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    area = 0.5 * np.linalg.norm(np.cross(u, v), axis=1)
+    longest = np.maximum(np.linalg.norm(u, axis=1), np.linalg.norm(v, axis=1))
+    del u, v
+    np.maximum(longest, np.linalg.norm(tri[:, 2] - tri[:, 1], axis=1), out=longest)
     keep = (area > (FLAT_FACET_RTOL * size) ** 2) & (2.0 * area > resolution * longest)
     if keep.all():
         return cells
