@@ -35,6 +35,7 @@ from scipy.spatial import Delaunay
 
 from .._sets import distinct, isin
 from ..errors import GeometryError
+from ._kernels import solid_tetrahedra
 from .face_refinement import refine_faces
 
 __all__ = ["Tetrahedrisation", "conforming_tetrahedra", "signed_volumes", "region_volumes",
@@ -42,7 +43,6 @@ __all__ = ["Tetrahedrisation", "conforming_tetrahedra", "signed_volumes", "regio
 
 #: The faces of a tetrahedron (a, b, c, d), each opposite one vertex.
 _FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
-_EDGES = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])
 #: Relative tolerance of the tie tests (cospherical, coplanar), in units of the model's size.
 _TIE = 1e-8
 #: Half-width of the cube whose corners Qhull gets beside the nodes (`_delaunay`), in units
@@ -506,15 +506,11 @@ def _delaunay(points, centre, scale, far):
     return np.ascontiguousarray(tets[(tets < n).all(axis=1)], dtype=np.int64)
 
 
-def _longest_edges(points, tets):
-    """The longest edge ``(t,)`` of each tetrahedron."""
-    edge = points[tets[:, _EDGES[:, 0]]] - points[tets[:, _EDGES[:, 1]]]
-    return np.sqrt(np.einsum("tek,tek->te", edge, edge).max(axis=1))
-
-
 def _solid(points, tets):
-    """Which tetrahedra ``(t,)`` are not flat slivers (four coplanar nodes)."""
-    return np.abs(signed_volumes(points, tets)) > _TIE * _longest_edges(points, tets) ** 3
+    """Which tetrahedra ``(t,)`` are not flat slivers (four coplanar nodes): ``|V| >
+    _TIE L^3``, ``L`` the longest edge."""
+    return solid_tetrahedra(points, np.ascontiguousarray(tets, dtype=np.int64).reshape(-1, 4),
+                            _TIE)
 
 
 def _missing_faces(points, tets, faces):
@@ -613,8 +609,10 @@ def _recovered(points, faces, centre, scale, far):
             for f in missing.tolist():
                 fixer.recover(faces[f])
             tets = fixer.result()
+        before = tets
         tets = _remove_flats(points, tets, faces, scale)
-        missing = _missing_faces(points, tets, faces)
+        if len(missing) or tets is not before:        # else nothing changed
+            missing = _missing_faces(points, tets, faces)
         if len(missing) == 0:
             break
     return tets, missing
