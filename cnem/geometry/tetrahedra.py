@@ -2,7 +2,8 @@
 
 Every boundary (and interface) triangle becomes a face of the tetrahedrisation:
 
-1. Qhull's Delaunay tetrahedrisation of the nodes;
+1. Qhull's Delaunay tetrahedrisation of the nodes (eight far corners added, so that
+   Qhull does not merge the coplanar nodes of the cloud's hull; `_delaunay`);
 2. a boundary face missing only because of a tie (four cospherical nodes, a lattice
    square triangulated the other way) is recovered by re-triangulating the
    tetrahedra around the crossing diagonal (a cone from the face's far vertex;
