@@ -481,7 +481,8 @@ def _remove_flats(points, tets, faces, scale):
 
 
 def _delaunay(points, centre, scale, far):
-    """Qhull's Delaunay tetrahedra ``(t, 4)`` of ``points``, with eight far corners if ``far``.
+    """Qhull's Delaunay tetrahedra ``(t, 4)`` of ``points``, with eight far corners if
+    ``far``, and which nodes ``(n,)`` a tetrahedron with a corner had.
 
     The nodes are moved and scaled into the ball of diameter 1. With ``far`` the corners
     of the cube ``[-_FAR, _FAR]^3`` join them: the convex hull Qhull builds is then that
@@ -491,7 +492,8 @@ def _delaunay(points, centre, scale, far):
     every node, so they are Delaunay tetrahedra of the nodes. A face on the cloud's hull
     stays a face when a sphere through it, bulging out, keeps out both the nodes inside
     and the corners (a spacing deep suffices); one with a node very close beneath it
-    may go missing: the caller then runs Qhull without the corners.
+    may go missing (its nodes are then nodes of the corners' tetrahedra): the caller
+    then runs Qhull without the corners.
     """
     n = len(points)
     corners = _FAR * np.array([[i, j, k] for i in (-1.0, 1.0) for j in (-1.0, 1.0)
@@ -504,7 +506,10 @@ def _delaunay(points, centre, scale, far):
             f"other nodes), first: " + ", ".join(f"{i}: {points[i].tolist()}" for i in dup[:5])
             + "; remove duplicated nodes")
     tets = tri.simplices
-    return np.ascontiguousarray(tets[(tets < n).all(axis=1)], dtype=np.int64)
+    inner = (tets < n).all(axis=1)
+    by_corner = np.zeros(n + 8, dtype=bool)
+    by_corner[tets[~inner].ravel()] = True
+    return np.ascontiguousarray(tets[inner], dtype=np.int64), by_corner[:n]
 
 
 def _solid(points, tets):
@@ -601,8 +606,9 @@ def _flat_regions(region, flat, i0, i1):
 
 def _recovered(points, faces, centre, scale, far):
     """Qhull's tetrahedra (`_delaunay`), the missing faces recovered through ties and the
-    flat slivers removed; the faces ``(k,)`` still missing."""
-    tets = _delaunay(points, centre, scale, far)
+    flat slivers removed; the faces ``(k,)`` still missing; which nodes ``(n,)`` a
+    tetrahedron with a far corner had."""
+    tets, by_corner = _delaunay(points, centre, scale, far)
     missing = _missing_faces(points, tets, faces)
     for _ in range(3):                # each pass may leave a face held by a sliver only
         if len(missing):
@@ -616,7 +622,7 @@ def _recovered(points, faces, centre, scale, far):
             missing = _missing_faces(points, tets, faces)
         if len(missing) == 0:
             break
-    return tets, missing
+    return tets, missing, by_corner
 
 
 def conforming_tetrahedra(points: ArrayLike, boundary_faces: ArrayLike,
@@ -653,9 +659,9 @@ def conforming_tetrahedra(points: ArrayLike, boundary_faces: ArrayLike,
     for _ in range(max_rounds):
         # far corners first (fast); without them when faces are missing, before splitting
         for far in (True, False):
-            tets, missing = _recovered(points, faces, centre, scale, far)
-            if len(missing) == 0:
-                break
+            tets, missing, by_corner = _recovered(points, faces, centre, scale, far)
+            if not by_corner[faces[missing]].all(axis=1).any():
+                break                 # no missing face where the corners' tetrahedra reach
         if len(missing) == 0:
             break
         points, faces, face_regions = refine_faces(points, faces, face_regions, missing)
