@@ -6,7 +6,10 @@ import pytest
 import cases3d
 import cnem
 from cnem.errors import GeometryError
-from cnem.geometry.tetrahedra import _FACES, conforming_tetrahedra, signed_volumes
+from scipy.spatial import ConvexHull, Delaunay
+
+from cnem.geometry.tetrahedra import (_FACES, _face_keys, conforming_tetrahedra, signed_volumes,
+                                     tet_neighbors)
 
 #: case -> (builder, exact volume of each region)
 CASES = {
@@ -111,3 +114,44 @@ def test_flat_slivers_in_a_faceted_surface_do_not_vote():
     tets = conforming_tetrahedra(cloud.points, cloud.boundary_faces, cloud.boundary_face_regions)
     volume = np.abs(signed_volumes(tets.points, tets.tetrahedra)).sum()
     np.testing.assert_allclose(volume, dom.volume, rtol=1e-12)
+
+
+def test_face_keys_do_not_wrap_past_two_million_nodes():
+    """With n = 2^22 nodes, ``(a n + b) n + c`` wraps in int64: (1, b, c) and
+    (1 + 2^20, b, c) would share a key. The keys tell every pair of triangles apart
+    exactly when their node sets differ, across the arrays given together."""
+    n = 2 ** 22
+    rng = np.random.default_rng(0)
+    tris = np.vstack([[[1, 2_000_000, 3_000_000], [1 + 2 ** 20, 2_000_000, 3_000_000]],
+                      rng.integers(0, n, (200, 3)), rng.integers(0, 50, (200, 3))])
+    faces = tris[rng.permutation(len(tris))[:50]][:, ::-1]            # the same, reordered
+    keys, face_keys = _face_keys([tris, faces], n)
+    same = (np.sort(tris, axis=1)[:, None] == np.sort(tris, axis=1)[None]).all(axis=2)
+    np.testing.assert_array_equal(keys[:, None] == keys[None], same)
+    same = (np.sort(faces, axis=1)[:, None] == np.sort(tris, axis=1)[None]).all(axis=2)
+    np.testing.assert_array_equal(face_keys[:, None] == keys[None], same)
+
+
+def test_tet_neighbors_with_keys_past_two_million_nodes():
+    p, f, r = cases3d.box(jitter=0.3)
+    tets = conforming_tetrahedra(p, f, r).tetrahedra
+    np.testing.assert_array_equal(tet_neighbors(tets, 3_000_000), tet_neighbors(tets, len(p)))
+
+
+def test_generic_points_give_qhulls_delaunay_tetrahedra():
+    """Points in general position inside their convex hull (the body): the conforming
+    tetrahedrisation is the unique Delaunay one, the tetrahedra Qhull gives without the
+    far corners."""
+    rng = np.random.default_rng(1)
+    p = rng.normal(size=(400, 3)) * [3.0, 1.0, 0.2] + 1e3
+    hull = ConvexHull(p)
+    faces = hull.simplices.copy()
+    inward = np.einsum("ij,ij->i", hull.equations[:, :3],
+                       np.cross(p[faces[:, 1]] - p[faces[:, 0]], p[faces[:, 2]] - p[faces[:, 0]]))
+    faces[inward < 0] = faces[inward < 0][:, ::-1]                     # normals outwards
+    regions = np.column_stack([np.zeros(len(faces), dtype=np.int64),
+                               np.full(len(faces), -1, dtype=np.int64)])
+    got = conforming_tetrahedra(p, faces, regions)
+    assert got.n_input == len(got.points)
+    want = {tuple(sorted(t)) for t in Delaunay(p).simplices.tolist()}
+    assert {tuple(sorted(t)) for t in got.tetrahedra.tolist()} == want

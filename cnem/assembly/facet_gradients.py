@@ -417,13 +417,16 @@ def boundary_points_3d(model: Any, interface: InterfacePieces | None = None
     cells = model.cells
     if interface is None:
         interface = model_interface_pieces(model, cells)
-    group, _, point, area_normal = _grouped_facet_points(cells.facet_triangles, cells.facet_cell,
-                                                         cells.facet_normal, interface.on_interface)
+    faces, normal = model.boundary_with_normals()
+    # only the facets facing like a boundary triangle (either way: their partners too)
+    take = _facing_boundary(cells.facet_normal, normal)
+    on_interface = interface.on_interface[take]
+    group, _, point, area_normal = _grouped_facet_points(
+        cells.facet_triangles[take], cells.facet_cell[take], cells.facet_normal[take], on_interface)
     _, tol = _pair_tolerance(model)
     shared = _paired(point, area_normal, tol)
-    shared[group[interface.on_interface]] = True
+    shared[group[on_interface]] = True
     outer = np.flatnonzero(~shared)
-    faces, normal = model.boundary_with_normals()
     corners = model.nodes[faces]
     face = _face_holding(point[outer], area_normal[outer], corners, normal, tol)
     keep = face >= 0
@@ -431,6 +434,22 @@ def boundary_points_3d(model: Any, interface: InterfacePieces | None = None
         raise GeometryError(f"{int((~keep).sum())} cell facets on the boundary lie on no "
                             f"boundary triangle, first at {point[outer][~keep][:3].tolist()}")
     return point[outer], area_normal[outer], face
+
+
+def _facing_boundary(facet_normal, boundary_normal, resolution=1e-3):
+    """Which facet triangles ``(q,)`` have a unit normal within ``resolution / 2`` (each
+    component) of a boundary triangle's outward normal or its opposite, and some
+    others nearby: a superset of those that can lie on the boundary, found by rounding
+    the normals to a grid of that step (the boundary ones with their 26 neighbours)."""
+    def keys(cells):
+        side = int(round(2.0 / resolution)) + 3
+        c = cells + side // 2
+        return (c[:, 0] * side + c[:, 1]) * side + c[:, 2]
+
+    grid = np.round(np.vstack([boundary_normal, -boundary_normal]) / resolution).astype(np.int64)
+    shifts = np.array([[i, j, k] for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)])
+    near = keys((grid[:, None, :] + shifts[None]).reshape(-1, 3))
+    return isin(keys(np.round(facet_normal / resolution).astype(np.int64)), near)
 
 
 def _face_holding(points, area_normal, corners, normal, tol):

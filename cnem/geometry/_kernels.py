@@ -351,3 +351,26 @@ def fan_regions(pts, tri, region, offsets, star, nodes):
             node[m], reg[at], far[at] = i, r, d
             m += 1
     return node[:m], reg[:m], far[:m]
+
+
+@numba.njit(cache=True)
+def solid_tetrahedra(points, tets, tie):
+    """Which tetrahedra ``(t,)`` are not flat: ``|V| > tie L^3``, ``L`` the longest edge
+    (`.tetrahedra._solid`)."""
+    out = np.empty(len(tets), dtype=np.bool_)
+    x = np.empty((4, 3))
+    for k in range(len(tets)):
+        for i in range(4):
+            for c in range(3):
+                x[i, c] = points[tets[k, i], c]
+        u0, u1, u2 = x[1, 0] - x[0, 0], x[1, 1] - x[0, 1], x[1, 2] - x[0, 2]
+        v0, v1, v2 = x[2, 0] - x[0, 0], x[2, 1] - x[0, 1], x[2, 2] - x[0, 2]
+        w0, w1, w2 = x[3, 0] - x[0, 0], x[3, 1] - x[0, 1], x[3, 2] - x[0, 2]
+        six_v = u0 * (v1 * w2 - v2 * w1) + u1 * (v2 * w0 - v0 * w2) + u2 * (v0 * w1 - v1 * w0)
+        longest = 0.0
+        for i in range(3):
+            for j in range(i + 1, 4):
+                e0, e1, e2 = x[i, 0] - x[j, 0], x[i, 1] - x[j, 1], x[i, 2] - x[j, 2]
+                longest = max(longest, e0 * e0 + e1 * e1 + e2 * e2)
+        out[k] = abs(six_v) / 6.0 > tie * longest ** 1.5
+    return out

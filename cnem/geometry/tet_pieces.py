@@ -18,7 +18,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .polytope import _ON, Plane, Polytope
-from .tetrahedra import _FACES, tet_neighbors
+from .tetrahedra import _FACES, _face_keys, tet_neighbors
 
 __all__ = ["RegionTets", "open_facets", "connected"]
 
@@ -43,10 +43,7 @@ class RegionTets:
                  faces: np.ndarray):
         n = len(points)
         self.points, self.tets = points, tets
-        tri = np.sort(tets[:, _FACES], axis=2)                           # (t, 4, 3)
-        self.face_key = (tri[..., 0] * n + tri[..., 1]) * n + tri[..., 2]
-        fs = np.sort(faces, axis=1)
-        fkey = (fs[:, 0] * n + fs[:, 1]) * n + fs[:, 2]
+        self.face_key, fkey = _face_keys([tets[:, _FACES], faces], n)     # (t, 4), (b,)
         order = np.argsort(fkey)
         pos = np.minimum(np.searchsorted(fkey[order], self.face_key), len(fkey) - 1)
         #: the boundary face each tetrahedron face lies on, -1 for an internal face

@@ -2,7 +2,8 @@
 
 Every boundary (and interface) triangle becomes a face of the tetrahedrisation:
 
-1. Qhull's Delaunay tetrahedrisation of the nodes;
+1. Qhull's Delaunay tetrahedrisation of the nodes (eight far corners added, so that
+   Qhull does not merge the coplanar nodes of the cloud's hull; `_delaunay`);
 2. a boundary face missing only because of a tie (four cospherical nodes, a lattice
    square triangulated the other way) is recovered by re-triangulating the
    tetrahedra around the crossing diagonal (a cone from the face's far vertex;
@@ -35,6 +36,7 @@ from scipy.spatial import Delaunay
 
 from .._sets import distinct, isin
 from ..errors import GeometryError
+from ._kernels import solid_tetrahedra
 from .face_refinement import refine_faces
 
 __all__ = ["Tetrahedrisation", "conforming_tetrahedra", "signed_volumes", "region_volumes",
@@ -42,9 +44,13 @@ __all__ = ["Tetrahedrisation", "conforming_tetrahedra", "signed_volumes", "regio
 
 #: The faces of a tetrahedron (a, b, c, d), each opposite one vertex.
 _FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
-_EDGES = np.array([[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]])
 #: Relative tolerance of the tie tests (cospherical, coplanar), in units of the model's size.
 _TIE = 1e-8
+#: Half-width of the cube whose corners Qhull gets beside the nodes (`_delaunay`), in units
+#: of the nodes' bounding-box diagonal (the nodes lie within 1/2 of its centre).
+_FAR = 4.0
+#: The most nodes for which `_face_keys` packs a triangle's nodes directly (``n^3 <= 2^63``).
+_DIRECT_KEYS = 2 ** 21
 
 @dataclass(frozen=True)
 class Tetrahedrisation:
@@ -112,9 +118,28 @@ def region_volumes(points: np.ndarray, faces: np.ndarray, face_regions: np.ndarr
     return out
 
 
-def _face_keys(tri: np.ndarray, n: int) -> np.ndarray:
-    s = np.sort(tri, axis=1).astype(np.int64)
-    return (s[:, 0] * n + s[:, 1]) * n + s[:, 2]
+def _face_keys(triangles: list[np.ndarray], n: int) -> list[np.ndarray]:
+    """An int64 key ``(...)`` for each triangle ``(..., 3)`` of every array of
+    ``triangles`` (indices into ``n`` nodes, in any order), equal exactly when two
+    triangles, of the same array or not, have the same three nodes.
+
+    The key is ``(a n + b) n + c`` of the sorted nodes ``a < b < c`` while ``n^3`` fits
+    in int64 (``n <= 2^21``); above, the pairs ``(a, b)`` of all the arrays are numbered
+    in sorted order first and the key is ``rank(a, b) n + c``.
+    """
+    n = int(n)
+    sorted_ = [np.sort(np.asarray(t, dtype=np.int64), axis=-1) for t in triangles]
+    if n <= _DIRECT_KEYS:
+        return [(s[..., 0] * n + s[..., 1]) * n + s[..., 2] for s in sorted_]
+    pair = np.concatenate([(s[..., 0] * n + s[..., 1]).ravel() for s in sorted_])
+    order = np.argsort(pair, kind="stable")
+    new = np.ones(len(pair), dtype=bool)
+    np.not_equal(pair[order][1:], pair[order][:-1], out=new[1:])
+    rank = np.empty(len(pair), dtype=np.int64)
+    rank[order] = np.cumsum(new) - 1
+    ends = np.cumsum([0] + [s[..., 0].size for s in sorted_])
+    return [rank[ends[i]:ends[i + 1]].reshape(s.shape[:-1]) * n + s[..., 2]
+            for i, s in enumerate(sorted_)]
 
 
 def tet_neighbors(tets: np.ndarray, n: int) -> np.ndarray:
@@ -126,7 +151,7 @@ def tet_neighbors(tets: np.ndarray, n: int) -> np.ndarray:
     n : int
         Number of nodes (``tets`` index ``0 .. n-1``).
     """
-    keys = _face_keys(tets[:, _FACES].reshape(-1, 3), n)
+    keys, = _face_keys([tets[:, _FACES].reshape(-1, 3)], n)
     order = np.argsort(keys, kind="stable")
     pair = np.flatnonzero(keys[order][1:] == keys[order][:-1])
     a, b = order[pair], order[pair + 1]
@@ -455,44 +480,60 @@ def _remove_flats(points, tets, faces, scale):
     return fixer.result()
 
 
-def _delaunay(points, centre, scale):
-    tri = Delaunay((points - centre) / scale)
+def _delaunay(points, centre, scale, far):
+    """Qhull's Delaunay tetrahedra ``(t, 4)`` of ``points``, with eight far corners if
+    ``far``, and which nodes ``(n,)`` a tetrahedron with a corner had.
+
+    The nodes are moved and scaled into the ball of diameter 1. With ``far`` the corners
+    of the cube ``[-_FAR, _FAR]^3`` join them: the convex hull Qhull builds is then that
+    cube's, not the cloud's, whose flat faces (a box's sides: thousands of coplanar
+    nodes) Qhull merges slowly (7 times its whole time on the 100k-node cantilever).
+    The tetrahedra with a corner are dropped; the others have circumspheres empty of
+    every node, so they are Delaunay tetrahedra of the nodes. A face on the cloud's hull
+    stays a face when a sphere through it, bulging out, keeps out both the nodes inside
+    and the corners (a spacing deep suffices); one with a node very close beneath it
+    may go missing (its nodes are then nodes of the corners' tetrahedra): the caller
+    then runs Qhull without the corners.
+    """
+    n = len(points)
+    corners = _FAR * np.array([[i, j, k] for i in (-1.0, 1.0) for j in (-1.0, 1.0)
+                               for k in (-1.0, 1.0)])
+    tri = Delaunay(np.vstack([(points - centre) / scale] + ([corners] if far else [])))
     if len(tri.coplanar):
         dup = tri.coplanar[:, 0]
         raise GeometryError(
             f"{len(dup)} nodes are not vertices of the Delaunay tetrahedrisation (duplicates of "
             f"other nodes), first: " + ", ".join(f"{i}: {points[i].tolist()}" for i in dup[:5])
             + "; remove duplicated nodes")
-    return np.ascontiguousarray(tri.simplices, dtype=np.int64)
-
-
-def _longest_edges(points, tets):
-    """The longest edge ``(t,)`` of each tetrahedron."""
-    edge = points[tets[:, _EDGES[:, 0]]] - points[tets[:, _EDGES[:, 1]]]
-    return np.sqrt(np.einsum("tek,tek->te", edge, edge).max(axis=1))
+    tets = tri.simplices
+    inner = (tets < n).all(axis=1)
+    by_corner = np.zeros(n + 8, dtype=bool)
+    by_corner[tets[~inner].ravel()] = True
+    return np.ascontiguousarray(tets[inner], dtype=np.int64), by_corner[:n]
 
 
 def _solid(points, tets):
-    """Which tetrahedra ``(t,)`` are not flat slivers (four coplanar nodes)."""
-    return np.abs(signed_volumes(points, tets)) > _TIE * _longest_edges(points, tets) ** 3
+    """Which tetrahedra ``(t,)`` are not flat slivers (four coplanar nodes): ``|V| >
+    _TIE L^3``, ``L`` the longest edge."""
+    return solid_tetrahedra(points, np.ascontiguousarray(tets, dtype=np.int64).reshape(-1, 4),
+                            _TIE)
 
 
 def _missing_faces(points, tets, faces):
     """Faces that no solid tetrahedron has (a face of flat slivers only does not separate)."""
     n = len(points)
     tets = tets[_solid(points, tets)]
-    keys = _face_keys(tets[:, _FACES].reshape(-1, 3), n)
-    return np.flatnonzero(~isin(_face_keys(faces, n), keys))
+    keys, face_keys = _face_keys([tets[:, _FACES].reshape(-1, 3), faces], n)
+    return np.flatnonzero(~isin(face_keys, keys))
 
 
 def _classify(points, tets, faces, face_regions):
     """Region of each tetrahedron (-1 outside), by components between boundary faces."""
     n, t = len(points), len(tets)
     slots = tets[:, _FACES].reshape(-1, 3)
-    keys = _face_keys(slots, n)
+    keys, bkeys = _face_keys([slots, faces], n)
     order = np.argsort(keys, kind="stable")
     sk = keys[order]
-    bkeys = _face_keys(faces, n)
     pair = np.flatnonzero(sk[1:] == sk[:-1])
     inner = ~isin(sk[pair], bkeys)
     i0, i1 = order[pair[inner]] // 4, order[pair[inner] + 1] // 4
@@ -563,6 +604,27 @@ def _flat_regions(region, flat, i0, i1):
     return region
 
 
+def _recovered(points, faces, centre, scale, far):
+    """Qhull's tetrahedra (`_delaunay`), the missing faces recovered through ties and the
+    flat slivers removed; the faces ``(k,)`` still missing; which nodes ``(n,)`` a
+    tetrahedron with a far corner had."""
+    tets, by_corner = _delaunay(points, centre, scale, far)
+    missing = _missing_faces(points, tets, faces)
+    for _ in range(3):                # each pass may leave a face held by a sliver only
+        if len(missing):
+            fixer = _TieRecovery(points, tets, distinct(faces[missing]), scale)
+            for f in missing.tolist():
+                fixer.recover(faces[f])
+            tets = fixer.result()
+        before = tets
+        tets = _remove_flats(points, tets, faces, scale)
+        if len(missing) or tets is not before:        # else nothing changed
+            missing = _missing_faces(points, tets, faces)
+        if len(missing) == 0:
+            break
+    return tets, missing, by_corner
+
+
 def conforming_tetrahedra(points: ArrayLike, boundary_faces: ArrayLike,
                           boundary_face_regions: ArrayLike, *,
                           max_rounds: int = 8) -> Tetrahedrisation:
@@ -595,18 +657,11 @@ def conforming_tetrahedra(points: ArrayLike, boundary_faces: ArrayLike,
     lo, hi = points.min(axis=0), points.max(axis=0)
     centre, scale = 0.5 * (lo + hi), float(np.linalg.norm(hi - lo))
     for _ in range(max_rounds):
-        tets = _delaunay(points, centre, scale)
-        missing = _missing_faces(points, tets, faces)
-        for _ in range(3):            # each pass may leave a face held by a sliver only
-            if len(missing):
-                fixer = _TieRecovery(points, tets, distinct(faces[missing]), scale)
-                for f in missing.tolist():
-                    fixer.recover(faces[f])
-                tets = fixer.result()
-            tets = _remove_flats(points, tets, faces, scale)
-            missing = _missing_faces(points, tets, faces)
-            if len(missing) == 0:
-                break
+        # far corners first (fast); without them when faces are missing, before splitting
+        for far in (True, False):
+            tets, missing, by_corner = _recovered(points, faces, centre, scale, far)
+            if not by_corner[faces[missing]].all(axis=1).any():
+                break                 # no missing face where the corners' tetrahedra reach
         if len(missing) == 0:
             break
         points, faces, face_regions = refine_faces(points, faces, face_regions, missing)
