@@ -131,3 +131,24 @@ def test_free_rigid_motions_are_refused_up_front():
 def test_bad_counts_are_refused():
     with pytest.raises(cnem.InputError, match="steps: expected a whole number >= 1"):
         newton(chain(2), np.zeros(3), [0], [0.0], points=None, steps=0)
+
+
+def test_values_at_replaces_the_linear_ramp():
+    """A linear chain with its end held along ``values_at(t) = sin(pi t / 2)``: after each
+    load step the end sits at the path's value, the chain on the line to it."""
+    K = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(5, 5)).tocsr()
+    path = lambda t: np.array([0.0, np.sin(np.pi * t / 2)])     # noqa: E731
+    states = []
+    newton(lambda u, tangent: (K @ u, K), np.zeros(5), [0, 4], path(1.0), points=None,
+           linear=True, steps=3, values_at=path, on_step=lambda k, u: states.append(u))
+    for k, u in enumerate(states, 1):
+        np.testing.assert_allclose(u, path(k / 3)[1] * np.arange(5) / 4, atol=1e-12)
+
+
+def test_values_at_of_the_wrong_shape_is_named():
+    with pytest.raises(cnem.InputError, match=r"values_at\(0.5\): expected 2 finite values"):
+        newton(chain(3), np.zeros(4), [0, 3], [0.0, 1.0], points=None, steps=2,
+               values_at=lambda t: np.array([0.0, t, 1.0]))
+    with pytest.raises(cnem.InputError, match="NaN or inf"):
+        newton(chain(3), np.zeros(4), [0, 3], [0.0, 1.0], points=None,
+               values_at=lambda t: np.array([0.0, np.nan]))

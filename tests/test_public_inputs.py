@@ -507,6 +507,10 @@ EXAMPLES = {
         lambda f: dict(self=_setup(f.model), where=np.array([0]), component=None,
                        value=np.array([0.1, 0.2])),
         skip={("value", "scalar"): "a number is valid: the same value on every component"}),
+    "cnem.Hyperelasticity.add_dirichlet": Example(
+        lambda f: dict(self=cnem.Hyperelasticity(f.model, cnem.material.NeoHookean(1.0, 1.5)),
+                       where=np.array([0]), component=None, value=np.array([0.1, 0.2])),
+        skip={("value", "scalar"): "a number is valid: the same value on every component"}),
     "cnem.Elasticity.add_traction": Example(
         lambda f: dict(self=_setup(f.model), where=lambda x, n: x[:, 1] > 1 - 1e-9,
                        t=np.array([0.0, 1.0]))),

@@ -3,6 +3,7 @@ Newton with load steps)."""
 
 from __future__ import annotations
 
+import inspect
 import logging
 import sys
 import time
@@ -14,6 +15,7 @@ from tqdm.auto import tqdm
 from ..assembly import CellBasis
 from ..errors import InputError, MaterialError, OptionError
 from ..material import Hyperelastic, NeoHookean, check_plane, parse_materials
+from ..solvers.conditions import dirichlet_dofs, merged_conditions, per_point
 from ..solvers.linsolve import rigid_modes
 from ..solvers.multigrid import hierarchy
 from ..solvers.newton import newton
@@ -25,10 +27,13 @@ from .model_problem import ModelProblem
 from .stabilization import IsochoricNeoHookean
 
 if TYPE_CHECKING:
-    from typing import Literal, Sequence
+    from typing import Callable, Literal, Sequence
+
+    from numpy.typing import ArrayLike
 
     from ..assembly.gradients import GradientCache
     from ..geometry.model import Model
+    from ..solvers.conditions import Where
 
 __all__ = ["Hyperelasticity"]
 
@@ -44,7 +49,8 @@ class Hyperelasticity(ModelProblem):
     Conditions are those of `cnem.Elasticity` (`add_dirichlet`, `add_traction`,
     `add_body_force`): the Dirichlet values are reached at the last load step,
     tractions and body forces are dead loads on the reference configuration, all
-    ramped in equal load steps.
+    ramped in equal load steps; a Dirichlet condition may instead follow a ``path``
+    over the load steps (`add_dirichlet`: a rigid rotation of a face, say).
 
     Parameters
     ----------
@@ -133,6 +139,7 @@ class Hyperelasticity(ModelProblem):
         self._operator = None
         self._system = None
         self._preconditioner = None          # (dofs, VCycle) of `solver_options`
+        self._paths = {}          # index in self.dirichlet -> (nodes, components, path)
 
     def __repr__(self):
         idealisation = f"plane {self.plane}" if self.plane else "3-D"
@@ -217,6 +224,104 @@ class Hyperelasticity(ModelProblem):
 
         return dict(options, preconditioner=preconditioner)
 
+    def add_dirichlet(self, where: Where, component: int | None,
+                      value: ArrayLike | Callable[[np.ndarray], np.ndarray] = 0.0, *,
+                      path: Callable[[np.ndarray, float], np.ndarray] | None = None) -> None:
+        """Prescribe displacements at nodes: ``value``, ramped linearly over the load
+        steps, or the displacements of a ``path``.
+
+        Parameters
+        ----------
+        where : str, callable ``(n, d) -> (n,) bool``, or a boolean mask / index array over
+            the nodes
+            As `cnem.Elasticity.add_dirichlet`.
+        component : {0, ..., d - 1, None}
+            ``None`` prescribes every component.
+        value : float, or callable ``(p, d) -> (p,)`` (``(p, d)`` for every component)
+            The displacement at the last load step; at the load factor
+            ``t = step / steps`` it is ``t * value``.
+        path : callable ``(points (p, d), t: float) -> (p,)`` (``(p, d)`` for every component), optional
+            The displacements of the selected nodes at the load factor
+            ``t = step / steps`` of each load step (``t = 1``: the last), in place of
+            the linear ramp, for a motion that a ramp would distort: the rigid rotation
+            of a face by ``t * theta``, whose linear ramp shrinks the face between the
+            steps. Give ``value`` or ``path``, not both.
+
+        Raises
+        ------
+        InputError
+            ``path`` not a callable of the points and the load factor, or given with a
+            ``value``; `cnem.errors.ConditionError` (an InputError): nothing selected,
+            or values of the wrong shape or not finite (``path``'s are checked at
+            ``t = 1`` here and at every load step in `solve`).
+
+        Examples
+        --------
+        >>> import numpy as np, cnem
+        >>> model = cnem.discretize(cnem.nodes.irregular(cnem.geometry.rectangle(1.0, 1.0), 0.25, seed=1))
+        >>> prob = cnem.Hyperelasticity(model, cnem.material.NeoHookean(1.0, 1.5))
+        >>> def turned(p, t, theta=np.pi / 2):       # the rotation by t theta about the origin
+        ...     c, s = np.cos(t * theta), np.sin(t * theta)
+        ...     return p @ np.array([[c - 1, s], [-s, c - 1]])
+        >>> prob.add_dirichlet(lambda p: (p[:, 0] < 1e-9) | (p[:, 0] > 1 - 1e-9), None, path=turned)
+        >>> sol = prob.solve(steps=3)
+        >>> bool(np.abs(sol.stress).max() < 1e-8)        # turned rigidly at every step
+        True
+        """
+        if path is None:
+            super().add_dirichlet(where, component, value)
+            return
+        if not callable(path):
+            raise InputError(f"add_dirichlet: path: expected a callable (points (p, d), t) -> "
+                             f"displacements, received {type(path).__name__}; for a "
+                             f"displacement ramped linearly pass it as value")
+        if callable(value) or np.any(np.asarray(value) != 0):
+            raise InputError("add_dirichlet: received both a value and a path; give the "
+                             "displacements as path(points, t) alone (value is what a "
+                             "linear ramp reaches at the last load step)")
+        try:
+            inspect.signature(path).bind(np.zeros((0, self.dim)), 1.0)
+        except TypeError:
+            raise InputError("add_dirichlet: path: expected a callable of two arguments, the "
+                             "points (p, d) and the load factor t in (0, 1], received one "
+                             "that does not take them; e.g. lambda p, t: t * p[:, 0]") from None
+        except ValueError:                    # no signature to read (a builtin): just call
+            pass
+        dofs, values = dirichlet_dofs(self.condition_points, where, component,
+                                      lambda p: path(p, 1.0), where_to_look=self.points_name,
+                                      what="add_dirichlet path", named=self.named_nodes)
+        width = self.dim if component is None else 1
+        self._paths[len(self.dirichlet)] = (dofs[::width] // self.dim, width, path)
+        self.dirichlet.append((dofs, values))
+
+    def prescribed_at(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """The prescribed dofs and their values at the load factor ``t``: the conditions'
+        ``value`` times ``t``, their ``path`` at ``t``.
+
+        Returns
+        -------
+        dofs : (k,) int64 ndarray
+            Sorted, distinct (those of `prescribed`).
+        values : (k,) ndarray
+
+        Raises
+        ------
+        ConditionError
+            A path's values of the wrong shape or not finite, or two conditions that
+            give one dof different values at ``t``.
+        """
+        points = self.condition_points
+        conditions = []
+        for k, (dofs, values) in enumerate(self.dirichlet):
+            if k in self._paths:
+                nodes, width, path = self._paths[k]
+                values = per_point(path(points[nodes], t), points[nodes], width,
+                                   f"add_dirichlet path at t = {t:g}").reshape(-1)
+            else:
+                values = t * np.asarray(values)
+            conditions.append((dofs, values))
+        return merged_conditions(conditions, self.dim, "add_dirichlet")
+
     def load(self) -> np.ndarray:
         """The whole dead load (tractions and body forces), ``(dim n,)``."""
         return self.nodal_load().reshape(-1)
@@ -229,7 +334,8 @@ class Hyperelasticity(ModelProblem):
         Parameters
         ----------
         steps : int
-            Load steps: the Dirichlet values and loads grow by ``1 / steps`` each.
+            Load steps: the Dirichlet values and loads grow by ``1 / steps`` each (the
+            values of a Dirichlet ``path`` follow it, `add_dirichlet`).
         tol : float
             Relative residual of each step (see `cnem.solvers.newton.newton`).
         max_iterations : int
@@ -259,6 +365,7 @@ class Hyperelasticity(ModelProblem):
         system = self.system
         t1 = time.perf_counter()
         D, values = self.prescribed()
+        values_at = (lambda t: self.prescribed_at(t)[1]) if self._paths else None
         states = []
         show = sys.stderr.isatty() if progress is None else progress
         bar = tqdm(total=steps, desc="hyperelasticity load steps", unit="step",
@@ -271,8 +378,8 @@ class Hyperelasticity(ModelProblem):
         try:
             u, history = newton(system.evaluate, self.load(), D, values, points=self.model.nodes,
                                 tol=tol, steps=steps, max_iterations=max_iterations,
-                                line_search=line_search, on_step=on_step,
-                                options=self.solver_options)
+                                line_search=line_search, values_at=values_at,
+                                on_step=on_step, options=self.solver_options)
         finally:
             bar.close()
         t2 = time.perf_counter()

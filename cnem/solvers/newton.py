@@ -43,11 +43,12 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
            initial: ArrayLike | None = None, tol: float = 1e-10, steps: int = 1,
            max_iterations: int = 20, line_search: bool = False, linear: bool = False,
            halvings: int = LINE_SEARCH_HALVINGS,
+           values_at: Callable[[float], np.ndarray] | None = None,
            on_step: Callable[[int, np.ndarray], None] | None = None,
            options: Callable[[np.ndarray], dict] | None = None
            ) -> tuple[np.ndarray, list[list[float]]]:
     """Newton-Raphson with the exact tangent, Dirichlet values and loads ramped in
-    ``steps`` equal increments.
+    ``steps`` equal increments (the Dirichlet values along ``values_at`` when given).
 
     The residual is ``R(u) = f_int(u) - f_ext`` on the free dofs. Each load step starts
     with a tangent predictor: the increments of the Dirichlet values and loads, spread
@@ -90,6 +91,10 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
         ``f_int = K u`` with a constant ``K``: every correction is solved to round-off.
     halvings : int
         Most halvings of the line search.
+    values_at : callable ``(factor: float) -> (k,) ndarray``, optional
+        The prescribed values at the load factor ``factor = step / steps`` (a rigid
+        rotation of a face by ``factor`` times an angle, say), in place of the linear
+        ramp ``factor * values``; ``values`` are then its values at 1.
     on_step : callable ``(step, u (N,)) -> None``, optional
         Called after each converged load step ``1..steps`` with a copy of ``u``.
     options : callable, optional
@@ -105,7 +110,8 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
     Raises
     ------
     InputError
-        ``steps`` or ``max_iterations`` below 1.
+        ``steps`` or ``max_iterations`` below 1, or ``values_at`` returning other than
+        one finite value per prescribed dof.
     SolveError
         Rigid motions not fixed (named), or a linear solve that fails.
     ConvergenceError
@@ -136,7 +142,9 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
 
     history = []
     for step in range(1, steps + 1):
-        step_load, target = step / steps * load, step / steps * values
+        step_load = step / steps * load
+        target = step / steps * values if values_at is None else \
+            _path_values(values_at, step / steps, len(fixed))
         jump = np.zeros(size)
         jump[fixed] = target - u[fixed]
         residual = f - step_load + Kt @ jump                 # linearised, on the free dofs
@@ -176,6 +184,17 @@ def newton(evaluate: Callable[[np.ndarray, bool], tuple[np.ndarray, sp.spmatrix 
         if on_step is not None:
             on_step(step, u.copy())
     return u, history
+
+
+def _path_values(values_at, factor, count):
+    """``values_at(factor)``, checked to be ``count`` finite values."""
+    target = np.asarray(values_at(factor), dtype=float)
+    if target.shape != (count,) or not np.isfinite(target).all():
+        raise InputError(f"values_at({factor:g}): expected {count} finite values, one per "
+                         f"prescribed dof, received shape {target.shape}"
+                         f"{'' if target.shape != (count,) else ' with NaN or inf'}; return "
+                         f"the prescribed values at that load factor")
+    return target
 
 
 def _reference(load, reactions, res):

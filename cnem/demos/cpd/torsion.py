@@ -70,12 +70,17 @@ def lattice_factor(spacing: float, horizon: float) -> float:
     return float(total / (np.pi * horizon ** 4))
 
 
+def _ends(points, length):
+    """The bottom and top faces' nodes (bool ``(n,)`` each) and the section's centre."""
+    tol = 1e-9 * length
+    centre = 0.5 * (points[:, :2].min(axis=0) + points[:, :2].max(axis=0))
+    return points[:, 2] < tol, points[:, 2] > length - tol, centre
+
+
 def _supports(points, length, angle):
     """Prescribed dofs (node-major, 3 per node) of the clamped bottom and the turned top,
     and their values at ``angle``."""
-    tol = 1e-9 * length
-    bottom, top = points[:, 2] < tol, points[:, 2] > length - tol
-    centre = 0.5 * (points[:, :2].min(axis=0) + points[:, :2].max(axis=0))
+    bottom, top, centre = _ends(points, length)
     nodes = np.flatnonzero(bottom | top)
     fixed = (3 * nodes[:, None] + np.arange(3)).ravel()
     values = np.where(top[nodes, None], rigid_twist(points[nodes], angle, centre), 0.0).ravel()
@@ -102,9 +107,22 @@ def _twist(evaluate, points, length, angles, pattern=None):
 
 def twist_cnem(model: cnem.Model, mu: float, length: float, angles: Sequence[float]) -> Run:
     """C-NEM (`cnem.Hyperelasticity`, Saint Venant-Kirchhoff with ``lambda = mu``) of the
-    column ``model`` at the twist ``angles`` (radians)."""
+    column ``model`` at the twist ``angles`` (radians): one load step per angle, the top
+    face turned rigidly along a Dirichlet ``path`` through them."""
     prob = cnem.Hyperelasticity(model, cnem.material.SaintVenantKirchhoff(2.5 * mu, 0.25))
-    return _twist(prob.system.evaluate, model.nodes, length, angles)
+    points, steps = model.nodes, len(angles)
+    bottom, top, centre = _ends(points, length)
+    factors = np.arange(1, steps + 1) / steps                  # the load factors k / steps
+    prob.add_dirichlet(bottom, None)
+    prob.add_dirichlet(top, None,
+                       path=lambda p, t: rigid_twist(p, np.interp(t, factors, angles), centre))
+    sol = prob.solve(steps=steps, tol=TOL, max_iterations=MAX_ITERATIONS, progress=False)
+    return Run(u=np.array([dofs.reshape(-1, 3) for _, dofs in sol.steps]),
+               force=np.array([prob.system.evaluate(dofs, False)[0].reshape(-1, 3)
+                               for _, dofs in sol.steps]),
+               history=sol.residual_history,
+               iterations=sum(len(h) - 1 for h in sol.residual_history),
+               seconds=sol.timings["newton"], top=top, centre=centre)
 
 
 def twist_cpd(cloud: cnem.NodeCloud, horizon_factor: float, mu: float, spacing: float,
