@@ -157,17 +157,18 @@ class FreeBlock(spla.LinearOperator):
         kept), formed at the first call and kept."""
         if self._matrix is None:
             if self._triangle:
-                self._matrix = self.upper().tocsr()
+                self._matrix = self.submatrix(np.arange(self.shape[0]))
             else:
                 self._matrix = self._K if self._all else principal_submatrix(self._K, self.free)
         return self._matrix
 
     def upper(self) -> UpperTriangle:
         """The submatrix's upper triangle (half its bytes), formed at the first call and
-        kept; the block's products then run on it (reading half the data of ``K``'s)."""
+        kept (of an `UpperTriangle` ``K``, a view of it on the free dofs, no copy); the
+        block's products then run on it (reading half the data of ``K``'s)."""
         if self._upper is None:
-            if self._triangle and self._all:
-                self._upper = self._K
+            if self._triangle:                 # a view of K's triangle: no copy
+                self._upper = self._K if self._all else self._K.principal(self.free)
             else:
                 data, indices, indptr = _kept_arrays(self._K, self.free, upper=True)
                 self._upper = UpperTriangle(indptr, indices, data)
