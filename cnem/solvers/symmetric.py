@@ -3,9 +3,10 @@ and its symmetric Gauss-Seidel sweep each reading half the data
 (`cnem.solvers._symmetric_kernels`).
 
 The stiffness of 3-D SCNI has about 530 entries per row (175 neighbour nodes): 159M
-at 100k nodes, 1.9 GB as CSR (float64 values, int32 columns). The iterative solve holds
-the system on the free dofs once, in this form, for its products and for the smoothing
-of the finest level, instead of a second CSR copy of the stiffness.
+at 100k nodes, 1.9 GB as CSR (float64 values, int32 columns). 3-D elasticity assembles
+it in this form (`cnem.Elasticity.stiffness` with ``upper``), and the iterative solve
+runs its products and the smoothing of the finest level on a view of it on the free dofs
+(`UpperTriangle.principal`): one half-size copy of the stiffness in all.
 
 >>> import numpy as np, scipy.sparse as sp
 >>> from cnem.solvers.symmetric import UpperTriangle
