@@ -25,7 +25,8 @@ tiny cantilever, twice: ``_harness.warm_both``), C-NEM first, then P1 on the sam
   exclude them;
 * ``smoothed gradients``: B~ of the cells and of their sub-cells (building
   ``prob.basis``); P1: ``from_model`` (the scikit-fem mesh and basis);
-* ``K``: ``prob.stiffness()``;
+* ``K``: ``prob.stiffness()``, C-NEM's as its upper triangle as ``prob.solve()`` makes it
+  (``stiffness(upper=True)``);
 * ``loads``: the traction loads (``prob.load()``);
 * ``solve``: ``solve_constrained`` as ``prob.solve()`` runs it (support check,
   condensation, direct solve up to 2.5M non-zeros, smoothed aggregation + CG above);
@@ -137,7 +138,8 @@ def _sides(model, clock):
             prob = _stage(times, peaks, "smoothed gradients",
                           lambda: cnem.fem.P1Elasticity.from_model(model, MATERIAL))
         _conditions(prob)
-        K = _stage(times, peaks, "K", prob.stiffness)
+        K = _stage(times, peaks, "K", lambda: prob.stiffness(upper=True) if side == "C-NEM"
+                   else prob.stiffness())
         f = _stage(times, peaks, "loads", prob.load, clock)
         options = prob.solver_options if side == "C-NEM" else None
         dofs, values = prob.prescribed()

@@ -11,7 +11,9 @@ from skfem.models.poisson import laplace
 from cnem._parallel import always_parallel
 from cnem.solvers.condensation import (FreeBlock, condensed_system, free_dofs, free_system,
                                         principal_submatrix)
+from cnem.solvers.constrained import solve_constrained
 from cnem.solvers.linsolve import solve_spd
+from cnem.solvers.symmetric import UpperTriangle
 from cnem.errors import InputError
 
 N = 60
@@ -101,15 +103,17 @@ def _symmetric(seed, fmt):
     """A random SPD (N, N) matrix: a diagonally dominant symmetric pattern."""
     A = _matrix(seed, "csr")
     S = A + A.T
-    return (S + sp.diags(abs(S).sum(axis=1).A1 + 1.0)).asformat(fmt)
+    S = (S + sp.diags(abs(S).sum(axis=1).A1 + 1.0)).tocsr()
+    return UpperTriangle.from_matrix(S) if fmt == "upper" else S.asformat(fmt)
 
 
 @pytest.mark.parametrize("parallel", [False, True])
 @pytest.mark.parametrize("fixed", list(FIXED))
-@pytest.mark.parametrize("fmt", ["csr", "csc"])
+@pytest.mark.parametrize("fmt", ["csr", "csc", "upper"])
 def test_free_block_is_the_condensed_matrix(fmt, fixed, parallel):
     """The block's products, entries, count and sub-blocks are those of skfem.condense's
-    matrix; its right-hand side and free dofs too."""
+    matrix; its right-hand side and free dofs too; from the whole matrix or from its
+    upper triangle alone (`UpperTriangle`)."""
     K, D = _symmetric(7, fmt), FIXED[fixed]
     rng = np.random.default_rng(8)
     f, x = rng.uniform(-1, 1, N), rng.uniform(-1, 1, N)
@@ -119,7 +123,7 @@ def test_free_block_is_the_condensed_matrix(fmt, fixed, parallel):
             A, b, I = free_system(K, f, x=x, D=D)
     else:
         A, b, I = free_system(K, f, x=x, D=D)
-    scale = abs(K).max()
+    scale = abs(K.tocsr()).max()
     np.testing.assert_array_equal(I, I_ref)
     np.testing.assert_array_equal(A.free, I_ref)
     np.testing.assert_allclose(b, b_ref, rtol=0, atol=1e-14 * scale * N)
@@ -140,6 +144,22 @@ def test_free_block_of_every_dof_is_the_matrix_itself():
     assert block.matrix() is K and block.nnz == K.nnz
     v = np.random.default_rng(9).uniform(-1, 1, N)
     np.testing.assert_allclose(block @ v, K @ v, rtol=0, atol=1e-14 * abs(K).max() * N)
+    U = UpperTriangle.from_matrix(K)
+    block = FreeBlock(U)
+    assert block.upper() is U and block.nnz == K.nnz
+    np.testing.assert_array_equal(block.matrix().toarray(), K.toarray())
+    np.testing.assert_allclose(block @ v, K @ v, rtol=0, atol=1e-14 * abs(K).max() * N)
+
+
+@pytest.mark.parametrize("fixed", ["some", "none"])
+def test_constrained_solve_of_the_upper_triangle_is_the_full_one(fixed):
+    """solve_constrained given K's upper triangle alone gives the solution given K."""
+    K, D = _symmetric(11, "csr"), np.unique(FIXED[fixed])
+    rng = np.random.default_rng(12)
+    f, values = rng.uniform(-1, 1, N), rng.uniform(-1, 1, len(D))
+    expected = solve_constrained(K, f, D, values, points=None)
+    got = solve_constrained(UpperTriangle.from_matrix(K), f, D, values, points=None)
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
 
 
 @pytest.mark.parametrize("method", ["direct", "amg"])

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 import cases3d
 import cnem
@@ -64,6 +65,23 @@ def test_cells_fill_each_region(two_materials):
     name, m = two_materials
     got = np.bincount(m.cells.region, weights=m.cells.volume, minlength=2)
     np.testing.assert_allclose(got, BODIES[name], rtol=1e-12)
+
+
+@pytest.mark.parametrize("stabilization", [0.0, 1.0])
+def test_upper_stiffness_is_the_triangle_of_the_whole(two_materials, stabilization):
+    """K assembled as its upper triangle (what `Elasticity.solve` uses in 3-D) is the
+    whole K's diagonal and right of it, pattern and values, exactly; the whole one
+    asked of a problem that holds the triangle is K."""
+    _, m = two_materials
+    whole = cnem.Elasticity(m, [LOWER, UPPER], stabilization=stabilization).stiffness()
+    prob = cnem.Elasticity(m, [LOWER, UPPER], stabilization=stabilization)
+    upper = prob.stiffness(upper=True)
+    want = sp.triu(whole, format="csr")
+    want.sort_indices()
+    np.testing.assert_array_equal(upper.indptr, want.indptr)
+    np.testing.assert_array_equal(upper.indices, want.indices)
+    np.testing.assert_array_equal(upper.data, want.data)
+    assert abs(prob.stiffness() - whole).max() <= 1e-14 * abs(whole).max()
 
 
 @pytest.mark.parametrize("stabilization", [0.0, 1.0])

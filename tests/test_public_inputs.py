@@ -82,6 +82,7 @@ NOT_ENTRY_POINTS = {
         "cnem.fem.P1Solution.write_fields", "cnem.pd.StaticSolution.write_fields",
         "cnem.geometry.Cells.subset", "cnem.assembly.CellBasis.at_points",
         "cnem.assembly.CellBasis.from_operators", "cnem.assembly.BilinearForm.assemble",
+        "cnem.assembly.BilinearForm.assemble_over",
         "cnem.fracture.Enrichment.edge_loads", "cnem.fracture.Enrichment.evaluate",
         "cnem.fracture.Enrichment.in_support", "cnem.fracture.Enrichment.smoothed_gradient",
         "cnem.fracture.Enrichment.values", "cnem.spatial.RTree.from_points_in",

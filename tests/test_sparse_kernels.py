@@ -128,3 +128,35 @@ def test_gradient_block_gram_matches_scipy(nch, grouped):
     np.testing.assert_allclose(K.toarray(), expected, atol=1e-13)
     for i in range(2 * n):                                 # sorted, no duplicates
         assert np.all(np.diff(indices[indptr[i]:indptr[i + 1]]) > 0)
+
+
+@pytest.mark.parametrize("nch", [1, 3, 16])
+@pytest.mark.parametrize("d", [2, 3])
+def test_gradient_block_upper_triangle_is_the_triangle_of_the_whole(d, nch):
+    """The upper-triangle pattern and values of a symmetric gradient gram are those of
+    the whole matrix's right of its diagonal, exactly (the same sums in the same order);
+    a node in no cell keeps a stored zero diagonal, its row's first entry."""
+    rng = np.random.default_rng(10 * d + nch)
+    m, n = 40, 25
+    G = _random_csr(rng, (m, n), 0.2)
+    G = sp.csr_matrix((G.data, G.indices, G.indptr), shape=(m, n + 1))    # node n: no cell
+    grads = np.vstack([G.data] + [rng.uniform(-1, 1, G.nnz) for _ in range(d - 1)])
+    coeff = rng.uniform(-1, 1, (5, d * d, d * d))
+    coeff = coeff + coeff.transpose(0, 2, 1)                  # a symmetric form
+    group, weight = rng.integers(0, 5, m), rng.uniform(0.5, 2.0, m)
+    indptr, indices, data = SK.gradient_block_gram_nd(G.indptr, G.indices, grads, coeff,
+                                                      group, weight, n + 1, nch)
+    whole = sp.triu(sp.csr_matrix((data, indices, indptr), shape=(d * (n + 1),) * 2), format="csr")
+    whole.sort_indices()
+    out_ptr, out_idx, *pattern = SK.gradient_block_pattern(G.indptr, G.indices, d, n + 1, nch,
+                                                           True)
+    t_ptr, t_row, t_pos = pattern[2:]
+    upper = SK.gradient_block_values_nd(G.indptr, G.indices, grads, coeff, group, weight, t_ptr,
+                                        t_row, t_pos, pattern[0], pattern[1], out_ptr, n + 1,
+                                        nch, True)
+    last = out_ptr[d * n]                                     # the lone node's d (d + 1) / 2
+    assert len(upper) - last == d * (d + 1) // 2 and not upper[last:].any()
+    np.testing.assert_array_equal(out_ptr[:d * n + 1], whole.indptr[:d * n + 1])
+    np.testing.assert_array_equal(out_idx[:last], whole.indices)
+    np.testing.assert_array_equal(upper[:last], whole.data)
+    np.testing.assert_array_equal(out_idx[out_ptr[d * np.arange(n + 1)]], d * np.arange(n + 1))

@@ -108,3 +108,28 @@ def test_free_blocks_triangle_is_the_submatrixs(fmt):
     assert abs(block.upper().tocsr() - sub).max() == 0.0
     np.testing.assert_allclose(block @ x, before, rtol=1e-12, atol=1e-12)   # now on the triangle
     np.testing.assert_allclose(before, sub @ x, rtol=1e-12, atol=1e-12)
+
+
+def test_principal_view_is_the_submatrixs_triangle():
+    """The view of a triangle on some rows multiplies and sweeps as the triangle of the
+    principal submatrix (formed apart) does, its arrays shared, not copied."""
+    A = random_symmetric(400, 11)
+    keep = np.flatnonzero(np.random.default_rng(11).random(400) < 0.7)
+    U = UpperTriangle.from_matrix(A)
+    view = U.principal(keep)
+    sub = UpperTriangle.from_matrix(principal_submatrix(A, keep))
+    assert view.shape == sub.shape and view.data is U.data
+    rng = np.random.default_rng(12)
+    x, b = rng.standard_normal(len(keep)), rng.standard_normal(len(keep))
+    np.testing.assert_allclose(view @ x, sub @ x, rtol=0, atol=1e-12)
+    assert abs(view.tocsr() - sub.tocsr()).max() == 0.0
+    for from_zero in (False, True):
+        start = np.zeros(len(keep)) if from_zero else x
+        got, want = start.copy(), start.copy()
+        r_got = view.sweep(b, got, from_zero=from_zero)
+        r_want = sub.sweep(b, want, from_zero=from_zero)
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(r_got, r_want, rtol=0, atol=1e-11)
+        np.testing.assert_allclose(r_got, b - sub @ got, rtol=0, atol=1e-11)
+    with pytest.raises(InputError, match="keep"):
+        U.principal(keep[::-1])

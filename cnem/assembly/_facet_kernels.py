@@ -35,14 +35,14 @@ def weighted_rows(ptr, item, weight, v_ptr, v_idx, v_val, ncol, nch):
     data : (d, nnz) float64
     """
     m, d = len(ptr) - 1, weight.shape[1]
-    indptr = SK._offsets(SK._block_counts(ptr, item, v_ptr, v_idx, ncol, nch))
+    indptr = SK._offsets(SK._block_counts(ptr, item, v_ptr, v_idx, ncol, nch, False))
     indices = np.empty(indptr[m], dtype=np.int32)
     data = np.zeros((d, indptr[m]))
     for ch in numba.prange(nch):
         slot = np.full(ncol, -1, dtype=np.int64)
         lo, hi = SK._chunk(ch, nch, m)
         for i in range(lo, hi):                             # the row's columns, sorted ...
-            SK._block_row_columns(i, ptr, item, v_ptr, v_idx, indptr[i], slot, indices)
+            SK._block_row_columns(i, ptr, item, v_ptr, v_idx, indptr[i], slot, indices, False)
             for p in range(ptr[i], ptr[i + 1]):             # ... then their values
                 r = item[p]
                 for k in range(v_ptr[r], v_ptr[r + 1]):

@@ -284,11 +284,12 @@ def _transpose_pattern(ptr, idx, ncol):
 
 
 @numba.njit(cache=True, inline="always")
-def _block_counts(t_ptr, t_row, ptr, idx, ncol, nch):
+def _block_counts(t_ptr, t_row, ptr, idx, ncol, nch, upper):
     """Number of node columns in every block row of ``G^T G`` (``G`` the CSR pattern
     ``ptr, idx``, its columns ``t_ptr, t_row``), ``(ncol,)`` (inlined: its loop over
     chunks runs in parallel in the parallel copy of the caller); for any ``t_ptr, t_row``
-    (rows of ``G`` summed per output row), the columns of each of its rows."""
+    (rows of ``G`` summed per output row), the columns of each of its rows. With
+    ``upper``, the columns ``j >= i`` of row ``i`` only, its diagonal always counted."""
     rows = t_ptr.shape[0] - 1
     counts = np.zeros(rows, dtype=np.int64)
     for ch in numba.prange(nch):
@@ -296,10 +297,14 @@ def _block_counts(t_ptr, t_row, ptr, idx, ncol, nch):
         lo, hi = _chunk(ch, nch, rows)
         for i in range(lo, hi):
             count = 0
+            lowest = i if upper else 0
+            if upper:
+                mark[i] = i
+                count = 1
             for t in range(t_ptr[i], t_ptr[i + 1]):
                 k = t_row[t]
                 for p in range(ptr[k], ptr[k + 1]):
-                    if mark[idx[p]] != i:
+                    if idx[p] >= lowest and mark[idx[p]] != i:
                         mark[idx[p]] = i
                         count += 1
             counts[i] = count
@@ -307,20 +312,31 @@ def _block_counts(t_ptr, t_row, ptr, idx, ncol, nch):
 
 
 @numba.njit(cache=True, inline="always")
-def _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices):
-    """Write the node columns of block row ``i`` (see `_block_row_count`) sorted into
+def _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices, upper):
+    """Write the node columns of block row ``i`` (see `_block_counts`) sorted into
     ``indices[start:end]``, ``slot`` pointing at them; returns ``end``."""
-    end = start
+    end = _add_column(i, start, start, slot, indices) if upper else start
+    lowest = i if upper else 0
     for t in range(t_ptr[i], t_ptr[i + 1]):
         k = t_row[t]
         for p in range(ptr[k], ptr[k + 1]):
-            end = _add_column(idx[p], start, end, slot, indices)
+            if idx[p] >= lowest:
+                end = _add_column(idx[p], start, end, slot, indices)
     _sort_slots(indices, start, end, slot)
     return end
 
 
+@numba.njit(cache=True, inline="always")
+def _dof_row_base(out_ptr, indptr, d, i, r, upper):
+    """Where block column ``q`` (an index into the node blocks' pattern) of dof row
+    ``d i + r`` starts, less ``d q``: the entry of trial component ``s`` is at
+    ``base + d q + s`` (in the upper triangle, whose diagonal block keeps ``s >= r``
+    only, too)."""
+    return out_ptr[d * i + r] - d * indptr[i] - (r if upper else 0)
+
+
 @parallel_kernel("ncol")
-def gradient_block_pattern(ptr, idx, d, ncol, nch):
+def gradient_block_pattern(ptr, idx, d, ncol, nch, upper=False):
     """The pattern of `gradient_block_gram` (``d x d`` node blocks of ``G^T G``, ``G`` the
     CSR pattern ``ptr, idx``, ``(m, ncol)``), computed once for any number of value
     passes (`gradient_block_values`, `gradient_block_values_nd`).
@@ -331,6 +347,9 @@ def gradient_block_pattern(ptr, idx, d, ncol, nch):
     d : int
         Components per node.
     ncol, nch : int
+    upper : bool
+        Only the upper triangle (the diagonal and the entries right of it, every row's
+        diagonal stored first): half the entries of the symmetric matrix.
 
     Returns
     -------
@@ -339,30 +358,33 @@ def gradient_block_pattern(ptr, idx, d, ncol, nch):
         ``K``'s CSR pattern over the interleaved dofs, ``(d ncol, d ncol)``, sorted.
     indptr : (ncol + 1,) int64
     indices : (nnz / d^2,) int32
-        The node blocks' CSR pattern, ``(ncol, ncol)``, sorted.
+        The node blocks' CSR pattern, ``(ncol, ncol)``, sorted (with ``upper``, the
+        blocks on and right of the diagonal).
     t_ptr, t_row, t_pos : int64 arrays
         ``G``'s columns: the rows holding column ``j`` and the positions of those entries.
     """
     t_ptr, t_row, t_pos = _transpose_pattern(ptr, idx, ncol)
-    counts = _block_counts(t_ptr, t_row, ptr, idx, ncol, nch)
+    counts = _block_counts(t_ptr, t_row, ptr, idx, ncol, nch, upper)
     indptr = _offsets(counts)                   # of the node blocks
+    cut = d * (d - 1) // 2 if upper else 0      # entries left of the diagonal per block
     out_ptr = np.empty(d * ncol + 1, dtype=np.int64)     # of the dofs: d rows per node
     out_ptr[0] = 0
     for i in range(ncol):
         for r in range(d):
-            out_ptr[d * i + r + 1] = d * d * indptr[i] + (r + 1) * d * counts[i]
+            out_ptr[d * i + r + 1] = (d * d * indptr[i] - i * cut + (r + 1) * d * counts[i]
+                                      - (r * (r + 1) // 2 if upper else 0))
     indices = np.empty(indptr[ncol], dtype=np.int32)
-    out_idx = np.empty(d * d * indptr[ncol], dtype=np.int32)
+    out_idx = np.empty(out_ptr[d * ncol], dtype=np.int32)
     for ch in numba.prange(nch):
         slot = np.full(ncol, -1, dtype=np.int64)
         lo, hi = _chunk(ch, nch, ncol)
         for i in range(lo, hi):
             start = indptr[i]
-            end = _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices)
+            end = _block_row_columns(i, t_ptr, t_row, ptr, idx, start, slot, indices, upper)
             for r in range(d):
-                row = out_ptr[d * i + r] - d * start        # block q -> row + d q
+                row = _dof_row_base(out_ptr, indptr, d, i, r, upper)
                 for q in range(start, end):
-                    for c in range(d):
+                    for c in range(r if upper and q == start else 0, d):
                         out_idx[row + d * q + c] = d * indices[q] + c
     return out_ptr, out_idx, indptr, indices, t_ptr, t_row, t_pos
 
@@ -408,9 +430,9 @@ def gradient_block_values(ptr, idx, gx, gy, coeff, group, weight, t_ptr, t_row, 
 
 @parallel_kernel("ncol")
 def gradient_block_values_nd(ptr, idx, grads, coeff, group, weight, t_ptr, t_row, t_pos,
-                             indptr, indices, out_ptr, ncol, nch):
-    """The values of `gradient_block_gram_nd` on its pattern (`gradient_block_pattern`):
-    ``(nnz,)`` float64, in the order of ``out_idx``."""
+                             indptr, indices, out_ptr, ncol, nch, upper=False):
+    """The values of `gradient_block_gram_nd` on its pattern (`gradient_block_pattern`,
+    with the same ``upper``): ``(nnz,)`` float64, in the order of ``out_idx``."""
     d = grads.shape[0]
     data = np.zeros(out_ptr[d * ncol])
     for ch in numba.prange(nch):
@@ -422,7 +444,8 @@ def gradient_block_values_nd(ptr, idx, grads, coeff, group, weight, t_ptr, t_row
         for i in range(lo, hi):
             _point_slots(indptr, indices, i, slot)
             for r in range(d):
-                row[r] = out_ptr[d * i + r] - d * indptr[i]     # block q -> row[r] + d q
+                row[r] = _dof_row_base(out_ptr, indptr, d, i, r, upper)   # + d q + s
+            lowest = i if upper else 0
             for t in range(t_ptr[i], t_ptr[i + 1]):
                 k = t_row[t]
                 c = group[k]
@@ -435,9 +458,12 @@ def gradient_block_values_nd(ptr, idx, grads, coeff, group, weight, t_ptr, t_row
                             total += gi[e] * coeff[c, a, d * r + e]
                         v[r, a] = total
                 for p in range(ptr[k], ptr[k + 1]):
+                    if idx[p] < lowest:
+                        continue
                     q = d * slot[idx[p]]
+                    diagonal = upper and idx[p] == i
                     for r in range(d):
-                        for s in range(d):                  # trial component s
+                        for s in range(r if diagonal else 0, d):      # trial component s
                             total = 0.0
                             for e in range(d):
                                 total += v[r, d * s + e] * grads[e, p]

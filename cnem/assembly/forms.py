@@ -21,6 +21,7 @@ from skfem.assembly.form.form import FormExtraParams
 
 from .._parallel import work_chunks
 from ..errors import FormError
+from ..solvers.symmetric import UpperTriangle
 from . import _sparse_kernels as SK
 
 if TYPE_CHECKING:
@@ -176,6 +177,43 @@ class BilinearForm(_Form):
                     weights[:, i, j] = basis.dx * grad_coeff[group, a - g, b - g]
         return _weighted_gram([ops[d] for d in used], weights, basis.N)
 
+    def assemble_over(self, bases: Sequence[CellBasis], *, groups: np.ndarray,
+                      upper: bool = False, **kwargs: Any) -> sp.csr_matrix | UpperTriangle:
+        """The matrix of a form that sees only gradients (``grad(u)``, ``grad(v)``) over
+        the cells of several vector bases on the same dofs (cells and their sub-cells,
+        say), in one pass (`GradientGram`), the bases' operators not copied into one.
+
+        Parameters
+        ----------
+        bases : sequence of CellBasis
+            Vector bases of one dimension on the same dofs, ``m_1, m_2, ...`` cells,
+            taken in this order.
+        groups : (m_1 + m_2 + ...,) int array_like
+            The group of every cell, as in `assemble` (the form evaluated once per group).
+        upper : bool
+            Return the upper triangle alone (`cnem.solvers.symmetric.UpperTriangle`,
+            half the work and bytes): for a symmetric form.
+        **kwargs
+            Extras ``w`` of the form, per group.
+
+        Returns
+        -------
+        scipy.sparse.csr_matrix or UpperTriangle, shape (N, N)
+        """
+        bases = tuple(bases)
+        if not bases:
+            raise FormError("assemble_over: expected at least one basis, received none")
+        first = bases[0]
+        group, count = _check_groups(groups, sum(len(b.dx) for b in bases), kwargs)
+        g = first.ncomp
+        coeff = np.zeros((count, first.descriptors - g, first.descriptors - g))
+        for a, b, value in self._nonzero_coefficients(first, kwargs, count):
+            if a < g or b < g:
+                raise FormError(f"assemble_over: form {self.__name__} uses the field values; "
+                                f"expected a form of the gradients alone, use assemble")
+            coeff[:, a - g, b - g] = value
+        return GradientGram(bases, upper=upper).matrix(coeff, group)
+
 
 def _weighted_gram(ops, weights, N):
     """``sum_k sum_ab P_b[k]^T weights[k, a, b] P_a[k]`` ``(N, N)`` CSR from descriptor
@@ -218,6 +256,11 @@ class GradientGram:
     bases : sequence of CellBasis
         Vector bases of the same dimension and dofs, ``m_1, m_2, ...`` cells; their
         cells are taken in this order (``m = m_1 + m_2 + ...``).
+    upper : bool
+        `matrix` gives the upper triangle of the (symmetric) matrix, a
+        `cnem.solvers.symmetric.UpperTriangle`, computed alone: half the work and the
+        bytes. The coefficients must then make a symmetric matrix (``coeff[k]``
+        symmetric).
 
     Examples
     --------
@@ -230,15 +273,18 @@ class GradientGram:
     >>> twice = 2 * gradient_gram(basis, coeff[:len(basis.dx)])
     >>> bool(abs(gram.matrix(coeff) - twice).max() < 1e-12)
     True
+    >>> upper = GradientGram([basis, basis], upper=True).matrix(coeff)
+    >>> bool(abs(upper.tocsr() - twice).max() < 1e-12)
+    True
     """
 
-    def __init__(self, bases: Sequence[CellBasis]):
+    def __init__(self, bases: Sequence[CellBasis], *, upper: bool = False):
         bases = tuple(bases)
         shapes = {(b.vector, b.ncomp, b.N) for b in bases}
         if not bases or len(shapes) != 1 or not bases[0].vector:
             raise FormError(f"GradientGram: expected vector bases of one dimension on the same "
                             f"dofs, received (vector, components, dofs) {sorted(shapes)}")
-        self.d, self.N = bases[0].ncomp, bases[0].N
+        self.d, self.N, self.upper = bases[0].ncomp, bases[0].N, bool(upper)
         self.size = sum(len(b.dx) for b in bases)
         self.weight = np.concatenate([b.dx for b in bases])
         grads = [b.component_gradients() for b in bases]
@@ -247,21 +293,32 @@ class GradientGram:
             self._ops = [sp.vstack(ops, format="csr") for ops in
                          zip(*(b.operators[self.d:] for b in bases))]
             return
-        # each basis's axes share one pattern, and so do the stacked axes
-        stacked = [sp.vstack(axis, format="csr") for axis in zip(*grads)]
-        self._ptr, self._idx = stacked[0].indptr, stacked[0].indices
-        self._values = np.stack([g.data for g in stacked])
+        # each basis's axes share one pattern: the bases' patterns one after the other,
+        # the axes' values in one (d, nnz) array (one copy of the gradients)
+        self._ptr = np.concatenate([[0]] + [g[0].indptr[1:].astype(np.int64) + offset
+                                            for g, offset in zip(grads, np.cumsum(
+                                                [0] + [g[0].nnz for g in grads[:-1]]))])
+        self._idx = np.concatenate([g[0].indices for g in grads])
+        self._values = np.empty((self.d, len(self._idx)))
+        at = 0
+        for g in grads:
+            for axis in range(self.d):
+                self._values[axis, at:at + g[axis].nnz] = g[axis].data
+            at += g[0].nnz
+        del grads
         self._pattern = SK.gradient_block_pattern(self._ptr, self._idx, self.d, self.N // self.d,
-                                                  work_chunks())
+                                                  work_chunks(), self.upper)
 
     def __repr__(self):
         return f"<GradientGram {self.d}-D, {self.size} cells, {self.N} dofs>"
 
-    def matrix(self, coeff: np.ndarray, group: np.ndarray | None = None) -> sp.csr_matrix:
+    def matrix(self, coeff: np.ndarray, group: np.ndarray | None = None
+               ) -> sp.csr_matrix | UpperTriangle:
         """The matrix of the coefficients ``coeff`` (``coeff[k, a, b]``: trial descriptor
         ``a``, test descriptor ``b``), per cell ``(m, d d, d d)`` or, with ``group``
         ``(m,)`` int, per group ``(G, d d, d d)`` (cell ``k`` takes
-        ``coeff[group[k]]``); ``(N, N)`` CSR."""
+        ``coeff[group[k]]``); ``(N, N)`` CSR, or its upper triangle as an
+        `cnem.solvers.symmetric.UpperTriangle` if the gram was made with ``upper``."""
         d, m = self.d, self.size
         coeff = np.ascontiguousarray(coeff, dtype=float)
         group = np.arange(m) if group is None else np.asarray(group, dtype=np.int64)
@@ -271,10 +328,14 @@ class GradientGram:
                             f"{d * d}) (or one per group with a ({m},) group index), received "
                             f"shape {coeff.shape} with group shape {group.shape}")
         if self._pattern is None:
-            return _weighted_gram(self._ops, self.weight[:, None, None] * coeff[group], self.N)
+            K = _weighted_gram(self._ops, self.weight[:, None, None] * coeff[group], self.N)
+            return UpperTriangle.from_matrix(K) if self.upper else K
         out_ptr, out_idx, indptr, indices, t_ptr, t_row, t_pos = self._pattern
         args = (coeff, group, self.weight, t_ptr, t_row, t_pos, indptr, indices, out_ptr,
                 self.N // d, work_chunks())
+        if self.upper:
+            data = SK.gradient_block_values_nd(self._ptr, self._idx, self._values, *args, True)
+            return UpperTriangle(out_ptr, out_idx.view(np.uint32), data)
         if d == 2:
             data = SK.gradient_block_values(self._ptr, self._idx, *self._values, *args)
         else:

@@ -293,5 +293,5 @@ class ElasticSolution(CellSolution):
             raise ConditionError("reaction: `where` selects no node; check it against the "
                                  "nodes (boundary nodes lie exactly on the boundary)")
         d = self.u.shape[1]
-        residual = problem.stiffness() @ self.dofs - problem.load()
+        residual = problem.stiffness(upper=problem.dim == 3) @ self.dofs - problem.load()
         return residual[:d * len(self.u)].reshape(-1, d)[nodes].sum(axis=0)

@@ -56,7 +56,7 @@ def multiply(indptr, indices, data, x, out, partial):
 
 
 @numba.njit(cache=True)
-def symmetric_sweep(indptr, indices, data, b, x, lower, residual, from_zero):
+def symmetric_sweep(indptr, indices, data, b, x, lower, residual, from_zero, kept):
     """A forward then a backward Gauss-Seidel sweep on ``A x = b``, in place on ``x``,
     and the residual ``b - A x`` after it.
 
@@ -76,10 +76,16 @@ def symmetric_sweep(indptr, indices, data, b, x, lower, residual, from_zero):
         rows as they change (no further pass over the matrix).
     from_zero : bool
         ``x`` is zero on entry: the forward sweep reads nothing right of the diagonal.
+    kept : (n,) bool or (0,) ndarray
+        Unless empty, sweep only the rows it marks, the others' ``x`` zero and left so:
+        the sweep of the principal submatrix on the kept rows (their residual only).
     """
     n = x.shape[0]
+    every = kept.shape[0] == 0
     lower[:] = 0.0
     for i in range(n):                      # forward: new values left, old right
+        if not (every or kept[i]):
+            continue
         first, end = indptr[i], indptr[i + 1]
         s = b[i] - lower[i]
         if not from_zero:
@@ -92,6 +98,8 @@ def symmetric_sweep(indptr, indices, data, b, x, lower, residual, from_zero):
     track = residual.shape[0] == n
     residual[:] = 0.0
     for i in range(n - 1, -1, -1):          # backward: new values right, forward's left
+        if not (every or kept[i]):
+            continue
         first, end = indptr[i], indptr[i + 1]
         s = b[i] - lower[i]
         for p in range(first + 1, end):

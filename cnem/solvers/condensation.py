@@ -11,7 +11,10 @@ a 2M-dof solve). ``cnem.assembly.condense`` stays scikit-fem's, with its wider i
 `free_system` gives the same system with the submatrix as a `FreeBlock`: products on
 the stiffness itself (scatter, parallel product, gather), the submatrix formed only
 when a solver needs its entries (a direct solve, a smoother on it), so that an
-iterative solve holds one copy of the stiffness, not two (1.3 GB at 1M nodes).
+iterative solve holds one copy of the stiffness, not two (1.3 GB at 1M nodes). The
+stiffness may be given as its upper triangle (`cnem.solvers.symmetric.UpperTriangle`,
+as 3-D elasticity assembles it): the block and the lifting are then taken from it, the
+whole matrix never formed unless a solver needs its entries.
 
 >>> import numpy as np, scipy.sparse as sp
 >>> K = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(5, 5), format="csr")
@@ -114,9 +117,9 @@ class FreeBlock(spla.LinearOperator):
 
     Parameters
     ----------
-    K : sparse (n, n)
+    K : sparse (n, n) or UpperTriangle
         Symmetric. CSR, or CSC (its transpose, CSR, is multiplied: the same matrix,
-        no copy); other formats are converted to CSR.
+        no copy), or its upper triangle; other formats are converted to CSR.
     free : (k,) int ndarray, strictly increasing, or (n,) bool ndarray, optional
         The kept dofs; all of them if None (the operator is then ``K``).
 
@@ -131,7 +134,9 @@ class FreeBlock(spla.LinearOperator):
         n = self._K.shape[0]
         self.free = np.arange(n) if free is None else _kept(free, n)
         self._all = len(self.free) == n
-        self._product = parallel_operator(self._K.T if self._K.format == "csc" else self._K)
+        self._triangle = isinstance(self._K, UpperTriangle)
+        self._product = (self._K if self._triangle else
+                         parallel_operator(self._K.T if self._K.format == "csc" else self._K))
         self._matrix = None
         self._upper = None
         self._nnz = None
@@ -142,22 +147,31 @@ class FreeBlock(spla.LinearOperator):
         """Stored entries of the submatrix (counted without forming it)."""
         if self._nnz is None:
             self._nnz = (self._K.nnz if self._all
-                         else int(_kept_counts(self._K, self.free)[0].sum()))
+                         else int(_kept_counts(self._K, self.free, self._triangle)[0].sum()))
+            if self._triangle:                 # the diagonal once, the rest twice
+                self._nnz = 2 * self._nnz - self.shape[0]
         return self._nnz
 
     def matrix(self) -> sp.spmatrix:
         """The submatrix's entries (`principal_submatrix`; ``K`` itself when every dof is
         kept), formed at the first call and kept."""
         if self._matrix is None:
-            self._matrix = self._K if self._all else principal_submatrix(self._K, self.free)
+            if self._triangle:
+                self._matrix = self.submatrix(np.arange(self.shape[0]))
+            else:
+                self._matrix = self._K if self._all else principal_submatrix(self._K, self.free)
         return self._matrix
 
     def upper(self) -> UpperTriangle:
         """The submatrix's upper triangle (half its bytes), formed at the first call and
-        kept; the block's products then run on it (reading half the data of ``K``'s)."""
+        kept (of an `UpperTriangle` ``K``, a view of it on the free dofs, no copy); the
+        block's products then run on it (reading half the data of ``K``'s)."""
         if self._upper is None:
-            data, indices, indptr = _kept_arrays(self._K, self.free, upper=True)
-            self._upper = UpperTriangle(indptr, indices, data)
+            if self._triangle:                 # a view of K's triangle: no copy
+                self._upper = self._K if self._all else self._K.principal(self.free)
+            else:
+                data, indices, indptr = _kept_arrays(self._K, self.free, upper=True)
+                self._upper = UpperTriangle(indptr, indices, data)
         return self._upper
 
     def submatrix(self, keep: np.ndarray) -> sp.spmatrix:
@@ -172,7 +186,11 @@ class FreeBlock(spla.LinearOperator):
         -------
         sparse (m, m)
         """
-        return principal_submatrix(self._K, self.free[_kept(keep, self.shape[0])])
+        rows = self.free[_kept(keep, self.shape[0])]
+        if self._triangle:
+            data, indices, indptr = _kept_arrays(self._K, rows, upper=True)
+            return UpperTriangle(indptr, indices, data).tocsr()
+        return principal_submatrix(self._K, rows)
 
     def _matvec(self, x):
         x = np.asarray(x, dtype=float).reshape(-1)
@@ -195,8 +213,9 @@ def free_system(K: sp.spmatrix, f: np.ndarray, *, x: np.ndarray, D: np.ndarray
 
     Parameters
     ----------
-    K : sparse (n, n)
-        CSR or CSC (kept), other formats as CSR; symmetric for the block's products.
+    K : sparse (n, n) or UpperTriangle
+        CSR or CSC (kept), or the upper triangle of a symmetric matrix (kept), other
+        formats as CSR; symmetric for the block's products.
     f : (n,) ndarray
     x : (n,) ndarray
         The prescribed values on ``D`` (the rest is not read).
@@ -218,13 +237,13 @@ def free_system(K: sp.spmatrix, f: np.ndarray, *, x: np.ndarray, D: np.ndarray
             raise InputError(f"{name}: expected shape ({n},) like K's rows, received "
                              f"{vector.shape}; pass one value per dof")
     I = free_dofs(n, D)
-    if K.format == "csc":                      # the fixed columns, a few (once each)
+    if not isinstance(K, UpperTriangle) and K.format == "csc":  # the fixed columns (once each)
         D = distinct(np.asarray(D, dtype=np.int64))
         lifted = K[:, D] @ x[D]
     else:
         xd = x.astype(float)
         xd[I] = 0.0
-        lifted = parallel_operator(K) @ xd
+        lifted = (K if isinstance(K, UpperTriangle) else parallel_operator(K)) @ xd
     return FreeBlock(K, I), f[I] - lifted[I], I
 
 
@@ -267,7 +286,10 @@ def _kept_counts(A, rows, upper=False):
 
 
 def _compressed(A):
-    """``A`` square, CSC or else CSR, canonical (a copy if it was not)."""
+    """``A`` square, CSC or else CSR, canonical (a copy if it was not); an
+    `UpperTriangle` as it is."""
+    if isinstance(A, UpperTriangle):
+        return A
     if not sp.issparse(A):
         raise InputError(f"expected a scipy sparse matrix, received {type(A).__name__}; "
                          "pass scipy.sparse.csr_matrix(A)")

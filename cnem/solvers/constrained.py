@@ -17,15 +17,16 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import InputError, SolveError
 from .condensation import free_system
 from .linsolve import free_rigid_motions, rigid_modes, solve_spd
+from .symmetric import UpperTriangle
 
 if TYPE_CHECKING:
     from typing import Callable
 
-    import scipy.sparse as sp
     from numpy.typing import ArrayLike
 
 __all__ = ["check_supports", "solve_constrained"]
@@ -36,7 +37,7 @@ def check_supports(K: sp.spmatrix, points: np.ndarray, fixed: np.ndarray) -> Non
 
     Parameters
     ----------
-    K : sparse (N, N)
+    K : sparse (N, N) or UpperTriangle
         The stiffness (its pattern tells which nodes hang together); its first
         ``d n`` dofs are the nodes' (``d`` per node, node-major), any further ones
         (enrichment) are not looked at.
@@ -53,7 +54,11 @@ def check_supports(K: sp.spmatrix, points: np.ndarray, fixed: np.ndarray) -> Non
     points = np.asarray(points)
     nodal = points.size
     fixed = np.asarray(fixed, dtype=np.int64)
-    free = free_rigid_motions(K[:nodal, :nodal], points, fixed[fixed < nodal])
+    if isinstance(K, UpperTriangle):           # its pattern, one triangle: the same parts
+        K = sp.csr_matrix((K.data, K.indices, K.indptr), shape=K.shape)
+    if nodal < K.shape[0]:
+        K = K[:nodal, :nodal]
+    free = free_rigid_motions(K, points, fixed[fixed < nodal])
     if free:
         raise SolveError("the system is singular: the Dirichlet conditions leave free the "
                          + "; ".join(free) + ". Fix them with add_dirichlet")
@@ -67,8 +72,9 @@ def solve_constrained(K: sp.spmatrix, f: np.ndarray, fixed: ArrayLike, values: A
 
     Parameters
     ----------
-    K : sparse (N, N)
-        Symmetric positive definite on the free dofs once the supports are fixed.
+    K : sparse (N, N) or UpperTriangle
+        Symmetric positive definite on the free dofs once the supports are fixed; its
+        upper triangle alone is enough (`cnem.solvers.condensation.free_system`).
     f : (N,) ndarray
     fixed : (k,) int array_like
         Prescribed dofs (a later repeat of a dof wins).

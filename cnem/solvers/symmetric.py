@@ -3,9 +3,10 @@ and its symmetric Gauss-Seidel sweep each reading half the data
 (`cnem.solvers._symmetric_kernels`).
 
 The stiffness of 3-D SCNI has about 530 entries per row (175 neighbour nodes): 159M
-at 100k nodes, 1.9 GB as CSR (float64 values, int32 columns). The iterative solve holds
-the system on the free dofs once, in this form, for its products and for the smoothing
-of the finest level, instead of a second CSR copy of the stiffness.
+at 100k nodes, 1.9 GB as CSR (float64 values, int32 columns). 3-D elasticity assembles
+it in this form (`cnem.Elasticity.stiffness` with ``upper``), and the iterative solve
+runs its products and the smoothing of the finest level on a view of it on the free dofs
+(`UpperTriangle.principal`): one half-size copy of the stiffness in all.
 
 >>> import numpy as np, scipy.sparse as sp
 >>> from cnem.solvers.symmetric import UpperTriangle
@@ -16,6 +17,8 @@ of the finest level, instead of a second CSR copy of the stiffness.
 """
 
 from __future__ import annotations
+
+import copy
 
 import numba
 import numpy as np
@@ -44,6 +47,9 @@ class UpperTriangle(spla.LinearOperator):
         Stored entries.
     nbytes : int
         Bytes of the three arrays.
+    keep : (k,) int64 ndarray or None
+        For a principal view (`principal`): the rows and columns it keeps (its
+        ``shape`` is then ``(k, k)``, ``nnz`` and ``nbytes`` still the whole triangle's).
     """
 
     def __init__(self, indptr: np.ndarray, indices: np.ndarray, data: np.ndarray) -> None:
@@ -58,7 +64,41 @@ class UpperTriangle(spla.LinearOperator):
         self.nnz = len(self.data)
         self.nbytes = self.indptr.nbytes + self.indices.nbytes + self.data.nbytes
         self._work = None
+        self.keep = None
         super().__init__(dtype=float, shape=(n, n))
+
+    def principal(self, keep: np.ndarray) -> UpperTriangle:
+        """The principal submatrix on ``keep`` as a view sharing this triangle's arrays (no
+        copy): its product and sweep run on the whole triangle, the other rows and
+        columns held at zero (the system on the free dofs of a stiffness, say).
+
+        Parameters
+        ----------
+        keep : (k,) int ndarray
+            Strictly increasing rows in ``[0, n)``.
+
+        Returns
+        -------
+        UpperTriangle
+            Of shape ``(k, k)``.
+        """
+        keep = np.asarray(keep, dtype=np.int64).reshape(-1)
+        n = len(self.indptr) - 1
+        if self.keep is not None or (keep.size and (keep[0] < 0 or keep[-1] >= n or
+                                                    np.any(np.diff(keep) <= 0))):
+            raise InputError(f"keep: expected strictly increasing rows in [0, {n}) of a whole "
+                             f"triangle; pass np.unique(keep) to the triangle itself")
+        out = copy.copy(self)
+        out.keep, out.shape, out._work = keep, (len(keep), len(keep)), None
+        out._kept = np.zeros(n, dtype=bool)
+        out._kept[keep] = True
+        return out
+
+    def _whole(self, v):
+        """``v`` on the kept rows as a vector of the whole triangle, zero elsewhere."""
+        whole = np.zeros(len(self.indptr) - 1)
+        whole[self.keep] = v
+        return whole
 
     @classmethod
     def from_matrix(cls, A: sp.spmatrix) -> UpperTriangle:
@@ -80,12 +120,14 @@ class UpperTriangle(spla.LinearOperator):
 
     def _matvec(self, x):
         x = np.ascontiguousarray(x, dtype=float).reshape(-1)
-        out = np.empty(self.shape[0])
+        if self.keep is not None:
+            x = self._whole(x)
+        out = np.empty(len(x))
         chunks = numba.get_num_threads()
         if self._work is None or self._work.shape[0] != chunks:
-            self._work = np.empty((chunks, self.shape[0]))
+            self._work = np.empty((chunks, len(x)))
         kernels.multiply(self.indptr, self.indices, self.data, x, out, self._work)
-        return out
+        return out if self.keep is None else out[self.keep]
 
     def _rmatvec(self, x):                  # symmetric
         return self._matvec(x)
@@ -109,13 +151,24 @@ class UpperTriangle(spla.LinearOperator):
         (n,) ndarray or None
             ``b - A x`` after the sweep, if ``residual``.
         """
-        out = np.empty(self.shape[0] if residual else 0)
-        kernels.symmetric_sweep(self.indptr, self.indices, self.data, b, x,
-                                np.empty(self.shape[0]), out, from_zero)
-        return out if residual else None
+        if self.keep is None:
+            out = np.empty(self.shape[0] if residual else 0)
+            kernels.symmetric_sweep(self.indptr, self.indices, self.data, b, x,
+                                    np.empty(self.shape[0]), out, from_zero, np.empty(0, bool))
+            return out if residual else None
+        whole_x, n = self._whole(x), len(self.indptr) - 1
+        out = np.empty(n if residual else 0)
+        kernels.symmetric_sweep(self.indptr, self.indices, self.data, self._whole(b), whole_x,
+                                np.empty(n), out, from_zero, self._kept)
+        x[:] = whole_x[self.keep]
+        return out[self.keep] if residual else None
 
     def tocsr(self) -> sp.csr_matrix:
-        """The whole matrix, CSR ``(n, n)`` (for a direct solve or a check)."""
+        """The whole matrix, CSR ``(n, n)`` (for a direct solve or a check); of a
+        principal view, its submatrix ``(k, k)``."""
+        n = len(self.indptr) - 1
         U = sp.csr_matrix((self.data, self.indices.astype(np.int64), self.indptr),
-                          shape=self.shape)
+                          shape=(n, n))
+        if self.keep is not None:
+            U = U[self.keep][:, self.keep]
         return (U + sp.triu(U, k=1).T).tocsr()
