@@ -1092,6 +1092,10 @@ def cook_membrane_mixed(material, load, *, divisions, order=2, steps=10, graded=
     return _cook_corner_uy(mesh, ubasis, x)
 
 
+#: Points per call of scikit-fem's ``probes`` in `cantilever_p2`'s displacement.
+PROBE_CHUNK = 5000
+
+
 def cantilever_p2(length, width, material, load, cells_across):
     """Tip deflection of the clamped square-section cantilever by scikit-fem P2 tetrahedra.
 
@@ -1151,8 +1155,14 @@ def cantilever_p2(length, width, material, load, cells_across):
     mean = deflection.assemble(end, uz=end.interpolate(uz)) / width ** 2
 
     def displacement(points):
-        probes = basis.probes(np.ascontiguousarray(np.asarray(points, dtype=float).T))
-        return (probes @ u).reshape(3, -1).T
+        # in chunks: scikit-fem's element finder holds (points x candidates) temporaries
+        # (over 20 GB for 100k points)
+        points = np.asarray(points, dtype=float).reshape(-1, 3)
+        out = np.empty_like(points)
+        for start in range(0, len(points), PROBE_CHUNK):
+            chunk = np.ascontiguousarray(points[start:start + PROBE_CHUNK].T)
+            out[start:start + PROBE_CHUNK] = (basis.probes(chunk) @ u).reshape(3, -1).T
+        return out
 
     return float(mean), displacement, basis.N
 
