@@ -379,8 +379,10 @@ def check_growth_two_holes(demo, res, outdir):
     tips = res["tips"]
     assert np.hypot(*(tips[1:] - tips[:-1]).transpose(2, 0, 1)) == pytest.approx(1.0, rel=1e-9)
     assert np.all(np.diff(tips[:, 0, 0]) > 0) and np.all(np.diff(tips[:, 1, 0]) < 0)
-    # the plate is point-symmetric about its centre: so are the two paths (to the cloud's asymmetry)
-    assert np.abs(tips[:, 0] + tips[:, 1] - [20.0, 10.0]).max() < 0.15
+    # the plate is point-symmetric about its centre: so are the two paths, to the cloud's
+    # asymmetry, which the free grips' kinks of -25 to -34 degrees at a = 5-6 amplify
+    # (measured 0.14 with the shear-only stabilisation, 0.157 with the deviatoric one)
+    assert np.abs(tips[:, 0] + tips[:, 1] - [20.0, 10.0]).max() < 0.2
     clamped = res["runs"].get("clamped")
     if clamped is None:
         return

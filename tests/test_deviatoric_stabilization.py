@@ -15,7 +15,7 @@ import pytest
 import cases
 import cases3d
 import cnem
-from cnem.elasticity.stabilization import IsochoricNeoHookean, deviatoric_lame
+from cnem.elasticity.stabilization import IsochoricNeoHookean, deviatoric_lame, stabilization_lame
 from cnem.material import SaintVenantKirchhoff
 
 RNG = np.random.default_rng(61)
@@ -42,6 +42,15 @@ def test_the_linear_law_is_the_deviatoric_energy_of_the_3d_strain(plane, nu):
     lam_s = deviatoric_lame(mu, nu, plane)
     law = 2.0 * mu * np.einsum("qij,qij->q", e, e) + lam_s * trace ** 2
     np.testing.assert_allclose(law, _deviatoric_energy(e3, mu), rtol=1e-12)
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.3, 0.4999])
+def test_plane_stress_keeps_the_shear_only_law_and_the_rest_the_deviatoric_one(nu):
+    mu = np.array([1.7, 0.4])
+    np.testing.assert_array_equal(stabilization_lame(mu, nu, "stress"), 0.0)
+    for plane in ("strain", None):
+        np.testing.assert_allclose(stabilization_lame(mu, nu, plane), -2.0 * mu / 3.0,
+                                   rtol=1e-15)
 
 
 def _clouds():

@@ -75,12 +75,12 @@ def test_stabilised_stiffness_is_the_difference_form(name, weight):
     """K = sum_k A_k B~_k^T C B~_k + a sum_s A_s (B~_s - B~_k)^T C_dev (B~_s - B~_k),
     built here term by term from the fan sub-cells (slow reference); the sub-cells'
     spokes integrated whole or cut, their integrals cancel between neighbours. The
-    stabilisation's C_dev is the deviatoric law of the shear modulus alone
-    (`deviatoric_lame`: no locking, no volumetric stiffening)."""
+    stabilisation's C_dev is the law of the shear modulus alone (`stabilization_lame`:
+    in plane stress, these models', ``lam_s = 0``)."""
     import scipy.sparse as sp
     from cnem.assembly.subdivision import subdivide, tip_cells
     from cnem.elasticity.linear import elasticity_form, lame
-    from cnem.elasticity.stabilization import deviatoric_lame
+    from cnem.elasticity.stabilization import stabilization_lame
     _, _, model = cases.model(name)
     nreg = len(model.domain.regions)
     mats = [(E * (1 + r), NU - 0.1 * r) for r in range(nreg)]
@@ -96,7 +96,7 @@ def test_stabilised_stiffness_is_the_difference_form(name, weight):
                            shape=(len(parent), len(prob.cells.area)))
     fine.operators = [f - to_sub @ c for f, c in zip(fine.operators, coarse.operators)]
     _, mu = lame(*prob.materials[sub.region].T, "stress")
-    lam_s = deviatoric_lame(mu, prob.materials[sub.region, 1], "stress")
+    lam_s = stabilization_lame(mu, prob.materials[sub.region, 1], "stress")
     reference += weight * elasticity_form.assemble(fine, lam=lam_s, mu=mu).toarray()
     np.testing.assert_allclose(K, reference, atol=1e-11 * np.abs(reference).max())
 
@@ -238,7 +238,7 @@ def test_block_assembly_equals_the_general_one(name, monkeypatch):
     """Forms that see only gradients of a vector field are assembled by 2 x 2 node
     blocks; the result is the general descriptor-by-descriptor assembly's."""
     from cnem.elasticity.linear import elasticity_form, lame
-    from cnem.elasticity.stabilization import deviatoric_lame
+    from cnem.elasticity.stabilization import stabilization_lame
     _, _, model = cases.model(name)
     nreg = len(model.domain.regions)
     prob = cnem.Elasticity(model, [(E * (1 + r), NU - 0.1 * r) for r in range(nreg)])

@@ -26,7 +26,7 @@ from ..errors import InputError
 from ..material import check_plane, check_stiffness, lame, moduli, parse_materials, stiffness_matrix
 from .model_problem import ModelProblem
 from .solution import ElasticSolution
-from .stabilization import deviatoric_lame
+from .stabilization import stabilization_lame
 
 if TYPE_CHECKING:
     from typing import Literal, Sequence
@@ -221,9 +221,10 @@ class Elasticity(ModelProblem):
         """Lamé parameters per region of the cells' term of `stiffness` and of its
         stabilisation term (None without stabilisation).
 
-        The sub-cell stabilisation of weight ``a`` is deviatoric: ``a mu`` and ``a lam_s``
-        with ``lam_s`` of `cnem.elasticity.stabilization.deviatoric_lame` (``-2 mu / 3``
-        in 3-D and plane strain). With sub-cells, whose strains average to their cell's,
+        The sub-cell stabilisation of weight ``a`` is deviatoric in 3-D and plane strain:
+        ``a mu`` and ``a lam_s`` with ``lam_s`` of
+        `cnem.elasticity.stabilization.stabilization_lame` (``-2 mu / 3``; ``0``, the
+        shear-only law, in plane stress, which does not lock). With sub-cells, whose strains average to their cell's,
         ``K_cells(lam, mu) + a sum_s A_s (B~_s - B~_k)^T C_dev (B~_s - B~_k)`` is
         ``K_cells(lam - a lam_s, (1 - a) mu) + a sum_s K_s(lam_s, mu)``
         (`_cell_and_sub_cell_stiffness`). The
@@ -243,7 +244,7 @@ class Elasticity(ModelProblem):
             # with enrichment the pointwise term completes the smoothed stiffness towards
             # the Galerkin one on the few cells near the tips: it keeps the full law
             return (lam, mu), (a * lam, a * mu)
-        lam_s = a * deviatoric_lame(mu, self.materials[:, 1], self.plane)
+        lam_s = a * stabilization_lame(mu, self.materials[:, 1], self.plane)
         return (lam - lam_s, (1.0 - a) * mu), (lam_s, a * mu)
 
     def _sub_cells(self):
