@@ -58,7 +58,7 @@ TRACTION = (5.0, 0.0, 0.0)               # MPa on the arm's end face y = 40
 TIP = (10.0, 40.0, 5.0)                  # the centre of the arm's end face
 
 #: How long the demo runs at its defaults (its --help says it; see cnem.cli.demo_parser).
-RUN_TIME = "about 2 min 30 s"
+RUN_TIME = "about 15 s"
 
 
 def bracket_stl(path: pathlib.Path) -> pathlib.Path:
